@@ -1,0 +1,76 @@
+!> Status codes returned by every frirom routine through `info` (0 = success) and the
+!> text that goes with each. Library code never stops: it returns one of these, and a
+!> routine that knows more (which element, which argument) also fills `errmsg`.
+module frirom_status
+    use frirom_kinds, only: ip
+    implicit none
+    private
+    public :: frirom_status_message, set_status
+    public :: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, FRIROM_ERR_NONFINITE, &
+              FRIROM_ERR_SAMPLES, FRIROM_ERR_ALLOC, FRIROM_ERR_FFTW, FRIROM_ERR_LAPACK, &
+              FRIROM_ERR_ARPACK, FRIROM_ERR_NOCONV, FRIROM_ERR_SINGULAR, FRIROM_ERR_LAW, &
+              FRIROM_ERR_NOCLOSE
+
+    ! General codes 1-19; solver codes from 20; reduction codes from 40.
+    integer(ip), parameter :: FRIROM_OK = 0
+    integer(ip), parameter :: FRIROM_ERR_SIZE = 1
+    integer(ip), parameter :: FRIROM_ERR_PARAM = 2
+    integer(ip), parameter :: FRIROM_ERR_NONFINITE = 3
+    integer(ip), parameter :: FRIROM_ERR_SAMPLES = 4
+    integer(ip), parameter :: FRIROM_ERR_ALLOC = 5
+    integer(ip), parameter :: FRIROM_ERR_FFTW = 6
+    integer(ip), parameter :: FRIROM_ERR_LAPACK = 7
+    integer(ip), parameter :: FRIROM_ERR_ARPACK = 8
+    integer(ip), parameter :: FRIROM_ERR_NOCONV = 9
+    integer(ip), parameter :: FRIROM_ERR_SINGULAR = 10
+    integer(ip), parameter :: FRIROM_ERR_LAW = 11
+    integer(ip), parameter :: FRIROM_ERR_NOCLOSE = 12
+
+contains
+
+    !> The generic text of a status code.
+    pure function frirom_status_message(info) result(msg)
+        integer(ip), intent(in) :: info  !! status code
+        character(len=:), allocatable :: msg
+        select case (info)
+        case (FRIROM_OK)
+            msg = 'success'
+        case (FRIROM_ERR_SIZE)
+            msg = 'array sizes do not match'
+        case (FRIROM_ERR_PARAM)
+            msg = 'invalid parameter'
+        case (FRIROM_ERR_NONFINITE)
+            msg = 'non-finite input (NaN or Inf)'
+        case (FRIROM_ERR_SAMPLES)
+            msg = 'too few time samples: N must be at least 2H+1'
+        case (FRIROM_ERR_ALLOC)
+            msg = 'memory allocation failed'
+        case (FRIROM_ERR_FFTW)
+            msg = 'FFTW could not create a plan'
+        case (FRIROM_ERR_LAPACK)
+            msg = 'a LAPACK routine failed'
+        case (FRIROM_ERR_ARPACK)
+            msg = 'an ARPACK routine failed'
+        case (FRIROM_ERR_NOCONV)
+            msg = 'iteration did not converge'
+        case (FRIROM_ERR_SINGULAR)
+            msg = 'matrix is singular'
+        case (FRIROM_ERR_LAW)
+            msg = 'unknown contact law'
+        case (FRIROM_ERR_NOCLOSE)
+            msg = 'hysteresis cycle did not close within the allowed number of periods'
+        case default
+            msg = 'unknown status code'
+        end select
+    end function frirom_status_message
+
+    !> Set `info` and, when the caller passed one, a message naming what went wrong.
+    pure subroutine set_status(info, code, errmsg, detail)
+        integer(ip), intent(out) :: info                    !! status code to return
+        integer(ip), intent(in) :: code                     !! one of FRIROM_*
+        character(len=*), intent(inout), optional :: errmsg !! message for the caller
+        character(len=*), intent(in) :: detail              !! what, where, expected what
+        info = code
+        if (present(errmsg)) errmsg = frirom_status_message(code)//': '//detail
+    end subroutine set_status
+end module frirom_status
