@@ -12,7 +12,7 @@ frirom.InputError naming the file, the line and what was expected on malformed i
 
 from ._common import DIRECTION_NAMES, FEModel
 from .abaqus import read_abaqus, write_abaqus_matrix
-from .calculix import read_calculix, read_inp, write_calculix_matrices
+from .calculix import read_calculix, read_ccx_eigenvalues, read_inp, write_calculix_matrices
 from .harwell_boeing import (read_ansys_mapping, read_hb, read_hbmat, write_ansys_mapping,
                              write_hb)
 from .matrix_market import (read_dof_table, read_matrix_market, read_mtx, write_dof_table,
@@ -20,7 +20,7 @@ from .matrix_market import (read_dof_table, read_matrix_market, read_mtx, write_
 from .op4 import read_op4
 
 __all__ = ["FEModel", "DIRECTION_NAMES", "read_calculix", "read_inp",
-           "write_calculix_matrices", "read_matrix_market", "read_mtx", "write_mtx",
+           "write_calculix_matrices", "read_ccx_eigenvalues", "read_matrix_market", "read_mtx", "write_mtx",
            "read_dof_table", "write_dof_table", "read_abaqus", "write_abaqus_matrix",
            "read_hbmat", "read_hb", "write_hb", "read_ansys_mapping", "write_ansys_mapping",
            "read_op4"]

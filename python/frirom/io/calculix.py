@@ -17,7 +17,7 @@ import numpy as np
 
 from ._common import FEModel, fail, parse_table, read_lines, symmetric_from_triplets
 
-__all__ = ["read_calculix", "read_inp", "write_calculix_matrices"]
+__all__ = ["read_calculix", "read_inp", "write_calculix_matrices", "read_ccx_eigenvalues"]
 
 
 def _jobname(path) -> Path:
@@ -236,3 +236,33 @@ def write_calculix_matrices(job, K, M, dofs) -> None:
     with open(job.with_suffix(".dof"), "w") as fh:
         for nd, d in dofs:
             fh.write(f"{nd}.{d}\n")
+
+
+def read_ccx_eigenvalues(path) -> np.ndarray:
+    """Eigenvalues [rad^2/s^2] of the first *FREQUENCY step in a ccx ``.dat`` file."""
+    lines = read_lines(path)
+    start = None
+    for i, line in enumerate(lines):
+        if "E I G E N V A L U E   O U T P U T" in line:
+            start = i
+            break
+    if start is None:
+        fail(path, 0, "an 'E I G E N V A L U E   O U T P U T' block", "none")
+    vals = []
+    for i in range(start + 1, len(lines)):
+        parts = lines[i].split()
+        if not parts:
+            if vals:
+                break
+            continue
+        if not parts[0].isdigit():
+            if vals:
+                break
+            continue
+        if len(parts) != 5:
+            fail(path, i + 1, "'mode eigenvalue omega frequency imaginary'", lines[i])
+        try:
+            vals.append(float(parts[1]))
+        except ValueError:
+            fail(path, i + 1, "a number in the eigenvalue column", lines[i])
+    return np.array(vals)
