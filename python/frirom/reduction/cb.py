@@ -19,7 +19,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .._errors import InputError
-from .eigen import eigsh_shift_invert
+from .eigen import default_ncv, eigsh_shift_invert
 
 __all__ = ["CraigBampton", "craig_bampton"]
 
@@ -109,7 +109,8 @@ def craig_bampton(model, n_modes: int, interface=None, active=None, directions=(
         singular (then the constraint modes do not exist either: add masters).
     tol, ncv : ARPACK tolerance and Lanczos basis size (0 = defaults).
     solver : "frirom" (Fortran: ARPACK + MUMPS, the default) or "scipy" (eigsh on one
-        SuperLU factor of K_ss, reused for the constraint modes; reference and fallback).
+        SuperLU factor of K_ss, reused for the constraint modes, same Lanczos basis size;
+        reference and fallback).
     """
     if isinstance(model, tuple):
         K, M = model
@@ -146,8 +147,10 @@ def craig_bampton(model, n_modes: int, interface=None, active=None, directions=(
     Mss = M[si][:, si]
     Ksm = K[si][:, mi]
     if solver == "frirom":
-        lam, phi, psi = eigsh_shift_invert(Kss, Mss, n_modes, sigma=sigma,
-                                           rhs=-Ksm.toarray(), tol=tol, ncv=ncv)
+        rhs = np.asfortranarray((-Ksm).toarray(order="F"))
+        lam, phi, psi = eigsh_shift_invert(Kss, Mss, n_modes, sigma=sigma, rhs=rhs, tol=tol,
+                                           ncv=ncv, overwrite_rhs=True)
+        del rhs
     elif solver == "scipy":
         lam, phi, psi = _scipy_modes_and_statics(Kss, Mss, Ksm, n_modes, sigma, tol, ncv)
     else:
@@ -190,7 +193,7 @@ def _scipy_modes_and_statics(Kss, Mss, Ksm, n_modes, sigma, tol, ncv):
     if n_modes > 0:
         op = spla.LinearOperator((n, n), matvec=lu.solve, dtype=np.float64)
         lam, phi = spla.eigsh(Kss, k=n_modes, M=Mss, sigma=sigma, OPinv=op, tol=tol,
-                              ncv=ncv or None)
+                              ncv=ncv or default_ncv(n_modes, n))
         order = np.argsort(lam)
         lam, phi = lam[order], phi[:, order]
     else:

@@ -21,8 +21,13 @@ def _upper_coo(A, name):
             np.ascontiguousarray(U.data, dtype=np.float64))
 
 
+def default_ncv(n_modes: int, n: int) -> int:
+    """Lanczos basis size used when ncv = 0: n_modes + 30 % + 10 (see frirom_eigen)."""
+    return min(n, n_modes + (3 * n_modes) // 10 + 10)
+
+
 def eigsh_shift_invert(K, M, n_modes: int, sigma: float = 0.0, rhs=None, tol: float = 0.0,
-                       ncv: int = 0, maxiter: int = 500):
+                       ncv: int = 0, maxiter: int = 500, overwrite_rhs: bool = False):
     """Lowest (nearest sigma) eigenpairs and optional static solves.
 
     K, M : (n, n) symmetric scipy.sparse matrices (full storage; only the upper triangle
@@ -31,7 +36,9 @@ def eigsh_shift_invert(K, M, n_modes: int, sigma: float = 0.0, rhs=None, tol: fl
     sigma : shift [rad^2/s^2]; K - sigma M must be nonsingular.
     rhs : (n, n_rhs) array or None; solved as K x = rhs with the factor of K.
     tol : ARPACK relative tolerance (0 = machine precision); ncv : Lanczos basis size
-        (0 = default 2 n_modes + 20); maxiter : ARPACK restarts allowed.
+        (0 = default_ncv); maxiter : ARPACK restarts allowed.
+    overwrite_rhs : solve in place when rhs is a float64 Fortran-ordered array (saves a
+        copy of an (n, n_rhs) block).
 
     Returns (lam (n_modes,) ascending, phi (n, n_modes) M-orthonormal, x (n, n_rhs) or None).
     """
@@ -49,8 +56,12 @@ def eigsh_shift_invert(K, M, n_modes: int, sigma: float = 0.0, rhs=None, tol: fl
     M.sort_indices()
     mptr = (M.indptr + 1).astype(np.int32)
     mind = (M.indices + 1).astype(np.int32)
-    x = (np.zeros((n, 0), order="F") if rhs is None
-         else np.array(rhs, dtype=np.float64, order="F", copy=True))
+    if rhs is None:
+        x = np.zeros((n, 0), order="F")
+    else:
+        x = np.asfortranarray(rhs, dtype=np.float64)
+        if x is rhs and not overwrite_rhs:
+            x = x.copy(order="F")
     if x.ndim != 2 or x.shape[0] != n:
         raise InputError(f"rhs must be ({n}, n_rhs), got {x.shape}")
     lam, phi, info, msg = _kernels.eigen_shift_invert(
