@@ -76,3 +76,95 @@ def two_blocks(nx=6, ny=4, nz=3, seed=0):
     active = new[3 * mid + np.arange(3)]
     return {"K": K, "M": M, "dofs_a": dofs_a, "dofs_b": dofs_b, "active": active,
             "coords": coords, "map": new}
+
+
+def _rotation_to(axis):
+    """Rotation matrix whose third column is the unit ``axis`` (a right-handed frame)."""
+    a = np.asarray(axis, float) / np.linalg.norm(axis)
+    e1 = np.array([1.0, 0.0, 0.0]) if abs(a[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    e1 = e1 - e1 @ a * a
+    e1 /= np.linalg.norm(e1)
+    return np.column_stack([e1, np.cross(a, e1), a])
+
+
+def tuned_rotor(n_sectors=7, per_sector=3, radii=(1.0, 1.15, 1.3), n_axial=3, blade=2,
+                uniform=False, seed=0, axis=(0.0, 0.0, 1.0), origin=(0.0, 0.0, 0.0),
+                k_ground=(2e5, 2e5, 8e5)):
+    """A tuned lattice rotor: NZ = N Z angular stations x radii x axial layers, plus a
+    blade (a chain of ``blade`` nodes outward) per sector. Sector-periodic by construction:
+    every sector has the same (random) angular offsets, stiffnesses and masses. The face at
+    axial layer 0 is the interface: its nodes are tied to ground by springs (kt, kt, kn) in
+    cylindrical frames. Returns dict with K, M, iface_nodes, iface coords/dofs, blade-tip
+    dofs per sector, coords, frame rotation, ground pairs data.
+    """
+    rng = np.random.default_rng(seed)
+    n, z = n_sectors, per_sector
+    nz = n * z
+    nr = len(radii)
+    # sector-periodic perturbations
+    dth = np.zeros(z) if uniform else 0.25 * (2 * np.pi / nz) * (rng.random(z) - 0.5)
+    dth[0] = 0.0
+    dr = 0.03 * rng.standard_normal((z, nr, n_axial))
+    dz = 0.03 * rng.standard_normal((z, nr, n_axial))
+    dr[:, :, 0] = 0.0          # interface nodes: common radial/axial positions
+    dz[:, :, 0] = 0.0
+    dth_node = 0.02 * rng.standard_normal((z, nr, n_axial)) / nz
+    dth_node[:, :, 0] = 0.0    # interface nodes of a segment share its angle
+    idx = -np.ones((nz, nr, n_axial), dtype=np.int64)
+    cyl = []
+    for k in range(nz):
+        for j in range(nr):
+            for l in range(n_axial):
+                idx[k, j, l] = len(cyl)
+                th = 2 * np.pi * k / nz + dth[k % z] + dth_node[k % z, j, l]
+                cyl.append((radii[j] + dr[k % z, j, l], th, 0.2 * l + dz[k % z, j, l]))
+    edges, kinds = [], []
+    offs = [(dk, dj, dl) for dk in (0, 1) for dj in (-1, 0, 1) for dl in (-1, 0, 1)
+            if (dk, dj, dl) > (0, 0, 0)]
+    for k in range(nz):
+        for j in range(nr):
+            for l in range(n_axial):
+                for o, (dk, dj, dl) in enumerate(offs):
+                    j2, l2 = j + dj, l + dl
+                    if 0 <= j2 < nr and 0 <= l2 < n_axial:
+                        edges.append((idx[k, j, l], idx[(k + dk) % nz, j2, l2]))
+                        kinds.append((k % z) * len(offs) + o)
+    n_ring = len(cyl)
+    tips = []
+    for s in range(n):
+        k = s * z + z // 2
+        root = [idx[(k + dk) % nz, nr - 1, l] for dk in (-1, 0, 1) for l in range(n_axial)]
+        th = 2 * np.pi * k / nz + dth[k % z]
+        prev = []
+        for b in range(blade):
+            cyl.append((radii[-1] + 0.3 * (b + 1), th + 0.01 * b, 0.2 * (n_axial - 1) / 2))
+            me = len(cyl) - 1
+            for o, p in enumerate(root + prev):
+                edges.append((p, me))
+                kinds.append(1000 + 100 * b + o)
+            prev = [me]
+        tips.append(len(cyl) - 1)
+    cyl = np.array(cyl)
+    loc = np.column_stack([cyl[:, 0] * np.cos(cyl[:, 1]), cyl[:, 0] * np.sin(cyl[:, 1]),
+                           cyl[:, 2]])
+    rot = _rotation_to(axis)
+    coords = loc @ rot.T + np.asarray(origin, float)
+    edges = np.array(edges)
+    kinds = np.array(kinds)
+    kval = {q: 1e6 * (0.7 + 0.6 * rng.random()) for q in np.unique(kinds)}
+    kax = np.array([kval[q] for q in kinds])
+    mvals = 0.02 * (1 + 0.3 * rng.random(z))
+    masses = np.array([mvals[(i // (nr * n_axial)) % z] if i < n_ring else 0.03
+                       for i in range(len(cyl))])
+    K, M = truss(coords, edges, kax, masses)
+    iface_nodes = idx[:, :, 0].ravel()
+    th_if = cyl[iface_nodes, 1]
+    er = np.column_stack([np.cos(th_if), np.sin(th_if), 0 * th_if]) @ rot.T
+    et = np.column_stack([-np.sin(th_if), np.cos(th_if), 0 * th_if]) @ rot.T
+    ea = np.tile(rot[:, 2], (len(th_if), 1))
+    frames = np.stack([et, er, ea], axis=1)         # t1 tangential, t2 radial, n axial
+    dofs = 3 * np.arange(len(cyl))[:, None] + np.arange(3)
+    return {"K": K, "M": M, "coords": coords, "dofs": dofs, "iface_nodes": iface_nodes,
+            "tips": np.array(tips), "frames": frames, "rot": rot,
+            "k_ground": np.tile(np.asarray(k_ground, float), (len(iface_nodes), 1)),
+            "n_sectors": n, "nz": nz}
