@@ -10,6 +10,7 @@ module frirom_status
               FRIROM_ERR_SAMPLES, FRIROM_ERR_ALLOC, FRIROM_ERR_FFTW, FRIROM_ERR_LAPACK, &
               FRIROM_ERR_ARPACK, FRIROM_ERR_NOCONV, FRIROM_ERR_SINGULAR, FRIROM_ERR_LAW, &
               FRIROM_ERR_NOCLOSE
+    public :: FRIROM_ERR_FACTOR
 
     ! General codes 1-19; solver codes from 20; reduction codes from 40.
     integer(ip), parameter :: FRIROM_OK = 0
@@ -25,6 +26,8 @@ module frirom_status
     integer(ip), parameter :: FRIROM_ERR_SINGULAR = 10
     integer(ip), parameter :: FRIROM_ERR_LAW = 11
     integer(ip), parameter :: FRIROM_ERR_NOCLOSE = 12
+    ! Reduction codes.
+    integer(ip), parameter :: FRIROM_ERR_FACTOR = 40
 
 contains
 
@@ -59,6 +62,8 @@ contains
             msg = 'unknown contact law'
         case (FRIROM_ERR_NOCLOSE)
             msg = 'hysteresis cycle did not close within the allowed number of periods'
+        case (FRIROM_ERR_FACTOR)
+            msg = 'sparse factorisation failed'
         case default
             msg = 'unknown status code'
         end select

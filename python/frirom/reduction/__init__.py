@@ -1,2 +1,1 @@
-"""Model reduction: Craig-Bampton CMS, interface reduction (GSI, multi-stage), cyclic
-symmetry and damping of reduced models."""
+"""Model reduction: eigen-solves, Craig-Bampton CMS, interface reduction."""
