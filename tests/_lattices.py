@@ -118,7 +118,8 @@ def tuned_rotor(n_sectors=7, per_sector=3, radii=(1.0, 1.15, 1.3), n_axial=3, bl
                 idx[k, j, l] = len(cyl)
                 th = 2 * np.pi * k / nz + dth[k % z] + dth_node[k % z, j, l]
                 cyl.append((radii[j] + dr[k % z, j, l], th, 0.2 * l + dz[k % z, j, l]))
-    edges, kinds = [], []
+    edges, kinds, owner = [], [], []
+    node_owner = [k // z for k in range(nz) for j in range(nr) for l in range(n_axial)]
     offs = [(dk, dj, dl) for dk in (0, 1) for dj in (-1, 0, 1) for dl in (-1, 0, 1)
             if (dk, dj, dl) > (0, 0, 0)]
     for k in range(nz):
@@ -129,6 +130,7 @@ def tuned_rotor(n_sectors=7, per_sector=3, radii=(1.0, 1.15, 1.3), n_axial=3, bl
                     if 0 <= j2 < nr and 0 <= l2 < n_axial:
                         edges.append((idx[k, j, l], idx[(k + dk) % nz, j2, l2]))
                         kinds.append((k % z) * len(offs) + o)
+                        owner.append(k // z)
     n_ring = len(cyl)
     tips = []
     for s in range(n):
@@ -139,9 +141,11 @@ def tuned_rotor(n_sectors=7, per_sector=3, radii=(1.0, 1.15, 1.3), n_axial=3, bl
         for b in range(blade):
             cyl.append((radii[-1] + 0.3 * (b + 1), th + 0.01 * b, 0.2 * (n_axial - 1) / 2))
             me = len(cyl) - 1
+            node_owner.append(s)
             for o, p in enumerate(root + prev):
                 edges.append((p, me))
                 kinds.append(1000 + 100 * b + o)
+                owner.append(s)
             prev = [me]
         tips.append(len(cyl) - 1)
     cyl = np.array(cyl)
@@ -164,7 +168,23 @@ def tuned_rotor(n_sectors=7, per_sector=3, radii=(1.0, 1.15, 1.3), n_axial=3, bl
     ea = np.tile(rot[:, 2], (len(th_if), 1))
     frames = np.stack([et, er, ea], axis=1)         # t1 tangential, t2 radial, n axial
     dofs = 3 * np.arange(len(cyl))[:, None] + np.arange(3)
-    return {"K": K, "M": M, "coords": coords, "dofs": dofs, "iface_nodes": iface_nodes,
+    # sector 0 alone: its edges and masses, its nodes plus the right boundary (station Z)
+    owner = np.array(owner)
+    node_owner = np.array(node_owner)
+    left = idx[0].ravel()
+    right = idx[z % nz].ravel()
+    snodes = np.union1d(np.nonzero(node_owner == 0)[0], right)
+    Ks, Ms = truss(coords, edges[owner == 0], kax[owner == 0],
+                   np.where(node_owner == 0, masses, 0.0))
+    sd = dofs[snodes].ravel()
+    Ks, Ms = Ks[sd][:, sd].tocsr(), Ms[sd][:, sd].tocsr()
+    pos = -np.ones(len(cyl), dtype=np.int64)
+    pos[snodes] = np.arange(snodes.size)
+    g0 = np.nonzero(node_owner[iface_nodes] == 0)[0]
+    sector = {"K": Ks, "M": Ms, "nodes": snodes, "node_dofs": 3 * np.arange(snodes.size)[:, None]
+              + np.arange(3), "left": pos[left], "right": pos[right],
+              "ground_nodes": pos[iface_nodes[g0]], "ground_frames": frames[g0]}
+    return {"sector": sector, "node_owner": node_owner, "K": K, "M": M, "coords": coords, "dofs": dofs, "iface_nodes": iface_nodes,
             "tips": np.array(tips), "frames": frames, "rot": rot,
             "k_ground": np.tile(np.asarray(k_ground, float), (len(iface_nodes), 1)),
             "n_sectors": n, "nz": nz}
