@@ -7,6 +7,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np
 import pytest
 import scipy.linalg as sla
+import scipy.sparse as sp
 
 from _lattices import tuned_rotor
 from frirom._errors import InputError
@@ -14,7 +15,7 @@ from frirom.reduction.interface import (ContactPairs, contact_matrix, reduce_int
                                         stick_stiffness)
 from frirom.reduction.multistage import (assemble, fourier_columns, fourier_matrix,
                                          harmonic_indices, ms_basis, radial_line_segments,
-                                         stage_contact_matrix)
+                                         stage_contact_matrix, stage_indices)
 
 AXIS = (0.3, 0.2, 1.0)          # a tilted rotor axis off the origin: the frame matters
 ORIGIN = (0.5, -0.2, 0.1)
@@ -224,3 +225,46 @@ def test_two_stages_non_matching_meshes_on_common_harmonics():
     assert np.allclose(rel[:, 2], -1e-3, rtol=0, atol=1e-15)
     assert np.abs(rel[:, :2]).max() < 1e-15
 
+
+
+@pytest.mark.parametrize("eo", [1, 2, 3])
+def test_two_stages_different_sector_counts_exact_under_travelling_wave(eo):
+    """Stage A (6 sectors x 4 segments) stuck to stage B (12 sectors x 2 segments) by
+    contact springs at coincident interface nodes. The assembly is cyclic with
+    gcd(6, 12) = 6 sectors, so an EO wave on stage A's blades excites, on both stages, the
+    indices +-EO mod 6: the MS model that keeps them (with the contact map evaluated on
+    common harmonics) reproduces the full physical model."""
+    a, b = _stage(6, 4, 1), _stage(12, 2, 2)
+    na, nb = a["K"].shape[0], b["K"].shape[0]
+    ia, ib = a["iface_nodes"], b["iface_nodes"]
+    # physical model: block-diagonal stages + stick springs between coincident nodes
+    d = np.linalg.norm(a["coords"][ia][:, None] - b["coords"][ib][None], axis=2)
+    match = ib[np.argmin(d, axis=1)]
+    assert d.min(axis=1).max() < 1e-12
+    kc = np.tile([3e5, 3e5, 1e6], (len(ia), 1))
+    pairs = ContactPairs(a["dofs"][ia], na + b["dofs"][match], a["frames"], kc)
+    K = sla.block_diag(a["K"].toarray(), b["K"].toarray()) + \
+        stick_stiffness(pairs, na + nb).toarray()
+    M = sla.block_diag(a["M"].toarray(), b["M"].toarray())
+    f = np.zeros(na + nb, complex)
+    for s, tip in enumerate(a["tips"]):
+        th = 2 * np.pi * s / 6
+        f[a["dofs"][tip]] = a["rot"] @ np.array([np.cos(th), np.sin(th), 0.4]) * \
+            np.exp(1j * eo * th)
+    lam = sla.eigh(K, M, eigvals_only=True, subset_by_index=[0, 9])
+    om = 1.02 * np.sqrt(lam[6])
+    x = np.linalg.solve(K * (1 + 1j * ETA) - om**2 * M, f)
+    # MS model
+    ind_a, ind_b = stage_indices(eo, [6, 12], [24, 24])
+    msa = ms_basis(a["coords"][ia], a["dofs"][ia], 6, ind_a, origin=ORIGIN, axis=AXIS)
+    msb = ms_basis(b["coords"][ib], b["dofs"][ib], 12, ind_b, origin=ORIGIN, axis=AXIS)
+    ra = reduce_interface(a["K"], a["M"], msa.interface, msa.basis)
+    rb = reduce_interface(b["K"], b["M"], msb.interface, msb.basis)
+    both = assemble([ra, rb])
+    frames = a["frames"][msa.segments.nodes.ravel()]         # elements in segment order
+    G = stage_contact_matrix(msa, msb, frames, ra.K.shape[0], rb.K.shape[0])
+    kr = both.K + (G.T @ sp.diags(kc.ravel()) @ G).toarray()
+    y = np.linalg.solve(kr * (1 + 1j * ETA) - om**2 * both.M, both.project(f))
+    err = np.linalg.norm(both.expand(y) - x) / np.linalg.norm(x)
+    assert err < 1e-10, err
+    assert both.K.shape[0] < K.shape[0] - 100          # and it is a reduction

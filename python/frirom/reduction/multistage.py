@@ -16,7 +16,8 @@ A tuned stage excited by an engine order EO responds in the harmonic indices
 h = z N +- EO (Eq. 1); time harmonic j of the response carries spatial index j EO. With Z
 segments per sector these fold into the family h = +-(j EO) mod N over 0..NZ/2
 (:func:`harmonic_indices`); keeping that family makes the reduction exact for a tuned stage
-(see tests/test_multistage.py).
+(see tests/test_multistage.py). Coupled stages of N_1 and N_2 sectors form an assembly of
+gcd(N_1, N_2) sectors, whose families are taken modulo that gcd (:func:`stage_indices`).
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ from .._errors import InputError, SizeError
 from .interface import InterfaceReduction
 
 __all__ = ["RadialSegments", "MultistageInterface", "cylindrical_frame", "fourier_matrix",
-           "fourier_columns", "harmonic_indices", "radial_line_segments", "ms_basis",
+           "fourier_columns", "harmonic_indices", "stage_indices", "radial_line_segments", "ms_basis",
            "stage_contact_matrix", "assemble"]
 
 
@@ -110,6 +111,21 @@ def harmonic_indices(engine_orders, n_sectors: int, n_segments: int,
                 if h % n == s or (-h) % n == s:
                     out.add(h)
     return np.array(sorted(out), dtype=np.int64)
+
+
+def stage_indices(engine_orders, sector_counts, n_segments, time_harmonics=(1,)) -> list:
+    """Harmonic indices to keep on each of several coupled stages.
+
+    Stages of N_1, N_2, ... sectors coupled together form a cyclic assembly of
+    gcd(N_1, N_2, ...) sectors, so the aliasing families are taken modulo that gcd.
+    n_segments: NZ of each stage. Returns one index array per stage.
+    """
+    counts = [int(c) for c in np.atleast_1d(sector_counts)]
+    nzs = [int(c) for c in np.atleast_1d(n_segments)]
+    if len(counts) != len(nzs):
+        raise SizeError(f"stage_indices: {len(counts)} sector counts for {len(nzs)} stages")
+    g = int(np.gcd.reduce(counts))
+    return [harmonic_indices(engine_orders, g, nz, time_harmonics) for nz in nzs]
 
 
 # --------------------------------------------------------------------------------------------
