@@ -154,17 +154,22 @@ class CyclicSector:
         lam = _eigvals(Kk, Mk, n_modes, sigma)
         return np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi)
 
-    def travelling_wave_load(self, f0, engine_order: int):
-        """Sector load of the EO wave f_s = Q^s f0 exp(i EO s alpha): (k, T^H f0).
+    def travelling_wave_load(self, f0, engine_order: int, sign: int = -1):
+        """Sector load of an engine-order travelling wave, f_s = Q^s f0 exp(sign i EO s alpha).
 
-        f0: (n_dof,) complex load on sector 0's DoFs (amplitude and phase per DoF);
-        returns the harmonic index k = EO mod N and the projected load (n_indep,).
+        f0: (n_dof,) complex load on sector 0's DoFs (amplitude and phase per DoF); sign:
+        -1 (default, the deck's convention: sector s lags by 2 pi EO s / N, a wave that
+        travels forward, in +theta, under Re(. exp(i omega t))) or +1. Returns the harmonic
+        index k = sign EO mod N of the response and the projected load T(k)^H f0 (n_indep,).
+        The response of sector s follows from :meth:`expand` with the same k.
         """
         f0 = np.asarray(f0)
         if f0.shape != (self.n_dof,):
             raise SizeError(f"travelling_wave_load: f0 must be ({self.n_dof},), got "
                             f"{f0.shape}")
-        k = int(engine_order) % self.n_sectors
+        if sign not in (-1, 1):
+            raise InputError(f"travelling_wave_load: sign must be -1 or +1, got {sign}")
+        k = (sign * int(engine_order)) % self.n_sectors
         return k, self.projection(k).conj().T @ f0
 
     def expand(self, y, k: int, sector: int, node_dofs=None) -> np.ndarray:

@@ -258,18 +258,32 @@ def gram_schmidt(columns: np.ndarray, n_keep: int, basis: np.ndarray | None = No
     return cur
 
 
-def _gsi_stream(K, M, masters, rows, n_keep, basis, tol):
-    """Accept n_keep new GSI vectors from the CC modes of (K, M), in eigenvalue order."""
-    n_m = len(masters)
-    n_eig = min(n_m, max(4 * (n_keep + (0 if basis is None else basis.shape[1])) + 20, 60))
+class _CCModes:
+    """Characteristic constraint modes of one condensed pair, computed on demand."""
+
+    def __init__(self, K, M, masters):
+        self.kc, self.mc = guyan_condense(K, M, masters)
+        self.w = None
+        self.v = None
+
+    def first(self, n: int):
+        n = min(n, self.kc.shape[0])
+        if self.v is None or self.v.shape[1] < n:
+            try:
+                self.w, self.v = sla.eigh(self.kc, self.mc, subset_by_index=[0, n - 1])
+            except (np.linalg.LinAlgError, ValueError) as exc:
+                raise NumericalError(f"GSI: eigen-solve of the master partition failed "
+                                     f"({exc}); is M_mm positive definite?") from exc
+        return self.w[:n], self.v[:, :n]
+
+
+def _gsi_stream(cc: _CCModes, rows, n_keep, basis, tol):
+    """Accept n_keep new GSI vectors from the CC modes, in eigenvalue order."""
+    n_m = cc.kc.shape[0]
     start = 0 if basis is None else basis.shape[1]
-    kc, mc = guyan_condense(K, M, masters)
+    n_eig = min(n_m, max(4 * (n_keep + start) + 20, 60))
     while True:
-        try:
-            w, v = sla.eigh(kc, mc, subset_by_index=[0, n_eig - 1])
-        except (np.linalg.LinAlgError, ValueError) as exc:
-            raise NumericalError(f"GSI: eigen-solve of the master partition failed ({exc})"
-                                 ) from exc
+        w, v = cc.first(n_eig)
         q = gram_schmidt(v[rows, :], n_keep, basis, tol)
         if q.shape[1] - start >= n_keep or n_eig == n_m:
             break
@@ -319,13 +333,15 @@ def gsi_basis(K, M, interface, active=(), pairs: ContactPairs | None = None,
         Kstick = sp.csr_matrix(K) + stick_stiffness(pairs, n)
     basis = np.zeros((i.size, 0))
     info = {"eig_free": None, "eig_stick": None, "groups": []}
+    cc_free = _CCModes(K, M, masters) if n_free else None
+    cc_stick = _CCModes(Kstick, M, masters) if n_stick else None
     for g in groups:
         q = None
         if n_free:
-            q, w = _gsi_stream(K, M, masters, g, n_free, None, tol)
+            q, w = _gsi_stream(cc_free, g, n_free, None, tol)
             info["eig_free"] = w
         if n_stick:
-            q, w = _gsi_stream(Kstick, M, masters, g, n_stick, q, tol)
+            q, w = _gsi_stream(cc_stick, g, n_stick, q, tol)
             info["eig_stick"] = w
         block = np.zeros((i.size, q.shape[1]))
         block[g] = q
