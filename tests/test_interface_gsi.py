@@ -161,3 +161,43 @@ def test_bad_input(joint):
         gsi_basis(K, M, iface[:6], (), None, 7, 0)
     with pytest.raises(InputError):
         ContactPairs(pairs.dofs_a, pairs.dofs_b[:, :2], pairs.frames, pairs.stiffness)
+
+
+def test_aft_on_reduced_contact_map_gives_the_stuck_rom(joint):
+    """The AFT evaluates the physical elements from G x_r; G^T f is the ROM's contact force.
+
+    In full stick with the contact closed (large mu and preload), the 'normal2d' forces
+    are kt u_t and n0 + kn v: G^T f must equal the stick springs of the ROM assembled from
+    the physical pairs, R^T (sum of element springs) R, plus the static preload."""
+    contact = pytest.importorskip("frirom.contact")
+    K, M, pairs, iface = joint["K"], joint["M"], joint["pairs"], joint["iface"]
+    n = K.shape[0]
+    B, _ = gsi_basis(K, M, iface, joint["active"], pairs, 10, 10)
+    red = reduce_interface(K, M, iface, B)
+    G = red.contact_matrix(pairs)
+    h = 3
+    rng = np.random.default_rng(7)
+    xr = 1e-7 * rng.standard_normal((red.K.shape[0], 2 * h + 1))
+    u = (G @ xr).reshape(pairs.n_elem, 3, 2 * h + 1)
+    kt, kn, n0 = 3e5, 1e6, 1e3
+    res = contact.aft("normal2d", u, {"kt": kt, "kn": kn, "mu": 1e3, "n0": n0},
+                      n_samples=64, jacobian=False)
+    fr = G.T @ res.forces.reshape(-1, 2 * h + 1)
+    k_stick = (red.R.T @ stick_stiffness(pairs, n) @ red.R).toarray()
+    expect = k_stick @ xr
+    pre = np.zeros((pairs.n_elem, 3))
+    pre[:, 2] = n0
+    expect[:, 0] += G.T @ pre.ravel()
+    assert np.abs(res.states[:, 0] - 1).max() == 0          # every element sticks
+    assert np.linalg.norm(fr - expect) < 1e-9 * np.linalg.norm(expect)
+
+
+def test_contact_group_of_reduced_model(joint):
+    model = pytest.importorskip("frirom.model")
+    K, M, pairs, iface = joint["K"], joint["M"], joint["pairs"], joint["iface"]
+    B, _ = gsi_basis(K, M, iface, joint["active"], pairs, 6, 6)
+    red = reduce_interface(K, M, iface, B)
+    cg = red.contact_group(pairs, "normal2d", [3e5, 1e6, 0.3, 50.0], name="joint")
+    assert isinstance(cg, model.ContactGroup)
+    assert cg.G.shape == (3 * pairs.n_elem, red.K.shape[0])
+    assert abs(cg.G - red.contact_matrix(pairs)).max() == 0
