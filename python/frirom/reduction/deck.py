@@ -243,9 +243,10 @@ def pairs_from_node_sets(model, set_a: str, set_b: str | None, normal, kt: float
 class ReducedModel:
     """Reduced matrices with their way back to the FE model.
 
-    K, M: (n_r, n_r); labels: one per reduced coordinate ('N12:UX' for a kept physical DoF,
+    K, M: (n_r, n_r), dense, or CSR for large models without CB; labels: one per reduced coordinate ('N12:UX' for a kept physical DoF,
     'gsi 3', 'ms h=2 c ...', 'cb mode 5'); pairs: {name: ContactPairs on the FE DoFs};
-    T: (n_fe, n_r) dense map x_fe = T q (CB and interface reduction composed); from_cache:
+    T: (n_fe, n_r) map x_fe = T q (CB and interface reduction composed; dense with CB,
+    sparse without); from_cache:
     True when read back from the cache file.
     """
 
@@ -279,7 +280,15 @@ class ReducedModel:
             h.attrs["fingerprint"] = fingerprint
             h.attrs["version"] = CACHE_VERSION
             for k in ("K", "M", "T"):
-                h.create_dataset(k, data=getattr(self, k))
+                a = getattr(self, k)
+                if sp.issparse(a):
+                    a = sp.csr_matrix(a)
+                    g = h.create_group(k)
+                    g.attrs["shape"] = a.shape
+                    for part in ("data", "indices", "indptr"):
+                        g.create_dataset(part, data=getattr(a, part))
+                else:
+                    h.create_dataset(k, data=a)
             h.create_dataset("labels", data=np.array(self.labels, dtype="S"))
             for name, p in self.pairs.items():
                 g = h.create_group(f"pairs/{name}")
@@ -300,7 +309,8 @@ class ReducedModel:
                     g = h[f"pairs/{name}"]
                     pairs[name] = ContactPairs(g["dofs_a"][()], g["dofs_b"][()],
                                                g["frames"][()], g["stiffness"][()])
-                return cls(K=h["K"][()], M=h["M"][()], T=h["T"][()],
+                K, M, T = (_read_matrix(h[k]) for k in ("K", "M", "T"))
+                return cls(K=K, M=M, T=T,
                            labels=[s.decode() for s in h["labels"][()]], pairs=pairs,
                            from_cache=True)
         except (OSError, KeyError):
@@ -496,14 +506,14 @@ def build_reduced_model(deck: dict, deck_path, progress=None) -> ReducedModel:
         basis, iface_r = ms.basis, ms.interface
         mode_labels = ms.labels()
     if basis is None:
-        K, M = _dense(K0), _dense(M0)
+        K, M = K0, M0
         T1 = None
         labels = labels0
     else:
         r = reduce_interface(K0, M0, iface_r, basis, labels=labels0, mode_labels=mode_labels)
         K, M, T1, labels = r.K, r.M, r.R, r.labels
-    if T0 is None:
-        T = np.eye(n_fe) if T1 is None else T1.toarray()
+    if T0 is None:      # no CB: T stays sparse (identity, or the interface basis)
+        T = sp.identity(n_fe, format="csr") if T1 is None else T1.tocsr()
     else:
         T = T0 if T1 is None else np.asarray(T1.T @ T0.T).T
     out = ReducedModel(K=K, M=M, T=T, labels=labels, pairs=pairs)
@@ -515,8 +525,12 @@ def build_reduced_model(deck: dict, deck_path, progress=None) -> ReducedModel:
     return out
 
 
-def _dense(A):
-    return A.toarray() if sp.issparse(A) else np.asarray(A)
+def _read_matrix(node):
+    import h5py
+    if isinstance(node, h5py.Group):
+        return sp.csr_matrix((node["data"][()], node["indices"][()], node["indptr"][()]),
+                             shape=tuple(node.attrs["shape"]))
+    return node[()]
 
 
 def _pad_frames(frames):

@@ -28,6 +28,9 @@ import scipy.sparse.linalg as spla
 
 from .._errors import InputError, NumericalError, SingularMatrixError, SizeError
 
+#: reduced models up to this size are returned as dense matrices, larger ones as CSR
+DENSE_LIMIT = 3000
+
 __all__ = ["ContactPairs", "InterfaceReduction", "local_frames", "contact_matrix",
            "stick_stiffness", "guyan_condense", "characteristic_constraint_modes",
            "gram_schmidt", "gsi_basis", "reduce_interface"]
@@ -359,7 +362,7 @@ class InterfaceReduction:
     """A model whose interface DoFs were replaced by interface modes (Eq. 15-16).
 
     Reduced coordinates x_r = [eta_k (n_k), x_kept (n - n_i)]; x = R @ x_r.
-    K, M: (n_r, n_r) dense reduced matrices; R: (n, n_r) sparse; interface: (n_i,) reduced
+    K, M: (n_r, n_r) reduced matrices (dense up to DENSE_LIMIT, else CSR); R: (n, n_r) sparse; interface: (n_i,) reduced
     DoFs; basis: (n_i, n_k) interface modes; kept: the other model DoFs in their order;
     labels: one label per reduced coordinate.
     """
@@ -398,7 +401,11 @@ class InterfaceReduction:
 
 def reduce_interface(K, M, interface, basis: np.ndarray, labels=None,
                      mode_labels=None) -> InterfaceReduction:
-    """Replace the ``interface`` DoFs of (K, M) by ``basis`` (n_i, n_k) (Eq. 14-16)."""
+    """Replace the ``interface`` DoFs of (K, M) by ``basis`` (n_i, n_k) (Eq. 14-16).
+
+    The reduced K, M are dense up to DENSE_LIMIT coordinates (CB models), sparse CSR above
+    (an FE model whose interface alone is reduced keeps its sparsity).
+    """
     _check_pair(K, M)
     n = K.shape[0]
     i = _as_index(interface, n, "reduce_interface interface")
@@ -418,10 +425,14 @@ def reduce_interface(K, M, interface, basis: np.ndarray, labels=None,
     R = sp.csr_matrix((vals, (rows, cols)), shape=(n, n_k + kept.size))
     Ks = sp.csr_matrix(K)
     Ms = sp.csr_matrix(M)
-    Kr = (R.T @ Ks @ R).toarray()
-    Mr = (R.T @ Ms @ R).toarray()
+    Kr = (R.T @ Ks @ R).tocsr()
+    Mr = (R.T @ Ms @ R).tocsr()
     Kr = 0.5 * (Kr + Kr.T)
     Mr = 0.5 * (Mr + Mr.T)
+    if Kr.shape[0] <= DENSE_LIMIT:
+        Kr, Mr = Kr.toarray(), Mr.toarray()
+    else:
+        Kr, Mr = Kr.tocsr(), Mr.tocsr()
     if mode_labels is None:
         mode_labels = [f"interface mode {j + 1}" for j in range(n_k)]
     if labels is None:
