@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -116,49 +117,85 @@ def read_lines(path):
         raise InputError(f"{os.fspath(path)}: cannot read ({exc.strerror})") from None
 
 
+def read_text(path) -> str:
+    """The whole text of a file; InputError if it is missing or unreadable."""
+    try:
+        with open(path, encoding="ascii", errors="replace") as fh:
+            return fh.read()
+    except OSError as exc:
+        raise InputError(f"{os.fspath(path)}: cannot read ({exc.strerror})") from None
+
+
 def parse_table(path, lines, first: int, ncols: int, kinds: str, what: str,
                 sep: str | None = None):
     """Parse lines[first:] as a table of ``ncols`` numbers per line.
 
+    ``lines`` is a list of lines or the whole text of the file (cheaper for big files).
     kinds: one character per column, 'i' (integer) or 'f' (float; Fortran D exponents
     allowed). Blank lines are skipped; ``sep`` (e.g. ',') is treated as white space.
     Returns one 1-D array per column. A malformed line raises InputError naming the file,
     the line (1-based, from the start of the file) and what was expected.
     """
-    body = lines[first:]
+    if isinstance(lines, str):
+        text = lines
+        pos = 0
+        for _ in range(first):
+            pos = text.find("\n", pos) + 1
+            if pos == 0:
+                pos = len(text)
+                break
+        text = text[pos:]
+    else:
+        text = "\n".join(lines[first:])
     if sep:
-        body = [b.replace(sep, " ") for b in body]
-    counts = np.fromiter((len(b.split()) for b in body), dtype=np.int64, count=len(body))
-    good = bool(np.all((counts == 0) | (counts == ncols))) and counts.any()
-    if good:
-        text = "\n".join(body)
-        if "D" in text or "d" in text:
-            text = text.replace("D", "E").replace("d", "e")
-        arr = np.array(text.split()).reshape(-1, ncols)
+        text = text.replace(sep, " ")
+    if "D" in text or "d" in text:
+        text = text.replace("D", "E").replace("d", "e")
+    n_lines = text.count("\n") + (0 if text.endswith("\n") or not text else 1)
+    # Fast path: numpy's C parser, accepted only if every line holds ncols numbers.
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
         try:
-            cols = [arr[:, c].astype(np.int64 if k == "i" else np.float64)
-                    for c, k in enumerate(kinds)]
-            if all(np.all(np.isfinite(col)) for col, k in zip(cols, kinds) if k == "f"):
-                return cols
+            flat = np.fromstring(text, sep=" ")
         except ValueError:
-            pass
-    # Slow path: find the first bad line and name it.
+            flat = np.zeros(0)
+    if n_lines and flat.size == ncols * n_lines and np.all(np.isfinite(flat)):
+        table = flat.reshape(-1, ncols)
+        cols = []
+        for c, k in enumerate(kinds):
+            col = table[:, c]
+            if k == "i":
+                ic = col.astype(np.int64)
+                if not np.array_equal(ic, col):
+                    break
+                col = ic
+            cols.append(col)
+        else:
+            return cols
+    # Slow path: parse line by line and name the first bad one.
+    body = text.split("\n")
+    rows = []
     for i, line in enumerate(body):
         parts = line.split()
         if not parts:
             continue
         if len(parts) != ncols:
-            fail(path, first + i + 1, f"{what} ({ncols} fields)", lines[first + i])
+            fail(path, first + i + 1, f"{what} ({ncols} fields)", line)
+        row = []
         for f, (p, k) in enumerate(zip(parts, kinds)):
             try:
-                v = int(p) if k == "i" else float(p.replace("D", "E").replace("d", "e"))
+                v = int(p) if k == "i" else float(p)
             except ValueError:
                 fail(path, first + i + 1, f"{what} ({'an integer' if k == 'i' else 'a number'}"
-                     f" in field {f + 1})", lines[first + i])
+                     f" in field {f + 1})", line)
             if k == "f" and not np.isfinite(v):
-                fail(path, first + i + 1, f"{what} (a finite number in field {f + 1})",
-                     lines[first + i])
-    fail(path, first + 1, what, "end of file")
+                fail(path, first + i + 1, f"{what} (a finite number in field {f + 1})", line)
+            row.append(v)
+        rows.append(row)
+    if not rows:
+        fail(path, first + 1, what, "end of file")
+    return [np.array(col, dtype=np.int64 if k == "i" else np.float64)
+            for col, k in zip(zip(*rows), kinds)]
 
 
 def symmetric_from_triplets(path, rows, cols, vals, n: int, what="matrix",

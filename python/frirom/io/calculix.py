@@ -15,7 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ._common import FEModel, fail, parse_table, read_lines, symmetric_from_triplets
+from ._common import (FEModel, fail, parse_table, read_lines, read_text,
+                      symmetric_from_triplets)
 
 __all__ = ["read_calculix", "read_inp", "write_calculix_matrices", "read_ccx_eigenvalues"]
 
@@ -47,8 +48,8 @@ def read_dof_file(path) -> np.ndarray:
 
 def read_matrix_file(path, n: int, what: str):
     """Full symmetric CSR (n, n) from a ccx ``row col value`` upper-triangle file."""
-    lines = read_lines(path)
-    r, c, v = parse_table(path, lines, 0, 3, "iif", f"'row col value' ({what} entry)")
+    r, c, v = parse_table(path, read_text(path), 0, 3, "iif",
+                          f"'row col value' ({what} entry)")
     return symmetric_from_triplets(path, r - 1, c - 1, v, n, what)
 
 

@@ -98,7 +98,7 @@ class CraigBampton:
 
 def craig_bampton(model, n_modes: int, interface=None, active=None, directions=(1, 2, 3),
                   masters=None, sigma: float = 0.0, tol: float = 0.0,
-                  ncv: int = 0) -> CraigBampton:
+                  ncv: int = 0, solver: str = "frirom") -> CraigBampton:
     """Craig-Bampton reduction of an FEModel (frirom.io) or of (K, M).
 
     model : frirom.io.FEModel (K, M, dofs, node_sets), or a tuple (K, M).
@@ -108,6 +108,8 @@ def craig_bampton(model, n_modes: int, interface=None, active=None, directions=(
     sigma : shift of the fixed-interface eigen-solve [rad^2/s^2]; 0 unless K_ss is
         singular (then the constraint modes do not exist either: add masters).
     tol, ncv : ARPACK tolerance and Lanczos basis size (0 = defaults).
+    solver : "frirom" (Fortran: ARPACK + MUMPS, the default) or "scipy" (eigsh on one
+        SuperLU factor of K_ss, reused for the constraint modes; reference and fallback).
     """
     if isinstance(model, tuple):
         K, M = model
@@ -143,8 +145,13 @@ def craig_bampton(model, n_modes: int, interface=None, active=None, directions=(
     Kss = K[si][:, si]
     Mss = M[si][:, si]
     Ksm = K[si][:, mi]
-    lam, phi, psi = eigsh_shift_invert(Kss, Mss, n_modes, sigma=sigma,
-                                       rhs=-Ksm.toarray(), tol=tol, ncv=ncv)
+    if solver == "frirom":
+        lam, phi, psi = eigsh_shift_invert(Kss, Mss, n_modes, sigma=sigma,
+                                           rhs=-Ksm.toarray(), tol=tol, ncv=ncv)
+    elif solver == "scipy":
+        lam, phi, psi = _scipy_modes_and_statics(Kss, Mss, Ksm, n_modes, sigma, tol, ncv)
+    else:
+        raise InputError(f"solver must be 'frirom' or 'scipy', got {solver!r}")
     del Ksm
     # Galerkin projection (Eq. 16). K_r is block diagonal: the constraint modes are
     # K-orthogonal to the fixed-interface modes by construction.
@@ -170,3 +177,25 @@ def craig_bampton(model, n_modes: int, interface=None, active=None, directions=(
     return CraigBampton(K=Kr, M=Mr, master_index=mi, slave_index=si,
                         master_dofs=np.asarray(dofs)[mi], psi=psi, phi=phi, eigenvalues=lam,
                         n_dof=n)
+
+
+def _scipy_modes_and_statics(Kss, Mss, Ksm, n_modes, sigma, tol, ncv):
+    """scipy reference: eigsh in shift-invert mode on a SuperLU factor of K_ss - sigma M_ss
+    (the factor eigsh would make itself), reused for the constraint modes when sigma = 0."""
+    import scipy.sparse.linalg as spla
+
+    A = (Kss - sigma * Mss).tocsc() if sigma else Kss.tocsc()
+    lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A")
+    n = Kss.shape[0]
+    if n_modes > 0:
+        op = spla.LinearOperator((n, n), matvec=lu.solve, dtype=np.float64)
+        lam, phi = spla.eigsh(Kss, k=n_modes, M=Mss, sigma=sigma, OPinv=op, tol=tol,
+                              ncv=ncv or None)
+        order = np.argsort(lam)
+        lam, phi = lam[order], phi[:, order]
+    else:
+        lam, phi = np.zeros(0), np.zeros((n, 0))
+    if sigma:
+        lu = spla.splu(Kss.tocsc(), permc_spec="MMD_AT_PLUS_A")
+    psi = lu.solve(-Ksm.toarray())
+    return lam, phi, psi
