@@ -8,7 +8,7 @@ program test_aft
     implicit none
     integer(ip), parameter :: nh = 3, nc = 2*nh + 1, ns = 256
     type(aft_plan) :: plan
-    integer(ip) :: info, per(1), j
+    integer(ip) :: info, per(1), j, c, d
     real(wp) :: x(nc, 1, 1), p(3, 1), w0(1, 1), f(nc, 1, 1)
     real(wp) :: x2(nc, 2, 1), p2(4, 1), f2(nc, 2, 1), fp(nc, 2, 1), fm(nc, 2, 1)
     real(wp) :: jac(2*nc, 2*nc, 1), fd(2*nc, 2*nc), ts, a1, b1, kt, fs, amp, h, err
@@ -44,12 +44,13 @@ program test_aft
     if (info /= FRIROM_OK) error stop 'normal1d eval'
     h = 1.0e-9_wp
     do j = 1, 2*nc
-        fp = 0.0_wp
-        x2(mod(j - 1, nc) + 1, (j - 1)/nc + 1, 1) = x2(mod(j - 1, nc) + 1, (j - 1)/nc + 1, 1) + h
+        c = mod(j - 1, nc) + 1
+        d = (j - 1)/nc + 1
+        x2(c, d, 1) = x2(c, d, 1) + h
         call aft_eval(plan, LAW_NORMAL1D, x2, p2, w0, fp, info, msg)
-        x2(mod(j - 1, nc) + 1, (j - 1)/nc + 1, 1) = x2(mod(j - 1, nc) + 1, (j - 1)/nc + 1, 1) - 2*h
+        x2(c, d, 1) = x2(c, d, 1) - 2*h
         call aft_eval(plan, LAW_NORMAL1D, x2, p2, w0, fm, info, msg)
-        x2(mod(j - 1, nc) + 1, (j - 1)/nc + 1, 1) = x2(mod(j - 1, nc) + 1, (j - 1)/nc + 1, 1) + h
+        x2(c, d, 1) = x2(c, d, 1) + h
         fd(:, j) = reshape(fp - fm, [2*nc])/(2*h)
     end do
     err = maxval(abs(jac(:, :, 1) - fd))/maxval(abs(fd))
