@@ -178,15 +178,7 @@ contains
 
         do e0 = 1, ne, nb
             m = min(nb, ne - e0 + 1)
-            do d = 1, nd
-                call clear_input(plan%fp, d)
-                do j = 1, m
-                    call load_harmonics(plan%fp, d, j, x(:, d, e0 + j - 1))
-                end do
-                call exec_c2r(plan%fp, d)
-            end do
-            call march_closed(plan, law, m, params(:, e0:e0 + m - 1), w0(:, e0:e0 + m - 1), &
-                              tl, mp)
+            call time_batch(plan, law, x, params, w0, e0, m, tl, mp)
             do j = 1, m
                 e = e0 + j - 1
                 nper = plan%closed_at(j)
@@ -264,15 +256,7 @@ contains
         nb = plan%fp%nbatch
         do e0 = 1, ne, nb
             m = min(nb, ne - e0 + 1)
-            do d = 1, nd
-                call clear_input(plan%fp, d)
-                do j = 1, m
-                    call load_harmonics(plan%fp, d, j, x(:, d, e0 + j - 1))
-                end do
-                call exec_c2r(plan%fp, d)
-            end do
-            call march_closed(plan, law, m, params(:, e0:e0 + m - 1), w0(:, e0:e0 + m - 1), &
-                              tl, mp)
+            call time_batch(plan, law, x, params, w0, e0, m, tl, mp)
             do j = 1, m
                 e = e0 + j - 1
                 if (plan%closed_at(j) > mp .and. info == FRIROM_OK) then
@@ -395,6 +379,24 @@ contains
             if (p(3) < 0.0_wp) why = 'mu must be >= 0'
         end select
     end subroutine check_params
+
+    !> Elements e0..e0+m-1: displacement harmonics to time samples (input slots), then
+    !> the law marched until their cycles close (see march_closed).
+    subroutine time_batch(plan, law, x, params, w0, e0, m, tol, max_periods)
+        type(aft_plan), intent(inout) :: plan
+        integer(ip), intent(in) :: law, e0, m, max_periods
+        real(wp), intent(in) :: x(:, :, :), params(:, :), w0(:, :), tol
+        integer(ip) :: d, j
+        do d = 1, NDIR(law)
+            call clear_input(plan%fp, d)
+            do j = 1, m
+                call load_harmonics(plan%fp, d, j, x(:, d, e0 + j - 1))
+            end do
+            call exec_c2r(plan%fp, d)
+        end do
+        call march_closed(plan, law, m, params(:, e0:e0 + m - 1), w0(:, e0:e0 + m - 1), tol, &
+                          max_periods)
+    end subroutine time_batch
 
     !> March the first m elements of the batch period after period until every slider
     !> closes its cycle; the last period's forces (output slots 1..ndir), states and

@@ -59,6 +59,7 @@ contains
         integer(ip), intent(out) :: info
         character(len=*), intent(inout), optional :: errmsg
         integer(c_int) :: n(1), nembed_c(1), flags, nb
+        logical :: aligned
         integer(ip) :: k, h, nc, nhalf
         real(wp) :: tau
         character(len=80) :: buf
@@ -110,8 +111,9 @@ contains
                                             1_c_int, plan%rin(:, :, 1), n, nb, 1_c_int, flags)
         plan%p_r2c = fftw_plan_many_dft_r2c(1_c_int, n, nb, plan%rout(:, :, 1), n, nb, 1_c_int, &
                                             plan%cout(:, :, 1), nembed_c, nb, 1_c_int, flags)
+        aligned = slot_alignment_ok(plan)
         if (.not. c_associated(plan%p_c2r) .or. .not. c_associated(plan%p_r2c) .or. &
-            .not. slot_alignment_ok(plan)) then
+            .not. aligned) then
             call fourier_plan_destroy(plan)
             call set_status(info, FRIROM_ERR_FFTW, errmsg, 'fftw_plan_many_dft (c2r/r2c)')
             return
@@ -149,14 +151,17 @@ contains
     logical function slot_alignment_ok(plan) result(ok)
         type(fourier_plan), intent(inout) :: plan
         integer(ip) :: s
+        integer(c_int) :: a1, a2
         ok = .true.
+        a1 = fftw_alignment_of(plan%rin(:, 1, 1))
         do s = 2, plan%nslot_in
-            ok = ok .and. fftw_alignment_of(plan%rin(:, 1, s)) == &
-                          fftw_alignment_of(plan%rin(:, 1, 1))
+            a2 = fftw_alignment_of(plan%rin(:, 1, s))
+            if (a2 /= a1) ok = .false.
         end do
+        a1 = fftw_alignment_of(plan%rout(:, 1, 1))
         do s = 2, plan%nslot_out
-            ok = ok .and. fftw_alignment_of(plan%rout(:, 1, s)) == &
-                          fftw_alignment_of(plan%rout(:, 1, 1))
+            a2 = fftw_alignment_of(plan%rout(:, 1, s))
+            if (a2 /= a1) ok = .false.
         end do
     end function slot_alignment_ok
 

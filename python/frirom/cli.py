@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 from . import __version__
 from ._errors import FriromError
@@ -12,8 +13,19 @@ from ._errors import FriromError
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="frirom", description=__doc__)
     parser.add_argument("--version", action="version", version=f"frirom {__version__}")
-    parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    demo = sub.add_parser("demo", help="hysteresis loops and harmonic content of contact "
+                                       "elements, plotted to PNG")
+    demo.add_argument("--out", type=Path, default=Path("results/demo"),
+                      help="output folder (default: results/demo)")
+    demo.set_defaults(func=_demo)
     return parser
+
+
+def _demo(args) -> int:
+    from . import demo
+    demo.run(args.out)
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:
