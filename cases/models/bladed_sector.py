@@ -34,52 +34,68 @@ STEEL = dict(E=2.1e11, nu=0.3, rho=7850.0)
 
 def sector_mesh(n_sectors=12, r=(0.10, 0.115, 0.14, 0.17, 0.20, 0.23, 0.26, 0.30),
                 n_theta=6, z_disk=(0.0, 0.01, 0.02), z_flange=(-0.04, -0.02),
-                blade_cells=(2, 4), twist=0.6):
-    """Nodes (ids, xyz) and C3D8 connectivity of the sector.
+                blade_cells=(2, 4), twist=0.6, n_copies=1):
+    """Nodes (ids, xyz) and C3D8 connectivity of the sector (or of n_copies sectors).
 
     r: radial grid, the flange arm is the first radial cell, the blade starts at r = 0.20;
     n_theta: angular cells; z_disk / z_flange: axial grids of the disk and of the flange arm
     (below z = 0); blade_cells: angular cell range [a, b) of the blade; twist: blade twist
-    [rad/m] (axial offset per unit radius and angle) so that bending and torsion couple.
+    [rad/m] (axial offset per unit radius and angle) so that bending and torsion couple;
+    n_copies: consecutive sectors meshed together (n_sectors: the whole tuned stage, the
+    last sector joined to the first). grid rows are (i, J, k) with J the global angular
+    station.
     """
     r = np.asarray(r, float)
     zg = np.concatenate([np.asarray(z_flange, float), np.asarray(z_disk, float)])
     nzf = len(z_flange)                       # axial cells of the flange arm
-    th = np.linspace(0.0, 2 * np.pi / n_sectors, n_theta + 1)
+    alpha = 2 * np.pi / n_sectors
+    n_st = n_sectors * n_theta
+    ring = n_copies == n_sectors
     i_blade = int(np.searchsorted(r, 0.20 - 1e-12))
     cells = []
-    for i in range(len(r) - 1):
-        for j in range(n_theta):
-            for k in range(len(zg) - 1):
-                flange = i == 0 and k < nzf
-                disk = i < i_blade and k >= nzf
-                blade = i >= i_blade and k >= nzf and blade_cells[0] <= j < blade_cells[1]
-                if flange or disk or blade:
-                    cells.append((i, j, k))
+    for s in range(n_copies):
+        for i in range(len(r) - 1):
+            for j in range(n_theta):
+                for k in range(len(zg) - 1):
+                    flange = i == 0 and k < nzf
+                    disk = i < i_blade and k >= nzf
+                    blade = (i >= i_blade and k >= nzf
+                             and blade_cells[0] <= j < blade_cells[1])
+                    if flange or disk or blade:
+                        cells.append((i, s * n_theta + j, k))
+
+    def key(i, jj, k):
+        return (i, jj % n_st if ring else jj, k)
+
     used = {}
-    for i, j, k in cells:
+    for i, jj, k in cells:
         for di in (0, 1):
             for dj in (0, 1):
                 for dk in (0, 1):
-                    used.setdefault((i + di, j + dj, k + dk), None)
+                    used.setdefault(key(i + di, jj + dj, k + dk), None)
     keys = sorted(used)
     ids = np.arange(1, len(keys) + 1)
-    for n, key in zip(ids, keys):
-        used[key] = n
-    th_mid = 0.5 * (th[blade_cells[0]] + th[blade_cells[1]])
+    for n, q in zip(ids, keys):
+        used[q] = n
+    th_mid = 0.5 * (blade_cells[0] + blade_cells[1]) * alpha / n_theta
     xyz = []
-    for i, j, k in keys:
-        rr, tt, zz = r[i], th[j], zg[k]
-        if rr > r[i_blade]:
-            zz = zz + twist * (rr - r[i_blade]) * (tt - th_mid) * rr
+    for i, jj, k in keys:
+        rr, tt, zz = r[i], jj * alpha / n_theta, zg[k]
+        if rr > r[i_blade]:                   # blade nodes: interior of their sector
+            local = (jj - (jj // n_theta) * n_theta) * alpha / n_theta
+            zz = zz + twist * (rr - r[i_blade]) * (local - th_mid) * rr
         xyz.append((rr * np.cos(tt), rr * np.sin(tt), zz))
     elems = []
-    for i, j, k in cells:
-        c = [(i, j, k), (i + 1, j, k), (i + 1, j + 1, k), (i, j + 1, k),
-             (i, j, k + 1), (i + 1, j, k + 1), (i + 1, j + 1, k + 1), (i, j + 1, k + 1)]
-        elems.append([used[q] for q in c])
+    for i, jj, k in cells:
+        c = [(i, jj, k), (i + 1, jj, k), (i + 1, jj + 1, k), (i, jj + 1, k),
+             (i, jj, k + 1), (i + 1, jj, k + 1), (i + 1, jj + 1, k + 1), (i, jj + 1, k + 1)]
+        elems.append([used[key(*q)] for q in c])
     grid = np.array(keys)
     return ids, np.array(xyz), np.array(elems, np.int64), grid, (len(r), n_theta, zg)
+
+
+# ccx reads at most 20 characters per field: 13 significant digits keep every coordinate
+# (sign, exponent included) within that.
 
 
 def _nset(fh, name, nodes):
@@ -101,7 +117,7 @@ def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, **mesh):
     common = []
     common.append(f"** bladed-disk sector with flange, {n_sectors} sectors, C3D8\n")
     common.append("*NODE, NSET=ALL\n")
-    common += [f"{i}, {x:.15g}, {y:.15g}, {z:.15g}\n" for i, (x, y, z) in zip(ids, xyz)]
+    common += [f"{i}, {x:.13g}, {y:.13g}, {z:.13g}\n" for i, (x, y, z) in zip(ids, xyz)]
     common.append("*ELEMENT, TYPE=C3D8, ELSET=EALL\n")
     common += [f"{e}, " + ", ".join(str(c) for c in conn) + "\n"
                for e, conn in enumerate(elems, start=1)]
@@ -133,6 +149,36 @@ def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, **mesh):
                 fh.write("*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n1\n*END STEP\n")
         paths.append(p)
     return paths
+
+
+def write_stage_deck(out, n_sectors=12, material=STEEL, **mesh):
+    """The whole tuned stage (all sectors meshed), free, with node sets FLANGE (the flange
+    contact face of every sector) and TIPS (one blade-tip node per sector, sector 0
+    first); ``stage.inp`` with a ``*FREQUENCY, SOLVER=MATRIXSTORAGE`` step."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    ids, xyz, elems, grid, (nr, nth, zg) = sector_mesh(n_sectors, n_copies=n_sectors,
+                                                       **mesh)
+    flange = ids[grid[:, 2] == 0]
+    rad = np.hypot(xyz[:, 0], xyz[:, 1])
+    tips = []
+    for s in range(n_sectors):
+        mine = np.nonzero(grid[:, 1] // nth == s)[0]
+        tips.append(ids[mine[np.argmax(rad[mine] + 1e-3 * xyz[mine, 2])]])
+    p = out / "stage.inp"
+    with open(p, "w") as fh:
+        fh.write(f"** bladed-disk stage with flange, {n_sectors} sectors, C3D8\n*NODE\n")
+        fh.writelines(f"{i}, {x:.13g}, {y:.13g}, {z:.13g}\n" for i, (x, y, z) in zip(ids, xyz))
+        fh.write("*ELEMENT, TYPE=C3D8, ELSET=EALL\n")
+        fh.writelines(f"{e}, " + ", ".join(str(c) for c in conn) + "\n"
+                      for e, conn in enumerate(elems, start=1))
+        _nset(fh, "FLANGE", flange)
+        _nset(fh, "TIPS", np.array(tips))
+        fh.write("*MATERIAL, NAME=STEEL\n*ELASTIC\n"
+                 f"{material['E']:.6g}, {material['nu']:.6g}\n*DENSITY\n"
+                 f"{material['rho']:.6g}\n*SOLID SECTION, ELSET=EALL, MATERIAL=STEEL\n"
+                 "*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n1\n*END STEP\n")
+    return p
 
 
 def run_ccx(inp, timeout=1800, expect=(".dat",)):
