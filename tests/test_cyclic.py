@@ -139,20 +139,35 @@ def test_boundary_errors(rotor):
                       origin=ORIGIN, axis=AXIS)
 
 
-@pytest.mark.skipif(shutil.which("ccx") is None, reason="ccx (calculix-ccx) not installed")
-def test_bladed_sector_matches_ccx_cyclic_symmetry(tmp_path, capsys):
-    """frirom's cyclic projection of ccx's own sector matrices vs ccx's cyclic model."""
-    n_sec, n_pairs = 12, 8
-    cyc, sec = bladed_sector.write_sector_decks(tmp_path, n_sec, n_modes=2 * n_pairs)
+N_SEC, N_PAIRS = 12, 8
+
+
+@pytest.fixture(scope="module")
+def ccx_sector(tmp_path_factory):
+    """ccx's cyclic eigenvalues per nodal diameter and the sector's matrices."""
+    if shutil.which("ccx") is None:
+        pytest.skip("ccx (calculix-ccx) not installed")
+    out = tmp_path_factory.mktemp("sector")
+    cyc, sec = bladed_sector.write_sector_decks(out, N_SEC, n_modes=2 * N_PAIRS)
     bladed_sector.run_ccx(cyc)
     bladed_sector.run_ccx(sec, expect=(".sti", ".mas", ".dof"))
-    ref = bladed_sector.read_cyclic_eigenvalues(tmp_path / "cyclic.dat")
-    assert sorted(ref) == list(range(n_sec // 2 + 1))
-    m = read_calculix(tmp_path / "sector")
+    ref = bladed_sector.read_cyclic_eigenvalues(out / "cyclic.dat")
+    return ref, read_calculix(out / "sector")
+
+
+def _node_dofs(m, nodes):
     key = {(a, b): i for i, (a, b) in enumerate(m.dofs)}
+    return np.array([[key.get((nd, c), -1) for c in (1, 2, 3)] for nd in nodes])
+
+
+def test_bladed_sector_matches_ccx_cyclic_symmetry(ccx_sector, capsys):
+    """frirom's cyclic projection of ccx's own sector matrices vs ccx's cyclic model."""
+    ref, m = ccx_sector
+    n_sec, n_pairs = N_SEC, N_PAIRS
+    assert sorted(ref) == list(range(n_sec // 2 + 1))
 
     def node_dofs(nodes):
-        return np.array([[key.get((nd, c), -1) for c in (1, 2, 3)] for nd in nodes])
+        return _node_dofs(m, nodes)
 
     L, R = m.node_sets["LEFT"], m.node_sets["RIGHT"]
     # ccx's slave (dependent) surface is LEFT; the flange nodes on RIGHT are clamped
@@ -173,3 +188,45 @@ def test_bladed_sector_matches_ccx_cyclic_symmetry(tmp_path, capsys):
     with pytest.raises(InputError, match="dependent"):
         cyclic_sector(m.coordinates(L), node_dofs(L), m.coordinates(R), node_dofs(R),
                       n_sec, m.n_dof, dependent="right")
+
+
+def test_cb_sector_with_tran_reduction_converges_to_ccx(ccx_sector, capsys):
+    """CB of the sector (masters: both cyclic boundaries and the blade tip), projected per
+    nodal diameter: frequencies converge to ccx's as fixed-interface modes are added, and
+    Tran's boundary modes converge to the unreduced boundary."""
+    from frirom.reduction.cb import craig_bampton
+    ref, m = ccx_sector
+    L, R = m.node_sets["LEFT"], m.node_sets["RIGHT"]
+    masters = m.dof_indices(["LEFT", "RIGHT", "TIP"], missing="ignore")
+    errs, tran = [], []
+    for n_modes in (10, 20, 40):
+        cb = craig_bampton(m, n_modes, masters=masters)
+        pos = -np.ones(m.n_dof, np.int64)
+        pos[cb.master_index] = np.arange(cb.n_masters)
+
+        def cb_dofs(nodes):
+            d = _node_dofs(m, nodes)
+            return np.where(d >= 0, pos[np.maximum(d, 0)], -1)
+
+        cs = cyclic_sector(m.coordinates(L), cb_dofs(L), m.coordinates(R), cb_dofs(R), N_SEC,
+                           cb.K.shape[0], dependent="left")
+        worst = 0.0
+        for k, lam in ref.items():
+            f = cs.frequencies(cb.K, cb.M, k, 4)
+            f_ccx = np.sqrt(lam[:4]) / (2 * np.pi)
+            assert np.all(f >= f_ccx * (1 - 1e-6))               # Rayleigh-Ritz bound
+            worst = max(worst, np.abs(f / f_ccx - 1).max())
+        errs.append(worst)
+    kk, mk = cs.matrices(cb.K, cb.M, 3)
+    exact = sla.eigh(kk.toarray(), mk.toarray(), eigvals_only=True, subset_by_index=[0, 3])
+    for nu in (5, 10, 20, 40):
+        kr, mr, _, _ = tran_reduce(kk, mk, cs.boundary, nu)
+        lam = sla.eigh(kr, mr, eigvals_only=True, subset_by_index=[0, 3])
+        tran.append(np.abs(np.sqrt(lam / exact) - 1).max())
+    with capsys.disabled():
+        print("\nCB sector vs ccx cyclic, max rel. freq. error of 4 modes x 7 NDs: "
+              + ", ".join(f"{n} modes {e:.1e}" for n, e in zip((10, 20, 40), errs))
+              + "\nTran (ND 3, CB 40): " + ", ".join(f"n_u={n} {e:.1e}" for n, e in
+                                                    zip((5, 10, 20, 40), tran)))
+    assert np.all(np.diff(errs) < 0) and errs[-1] < 1e-4
+    assert np.all(np.diff(tran) < 0) and tran[-1] < 1e-5
