@@ -148,10 +148,15 @@ class CyclicSector:
     def _is_real(self, k: int) -> bool:
         return (k % self.n_sectors) == 0 or (2 * k) % self.n_sectors == 0
 
-    def frequencies(self, K, M, k: int, n_modes: int, sigma: float = 0.0) -> np.ndarray:
-        """Lowest ``n_modes`` natural frequencies [Hz] of harmonic index k (each once)."""
+    def frequencies(self, K, M, k: int, n_modes: int, sigma: float = 0.0,
+                    method: str = "auto") -> np.ndarray:
+        """Lowest ``n_modes`` natural frequencies [Hz] of harmonic index k (each once).
+
+        method: 'dense' (LAPACK), 'arpack' (shift-invert about sigma [rad^2/s^2] on the
+        sparse Hermitian pair) or 'auto' (dense up to 4000 DoFs).
+        """
         Kk, Mk = self.matrices(K, M, k)
-        lam = _eigvals(Kk, Mk, n_modes, sigma)
+        lam = _eigvals(Kk, Mk, n_modes, sigma, method)
         return np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi)
 
     def travelling_wave_load(self, f0, engine_order: int, sign: int = -1):
@@ -199,11 +204,13 @@ def _real_form(A):
     return sp.bmat([[A.real, -A.imag], [A.imag, A.real]]).tocsr()
 
 
-def _eigvals(Kk, Mk, n_modes, sigma=0.0):
+def _eigvals(Kk, Mk, n_modes, sigma=0.0, method="auto"):
     n = Kk.shape[0]
     if n_modes < 1 or n_modes > n:
         raise InputError(f"n_modes must lie in 1..{n}, got {n_modes}")
-    if n <= 4000 or n_modes > n // 4:
+    if method not in ("auto", "dense", "arpack"):
+        raise InputError(f"method must be 'auto', 'dense' or 'arpack', got {method!r}")
+    if method == "dense" or (method == "auto" and (n <= 4000 or n_modes > n // 4)):
         try:
             return sla.eigh(Kk.toarray(), Mk.toarray(), eigvals_only=True,
                             subset_by_index=[0, n_modes - 1])
