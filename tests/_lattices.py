@@ -181,10 +181,12 @@ def tuned_rotor(n_sectors=7, per_sector=3, radii=(1.0, 1.15, 1.3), n_axial=3, bl
     pos = -np.ones(len(cyl), dtype=np.int64)
     pos[snodes] = np.arange(snodes.size)
     g0 = np.nonzero(node_owner[iface_nodes] == 0)[0]
-    sector = {"K": Ks, "M": Ms, "nodes": snodes, "node_dofs": 3 * np.arange(snodes.size)[:, None]
-              + np.arange(3), "left": pos[left], "right": pos[right],
+    node_dofs = 3 * np.arange(snodes.size)[:, None] + np.arange(3)
+    sector = {"K": Ks, "M": Ms, "nodes": snodes, "node_dofs": node_dofs,
+              "left": pos[left], "right": pos[right],
               "ground_nodes": pos[iface_nodes[g0]], "ground_frames": frames[g0]}
-    return {"sector": sector, "node_owner": node_owner, "K": K, "M": M, "coords": coords, "dofs": dofs, "iface_nodes": iface_nodes,
-            "tips": np.array(tips), "frames": frames, "rot": rot,
+    return {"sector": sector, "node_owner": node_owner, "K": K, "M": M, "coords": coords,
+            "dofs": dofs, "iface_nodes": iface_nodes, "tips": np.array(tips),
+            "frames": frames, "rot": rot,
             "k_ground": np.tile(np.asarray(k_ground, float), (len(iface_nodes), 1)),
             "n_sectors": n, "nz": nz}

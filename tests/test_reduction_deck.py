@@ -15,7 +15,7 @@ import scipy.sparse as sp
 from _lattices import tuned_rotor
 from frirom._errors import InputError
 from frirom.io import read_calculix, write_calculix_matrices
-from frirom.reduction.deck import build_reduced_model, load_reduction_deck
+from frirom.reduction.deck import load_reduction_deck
 from frirom.reduction.interface import contact_matrix, stick_stiffness
 from frirom.reduction.multistage import harmonic_indices
 

@@ -243,11 +243,11 @@ def pairs_from_node_sets(model, set_a: str, set_b: str | None, normal, kt: float
 class ReducedModel:
     """Reduced matrices with their way back to the FE model.
 
-    K, M: (n_r, n_r), dense, or CSR for large models without CB; labels: one per reduced coordinate ('N12:UX' for a kept physical DoF,
-    'gsi 3', 'ms h=2 c ...', 'cb mode 5'); pairs: {name: ContactPairs on the FE DoFs};
-    T: (n_fe, n_r) map x_fe = T q (CB and interface reduction composed; dense with CB,
-    sparse without); from_cache:
-    True when read back from the cache file.
+    K, M: (n_r, n_r), dense, or CSR for large models without CB; labels: one per reduced
+    coordinate ('N12:UX' for a kept physical DoF, 'gsi 3', 'ms h=2 c ...', 'cb mode 5');
+    pairs: {name: ContactPairs on the FE DoFs}; T: (n_fe, n_r) map x_fe = T q (CB and
+    interface reduction composed; dense with CB, sparse without); from_cache: True when
+    read back from the cache file.
     """
 
     K: np.ndarray

@@ -362,9 +362,9 @@ class InterfaceReduction:
     """A model whose interface DoFs were replaced by interface modes (Eq. 15-16).
 
     Reduced coordinates x_r = [eta_k (n_k), x_kept (n - n_i)]; x = R @ x_r.
-    K, M: (n_r, n_r) reduced matrices (dense up to DENSE_LIMIT, else CSR); R: (n, n_r) sparse; interface: (n_i,) reduced
-    DoFs; basis: (n_i, n_k) interface modes; kept: the other model DoFs in their order;
-    labels: one label per reduced coordinate.
+    K, M: (n_r, n_r) reduced matrices (dense up to DENSE_LIMIT, else CSR); R: (n, n_r)
+    sparse; interface: (n_i,) reduced DoFs; basis: (n_i, n_k) interface modes; kept: the
+    other model DoFs in their order; labels: one label per reduced coordinate.
     """
 
     K: np.ndarray

@@ -31,7 +31,8 @@ from .._errors import InputError, SizeError
 from .interface import InterfaceReduction
 
 __all__ = ["RadialSegments", "MultistageInterface", "cylindrical_frame", "fourier_matrix",
-           "fourier_columns", "harmonic_indices", "stage_indices", "radial_line_segments", "ms_basis",
+           "fourier_columns", "harmonic_indices", "stage_indices", "radial_line_segments",
+           "ms_basis",
            "stage_contact_matrix", "assemble"]
 
 
