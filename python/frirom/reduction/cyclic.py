@@ -25,6 +25,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from scipy.spatial import cKDTree
 
 from .._errors import InputError, NumericalError, SingularMatrixError, SizeError
 from .multistage import cylindrical_frame
@@ -246,15 +247,14 @@ def cyclic_sector(coords_left, dofs_left, coords_right, dofs_right, n_sectors: i
     if tol is None:
         tol = 1e-6 * max(np.abs(cl - o).max(), np.abs(cr - o).max(), 1e-300)
     rot = (cl - o) @ Q.T + o
-    d = np.linalg.norm(rot[:, None, :] - cr[None, :, :], axis=2)
-    j = np.argmin(d, axis=1)
-    bad = np.nonzero(d[np.arange(len(cl)), j] > tol)[0]
+    dist, j = cKDTree(cr).query(rot)
+    bad = np.nonzero(dist > tol)[0]
     names_l = np.arange(len(cl)) if nodes_left is None else np.asarray(nodes_left)
     names_r = np.arange(len(cr)) if nodes_right is None else np.asarray(nodes_right)
     if bad.size:
         p = int(bad[0])
         raise InputError(f"cyclic_sector: left-boundary node {names_l[p]} rotated by "
-                         f"{360.0 / n_sectors:.6g} deg lies {d[p, j[p]]:.3g} from the nearest "
+                         f"{360.0 / n_sectors:.6g} deg lies {dist[p]:.3g} from the nearest "
                          f"right-boundary node (tolerance {tol:.3g}): boundaries do not match")
     if np.unique(j).size != j.size:
         raise InputError("cyclic_sector: two left nodes map to the same right node")

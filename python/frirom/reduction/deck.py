@@ -207,12 +207,12 @@ def pairs_from_node_sets(model, set_a: str, set_b: str | None, normal, kt: float
         xb = model.coordinates(nb)
         scale = max(np.abs(xa).max(), np.abs(xb).max(), 1e-300)
         tol = 1e-6 * scale if tol is None else tol
-        d = np.linalg.norm(xa[:, None, :] - xb[None, :, :], axis=2)
-        j = np.argmin(d, axis=1)
-        far = np.nonzero(d[np.arange(len(na)), j] > tol)[0]
+        from scipy.spatial import cKDTree
+        dist, j = cKDTree(xb).query(xa)
+        far = np.nonzero(dist > tol)[0]
         if far.size:
             raise InputError(f"node {na[far[0]]} of set {set_a} has no node of set {set_b} "
-                             f"within {tol:.3g} (nearest {d[far[0], j[far[0]]]:.3g})")
+                             f"within {tol:.3g} (nearest {dist[far[0]]:.3g})")
         db = _node_dofs(model, nb[j])
     if isinstance(normal, str):
         a = np.asarray(axis, float) / np.linalg.norm(axis)
