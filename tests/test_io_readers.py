@@ -168,3 +168,15 @@ def test_malformed_files_name_file_and_line(tmp_path, case):
 def test_missing_file_is_an_input_error(tmp_path):
     with pytest.raises(InputError, match="nothere.dof"):
         io.read_calculix(tmp_path / "nothere")
+
+
+def test_constrain_removes_dofs_like_ccx(tmp_path):
+    """Removing a node's DoFs from an unconstrained model gives the constrained matrices."""
+    K, M, dofs = _model()
+    m = io.FEModel(K=K, M=M, dofs=dofs, node_sets={"CLAMP": dofs[[0, 3], 0]})
+    c = m.constrain("CLAMP", directions=(1, 2, 3))
+    keep = ~np.isin(dofs[:, 0], dofs[[0, 3], 0])
+    _same(c.K, K[keep][:, keep])
+    _same(c.M, M[keep][:, keep])
+    assert np.array_equal(c.dofs, dofs[keep])
+    assert c.constrained.shape == (6, 2)

@@ -97,6 +97,21 @@ class FEModel:
         order = np.lexsort((self.dofs[idx, 1], self.dofs[idx, 0]))
         return idx[order]
 
+    def constrain(self, node_set=None, nodes=None, directions=(1, 2, 3)) -> "FEModel":
+        """A copy without the DoFs of some nodes (e.g. a clamped face of an unconstrained
+        export, such as Abaqus or ANSYS matrices written before boundary conditions).
+
+        The removed (node, direction) pairs are added to ``constrained``.
+        """
+        drop = self.dof_indices(node_set, nodes, directions, missing="ignore")
+        keep = np.setdiff1d(np.arange(self.n_dof), drop)
+        K = self.K[keep][:, keep].tocsr()
+        M = None if self.M is None else self.M[keep][:, keep].tocsr()
+        con = np.concatenate([self.constrained, self.dofs[drop]]).astype(np.int64)
+        return FEModel(K=K, M=M, dofs=self.dofs[keep], node_ids=self.node_ids,
+                       coords=self.coords, node_sets=dict(self.node_sets), constrained=con,
+                       source=list(self.source))
+
 
 def fail(path, line, expected: str, got: str | None = None):
     """Raise InputError naming the file, the 1-based line and what was expected."""
