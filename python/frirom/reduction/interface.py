@@ -200,7 +200,8 @@ def guyan_condense(K, M, masters) -> tuple[np.ndarray, np.ndarray]:
         lu = spla.splu(kss)
     except RuntimeError as exc:
         raise SingularMatrixError(f"guyan_condense: K_ss (non-master partition) is singular "
-                                  f"({exc}); are the masters enough to restrain the body?")
+                                  f"({exc}); are the masters enough to restrain the body?"
+                                  ) from None
     psi = -lu.solve(kms.T.toarray())              # (n_s, n_m) static constraint modes
     if not np.all(np.isfinite(psi)):
         raise SingularMatrixError("guyan_condense: K_ss is singular (non-finite solve)")
