@@ -165,7 +165,7 @@ class TimeResult:
     period at tau_k = 2 pi k / N; drift (nb,) max change between the last two periods
     relative to the amplitude; periods: periods integrated; state_fractions
     (nb, n_groups, 3) stick/slip/lift-off sample fractions over the last period (all
-    elements of a group pooled); x, x_prev, w: final state (to continue).
+    elements of a group pooled); x, x_prev, v, w: final state (see :meth:`restart`).
     """
 
     omega: np.ndarray
@@ -178,7 +178,13 @@ class TimeResult:
     state_fractions: np.ndarray
     x: np.ndarray = field(repr=False)
     x_prev: np.ndarray = field(repr=False)
+    v: np.ndarray = field(repr=False)
     w: list = field(repr=False)
+
+    def restart(self) -> dict:
+        """Keyword arguments x0, v0, w0 of :func:`integrate` continuing from the end state
+        (v is the backward difference: first-order, good enough as a start)."""
+        return {"x0": self.x, "v0": self.v, "w0": self.w}
 
 
 def harmonics_from_samples(samples: np.ndarray, H: int) -> np.ndarray:
@@ -282,46 +288,42 @@ def integrate(M, C, K, contacts, F, omega, *, H: int = 5, periods: int = 200,
                                 (nb, c.n_elem, nsl)).copy()
         else:
             w = np.broadcast_to(c.w0, (nb, c.n_elem, nsl)).copy()
-        groups.append((c.law, c.G.T.copy(), c.G.copy(), p, ndir, w))
+        groups.append([c.law, c.G.T.copy(), c.G.copy(), p, ndir, w])
 
-    def contact_force(x, store_state=None):
+    def contact_force(x):
         g = np.zeros_like(x)
-        new_w = []
-        for gi, (law, GT, G, p, ndir, w) in enumerate(groups):
-            u = (x @ GT).reshape(nb, -1, ndir)
-            f, w2, st = _forces(law, p, u, w)
+        for law, GT, G, p, ndir, w in groups:
+            f, _, _ = _forces(law, p, (x @ GT).reshape(nb, -1, ndir), w)
             g += f.reshape(nb, -1) @ G
-            new_w.append(w2)
-            if store_state is not None:
-                store_state[gi] += np.stack([(st == k).mean(axis=1) for k in range(3)], -1)
-        return g, new_w
+        return g
 
     x = np.zeros((nb, n)) if x0 is None else np.broadcast_to(x0, (nb, n)).astype(float)
     v = np.zeros((nb, n)) if v0 is None else np.broadcast_to(v0, (nb, n)).astype(float)
     # x[-1] from a Taylor step backwards, with the initial acceleration
-    g, _ = contact_force(x)
+    g = contact_force(x)
     rhs = fe[0] - x @ K.T - v @ C.T - g
     a = np.linalg.solve(M, rhs.T).T
     x_prev = x - dt[:, None] * v + 0.5 * (dt ** 2)[:, None] * a
 
     last = np.empty((nb, N, n))
+    states = [np.empty((N, nb, c.n_elem), np.int8) for c in contacts]
     prev = None
     drift = np.full(nb, np.inf)
     stack = np.empty((nb, 3 * n))
+    sl_f, sl_x, sl_p = slice(0, n), slice(n, 2 * n), slice(2 * n, 3 * n)
     n_done = 0
     for period in range(int(periods)):
-        track = [np.zeros((nb, 3)) for _ in contacts]
         for k in range(N):
             last[:, k] = x
-            g, new_w = contact_force(x, track)
-            for gi, w2 in enumerate(new_w):
-                law, GT, G, p, ndir, _ = groups[gi]
-                groups[gi] = (law, GT, G, p, ndir, w2)
-            stack[:, :n] = fe[k] - g
-            stack[:, n:2 * n] = x
-            stack[:, 2 * n:] = x_prev
-            x_new = np.einsum("bi,bij->bj", stack, ET)
-            x_prev, x = x, x_new
+            g = np.zeros((nb, n))
+            for gi, grp in enumerate(groups):
+                law, GT, G, p, ndir, w = grp
+                f, grp[5], states[gi][k] = _forces(law, p, (x @ GT).reshape(nb, -1, ndir), w)
+                g += f.reshape(nb, -1) @ G
+            np.subtract(fe[k], g, out=stack[:, sl_f])
+            stack[:, sl_x] = x
+            stack[:, sl_p] = x_prev
+            x_prev, x = x, np.matmul(stack[:, None, :], ET)[:, 0]
         n_done = period + 1
         scale = np.maximum(np.abs(last).max(axis=(1, 2)), 1e-300)
         if prev is not None:
@@ -329,9 +331,10 @@ def integrate(M, C, K, contacts, F, omega, *, H: int = 5, periods: int = 200,
             if n_done >= min_periods and np.all(drift < tol):
                 break
         prev = last.copy()
-    fractions = (np.stack(track, axis=1) / N if contacts
-                 else np.zeros((nb, 0, 3)))
+    fractions = (np.stack([np.stack([(st == j).mean(axis=(0, 2)) for j in range(3)], -1)
+                           for st in states], axis=1) if contacts else np.zeros((nb, 0, 3)))
+    v_end = (x - x_prev) / dt[:, None]
     return TimeResult(omega=omega, harmonics=harmonics_from_samples(last, H),
                       amp_max=np.abs(last).max(axis=1), samples=last, drift=drift,
                       periods=n_done, steps_per_period=N, state_fractions=fractions,
-                      x=x, x_prev=x_prev, w=[gr[5] for gr in groups])
+                      x=x, x_prev=x_prev, v=v_end, w=[gr[5] for gr in groups])
