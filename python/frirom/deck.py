@@ -333,10 +333,15 @@ class _Parser:
             z = damp.get("zeta")
             if isinstance(z, (int, float)) and not isinstance(z, bool):
                 zeta = _num(ctx, damp, "zeta", "damping.zeta", nonneg=True)
+                if zeta >= 1:
+                    raise ctx.error("damping.zeta", "a damping ratio in [0, 1)", zeta)
                 zeta = np.full(n, float(zeta))
             elif isinstance(z, list) and z:
                 zeta = np.array([_num(ctx, {"z": zi}, "z", f"damping.zeta[{i}]", nonneg=True)
                                  for i, zi in enumerate(z)], float)
+                if np.any(zeta >= 1):
+                    i = int(np.argmax(zeta >= 1))
+                    raise ctx.error(f"damping.zeta[{i}]", "a damping ratio in [0, 1)", z[i])
                 if zeta.size > n:
                     raise ctx.error("damping.zeta", f"at most {n} modal ratios", zeta.size)
             else:

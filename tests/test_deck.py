@@ -1,0 +1,128 @@
+"""The TOML deck: the bundled case loads, and every malformed field raises InputError
+naming the deck, the key path and what was expected."""
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from frirom import InputError
+from frirom.deck import engine_order_loads, load_deck
+
+ROOT = Path(__file__).resolve().parents[1]
+JOINT = ROOT / "cases" / "joint"
+BASE = (JOINT / "joint.toml").read_text()
+
+
+@pytest.fixture
+def deckdir(tmp_path):
+    for f in ("M.mtx", "K.mtx", "dofs.txt"):
+        shutil.copy(JOINT / f, tmp_path / f)
+    return tmp_path
+
+
+def write(deckdir, text):
+    p = deckdir / "case.toml"
+    p.write_text(text)
+    return p
+
+
+def test_joint_deck_loads():
+    d = load_deck(JOINT / "joint.toml")
+    assert d.n_dof == 5 and d.harmonics == 5 and d.samples == 64
+    assert d.F[4, 1] == 2.0 and np.count_nonzero(d.F) == 1
+    c = d.contacts[0]
+    assert c.law == "normal1d" and c.G.shape == (2, 5)
+    # unit tangential and normal directions, orthogonal
+    Gd = c.G.toarray()
+    assert np.allclose(Gd @ Gd.T, np.eye(2))
+    assert np.allclose(c.params, [[1e7, 1e7, 0.5, 100.0]])
+    assert d.outputs == [4, 0, 1] and d.output_names[0] == "tip:x"
+    assert np.isclose(d.omega_start, 2 * np.pi * 400) and np.isclose(d.omega_end,
+                                                                     2 * np.pi * 520)
+    assert np.isclose(d.continuation["max_step"], 2 * np.pi * 4.0)
+
+
+def test_node_to_node_element_and_engine_order(deckdir):
+    text = BASE.replace('b = "ground"', 'b = ["blade_low:x", "blade_mid:x"]')
+    text = text.replace("[[excitation.load]]", """[[excitation.engine_order]]
+eo = 1
+dofs = [2, 3, 4]
+amplitude = 1.0
+
+[[excitation.load]]""")
+    d = load_deck(write(deckdir, text))
+    G = d.contacts[0].G.toarray()
+    assert np.allclose(G[:, 2:4], -G[:, :2])
+    ph = np.angle(d.F[[2, 3], 1])
+    assert np.allclose(ph, [0.0, -2 * np.pi / 3])
+    assert np.isclose(d.F[4, 1], 2.0 + np.exp(-4j * np.pi / 3))
+
+
+def test_engine_order_loads_pattern():
+    F = engine_order_loads(6, [0, 2, 4], eo=2, n_sectors=3, amplitude=2.0)
+    assert np.allclose(F[[0, 2, 4], 1], 2.0 * np.exp(-2j * np.pi * 2 * np.arange(3) / 3))
+
+
+BAD = [
+    # (replace this, with that, the key path and words expected in the message)
+    ('harmonics = 5', 'harmonics = 0', "solver.harmonics", ">= 1"),
+    ('harmonics = 5', 'harmonics = "five"', "solver.harmonics", "integer"),
+    ('samples = 64', 'samples = 8', "solver.samples", ">= 2*harmonics+1"),
+    ('formulation = "condensed"', 'formulation = "dense"', "solver.formulation", "banded"),
+    ('mu = 0.5', 'mu = -0.5', "contacts[0].mu", ">= 0"),
+    ('mu = 0.5', 'mu = [0.5, 0.4]', "contacts[0].mu", "1 numbers"),
+    ('mu = 0.5\n', '', "contacts[0].mu", "missing"),
+    ('kt = 1.0e7', 'kt = 0.0', "contacts[0].kt", "positive"),
+    ('law = "normal1d"', 'law = "coulomb"', "contacts[0].law", "jenkins"),
+    ('dof = "tip:x"', 'dof = "tip:z"', "excitation.load[0].dof", "label"),
+    ('dof = "tip:x"', 'dof = 7', "excitation.load[0].dof", "0..4"),
+    ('harmonic = 1\namp', 'harmonic = 9\namp', "excitation.load[0].harmonic", "0..solver"),
+    ('amplitude = 2.0 ', 'amplitud = 2.0 ', "excitation.load[0].amplitud", "unknown key"),
+    ('start = 400.0', 'start = -400.0', "frequency.start", "positive"),
+    ('unit = "Hz"', 'unit = "rpm"', "frequency.unit", "hz"),
+    ('mass = "M.mtx"', 'mass = "nothere.mtx"', "model.mass", "does not exist"),
+    ('format = "mtx"', 'format = "op4"', "model.format", "mtx"),
+    ('type = "modal"', 'type = "hysteretic"', "damping.type", "rayleigh"),
+    ('zeta = 0.003', 'zeta = 1.5', "damping.zeta", "[0, 1)"),
+    ('directions = [ [0.8660254037844386, 0.5], [-0.5, 0.8660254037844386] ]',
+     'directions = [ [0.8660254037844386, 0.5] ]', "contacts[0].directions", "2 direction"),
+    ('directions = [ [0.8660254037844386, 0.5], [-0.5, 0.8660254037844386] ]',
+     'directions = [ [0.0, 0.0], [-0.5, 0.8660254037844386] ]', "contacts[0].directions[0]",
+     "non-zero"),
+    ('b = "ground"', 'b = ["tip:x"]', "contacts[0].elements[0].b", "2 DoFs"),
+    ('dofs = ["tip:x", "platform:x", "platform:y"]', 'dofs = []', "outputs.dofs",
+     "non-empty"),
+    ('max_step = 4.0', 'max_step = 4.0\nmin_step = 5.0', "continuation.min_step", "max_step"),
+    ('[solver]', '[solvers]', "solvers", "unknown key"),
+]
+
+
+@pytest.mark.parametrize("old,new,key,words", BAD, ids=[b[2] + ":" + b[1][:20] for b in BAD])
+def test_malformed_field_names_key(deckdir, old, new, key, words):
+    assert old in BASE
+    path = write(deckdir, BASE.replace(old, new, 1))
+    with pytest.raises(InputError) as info:
+        load_deck(path)
+    msg = str(info.value)
+    assert str(path) in msg and key in msg and words in msg, msg
+
+
+def test_bad_toml_and_bad_matrix(deckdir):
+    p = write(deckdir, BASE.replace("[solver]", "[solver"))
+    with pytest.raises(InputError, match="not valid TOML"):
+        load_deck(p)
+    (deckdir / "M.mtx").write_text("%%MatrixMarket matrix coordinate real general\n5 5 1\n"
+                                   "1 1 nonsense\n")
+    with pytest.raises(InputError, match="M.mtx"):
+        load_deck(write(deckdir, BASE))
+    with pytest.raises(InputError, match="does not exist"):
+        load_deck(deckdir / "none.toml")
+
+
+def test_nonsymmetric_stiffness(deckdir):
+    (deckdir / "K.mtx").write_text("%%MatrixMarket matrix coordinate real general\n5 5 6\n"
+                                   "1 1 1e6\n2 2 1e6\n3 3 1e6\n4 4 1e6\n5 5 1e6\n1 2 5e5\n")
+    with pytest.raises(InputError, match="model.stiffness.*symmetric"):
+        load_deck(write(deckdir, BASE))
