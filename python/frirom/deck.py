@@ -206,13 +206,27 @@ class Deck:
         return Excitation(self.F)
 
     def options(self):
+        """SolverOptions: continuation steps (frequency units here) become the solver's
+        arc-length steps, scaled by the frequency range."""
         from .solver import SolverOptions
-        kw = dict(self.solver)
-        kw.update(self.continuation)
-        kw["H"] = self.harmonics
-        kw["N"] = self.samples
-        kw["formulation"] = self.formulation
-        return SolverOptions(**kw)
+        span = abs(self.omega_end - self.omega_start)
+        kw = {"harmonics": self.harmonics, "samples": self.samples,
+              "formulation": self.formulation}
+        for key, name in (("tol_residual", "tol_residual"), ("tol_update", "tol_update"),
+                          ("max_iterations", "max_iter")):
+            if key in self.solver:
+                kw[name] = self.solver[key]
+        for key, name in (("step", "ds"), ("min_step", "ds_min"), ("max_step", "ds_max")):
+            if key in self.continuation:
+                kw[name] = self.continuation[key] / span
+        if "max_points" in self.continuation:
+            kw["max_points"] = self.continuation["max_points"]
+        opts = SolverOptions(**kw)
+        if opts.ds_min > opts.ds_max or not opts.ds_min <= opts.ds <= opts.ds_max:
+            # keep the user's steps consistent with the solver's defaults for the others
+            lo, hi = min(opts.ds_min, opts.ds), max(opts.ds_max, opts.ds)
+            opts.ds_min, opts.ds_max = lo, hi
+        return opts
 
 
 def engine_order_loads(n_dof: int, dofs, eo: int, n_sectors: int, amplitude: complex,
