@@ -51,13 +51,13 @@ class SingularMatrixError(NumericalError):
 
 _BY_CODE = {cls.code: cls for cls in (SizeError, ParameterError, NonFiniteError,
                                       SamplesError, ConvergenceError, SingularMatrixError)}
+_BY_CODE[11] = ParameterError      # unknown contact law
+_BY_CODE[12] = ConvergenceError    # hysteresis cycle did not close
 
 
 def raise_for_status(info: int, message: str) -> None:
     """Raise the exception class of a nonzero Fortran status, with Fortran's message."""
     if info == 0:
         return
-    cls = _BY_CODE.get(int(info))
-    if cls is None:
-        cls = InputError if 1 <= info < 20 and info in (11,) else NumericalError
+    cls = _BY_CODE.get(int(info), NumericalError)
     raise cls(message.strip() or f"frirom status {info}", code=int(info))
