@@ -69,13 +69,14 @@ def first_harmonic(X):
 
 
 # ---- Duffing -----------------------------------------------------------------------------
-# x'' + c x' + k1 x + k3 x^3 = F cos(omega t), the cubic as a contact to ground.
+# x'' + c x' + k1 x + k3 x^3 = F cos(omega t): k1 in the structure's K (the condensed
+# formulation needs the receptance of the linear part), k3 x^3 as a cubic contact to ground.
 D_C, D_K1, D_K3, D_F = 0.04, 1.0, 1.0, 0.05
-D_M, D_CM, D_KM = np.eye(1), D_C * np.eye(1), np.zeros((1, 1))
+D_M, D_CM, D_KM = np.eye(1), D_C * np.eye(1), D_K1 * np.eye(1)
 
 
 def duffing_model():
-    return model_of(D_M, D_CM, D_KM, "cubic", [[1.0]], [D_K1, D_K3])
+    return model_of(D_M, D_CM, D_KM, "cubic", [[1.0]], [0.0, D_K3])
 
 
 def duffing_excitation():
@@ -100,7 +101,10 @@ def duffing_folds():
     ok = b * b - 4 * (q * q - (D_F / A) ** 2) >= 0
     A = A[ok]
     wp = np.sqrt(duffing_omega2(A)[1])
-    i_lo, i_hi = np.argmin(wp), np.argmax(wp)
+    # jump-up fold: the minimum of omega_+; jump-down fold: its maximum beyond that (just
+    # below the largest amplitude, where the two branches merge)
+    i_lo = int(np.argmin(wp))
+    i_hi = i_lo + int(np.argmax(wp[i_lo:]))
     folds = []
     for i, sign in ((i_lo, 1.0), (i_hi, -1.0)):
         res = scipy.optimize.minimize_scalar(
@@ -113,13 +117,13 @@ def duffing_folds():
 
 @pytest.fixture(scope="module")
 def duffing_h1():
-    opts = SolverOptions(harmonics=1, samples=16, ds=0.01, ds_max=0.01, max_points=3000)
+    opts = SolverOptions(harmonics=1, samples=16, ds=0.05, ds_max=0.1, max_points=3000)
     return frf(duffing_model(), duffing_excitation(), 0.6, 1.6, opts)
 
 
 @pytest.fixture(scope="module")
 def duffing_h5():
-    opts = SolverOptions(harmonics=5, samples=32, ds=0.01, ds_max=0.01, max_points=3000)
+    opts = SolverOptions(harmonics=5, samples=32, ds=0.05, ds_max=0.1, max_points=3000)
     return frf(duffing_model(), duffing_excitation(), 0.6, 1.6, opts)
 
 
@@ -159,7 +163,7 @@ def test_duffing_h1_turning_points(duffing_h1):
 def _ti_from_point(X, omega, **kw):
     """Time integration of the Duffing oscillator started on a point's harmonics."""
     x0, v0 = state_from_harmonics(X, omega)
-    cub = TimeContact("cubic", np.array([[1.0]]), [[D_K1, D_K3]])
+    cub = TimeContact("cubic", np.array([[1.0]]), [[0.0, D_K3]])
     return integrate(D_M, D_CM, D_KM, [cub], np.array([[0.0, D_F]], complex),
                      np.atleast_1d(omega), H=5, x0=x0, v0=v0, **kw)
 
@@ -176,7 +180,7 @@ def test_duffing_h5_against_time_integration(duffing_h5):
     picks = np.unique(np.r_[np.linspace(0, i_hi - 3, 5).astype(int),
                             np.linspace(i_lo + 3, w.size - 1, 4).astype(int)])
     X = r.X[picks][:, :1]                        # (k, 1, 11)
-    ti = _ti_from_point(X[:, 0], w[picks], periods=600, tol=1e-7, steps_per_period=512)
+    ti = _ti_from_point(X, w[picks], periods=600, tol=1e-7, steps_per_period=512)
     assert ti.drift.max() < 1e-6
     rel = np.abs(ti.amp_max[:, 0] / r.amp_max[picks, 0] - 1)
     assert rel.max() < 2e-3, rel
@@ -197,7 +201,7 @@ def test_duffing_h5_fold_brackets_time_integration(duffing_h5):
     X = r.X[i, 0]
     delta = 3e-3
     omegas = np.array([w_fold * (1 - delta), w_fold * (1 + delta)])
-    ti = _ti_from_point(np.stack([X, X]), omegas, periods=400, tol=1e-7,
+    ti = _ti_from_point(np.stack([X, X])[:, None], omegas, periods=400, tol=1e-7,
                         steps_per_period=256)
     a_fold = r.amp_max[i, 0]
     assert ti.amp_max[0, 0] > 0.9 * a_fold, ti.amp_max[:, 0]
@@ -222,7 +226,7 @@ def test_hill_stability_against_time_integration(duffing_h5):
     j_u = seg_mid[np.argmin(np.abs(r.omega[seg_mid] - w_mid))]
     j_s = seg_up[np.argmin(np.abs(r.omega[seg_up] - w_mid))]
     assert not r.stable[j_u] and r.stable[j_s]
-    X = np.stack([r.X[j_u, 0], r.X[j_s, 0]])
+    X = np.stack([r.X[j_u, :1], r.X[j_s, :1]])
     ti = _ti_from_point(X, r.omega[[j_u, j_s]], periods=150, min_periods=150, tol=0.0,
                         steps_per_period=256)
     left = abs(ti.amp_max[0, 0] / r.amp_max[j_u, 0] - 1)
@@ -234,23 +238,28 @@ def test_hill_stability_against_time_integration(duffing_h5):
 # ---- SDOF with a Jenkins element -----------------------------------------------------------
 J_M, J_K, J_C = np.eye(1), np.eye(1), 0.02 * np.eye(1)
 J_PAR = [2.0, 0.2, 1.0]          # kt, mu, fn0: slip force 0.2, stuck frequency sqrt(3)
-J_F = np.array([[0.0, 0.1]], complex)
+J_F = np.array([[0.0, 0.3]], complex)   # 90 % slip at the peak, 5x below the free one
 
 
 @pytest.fixture(scope="module")
 def jenkins_h5():
     m = model_of(J_M, J_C, J_K, "jenkins", [[1.0]], J_PAR)
-    opts = SolverOptions(harmonics=5, samples=64, ds=0.01, ds_max=0.01, max_points=2000)
-    return frf(m, Excitation(J_F), 0.9, 2.0, opts)
+    opts = SolverOptions(harmonics=5, samples=64, ds=0.02, ds_max=0.02, max_points=5000)
+    return frf(m, Excitation(J_F), 0.8, 1.3, opts)
 
 
-def _compare_peak(r, out, M, C, K, contacts, F, n0_check=None):
-    w_h, a_h = peak_of(r.omega, r.amp_max[:, out])
+def _compare_peak(r, out, M, C, K, contacts, F):
+    """Resonance of the HBM curve and of time integration on a 0.05 %-spaced grid around
+    it: (omega, max amplitude) for each. The frequency is the vertex of the first-harmonic
+    magnitude (exact on both sides), the amplitude the vertex of max |x(t)|."""
+    w_h, _ = peak_of(r.omega, np.abs(first_harmonic(r.X[:, out])))
+    _, a_h = peak_of(r.omega, r.amp_max[:, out])
     grid = w_h * (1 + 5e-4 * np.arange(-12, 13))
     ti = integrate(M, C, K, contacts, F, grid, H=5, periods=800, tol=2e-6,
                    steps_per_period=512)
     assert ti.drift.max() < 1e-5, ti.drift.max()
-    w_t, a_t = peak_of(grid, ti.amp_max[:, out])
+    w_t, _ = peak_of(grid, np.abs(first_harmonic(ti.harmonics[:, out])))
+    _, a_t = peak_of(grid, ti.amp_max[:, out])
     assert grid[1] < w_t < grid[-2], "time-integration peak not inside the grid"
     return (w_h, a_h), (w_t, a_t), ti
 
@@ -282,8 +291,10 @@ N_F = np.array([[0.0, 0.0], [0.0, 0.0], [0.0, 0.1]], complex)
 @pytest.fixture(scope="module")
 def normal_h5():
     m = model_of(N_M, N_C, N_K, "normal1d", N_G, N_PAR)
-    opts = SolverOptions(harmonics=5, samples=64, ds=0.01, ds_max=0.01, max_points=2000)
-    return frf(m, Excitation(N_F), 0.8, 1.3, opts)
+    # from 1.0 rad/s, where the contact already slips: see the xfail test below
+    opts = SolverOptions(harmonics=5, samples=64, ds=0.02, ds_max=0.02, max_points=3000,
+                         tol_residual=1e-9, tol_update=1e-9)
+    return frf(m, Excitation(N_F), 1.0, 1.2, opts)
 
 
 def test_normal1d_liftoff_peak_against_time_integration(normal_h5):
@@ -299,6 +310,17 @@ def test_normal1d_liftoff_peak_against_time_integration(normal_h5):
     assert abs(w_h / w_t - 1) < 2e-3, (w_h, w_t)
 
 
+@pytest.mark.xfail(reason="solver-core: continuation crawls (steps ~1e-7) where the 1-D "
+                   "contact goes from slipping to fully stuck (seen at 0.90 rad/s)",
+                   strict=False)
+def test_normal1d_continuation_through_stick_boundary():
+    m = model_of(N_M, N_C, N_K, "normal1d", N_G, N_PAR)
+    opts = SolverOptions(harmonics=5, samples=64, ds=0.02, ds_max=0.02, max_points=1500,
+                         tol_residual=1e-9, tol_update=1e-9)
+    r = frf(m, Excitation(N_F), 1.3, 0.8, opts)
+    assert r.complete, r.message
+
+
 # ---- limits --------------------------------------------------------------------------------
 
 def _balanced(F, G, n0):
@@ -309,7 +331,7 @@ def _balanced(F, G, n0):
     return F
 
 
-LIMIT_OPTS = dict(harmonics=3, samples=32, ds=0.05, ds_max=0.05, max_points=500)
+LIMIT_OPTS = dict(harmonics=3, samples=32, ds=0.05, ds_max=0.3, max_points=2000)
 
 
 def test_mu_zero_gives_free_linear_frf():
