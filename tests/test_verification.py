@@ -30,7 +30,7 @@ import pytest
 import scipy.optimize
 
 from frirom.model import ContactGroup, Damping, Excitation, Model
-from frirom.solver import SolverOptions, frf
+from frirom.solver import SolverOptions, frf, solve_point
 from frirom.timeint import TimeContact, integrate, state_from_harmonics
 
 # ---- helpers -----------------------------------------------------------------------------
@@ -152,7 +152,7 @@ def test_duffing_h1_turning_points(duffing_h1):
     found = sorted(vertex(A[i - 1:i + 2], w[i - 1:i + 2])[::-1] for i in turns)
     for (wf, Af), (we, Ae) in zip(found, [(w_lo, A_lo), (w_hi, A_hi)]):
         assert abs(wf / we - 1) < 1e-4, (wf, we)
-        assert abs(Af / Ae - 1) < 2e-2, (Af, Ae)   # A is flat at the turn: loose
+        assert abs(Af / Ae - 1) < 1e-3, (Af, Ae)   # A is flat at the turn: looser
     # the solver flags a fold within one point of each turn
     flagged = np.flatnonzero(r.fold)
     assert flagged.size == 2, flagged
@@ -241,34 +241,52 @@ J_PAR = [2.0, 0.2, 1.0]          # kt, mu, fn0: slip force 0.2, stuck frequency 
 J_F = np.array([[0.0, 0.3]], complex)   # 90 % slip at the peak, 5x below the free one
 
 
+def _run(model, excitation, w0, w1, opts):
+    """frf plus the converged points (with their unknowns, to restart from)."""
+    points = []
+    r = frf(model, excitation, w0, w1, opts, sink=points.append)
+    return {"model": model, "excitation": excitation, "opts": opts, "frf": r,
+            "points": points}
+
+
 @pytest.fixture(scope="module")
 def jenkins_h5():
     m = model_of(J_M, J_C, J_K, "jenkins", [[1.0]], J_PAR)
     opts = SolverOptions(harmonics=5, samples=64, ds=0.02, ds_max=0.02, max_points=5000)
-    return frf(m, Excitation(J_F), 0.8, 1.3, opts)
+    return _run(m, Excitation(J_F), 0.8, 1.3, opts)
 
 
-def _compare_peak(r, out, M, C, K, contacts, F):
-    """Resonance of the HBM curve and of time integration on a 0.05 %-spaced grid around
-    it: (omega, max amplitude) for each. The frequency is the vertex of the first-harmonic
+def _compare_peak(run, out, M, C, K, contacts, F):
+    """Resonance (omega, max amplitude) of the HBM and of time integration, both on the
+    same 0.05 %-spaced grid around the continuation's peak (HBM by solve_point restarted
+    from the nearest continuation point). The frequency is the vertex of the first-harmonic
     magnitude (exact on both sides), the amplitude the vertex of max |x(t)|."""
-    w_h, _ = peak_of(r.omega, np.abs(first_harmonic(r.X[:, out])))
-    _, a_h = peak_of(r.omega, r.amp_max[:, out])
-    grid = w_h * (1 + 5e-4 * np.arange(-12, 13))
+    r, pts = run["frf"], run["points"]
+    w_c, _ = peak_of(r.omega, np.abs(first_harmonic(r.X[:, out])))
+    grid = w_c * (1 + 5e-4 * np.arange(-12, 13))
+    hb = []
+    for w in grid:
+        near = pts[int(np.argmin(np.abs(r.omega - w)))]
+        hb.append(solve_point(run["model"], run["excitation"], w, run["opts"],
+                              start={"unknowns": near.unknowns}))
+    hX = np.array([p.X[out] for p in hb])
+    w_h, _ = peak_of(grid, np.abs(first_harmonic(hX)))
+    _, a_h = peak_of(grid, np.array([p.amp_max[out] for p in hb]))
     ti = integrate(M, C, K, contacts, F, grid, H=5, periods=800, tol=2e-6,
                    steps_per_period=512)
     assert ti.drift.max() < 1e-5, ti.drift.max()
     w_t, _ = peak_of(grid, np.abs(first_harmonic(ti.harmonics[:, out])))
     _, a_t = peak_of(grid, ti.amp_max[:, out])
     assert grid[1] < w_t < grid[-2], "time-integration peak not inside the grid"
+    assert grid[1] < w_h < grid[-2], "refined HBM peak not inside the grid"
     return (w_h, a_h), (w_t, a_t), ti
 
 
 def test_jenkins_sdof_peak_against_time_integration(jenkins_h5):
-    r = jenkins_h5
+    r = jenkins_h5["frf"]
     assert r.complete, r.message
     jen = TimeContact("jenkins", np.array([[1.0]]), [J_PAR])
-    (w_h, a_h), (w_t, a_t), ti = _compare_peak(r, 0, J_M, J_C, J_K, [jen], J_F)
+    (w_h, a_h), (w_t, a_t), ti = _compare_peak(jenkins_h5, 0, J_M, J_C, J_K, [jen], J_F)
     # partial slip at the peak: the friction element matters
     i = np.argmin(np.abs(ti.omega - w_t))
     assert 0.1 < ti.state_fractions[i, 0, 1] < 0.9
@@ -294,14 +312,14 @@ def normal_h5():
     # from 1.0 rad/s, where the contact already slips: see the xfail test below
     opts = SolverOptions(harmonics=5, samples=64, ds=0.02, ds_max=0.02, max_points=3000,
                          tol_residual=1e-9, tol_update=1e-9)
-    return frf(m, Excitation(N_F), 1.0, 1.2, opts)
+    return _run(m, Excitation(N_F), 1.0, 1.2, opts)
 
 
 def test_normal1d_liftoff_peak_against_time_integration(normal_h5):
-    r = normal_h5
+    r = normal_h5["frf"]
     assert r.complete, r.message
     con = TimeContact("normal1d", N_G, [N_PAR])
-    (w_h, a_h), (w_t, a_t), ti = _compare_peak(r, 2, N_M, N_C, N_K, [con], N_F)
+    (w_h, a_h), (w_t, a_t), ti = _compare_peak(normal_h5, 2, N_M, N_C, N_K, [con], N_F)
     i = np.argmin(np.abs(ti.omega - w_t))
     assert ti.state_fractions[i, 0, 2] > 0.05          # it really lifts off
     j = np.argmin(np.abs(r.omega - w_h))
