@@ -33,15 +33,29 @@ def test_joint_deck_loads():
     assert d.n_dof == 5 and d.harmonics == 5 and d.samples == 64
     assert d.F[4, 1] == 2.0 and np.count_nonzero(d.F) == 1
     c = d.contacts[0]
-    assert c.law == "normal1d" and c.G.shape == (2, 5)
-    # unit tangential and normal directions, orthogonal
-    Gd = c.G.toarray()
-    assert np.allclose(Gd @ Gd.T, np.eye(2))
-    assert np.allclose(c.params, [[1e7, 1e7, 0.5, 100.0]])
+    assert c.law == "jenkins" and c.G.shape == (1, 5)
+    assert np.allclose(c.G.toarray(), [[np.cos(np.pi / 6), 0.5, 0, 0, 0]])
+    assert np.allclose(c.params, [[1e7, 0.5, 100.0]])
     assert d.outputs == [4, 0, 1] and d.output_names[0] == "tip:x"
     assert np.isclose(d.omega_start, 2 * np.pi * 400) and np.isclose(d.omega_end,
                                                                      2 * np.pi * 520)
-    assert np.isclose(d.continuation["max_step"], 2 * np.pi * 4.0)
+    assert d.continuation == {"step": 0.05, "max_step": 0.2, "max_points": 1000}
+
+
+def test_normal1d_frame_and_solver_objects(deckdir):
+    text = BASE.replace('law = "jenkins"', 'law = "normal1d"').replace(
+        "directions = [ [0.8660254037844386, 0.5] ]",
+        "directions = [ [0.8660254037844386, 0.5], [-0.5, 0.8660254037844386] ]").replace(
+        "fn0 = 100.0", "kn = 2.0e7\nn0 = 100.0\nw0 = 1e-6")
+    d = load_deck(write(deckdir, text))
+    c = d.contacts[0]
+    Gd = c.G.toarray()
+    assert c.law == "normal1d" and np.allclose(Gd @ Gd.T, np.eye(2))   # orthonormal frame
+    assert np.allclose(c.params, [[1e7, 2e7, 0.5, 100.0]]) and np.allclose(c.w0, 1e-6)
+    model, exc, opts = d.model(), d.excitation(), d.options()
+    assert model.n_dof == 5 and model.contacts[0].name == "damper"
+    assert exc.F.shape == (5, 6)
+    assert opts.harmonics == 5 and opts.samples == 64 and opts.ds_max == 0.2
 
 
 def test_node_to_node_element_and_engine_order(deckdir):
@@ -73,9 +87,11 @@ BAD = [
     ('formulation = "condensed"', 'formulation = "dense"', "solver.formulation", "banded"),
     ('mu = 0.5', 'mu = -0.5', "contacts[0].mu", ">= 0"),
     ('mu = 0.5', 'mu = [0.5, 0.4]', "contacts[0].mu", "1 numbers"),
-    ('mu = 0.5\n', '', "contacts[0].mu", "missing"),
+    ('mu = 0.5                      # friction coefficient\n', '', "contacts[0].mu",
+     "missing"),
     ('kt = 1.0e7', 'kt = 0.0', "contacts[0].kt", "positive"),
-    ('law = "normal1d"', 'law = "coulomb"', "contacts[0].law", "jenkins"),
+    ('law = "jenkins"', 'law = "coulomb"', "contacts[0].law", "normal1d"),
+    ('fn0 = 100.0', 'n0 = 100.0', "contacts[0].n0", "unknown key"),
     ('dof = "tip:x"', 'dof = "tip:z"', "excitation.load[0].dof", "label"),
     ('dof = "tip:x"', 'dof = 7', "excitation.load[0].dof", "0..4"),
     ('harmonic = 1\namp', 'harmonic = 9\namp', "excitation.load[0].harmonic", "0..solver"),
@@ -86,15 +102,19 @@ BAD = [
     ('format = "mtx"', 'format = "op4"', "model.format", "mtx"),
     ('type = "modal"', 'type = "hysteretic"', "damping.type", "rayleigh"),
     ('zeta = 0.003', 'zeta = 1.5', "damping.zeta", "[0, 1)"),
-    ('directions = [ [0.8660254037844386, 0.5], [-0.5, 0.8660254037844386] ]',
-     'directions = [ [0.8660254037844386, 0.5] ]', "contacts[0].directions", "2 direction"),
-    ('directions = [ [0.8660254037844386, 0.5], [-0.5, 0.8660254037844386] ]',
-     'directions = [ [0.0, 0.0], [-0.5, 0.8660254037844386] ]', "contacts[0].directions[0]",
-     "non-zero"),
+    ('directions = [ [0.8660254037844386, 0.5] ]',
+     'directions = [ [0.8660254037844386, 0.5], [-0.5, 0.8660254037844386] ]',
+     "contacts[0].directions", "1 direction"),
+    ('directions = [ [0.8660254037844386, 0.5] ]', 'directions = [ [0.0, 0.0] ]',
+     "contacts[0].directions[0]", "non-zero"),
+    ('directions = [ [0.8660254037844386, 0.5] ]', 'directions = [ [1.0, 0.5, 0.1] ]',
+     "contacts[0].directions[0]", "2 numbers"),
     ('b = "ground"', 'b = ["tip:x"]', "contacts[0].elements[0].b", "2 DoFs"),
+    ('b = "ground"', 'b = ["platform:x", "tip:x"]', "contacts[0].elements[0].b",
+     "different"),
     ('dofs = ["tip:x", "platform:x", "platform:y"]', 'dofs = []', "outputs.dofs",
      "non-empty"),
-    ('max_step = 4.0', 'max_step = 4.0\nmin_step = 5.0', "continuation.min_step", "max_step"),
+    ('max_step = 0.2', 'max_step = 0.2\nmin_step = 0.5', "continuation.min_step", "max_step"),
     ('[solver]', '[solvers]', "solvers", "unknown key"),
 ]
 

@@ -7,10 +7,10 @@ damper (SI units: kg, N/m).
 
 The blade is a spring-mass chain clamped through the platform to the disk (springs to
 ground on DoFs 0 and 1). The damper rests on the platform's inclined face (30 deg from x)
-held by centrifugal load; it is modelled as ground, so the contact (law normal1d in
-joint.toml) has tangential direction (cos 30, sin 30) and normal direction
-(-sin 30, cos 30) in the platform's (x, y) DoFs: bending motion of the blade both rubs the
-face and varies the normal load, which lifts off at large amplitude.
+held by centrifugal load; it is modelled as ground, so the contact in joint.toml has the
+tangential direction (cos 30, sin 30) in the platform's (x, y) DoFs (and, for a law with
+normal load variation, the normal direction (-sin 30, cos 30)). First bending mode: 445 Hz
+free, 475 Hz with the damper stuck.
 
 Run `python make_joint.py` in this folder to rewrite M.mtx, K.mtx and dofs.txt.
 """

@@ -156,7 +156,8 @@ class ContactSpec:
 
 @dataclass
 class Deck:
-    """A checked deck. Frequencies in rad/s; F complex (n_dof, H+1)."""
+    """A checked deck. Frequencies in rad/s; F complex (n_dof, H+1); continuation steps
+    are the solver's dimensionless arc-length steps."""
 
     path: Path
     title: str
@@ -166,7 +167,7 @@ class Deck:
     F: np.ndarray
     contacts: list
     harmonics: int
-    samples: int
+    samples: int | None       # None: the solver's default
     formulation: str
     omega_start: float
     omega_end: float
@@ -206,10 +207,8 @@ class Deck:
         return Excitation(self.F)
 
     def options(self):
-        """SolverOptions: continuation steps (frequency units here) become the solver's
-        arc-length steps, scaled by the frequency range."""
+        """The solver's SolverOptions from the [solver] and [continuation] tables."""
         from .solver import SolverOptions
-        span = abs(self.omega_end - self.omega_start)
         kw = {"harmonics": self.harmonics, "samples": self.samples,
               "formulation": self.formulation}
         for key, name in (("tol_residual", "tol_residual"), ("tol_update", "tol_update"),
@@ -218,7 +217,7 @@ class Deck:
                 kw[name] = self.solver[key]
         for key, name in (("step", "ds"), ("min_step", "ds_min"), ("max_step", "ds_max")):
             if key in self.continuation:
-                kw[name] = self.continuation[key] / span
+                kw[name] = self.continuation[key]
         if "max_points" in self.continuation:
             kw["max_points"] = self.continuation["max_points"]
         opts = SolverOptions(**kw)
@@ -316,9 +315,8 @@ class _Parser:
                             "tol_update", "max_iterations"}, "solver")
         H = _num(ctx, sol, "harmonics", "solver.harmonics", required=True, integer=True,
                  minimum=1)
-        N = _num(ctx, sol, "samples", "solver.samples", default=max(32, 8 * H),
-                 integer=True)
-        if N < 2 * H + 1:
+        N = _num(ctx, sol, "samples", "solver.samples", integer=True)
+        if N is not None and N < 2 * H + 1:
             raise ctx.error("solver.samples", f"an integer >= 2*harmonics+1 = {2 * H + 1}", N)
         form = _str(ctx, sol, "formulation", "solver.formulation", default="condensed",
                     choices=("condensed", "banded"))
@@ -458,7 +456,7 @@ class _Parser:
         for k in ("step", "min_step", "max_step"):
             v = _num(ctx, con, k, f"continuation.{k}", positive=True)
             if v is not None:
-                cont[k] = float(v) * scale
+                cont[k] = float(v)
         if "min_step" in cont and "max_step" in cont and cont["min_step"] > cont["max_step"]:
             raise ctx.error("continuation.min_step", "a value <= continuation.max_step",
                             con["min_step"])

@@ -111,9 +111,10 @@ def plot_states(frf, path, *, contact_names=None, unit: str = "hz",
                      labels=("stick", "slip", "lift-off"), alpha=0.85)
         ax.set_ylim(0.0, 1.0)
         ax.set_ylabel("fraction of period")
-        ax.set_title(names[g], fontsize=9)
+        ax.set_title(names[g], fontsize=9, loc="left")
         ax.grid(True, alpha=0.3)
-    axes[0, 0].legend(loc="upper right", fontsize=8, ncol=3)
+    axes[0, 0].legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8, ncol=3,
+                      frameon=False, borderaxespad=0.2)
     axes[-1, 0].set_xlabel(xlabel if mono else "point along the continuation path")
     fig.suptitle(title or "Contact states", fontsize=11)
     fig.tight_layout()
