@@ -160,8 +160,10 @@ contains
             rref = rref1
             rn = rn1
             g = g1
-            if (rn <= opts%tol_r .and. dxn <= opts%tol_x .and. &
-                abs(g) <= max(opts%tol_x, 1.0e-12_wp)) return
+            ! converged: residual and update small; or the residual at round-off level
+            ! (near-singular J, e.g. gross slip, can keep the update above tol_x there)
+            if (rn <= opts%tol_r .and. abs(g) <= max(opts%tol_x, 1.0e-12_wp) .and. &
+                (dxn <= opts%tol_x .or. rn <= 100.0_wp*epsilon(1.0_wp))) return
         end do
         call set_status(info, FRIROM_ERR_NOCONV, errmsg, 'newton_correct: no convergence')
         write (buf, '(a,i0,a,es9.2,a,es9.2)') ' in ', opts%max_iter, &
@@ -233,7 +235,7 @@ contains
         real(wp), allocatable :: y1(:), yp(:), t1(:), cy(:)
         real(wp) :: lam1, lp, dirn, frac, cl
         integer(ip) :: n, iters
-        logical :: last
+        logical :: last, jumped
         character(len=len(errmsg)) :: why
         character(len=120) :: buf
         n = sys%n
@@ -254,6 +256,7 @@ contains
         end if
         allocate (y1(n), yp(n), t1(n + 1), cy(n))
         dirn = sign(1.0_wp, opts%lam_end - lam_lo)
+        jumped = .false.
         do while (npts < opts%max_points)
             ds = min(max(ds, opts%ds_min), opts%ds_max)
             yp = y + ds*t(1:n)*opts%yscale
@@ -277,6 +280,14 @@ contains
             if (info /= 0) then
                 why = errmsg
                 have_fact = .false.
+                if (ds <= opts%ds_min*1.000001_wp .and. .not. jumped) then
+                    ! a kink of the solution curve (an element starting to slip in one
+                    ! sample) can stall Newton at any small step: try once to step over it
+                    jumped = .true.
+                    ds = max(0.1_wp*opts%ds_max, 2.0_wp*opts%ds_min)
+                    info = FRIROM_OK
+                    cycle
+                end if
                 if (ds <= opts%ds_min*1.000001_wp) then
                     call set_status(info, FRIROM_ERR_CONT, errmsg, 'continuation stopped')
                     write (buf, '(a,es12.5,a,es9.2,a)') ' at parameter ', lam, &
@@ -294,6 +305,7 @@ contains
                 return
             end if
             have_fact = .true.
+            jumped = .false.
             npts = npts + 1
             y = y1
             lam = lam1

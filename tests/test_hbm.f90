@@ -9,7 +9,8 @@ program test_hbm
     implicit none
     integer(ip), parameter :: ndof = 4, nh = 3, nc = 2*nh + 1
     type(hbm_condensed) :: sc, scl
-    type(hbm_full) :: sf, sfl, sbad
+    type(hbm_full) :: sf, sfl, sbad, sfn
+    type(hbm_condensed) :: scn
     integer(ip) :: kp(ndof + 1), ki(10), mp(ndof + 1), mi(ndof), cp(ndof + 1), ci(10)
     real(wp) :: kx(10), mx(ndof), cx(10), fe0(ndof, nc), fe1(ndof, nc)
     integer(ip) :: perm(ndof), nl(3), ginfo(3, 1), gp(3), gi(3), outd(ndof)
@@ -62,6 +63,18 @@ program test_hbm
     call hbm_setup(sfl, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
                    fe1, 2, 0.9_wp, ginfo, gp, gi, gx, params, w0, outd, info, msg)
     call fd_check(sfl, 'full load')
+    ! a 1-D normal-load friction element (2 directions) between DoF 3 (tangential) and
+    ! DoF 4 (normal), kept closed by its preload: piecewise smooth, so the finite
+    ! differences are only checked where no sample changes state (small perturbation)
+    call hbm_setup(scn, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
+                   fe1, 1, 0.0_wp, reshape([2, 1, 2], [3, 1]), [1, 2, 3], [3, 4], &
+                   [1.0_wp, 1.0_wp], [0.5_wp, 1.0_wp, 0.3_wp, 0.2_wp], [0.0_wp], outd, info, msg)
+    call check(info == 0, 'setup normal1d: '//trim(msg))
+    call fd_check(scn, 'condensed normal1d')
+    call hbm_setup(sfn, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
+                   fe1, 1, 0.0_wp, reshape([2, 1, 2], [3, 1]), [1, 2, 3], [3, 4], &
+                   [1.0_wp, 1.0_wp], [0.5_wp, 1.0_wp, 0.3_wp, 0.2_wp], [0.0_wp], outd, info, msg)
+    call fd_check(sfn, 'full normal1d')
     ! bad input is reported, not crashed on
     perm = [1, 1, 2, 3]
     call hbm_setup(sbad, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &

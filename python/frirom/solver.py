@@ -43,15 +43,15 @@ class SolverOptions:
     harmonics: int = 3
     samples: int | None = None
     formulation: str = "condensed"
-    tol_residual: float = 1e-10
-    tol_update: float = 1e-9
+    tol_residual: float = 1e-8
+    tol_update: float = 1e-8
     max_iter: int = 25
     ds: float = 0.02
     ds_min: float = 1e-6
     ds_max: float = 0.1
     max_points: int = 2000
     parameter: str = "frequency"
-    reuse_jacobian: bool = True
+    reuse_jacobian: bool = False
     batch: int = 10
 
     def check(self) -> None:
@@ -204,7 +204,8 @@ class _Packed:
         return pts
 
 
-def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start):
+def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
+         keep_unknowns=False):
     o = packed.opts
     lscale = abs(lam_end - lam_start) or 1.0
     points, message, complete = [], "", True
@@ -234,6 +235,14 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start):
         res = packed.call(y0, lam0, tan0, 2, ds, lam_end, lam_lo, 1e-300, lscale, 1,
                           omega_fix)
         info, msg = res[10], res[11]
+        if info != 0 and packed.mode == 1 and start is None:
+            # Newton from the linear solution failed (strong slip or lift-off): reach the
+            # first point by continuation in the excitation level from the static state.
+            y_h = _homotopy_start(packed, lam0)
+            if y_h is not None:
+                res = packed.call(y_h, lam0, tan0, 2, ds, lam_end, lam_lo, 1e-300, lscale,
+                                  1, omega_fix)
+                info, msg = res[10], res[11]
         raise_for_status(info, msg.decode(errors="replace"))
         p = packed.points(res, omega_fix, time.perf_counter() - t0)[0]
         t0 = time.perf_counter()
@@ -282,8 +291,35 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start):
         complete = False
         message = f"stopped after max_points = {o.max_points} points"
     name = "omega" if packed.mode == 1 else "load"
-    return FRF.from_points(points, packed.outputs, packed.group_names, parameter_name=name,
-                           complete=complete, message=message)
+    out = FRF.from_points(points, packed.outputs, packed.group_names, parameter_name=name,
+                          complete=complete, message=message)
+    if keep_unknowns and points:
+        out._last_unknowns = points[-1].unknowns
+    return out
+
+
+def _homotopy_start(packed: _Packed, omega: float):
+    """Unknowns at omega reached by load continuation of the dynamic excitation from 0 to
+    1 (None if that fails too)."""
+    o = SolverOptions(**{**packed.opts.__dict__, "parameter": "load"})
+    lp = _Packed.__new__(_Packed)
+    lp.__dict__.update(packed.__dict__)
+    lp.opts = o
+    lp.mode = 2
+    fe = packed.fe0
+    mask = np.zeros(packed.nc, bool)
+    mask[1:] = True
+    lp.fe1 = np.where(mask, fe, 0.0)
+    lp.fe0 = fe - lp.fe1
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            r = _run(lp, 0.0, 1.0, omega, None, None, None, keep_unknowns=True)
+    except Exception:       # noqa: BLE001 - the caller reports the original failure
+        return None
+    if not r.complete or not r.parameter.size or r.parameter[-1] != 1.0:
+        return None
+    return r._last_unknowns
 
 
 def frf(model: Model, excitation: Excitation, omega_start: float, omega_end: float,
@@ -330,20 +366,30 @@ def load_curve(model: Model, excitation: Excitation, omega: float, scale_start: 
 
 
 def solve_point(model: Model, excitation: Excitation, omega: float,
-                options: SolverOptions | None = None, outputs=None, start=None) -> FRFPoint:
+                options: SolverOptions | None = None, outputs=None, start=None,
+                start_harmonics: int | None = None) -> FRFPoint:
     """The periodic response at one frequency omega (rad/s), Newton from the linear
-    solution (or from start['unknowns'])."""
+    solution, or from start['unknowns'] (of a solution with start_harmonics harmonics,
+    default options.harmonics; padded with zeros). If Newton from the linear solution
+    fails, the point is reached by continuation in the excitation level."""
     options = options or SolverOptions()
     options = SolverOptions(**{**options.__dict__, "parameter": "frequency"})
     if not (np.isfinite(omega) and omega > 0):
         raise ParameterError(f"omega: expected a positive frequency in rad/s, got {omega}")
     packed = _Packed(model, excitation, options, outputs)
-    y0 = np.zeros(packed.ny) if start is None else packed.pad_start(start["unknowns"],
-                                                                   options.harmonics)
+    y0 = np.zeros(packed.ny) if start is None else packed.pad_start(
+        start["unknowns"], options.harmonics if start_harmonics is None else start_harmonics)
     t0 = time.perf_counter()
     res = packed.call(y0, float(omega), np.zeros(packed.ny + 1), 2, options.ds,
                       float(omega) * 1.1, 0.0, 1e-300, float(omega), 1)
     info, msg = res[10], res[11]
+    if info != 0 and start is None:
+        # Newton from the linear solution failed: continuation in the excitation level
+        y_h = _homotopy_start(packed, float(omega))
+        if y_h is not None:
+            res = packed.call(y_h, float(omega), np.zeros(packed.ny + 1), 2, options.ds,
+                              float(omega) * 1.1, 0.0, 1e-300, float(omega), 1)
+            info, msg = res[10], res[11]
     raise_for_status(info, msg.decode(errors="replace"))
     pt = packed.points(res, 0.0, time.perf_counter() - t0)[0]
     pt.output_dofs = packed.outputs
