@@ -102,3 +102,23 @@ def test_bad_input_raises():
         TimeContact("coulomb", np.array([[1.0, 0.0]]), [[1.0, 0.3, 1.0]])
     with pytest.raises(InputError, match="omega"):
         integrate(M, C, K, [], np.ones((2, 2)), -1.0)
+
+
+def test_normal2d_in_one_plane_equals_normal1d():
+    # motion confined to the first tangential direction: the circular friction limit
+    # reduces to the 1-D one, so both laws must give the same response
+    M = np.diag([1.0, 1.0])
+    K = np.array([[2.0, -0.5], [-0.5, 1.5]])
+    C = 0.02 * K
+    F = np.zeros((2, 2), complex)
+    F[0, 1] = 0.4
+    G1 = np.array([[1.0, 0.0], [0.0, 1.0]])                  # u, v
+    G2 = np.array([[1.0, 0.0], [0.0, 0.0], [0.0, 1.0]])      # u1, u2 (= 0), v
+    par = [[1.5, 1.0, 0.3, 0.4]]
+    om = np.array([0.8, 1.1, 1.4])
+    kw = dict(H=3, periods=300, tol=1e-8, steps_per_period=256)
+    r1 = integrate(M, C, K, [TimeContact("normal1d", G1, par)], F, om, **kw)
+    r2 = integrate(M, C, K, [TimeContact("normal2d", G2, par)], F, om, **kw)
+    assert r1.state_fractions[:, 0, 1:].sum(axis=1).max() > 0.2     # slips / lifts off
+    assert np.allclose(r1.samples, r2.samples, rtol=0, atol=1e-12)
+    assert np.allclose(r1.state_fractions, r2.state_fractions)

@@ -1,4 +1,4 @@
-"""The ``frirom`` command line.
+"""frirom: nonlinear forced response of frictionally damped structures.
 
     frirom run DECK [--out DIR] [--resume]    forced response of a deck (docs/deck.md)
 """
