@@ -342,6 +342,27 @@ def test_normal1d_continuation_through_stick_boundary():
     assert r.complete, r.message
 
 
+@pytest.mark.xfail(reason="AFT: the Jacobian of a cycle that slipped in the first marched "
+                   "period and then stuck ignores that the closed slider depends on x",
+                   strict=False)
+def test_aft_jacobian_after_transient_slip_matches_finite_difference():
+    """The cause of the crawl above, at the point where it happens: the march slips in
+    its first period and sticks afterwards, so the converged force does not depend on the
+    mean tangential displacement (finite difference 0), while the AFT Jacobian reports kt.
+    """
+    from frirom.contact import aft
+    x = np.zeros((1, 2, 11))
+    x[0, 0, :3] = [0.05023744, 0.05856256, 0.00185013]     # u: a0, a1, b1
+    x[0, 1, :3] = [-0.1351831, -0.03381111, -0.00106817]   # v
+    p = np.array([N_PAR])
+    r0 = aft("normal1d", x, p, 64)
+    x1 = x.copy()
+    x1[0, 0, 0] += 1e-6
+    r1 = aft("normal1d", x1, p, 64)
+    fd = (r1.forces - r0.forces)[0, 0, 0] / 1e-6
+    assert abs(r0.jacobian[0, 0, 0] - fd) < 1e-3 * N_PAR[0], (r0.jacobian[0, 0, 0], fd)
+
+
 # ---- limits --------------------------------------------------------------------------------
 
 def _balanced(F, G, n0):
