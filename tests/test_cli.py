@@ -83,3 +83,32 @@ def test_bad_deck_gives_clear_error(deck, tmp_path, capsys):
 def test_resume_without_previous_run(deck, tmp_path, capsys):
     assert main(["run", str(deck), "--out", str(tmp_path / "none"), "--resume"]) == 2
     assert "nothing to resume" in capsys.readouterr().err
+
+
+def test_ctrl_c_keeps_points_and_resumes(deck, tmp_path, monkeypatch, capsys):
+    """An interrupt (Ctrl-C) after some points: exit code 130, the points are in frf.h5,
+    and --resume finishes the curve."""
+    import frirom.solver as solver
+    real = solver.frf
+
+    def interrupted(*args, sink=None, **kw):
+        count = {"n": 0}
+
+        def counting(p):
+            sink(p)
+            count["n"] += 1
+            if count["n"] == 25:
+                raise KeyboardInterrupt
+        return real(*args, sink=counting, **kw)
+
+    out = tmp_path / "out"
+    monkeypatch.setattr(solver, "frf", interrupted)
+    assert main(["run", str(deck), "--out", str(out), "--quiet"]) == 130
+    assert "--resume" in capsys.readouterr().err
+    r = FRF.load(out / "frf.h5")
+    assert len(r) == 25 and not r.complete
+    monkeypatch.setattr(solver, "frf", real)
+    assert main(["run", str(deck), "--out", str(out), "--quiet", "--resume"]) == 0
+    r = FRF.load(out / "frf.h5")
+    assert r.complete and r.omega[-1] == pytest.approx(2 * np.pi * 520.0)
+    assert np.all(np.diff(r.omega[:30]) > 0)

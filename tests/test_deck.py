@@ -166,3 +166,15 @@ def test_bladed_disk_engine_order_travelling_wave():
     err = np.abs(X1 - X1[:, :1] * lag).max() / np.abs(X1).max()
     assert err < 1e-8, err
     assert np.allclose(r.amp_max, r.amp_max[:, :1], rtol=1e-8)
+
+
+def test_per_element_frames_and_parameters(deckdir):
+    text = BASE.replace(
+        'elements = [ { a = ["platform:x", "platform:y"], b = "ground" } ]',
+        'elements = [ { a = ["platform:x", "platform:y"] },\n'
+        '             { a = ["platform:x", "platform:y"], b = "ground", '
+        'directions = [[0.0, 2.0]] } ]').replace("mu = 0.5 ", "mu = [0.5, 0.2] ")
+    d = load_deck(write(deckdir, text))
+    G = d.contacts[0].G.toarray()
+    assert np.allclose(G[0, :2], [np.cos(np.pi / 6), 0.5]) and np.allclose(G[1, :2], [0, 1])
+    assert np.allclose(d.contacts[0].params[:, 1], [0.5, 0.2])
