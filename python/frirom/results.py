@@ -65,6 +65,9 @@ class FRF:
     complete: bool = True
     message: str = ""
     stability_computed: bool = False
+    #: Fortran time split of the run: aft, assembly, factorization, solve, receptance (s),
+    #: evaluations, factorizations (counts), fortran_total (s)
+    timings: dict = field(default_factory=dict)
 
     @property
     def harmonics(self) -> int:
