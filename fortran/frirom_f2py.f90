@@ -110,8 +110,9 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
                         ci, cx, perm, nnl, nl, fe0, fe1, mode, omega_fix, ngroup, ginfo, nrows, &
                         nnzg, gp, gi, gx, npart, params, nw0, w0, nout, outdofs, ny, y0, lam0, &
                         tan0, start_mode, ds, ds_min, ds_max, lam_end, lam_lo, tol_r, tol_x, &
-                        tol_stall, max_iter, reuse, yscale, lscale, maxpts, netot, ys, lams, tans, iters, &
-                        xo, states, npts, finished, ds_out, timings, info, msg)
+                        tol_stall, max_iter, reuse, yscale, lscale, maxpts, netot, stability, ys, &
+                        lams, tans, iters, xo, states, hill_re, npts, finished, ds_out, timings, &
+                        info, msg)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options
@@ -136,9 +137,11 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     integer(4), intent(in) :: max_iter, reuse
     real(8), intent(in) :: yscale, lscale
     integer(4), intent(in) :: maxpts, netot
+    integer(4), intent(in) :: stability    !! 1: Hill stability of every point
     real(8), intent(out) :: ys(ny, maxpts), lams(maxpts), tans(ny + 1, maxpts)
     integer(4), intent(out) :: iters(maxpts)
     real(8), intent(out) :: xo(nout, 2*nh + 1, maxpts), states(3, netot, maxpts)
+    real(8), intent(out) :: hill_re(maxpts)   !! max real part of the Floquet exponents, 1/s
     integer(4), intent(out) :: npts, finished
     real(8), intent(out) :: ds_out, timings(8)
     integer(4), intent(out) :: info
@@ -198,8 +201,14 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     t = tan0
     lam = lam0
     dsl = ds
-    call hbm_run(sys, start_mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itl, xo, &
-                 states, np, fin, linfo, msg)
+    hill_re = 0.0d0
+    if (stability /= 0) then
+        call hbm_run(sys, start_mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itl, xo, &
+                     states, np, fin, linfo, msg, hill_re)
+    else
+        call hbm_run(sys, start_mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itl, xo, &
+                     states, np, fin, linfo, msg)
+    end if
     npts = np
     iters = itl
     finished = merge(1, 0, fin)

@@ -212,3 +212,22 @@ def test_modal_damping_gives_the_requested_ratios():
     w2, phi = sla.eigh(K, M)
     d = phi.T @ model.C.toarray() @ phi
     np.testing.assert_allclose(np.diag(d), 2 * np.array(z) * np.sqrt(w2), rtol=1e-10)
+
+
+@pytest.mark.parametrize("form", ["condensed", "banded"])
+def test_hill_stability_duffing_middle_branch(form):
+    """Hill's method: on the hardening Duffing curve exactly the points between the two
+    folds (the saddle branch) are unstable; the friction model's curve (no fold) is stable
+    everywhere."""
+    model, ex = duffing()
+    r = frf(model, ex, 0.5, 2.0, SolverOptions(harmonics=3, samples=32, formulation=form,
+                                               stability=True), outputs=[0])
+    assert r.complete and r.stability_computed
+    f1, f2 = np.where(r.fold)[0]
+    expected = np.zeros(len(r), bool)
+    expected[f1:f2] = True          # fold flags sit on the first point past each turn
+    np.testing.assert_array_equal(~r.stable, expected)
+    model, ex = friction_model()
+    r = frf(model, ex, 100.0, 155.0, SolverOptions(harmonics=3, samples=100, formulation=form,
+                                                   stability=True), outputs=[0])
+    assert r.complete and r.stable.all()

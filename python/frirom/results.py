@@ -38,6 +38,7 @@ class FRFPoint:
     time_s: float
     fold: bool = False
     stable: bool = True
+    floquet_max_re: float = 0.0  #: largest real part of the Floquet exponents, 1/s
 
 
 @dataclass
