@@ -110,8 +110,9 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
                         ci, cx, perm, nnl, nl, fe0, fe1, mode, omega_fix, ngroup, ginfo, nrows, &
                         nnzg, gp, gi, gx, npart, params, nw0, w0, nout, outdofs, ny, y0, lam0, &
                         tan0, start_mode, ds, ds_min, ds_max, lam_end, lam_lo, tol_r, tol_x, &
-                        max_iter, reuse, yscale, lscale, maxpts, netot, ys, lams, tans, iters, &
-                        xo, states, npts, finished, ds_out, timings, info, msg)
+                        tol_stall, max_iter, reuse, yscale, lscale, maxpts, netot, stability, ys, &
+                        lams, tans, iters, xo, states, hill_re, npts, finished, ds_out, timings, &
+                        info, msg)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options
@@ -132,13 +133,15 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     integer(4), intent(in) :: nout, outdofs(nout), ny
     real(8), intent(in) :: y0(ny), lam0, tan0(ny + 1)
     integer(4), intent(in) :: start_mode
-    real(8), intent(in) :: ds, ds_min, ds_max, lam_end, lam_lo, tol_r, tol_x
+    real(8), intent(in) :: ds, ds_min, ds_max, lam_end, lam_lo, tol_r, tol_x, tol_stall
     integer(4), intent(in) :: max_iter, reuse
     real(8), intent(in) :: yscale, lscale
     integer(4), intent(in) :: maxpts, netot
+    integer(4), intent(in) :: stability    !! 1: Hill stability of every point
     real(8), intent(out) :: ys(ny, maxpts), lams(maxpts), tans(ny + 1, maxpts)
     integer(4), intent(out) :: iters(maxpts)
     real(8), intent(out) :: xo(nout, 2*nh + 1, maxpts), states(3, netot, maxpts)
+    real(8), intent(out) :: hill_re(maxpts)   !! max real part of the Floquet exponents, 1/s
     integer(4), intent(out) :: npts, finished
     real(8), intent(out) :: ds_out, timings(8)
     integer(4), intent(out) :: info
@@ -184,6 +187,7 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     end if
     opts%tol_r = tol_r
     opts%tol_x = tol_x
+    opts%tol_stall = tol_stall
     opts%max_iter = max_iter
     opts%reuse_jac = reuse /= 0
     opts%yscale = yscale
@@ -197,8 +201,14 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     t = tan0
     lam = lam0
     dsl = ds
-    call hbm_run(sys, start_mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itl, xo, &
-                 states, np, fin, linfo, msg)
+    hill_re = 0.0d0
+    if (stability /= 0) then
+        call hbm_run(sys, start_mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itl, xo, &
+                     states, np, fin, linfo, msg, hill_re)
+    else
+        call hbm_run(sys, start_mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itl, xo, &
+                     states, np, fin, linfo, msg)
+    end if
     npts = np
     iters = itl
     finished = merge(1, 0, fin)
@@ -208,5 +218,26 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     call system_clock(c1)
     timings(8) = real(c1 - c0, 8)/real(rate, 8)
 end subroutine hbm_continue
+
+!> GFLOP/s of the dgemm the library links (reps products of n x n matrices), for benchmarks
+!> that compare factorisation rates with the BLAS actually used.
+subroutine hbm_dgemm_rate(n, reps, gflops)
+    implicit none
+    integer(4), intent(in) :: n, reps
+    real(8), intent(out) :: gflops
+    real(8), allocatable :: a(:, :), b(:, :), c(:, :)
+    integer(8) :: c0, c1, rate
+    integer(4) :: k
+    allocate (a(n, n), b(n, n), c(n, n))
+    call random_number(a)
+    call random_number(b)
+    call dgemm('N', 'N', n, n, n, 1.0d0, a, n, b, n, 0.0d0, c, n)
+    call system_clock(c0, rate)
+    do k = 1, reps
+        call dgemm('N', 'N', n, n, n, 1.0d0, a, n, b, n, 0.0d0, c, n)
+    end do
+    call system_clock(c1)
+    gflops = 2.0d0*real(n, 8)**3*reps/max(real(c1 - c0, 8)/real(rate, 8), 1.0d-9)/1.0d9
+end subroutine hbm_dgemm_rate
 
 ! ---- reduction: eigen-solves, Craig-Bampton, interface reduction -------------------

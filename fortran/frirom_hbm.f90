@@ -27,7 +27,7 @@ module frirom_hbm
     implicit none
     private
     public :: csr_matrix, contact_group, contact_set, hbm_system, hbm_condensed, hbm_full, &
-              hbm_setup, hbm_run, contact_eval, contact_assemble, HBM_FREQUENCY, HBM_LOAD, &
+              hbm_setup, hbm_run, hbm_hill, contact_eval, contact_assemble, HBM_FREQUENCY, HBM_LOAD, &
               T_AFT, T_ASM, T_FACT, T_SOLVE, T_REC, N_EVAL, N_FACT, N_TIMERS
 
     integer(ip), parameter :: HBM_FREQUENCY = 1, HBM_LOAD = 2
@@ -456,20 +456,23 @@ contains
 
     !> Add G^T J_loc G (from the last contact_eval with jac) to a dense matrix kd, index
     !> col + ncol (c-1), or to a banded matrix kb, index c + nc (iperm(col)-1).
-    subroutine contact_assemble(cs, kd, kb, iperm, info, errmsg)
+    subroutine contact_assemble(cs, kd, kb, iperm, info, errmsg, colmap, ldc)
         type(contact_set), intent(in) :: cs
         real(wp), intent(inout), optional :: kd(:, :)
         type(band_matrix), intent(inout), optional :: kb
         integer(ip), intent(in), optional :: iperm(:)
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
-        integer(ip) :: g, e, d1, d2, r1, r2, k1, k2, c1, c2, ncol, nc, i1, i2
+        integer(ip), intent(in), optional :: colmap(:)  !! dense: column -> row/col index
+        integer(ip), intent(in), optional :: ldc        !! dense: stride between harmonics
+        integer(ip) :: g, e, d1, d2, r1, r2, k1, k2, c1, c2, ncol, nc, i1, i2, m1, m2
         real(wp) :: v
         logical :: ok
         info = FRIROM_OK
         ok = .true.
         nc = cs%nc
         ncol = cs%g%ncol
+        if (present(ldc)) ncol = ldc
         do g = 1, size(cs%grp)
             associate (gr => cs%grp(g), gg => cs%g)
                 do e = 1, gr%ne
@@ -480,11 +483,17 @@ contains
                             do k1 = gg%p(r1), gg%p(r1 + 1) - 1
                                 do k2 = gg%p(r2), gg%p(r2 + 1) - 1
                                     v = gg%x(k1)*gg%x(k2)
+                                    m1 = gg%i(k1)
+                                    m2 = gg%i(k2)
+                                    if (present(colmap)) then
+                                        m1 = colmap(m1)
+                                        m2 = colmap(m2)
+                                    end if
                                     do c2 = 1, nc
                                         do c1 = 1, nc
                                             if (present(kd)) then
-                                                i1 = gg%i(k1) + ncol*(c1 - 1)
-                                                i2 = gg%i(k2) + ncol*(c2 - 1)
+                                                i1 = m1 + ncol*(c1 - 1)
+                                                i2 = m2 + ncol*(c2 - 1)
                                                 kd(i1, i2) = kd(i1, i2) + v* &
                                                     gr%jac(c1 + nc*(d1 - 1), c2 + nc*(d2 - 1), e)
                                             else
@@ -952,6 +961,149 @@ contains
         if (.false.) errmsg = ''
     end subroutine full_outputs
 
+
+    ! ---- stability --------------------------------------------------------------------
+
+    !> Floquet exponents of the periodic solution y at lam by Hill's method: the quadratic
+    !> eigenproblem (J + s D1 + s^2 M) p = 0 over all DoFs x harmonics (J = dR/dX of the
+    !> full equations, D1 = C + 2 M d/dt), linearised to a 2n standard eigenproblem (dense,
+    !> dgeev). Of the 2n(2H+1) eigenvalues, the 2 ndof with the smallest |Im s| are the
+    !> physically meaningful exponents (the others repeat them shifted by i h w).
+    !> maxre: their largest real part; the solution is stable when maxre <= 0.
+    subroutine hbm_hill(sys, y, lam, expo, maxre, info, errmsg)
+        class(hbm_system), intent(inout) :: sys
+        real(wp), intent(in) :: y(:), lam
+        complex(wp), intent(out) :: expo(:)   !! (2 ndof) selected exponents, 1/s
+        real(wp), intent(out) :: maxre        !! max real part of expo, 1/s
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        integer(ip), parameter :: NMAX = 4000
+        real(wp), allocatable :: jm(:, :), d1(:, :), md(:, :), a(:, :), wr(:), wi(:), &
+                                 work(:), xd(:, :), fd(:, :), key(:)
+        real(wp) :: w, s, hw, vl(1, 1), vr(1, 1), wq(1)
+        integer(ip), allocatable :: colmap(:), idx(:)
+        integer(ip) :: nd, nc, n, i, k, j, h, c, linfo, lwork, stat, m, t
+        info = FRIROM_OK
+        nd = sys%ndof
+        nc = sys%nc
+        n = nd*nc
+        if (size(expo) /= 2*nd) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'hbm_hill: expo needs 2 ndof')
+            return
+        end if
+        if (2*n > NMAX) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'Hill stability: 2 ndof (2H+1) '// &
+                            'exceeds 4000 (dense eigen-solve); reduce the model or H')
+            return
+        end if
+        call freq_load(sys, lam, w, s)
+        allocate (jm(n, n), d1(n, n), md(nd, nd), a(2*n, 2*n), wr(2*n), wi(2*n), key(2*n), &
+                  idx(2*n), stat=stat)
+        if (stat /= 0) then
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'Hill matrices')
+            return
+        end if
+        ! contact Jacobians at the solution
+        select type (sys)
+        type is (hbm_condensed)
+            xd = reshape(y, [sys%nnl, nc])
+            colmap = sys%nl
+        class default
+            allocate (xd(nd, nc))
+            do i = 1, nd
+                xd(i, :) = y(nc*(sys%iperm(i) - 1) + 1:nc*sys%iperm(i))
+            end do
+            colmap = [(i, i = 1, nd)]
+        end select
+        allocate (fd(size(xd, 1), nc))
+        call contact_eval(sys%cs, sys%plan, xd, fd, .true., info, errmsg)
+        if (info /= 0) return
+        jm = 0.0_wp
+        d1 = 0.0_wp
+        md = 0.0_wp
+        call contact_assemble(sys%cs, kd=jm, info=info, errmsg=errmsg, colmap=colmap, ldc=nd)
+        if (info /= 0) return
+        do i = 1, nd
+            do k = sys%k%p(i), sys%k%p(i + 1) - 1
+                j = sys%k%i(k)
+                do c = 1, nc
+                    jm(i + nd*(c - 1), j + nd*(c - 1)) = jm(i + nd*(c - 1), j + nd*(c - 1)) + &
+                                                         sys%k%x(k)
+                end do
+            end do
+            do k = sys%m%p(i), sys%m%p(i + 1) - 1
+                j = sys%m%i(k)
+                md(i, j) = md(i, j) + sys%m%x(k)
+                do h = 1, sys%nh
+                    hw = h*w
+                    jm(i + nd*(2*h - 1), j + nd*(2*h - 1)) = &
+                        jm(i + nd*(2*h - 1), j + nd*(2*h - 1)) - hw*hw*sys%m%x(k)
+                    jm(i + nd*(2*h), j + nd*(2*h)) = jm(i + nd*(2*h), j + nd*(2*h)) - &
+                                                     hw*hw*sys%m%x(k)
+                    d1(i + nd*(2*h - 1), j + nd*(2*h)) = d1(i + nd*(2*h - 1), j + nd*(2*h)) + &
+                                                         2*hw*sys%m%x(k)
+                    d1(i + nd*(2*h), j + nd*(2*h - 1)) = d1(i + nd*(2*h), j + nd*(2*h - 1)) - &
+                                                         2*hw*sys%m%x(k)
+                end do
+            end do
+            do k = sys%c%p(i), sys%c%p(i + 1) - 1
+                j = sys%c%i(k)
+                do c = 1, nc
+                    d1(i + nd*(c - 1), j + nd*(c - 1)) = d1(i + nd*(c - 1), j + nd*(c - 1)) + &
+                                                         sys%c%x(k)
+                end do
+                do h = 1, sys%nh
+                    hw = h*w
+                    jm(i + nd*(2*h - 1), j + nd*(2*h)) = jm(i + nd*(2*h - 1), j + nd*(2*h)) + &
+                                                         hw*sys%c%x(k)
+                    jm(i + nd*(2*h), j + nd*(2*h - 1)) = jm(i + nd*(2*h), j + nd*(2*h - 1)) - &
+                                                         hw*sys%c%x(k)
+                end do
+            end do
+        end do
+        ! M^-1 applied to every harmonic row block of J and D1 (Cholesky of M)
+        call dpotrf('L', nd, md, nd, linfo)
+        if (linfo /= 0) then
+            call set_status(info, FRIROM_ERR_SINGULAR, errmsg, 'Hill: dpotrf, M not positive '// &
+                            'definite')
+            return
+        end if
+        do c = 1, nc
+            call dpotrs('L', nd, n, md, nd, jm(nd*(c - 1) + 1, 1), n, linfo)
+            call dpotrs('L', nd, n, md, nd, d1(nd*(c - 1) + 1, 1), n, linfo)
+        end do
+        a = 0.0_wp
+        do i = 1, n
+            a(i, n + i) = 1.0_wp
+        end do
+        a(n + 1:2*n, 1:n) = -jm
+        a(n + 1:2*n, n + 1:2*n) = -d1
+        deallocate (jm, d1)
+        call dgeev('N', 'N', 2*n, a, 2*n, wr, wi, vl, 1, vr, 1, wq, -1, linfo)
+        lwork = int(wq(1))
+        allocate (work(lwork))
+        call dgeev('N', 'N', 2*n, a, 2*n, wr, wi, vl, 1, vr, 1, work, lwork, linfo)
+        if (linfo /= 0) then
+            call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'Hill: dgeev did not converge')
+            return
+        end if
+        ! the 2 ndof exponents with the smallest |Im s| (selection sort, m is small)
+        key = abs(wi)
+        idx = [(i, i = 1, 2*n)]
+        m = 2*nd
+        do i = 1, m
+            k = i
+            do j = i + 1, 2*n
+                if (key(idx(j)) < key(idx(k))) k = j
+            end do
+            t = idx(i)
+            idx(i) = idx(k)
+            idx(k) = t
+            expo(i) = cmplx(wr(idx(i)), wi(idx(i)), wp)
+        end do
+        maxre = maxval(real(expo, wp))
+    end subroutine hbm_hill
+
     ! ---- driver ---------------------------------------------------------------------
 
     !> Solve and continue: start_mode 0 solves at fixed lam from y then continues,
@@ -959,7 +1111,7 @@ contains
     !> fixed lam. Each point stores y, lam, tangent, Newton iterations, output harmonics
     !> and contact state fractions. On a failure every point already made is kept (npts).
     subroutine hbm_run(sys, start_mode, y, lam, t, ds, lam_lo, opts, ys, lams, tans, iters, &
-                       xo, states, npts, finished, info, errmsg)
+                       xo, states, npts, finished, info, errmsg, hill_re)
         class(hbm_system), intent(inout) :: sys
         integer(ip), intent(in) :: start_mode
         real(wp), intent(inout) :: y(:), lam, t(:), ds
@@ -975,6 +1127,8 @@ contains
         logical, intent(out) :: finished
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
+        real(wp), intent(out), optional :: hill_re(:)  !! (maxpts) max Re of the Floquet
+                                                        !! exponents (only when present)
         type(cont_options) :: o1
         real(wp), allocatable :: zero(:), yb(:, :), lb(:), tb(:, :), t0(:)
         integer(ip) :: it, n1, maxpts, ib(1)
@@ -1026,12 +1180,19 @@ contains
         subroutine store(itn)
             integer(ip), intent(in) :: itn
             integer(ip) :: g, e0
+            complex(wp), allocatable :: ex(:)
             npts = npts + 1
             ys(:, npts) = y
             lams(npts) = lam
             tans(:, npts) = t
             iters(npts) = itn
             call sys%outputs(y, lam, xo(:, :, npts), info, errmsg)
+            if (info /= 0) return
+            if (present(hill_re)) then
+                allocate (ex(2*sys%ndof))
+                call hbm_hill(sys, y, lam, ex, hill_re(npts), info, errmsg)
+                if (info /= 0) return
+            end if
             e0 = 0
             do g = 1, size(sys%cs%grp)
                 states(:, e0 + 1:e0 + sys%cs%grp(g)%ne, npts) = sys%cs%grp(g)%states

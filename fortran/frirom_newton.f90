@@ -53,6 +53,10 @@ module frirom_newton
     type :: cont_options
         real(wp) :: tol_r = 1.0e-10_wp   !! ||R|| / rref below this ...
         real(wp) :: tol_x = 1.0e-9_wp    !! ... and ||dy|| / max(||y||, yscale) below this
+        !> after max_iter, a residual that stagnated below this is accepted: at a contact
+        !> state change inside one time sample R is not differentiable and Newton can cycle
+        !> between the two sides at a level far below the AFT discretisation error
+        real(wp) :: tol_stall = 0.0_wp
         integer(ip) :: max_iter = 25     !! Newton iterations per corrector
         logical :: reuse_jac = .true.    !! keep a factorisation while iterations contract
         real(wp) :: reuse_rate = 0.1_wp  !! contraction factor below which J is kept
@@ -165,6 +169,7 @@ contains
             if (rn <= opts%tol_r .and. abs(g) <= max(opts%tol_x, 1.0e-12_wp) .and. &
                 (dxn <= opts%tol_x .or. rn <= 100.0_wp*epsilon(1.0_wp))) return
         end do
+        if (rn <= opts%tol_stall .and. abs(g) <= max(opts%tol_x, 1.0e-12_wp)) return
         call set_status(info, FRIROM_ERR_NOCONV, errmsg, 'newton_correct: no convergence')
         write (buf, '(a,i0,a,es9.2,a,es9.2)') ' in ', opts%max_iter, &
             ' iterations, |R|/rref = ', rn, ', update = ', dxn
@@ -236,6 +241,9 @@ contains
         real(wp) :: lam1, lp, dirn, frac, cl
         integer(ip) :: n, iters
         logical :: last, jumped
+        integer(ip) :: nfail
+        real(wp) :: ds_fail0
+        type(cont_options) :: fresh_opts
         character(len=len(errmsg)) :: why
         character(len=120) :: buf
         n = sys%n
@@ -257,6 +265,10 @@ contains
         allocate (y1(n), yp(n), t1(n + 1), cy(n))
         dirn = sign(1.0_wp, opts%lam_end - lam_lo)
         jumped = .false.
+        nfail = 0
+        ds_fail0 = ds
+        fresh_opts = opts
+        fresh_opts%reuse_jac = .false.
         do while (npts < opts%max_points)
             ds = min(max(ds, opts%ds_min), opts%ds_max)
             yp = y + ds*t(1:n)*opts%yscale
@@ -277,14 +289,26 @@ contains
             lam1 = lp
             call newton_correct(sys, y1, lam1, yp, lp, cy, cl, opts, iters, info, errmsg, &
                                 have_fact)
+            if (info /= 0 .and. opts%reuse_jac) then
+                ! chord steps can stall where a contact changes state: retry the same step
+                ! with a fresh Jacobian at every iteration before shrinking it
+                y1 = yp
+                lam1 = lp
+                have_fact = .false.
+                call newton_correct(sys, y1, lam1, yp, lp, cy, cl, fresh_opts, iters, info, &
+                                    errmsg, have_fact)
+            end if
             if (info /= 0) then
                 why = errmsg
                 have_fact = .false.
-                if (ds <= opts%ds_min*1.000001_wp .and. .not. jumped) then
-                    ! a kink of the solution curve (an element starting to slip in one
-                    ! sample) can stall Newton at any small step: try once to step over it
+                nfail = nfail + 1
+                if (nfail == 1) ds_fail0 = ds
+                if ((nfail == 5 .or. ds <= opts%ds_min*1.000001_wp) .and. .not. jumped) then
+                    ! a discontinuity or kink of R (a contact entering stick-all-cycle, a
+                    ! state change inside one sample) stalls Newton at any small step: try
+                    ! once to step over it with a larger step
                     jumped = .true.
-                    ds = max(0.1_wp*opts%ds_max, 2.0_wp*opts%ds_min)
+                    ds = min(max(4.0_wp*ds_fail0, 0.1_wp*opts%ds_max), opts%ds_max)
                     info = FRIROM_OK
                     cycle
                 end if
@@ -306,6 +330,7 @@ contains
             end if
             have_fact = .true.
             jumped = .false.
+            nfail = 0
             npts = npts + 1
             y = y1
             lam = lam1

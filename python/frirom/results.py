@@ -38,6 +38,7 @@ class FRFPoint:
     time_s: float
     fold: bool = False
     stable: bool = True
+    floquet_max_re: float = 0.0  #: largest real part of the Floquet exponents, 1/s
 
 
 @dataclass
@@ -65,6 +66,9 @@ class FRF:
     complete: bool = True
     message: str = ""
     stability_computed: bool = False
+    #: Fortran time split of the run: aft, assembly, factorization, solve, receptance (s),
+    #: evaluations, factorizations (counts), fortran_total (s)
+    timings: dict = field(default_factory=dict)
 
     @property
     def harmonics(self) -> int:

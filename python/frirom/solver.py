@@ -25,6 +25,14 @@ from .model import LAW_CODES, Excitation, Model
 from .results import FRF, FRFPoint, amplitude_max
 
 FORMULATIONS = {"condensed": 1, "banded": 2}
+#: Names of the Fortran timers/counters returned with each run (seconds, counts).
+TIMER_NAMES = ("aft", "assembly", "factorization", "solve", "receptance", "evaluations",
+               "factorizations", "fortran_total")
+
+
+def _add_timings(acc: dict, t) -> None:
+    for k, v in zip(TIMER_NAMES, t):
+        acc[k] = acc.get(k, 0.0) + float(v)
 
 
 @dataclass
@@ -33,11 +41,15 @@ class SolverOptions:
 
     harmonics: H (harmonics 0..H); samples: AFT time samples per period (>= 2H+1; default
     max(64, 8(2H+1))); formulation: 'condensed' or 'banded'; tol_residual: ||R|| relative to
-    the size of the terms of R; tol_update: ||dy|| relative to ||y||; ds, ds_min, ds_max:
+    the size of the terms of R; tol_update: ||dy|| relative to ||y||; tol_stall: after
+    max_iter, a residual stagnating below this is accepted (contact state changing inside
+    one time sample makes R non-differentiable; 0 disables); ds, ds_min, ds_max:
     arc-length steps in scaled variables (unknowns / |first point|, parameter / range);
     max_points: points per run; parameter: 'frequency' or 'load'; reuse_jacobian: keep a
-    factorisation while Newton contracts by at least reuse_rate per iteration; batch: points
-    per call into Fortran (sink granularity).
+    factorisation while Newton contracts by a factor 10 per iteration (a corrector that
+    fails with reuse is retried with a fresh Jacobian at every iteration); batch: points
+    per call into Fortran (sink granularity); stability: Hill's method at every point
+    (dense eigen-solve of size 2 n_dof (2H+1), up to 4000).
     """
 
     harmonics: int = 3
@@ -45,6 +57,7 @@ class SolverOptions:
     formulation: str = "condensed"
     tol_residual: float = 1e-8
     tol_update: float = 1e-8
+    tol_stall: float = 0.0
     max_iter: int = 25
     ds: float = 0.02
     ds_min: float = 1e-6
@@ -52,6 +65,7 @@ class SolverOptions:
     max_points: int = 2000
     parameter: str = "frequency"
     reuse_jacobian: bool = False
+    stability: bool = False
     batch: int = 10
 
     def check(self) -> None:
@@ -66,6 +80,8 @@ class SolverOptions:
                                  f"{sorted(FORMULATIONS)}, got {self.formulation!r}")
         if self.parameter not in ("frequency", "load"):
             raise ParameterError("options.parameter: expected 'frequency' or 'load'")
+        if not (np.isfinite(self.tol_stall) and self.tol_stall >= 0):
+            raise ParameterError("options.tol_stall: expected a number >= 0")
         for nm in ("tol_residual", "tol_update", "ds", "ds_min", "ds_max"):
             v = getattr(self, nm)
             if not (np.isfinite(v) and v > 0):
@@ -167,8 +183,8 @@ class _Packed:
             np.asfortranarray(self.fe0), np.asfortranarray(self.fe1), self.mode, omega_fix,
             self.ginfo, *self.G, self.params, self.w0, (self.outputs + 1).astype(np.int32),
             y0, lam0, tan0, start_mode, ds, o.ds_min, o.ds_max, lam_end, lam_lo,
-            o.tol_residual, o.tol_update, o.max_iter, int(o.reuse_jacobian), yscale, lscale,
-            maxpts, max(self.ne_tot, 1), nh=self.H, ndof=self.n_dof, nnl=self.nl.size or 1)
+            o.tol_residual, o.tol_update, o.tol_stall, o.max_iter, int(o.reuse_jacobian), yscale, lscale,
+            maxpts, max(self.ne_tot, 1), int(o.stability), nh=self.H, ndof=self.n_dof, nnl=self.nl.size or 1)
 
     def pad_start(self, y, H_from: int) -> np.ndarray:
         """Unknowns of a solution with H_from harmonics, extended or cut to this H."""
@@ -187,7 +203,8 @@ class _Packed:
         return out
 
     def points(self, res, omega_fix, t_call):
-        ys, lams, tans, iters, xo, states, npts, finished, ds_out, timings, info, msg = res
+        (ys, lams, tans, iters, xo, states, hill_re, npts, finished, ds_out, timings, info,
+         msg) = res
         pts = []
         for k in range(npts):
             st = np.zeros((len(self.group_sizes), 3))
@@ -200,7 +217,9 @@ class _Packed:
             pts.append(FRFPoint(omega=float(om), parameter=float(lams[k]),
                                 unknowns=ys[:, k].copy(), tangent=tans[:, k].copy(), X=X,
                                 amp_max=amplitude_max(X), state_fractions=st,
-                                iterations=int(iters[k]), time_s=t_call / max(npts, 1)))
+                                iterations=int(iters[k]), time_s=t_call / max(npts, 1),
+                                stable=bool(hill_re[k] <= 1e-9 * max(abs(om), 1.0)),
+                                floquet_max_re=float(hill_re[k])))
         return pts
 
 
@@ -209,6 +228,7 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
     o = packed.opts
     lscale = abs(lam_end - lam_start) or 1.0
     points, message, complete = [], "", True
+    timings: dict = {}
     t0 = time.perf_counter()
     if start is None:
         y0 = np.zeros(packed.ny)
@@ -234,7 +254,8 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
         # the converged point, one Newton iteration) computes the tangent in that scaling.
         res = packed.call(y0, lam0, tan0, 2, ds, lam_end, lam_lo, 1e-300, lscale, 1,
                           omega_fix)
-        info, msg = res[10], res[11]
+        info, msg = res[11], res[12]
+        _add_timings(timings, res[10])
         if info != 0 and packed.mode == 1 and start is None:
             # Newton from the linear solution failed (strong slip or lift-off): reach the
             # first point by continuation in the excitation level from the static state.
@@ -242,7 +263,7 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
             if y_h is not None:
                 res = packed.call(y_h, lam0, tan0, 2, ds, lam_end, lam_lo, 1e-300, lscale,
                                   1, omega_fix)
-                info, msg = res[10], res[11]
+                info, msg = res[11], res[12]
         raise_for_status(info, msg.decode(errors="replace"))
         p = packed.points(res, omega_fix, time.perf_counter() - t0)[0]
         t0 = time.perf_counter()
@@ -259,7 +280,8 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
                           maxpts, omega_fix)
         t_call = time.perf_counter() - t0
         t0 = time.perf_counter()
-        npts, finished, ds_out, info, msg = res[6], res[7], res[8], res[10], res[11]
+        npts, finished, ds_out, info, msg = res[7], res[8], res[9], res[11], res[12]
+        _add_timings(timings, res[10])
         new = packed.points(res, omega_fix, t_call)
         if skip_first and new:
             prev_t = new[0].tangent[-1]
@@ -285,6 +307,14 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
             break
         last = points[-1]
         y0, lam0, tan0, ds, mode = last.unknowns, last.parameter, last.tangent, ds_out, 1
+        # the arc length measures unknowns against the largest solution so far: near a
+        # resonance 100x above the first point, steps would otherwise crawl in frequency
+        ny0 = float(np.linalg.norm(y0))
+        if ny0 > 2.0 * yscale:
+            tan0 = tan0.copy()
+            tan0[:-1] *= yscale / ny0
+            tan0 /= np.linalg.norm(tan0)
+            yscale = ny0
         if finished:
             break
     else:
@@ -292,7 +322,9 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
         message = f"stopped after max_points = {o.max_points} points"
     name = "omega" if packed.mode == 1 else "load"
     out = FRF.from_points(points, packed.outputs, packed.group_names, parameter_name=name,
-                          complete=complete, message=message)
+                          complete=complete, message=message,
+                          stability_computed=bool(packed.opts.stability))
+    out.timings = timings
     if keep_unknowns and points:
         out._last_unknowns = points[-1].unknowns
     return out
@@ -382,15 +414,17 @@ def solve_point(model: Model, excitation: Excitation, omega: float,
     t0 = time.perf_counter()
     res = packed.call(y0, float(omega), np.zeros(packed.ny + 1), 2, options.ds,
                       float(omega) * 1.1, 0.0, 1e-300, float(omega), 1)
-    info, msg = res[10], res[11]
+    info, msg = res[11], res[12]
     if info != 0 and start is None:
         # Newton from the linear solution failed: continuation in the excitation level
         y_h = _homotopy_start(packed, float(omega))
         if y_h is not None:
             res = packed.call(y_h, float(omega), np.zeros(packed.ny + 1), 2, options.ds,
                               float(omega) * 1.1, 0.0, 1e-300, float(omega), 1)
-            info, msg = res[10], res[11]
+            info, msg = res[11], res[12]
     raise_for_status(info, msg.decode(errors="replace"))
     pt = packed.points(res, 0.0, time.perf_counter() - t0)[0]
     pt.output_dofs = packed.outputs
+    pt.timings = {}
+    _add_timings(pt.timings, res[10])
     return pt
