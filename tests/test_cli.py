@@ -49,6 +49,7 @@ def test_resume_continues_an_interrupted_run(deck, tmp_path):
     # the same deck with few points per call: each run stops early, --resume goes on
     short = deck.with_name("short.toml")
     short.write_text(deck.read_text().replace("max_points = 1000", "max_points = 60"))
+    assert len(ref) > 120
     part = tmp_path / "part"
     assert main(["run", str(short), "--out", str(part), "--quiet"]) == 0
     first = FRF.load(part / "frf.h5")

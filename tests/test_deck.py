@@ -39,7 +39,8 @@ def test_joint_deck_loads():
     assert d.outputs == [4, 0, 1] and d.output_names[0] == "tip:x"
     assert np.isclose(d.omega_start, 2 * np.pi * 400) and np.isclose(d.omega_end,
                                                                      2 * np.pi * 520)
-    assert d.continuation == {"step": 0.05, "max_step": 0.2, "max_points": 1000}
+    assert d.continuation == {"step": 0.02, "max_step": 0.04, "max_points": 1000}
+    assert d.solver["stability"] is True
 
 
 def test_normal1d_frame_and_solver_objects(deckdir):
@@ -55,7 +56,8 @@ def test_normal1d_frame_and_solver_objects(deckdir):
     model, exc, opts = d.model(), d.excitation(), d.options()
     assert model.n_dof == 5 and model.contacts[0].name == "damper"
     assert exc.F.shape == (5, 6)
-    assert opts.harmonics == 5 and opts.samples == 64 and opts.ds_max == 0.2
+    assert opts.harmonics == 5 and opts.samples == 64 and opts.ds_max == 0.04
+    assert opts.stability
 
 
 def test_node_to_node_element_and_engine_order(deckdir):
@@ -114,7 +116,10 @@ BAD = [
      "different"),
     ('dofs = ["tip:x", "platform:x", "platform:y"]', 'dofs = []', "outputs.dofs",
      "non-empty"),
-    ('max_step = 0.2', 'max_step = 0.2\nmin_step = 0.5', "continuation.min_step", "max_step"),
+    ('max_step = 0.04', 'max_step = 0.04\nmin_step = 0.5', "continuation.min_step",
+     "max_step"),
+    ('formulation = "condensed"', 'formulation = "condensed"\nstability = 1',
+     "solver.stability", "true or false"),
     ('[solver]', '[solvers]', "solvers", "unknown key"),
 ]
 

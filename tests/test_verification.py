@@ -58,6 +58,16 @@ def peak_of(omega, amp):
     return vertex(omega[i - 1:i + 2], amp[i - 1:i + 2])
 
 
+def turns_of(omega, margin=0.02):
+    """Indices where the path turns back in frequency, away from the ends of the range
+    (the last point is clamped onto the range end, which can look like a turn)."""
+    lo, hi = omega.min(), omega.max()
+    dw = np.diff(omega)
+    t = np.flatnonzero(np.sign(dw[1:]) != np.sign(dw[:-1])) + 1
+    inside = (omega[t] > lo + margin * (hi - lo)) & (omega[t] < hi - margin * (hi - lo))
+    return t[inside]
+
+
 def linear_frf(M, C, K, F, omegas):
     """Closed-form first-harmonic response (n_pts, n) of the linear system."""
     return np.array([np.linalg.solve(K - w * w * M + 1j * w * C, F) for w in omegas])
@@ -117,13 +127,14 @@ def duffing_folds():
 
 @pytest.fixture(scope="module")
 def duffing_h1():
-    opts = SolverOptions(harmonics=1, samples=16, ds=0.05, ds_max=0.1, max_points=3000)
+    opts = SolverOptions(harmonics=1, samples=16, ds=0.02, ds_max=0.02, max_points=3000)
     return frf(duffing_model(), duffing_excitation(), 0.6, 1.6, opts)
 
 
 @pytest.fixture(scope="module")
 def duffing_h5():
-    opts = SolverOptions(harmonics=5, samples=32, ds=0.05, ds_max=0.1, max_points=3000)
+    opts = SolverOptions(harmonics=5, samples=32, ds=0.02, ds_max=0.02, max_points=3000,
+                         stability=True)
     return frf(duffing_model(), duffing_excitation(), 0.6, 1.6, opts)
 
 
@@ -146,8 +157,7 @@ def test_duffing_h1_turning_points(duffing_h1):
     (w_lo, A_lo), (w_hi, A_hi) = duffing_folds()
     A = np.abs(first_harmonic(r.X[:, 0]))
     w = r.omega
-    dw = np.diff(w)
-    turns = np.flatnonzero(np.sign(dw[1:]) != np.sign(dw[:-1])) + 1
+    turns = turns_of(w)
     assert turns.size == 2, turns
     found = sorted(vertex(A[i - 1:i + 2], w[i - 1:i + 2])[::-1] for i in turns)
     for (wf, Af), (we, Ae) in zip(found, [(w_lo, A_lo), (w_hi, A_hi)]):
@@ -173,8 +183,7 @@ def test_duffing_h5_against_time_integration(duffing_h5):
     assert r.complete, r.message
     # stable points spread over the lower and upper branches (not the middle one)
     w = r.omega
-    dw = np.diff(w)
-    turns = np.flatnonzero(np.sign(dw[1:]) != np.sign(dw[:-1])) + 1
+    turns = turns_of(w)
     assert turns.size == 2
     i_hi, i_lo = sorted(turns)      # path goes up the upper branch first, then back
     picks = np.unique(np.r_[np.linspace(0, i_hi - 3, 5).astype(int),
@@ -195,8 +204,7 @@ def test_duffing_h5_fold_brackets_time_integration(duffing_h5):
     """Just below the HBM jump-down fold the upper branch exists (time integration started
     on it stays); just above it does not (it falls to the lower branch)."""
     r = duffing_h5
-    dw = np.diff(r.omega)
-    i = int(np.flatnonzero(np.sign(dw[1:]) != np.sign(dw[:-1]))[0] + 1)
+    i = int(turns_of(r.omega)[0])
     w_fold = r.omega[i]
     X = r.X[i, 0]
     delta = 3e-3
@@ -212,9 +220,7 @@ def test_hill_stability_against_time_integration(duffing_h5):
     r = duffing_h5
     if not r.stability_computed:
         pytest.skip("the solver did not compute Hill stability (FRF.stability_computed)")
-    dw = np.diff(r.omega)
-    turns = np.flatnonzero(np.sign(dw[1:]) != np.sign(dw[:-1])) + 1
-    i_hi, i_lo = sorted(turns)
+    i_hi, i_lo = sorted(turns_of(r.omega))
     # the middle branch lies between the two turns and must be flagged unstable, the rest
     # stable (away from the turning points themselves)
     assert not r.stable[i_hi + 2:i_lo - 1].any()

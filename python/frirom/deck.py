@@ -212,7 +212,7 @@ class Deck:
         kw = {"harmonics": self.harmonics, "samples": self.samples,
               "formulation": self.formulation}
         for key, name in (("tol_residual", "tol_residual"), ("tol_update", "tol_update"),
-                          ("max_iterations", "max_iter")):
+                          ("max_iterations", "max_iter"), ("stability", "stability")):
             if key in self.solver:
                 kw[name] = self.solver[key]
         for key, name in (("step", "ds"), ("min_step", "ds_min"), ("max_step", "ds_max")):
@@ -312,7 +312,7 @@ class _Parser:
         # ---- solver ----
         sol = _table(ctx, raw, "solver")
         _unknown(ctx, sol, {"harmonics", "samples", "formulation", "tol_residual",
-                            "tol_update", "max_iterations"}, "solver")
+                            "tol_update", "max_iterations", "stability"}, "solver")
         H = _num(ctx, sol, "harmonics", "solver.harmonics", required=True, integer=True,
                  minimum=1)
         N = _num(ctx, sol, "samples", "solver.samples", integer=True)
@@ -328,6 +328,7 @@ class _Parser:
         v = _num(ctx, sol, "max_iterations", "solver.max_iterations", integer=True, minimum=1)
         if v is not None:
             solver["max_iterations"] = v
+        solver["stability"] = _bool(ctx, sol, "stability", "solver.stability", True)
 
         # ---- damping ----
         damp = _table(ctx, raw, "damping")
