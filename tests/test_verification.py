@@ -7,8 +7,9 @@ Tolerances and why:
 * Duffing, H = 1: the HBM residual with N >= 4H+1 samples is exact for a cubic, so every
   point must satisfy the amplitude equation to the Newton tolerance (1e-7 relative).
   Turning points: the vertex of a parabola omega(A) through the three points around each
-  omega extremum of the path is within 1e-4 of the closed-form fold (vertex error is third
-  order in the point spacing, ~1e-3 in A here).
+  omega extremum of the path is within 1e-4 of the closed-form fold frequency (vertex
+  error third order in the point spacing, ~1e-3 in A here; reached 3e-6) and 3e-3 in A
+  (omega(A) is flat at a fold, so A is the ill-conditioned coordinate; reached 6e-4).
 * Time integration: central differences with N = 512 steps per period err by
   (2 pi/N)^2/24 = 6e-6 in frequency and, measured on the Jenkins oscillator, 1.2e-4 in
   amplitude (N = 256 ... 4096 study); steady state is declared at a period-to-period
@@ -17,9 +18,15 @@ Tolerances and why:
   1 % and resonance frequency within 0.2 %. The HBM truncation error (harmonics above 5
   dropped; stick-slip and lift-off kinks make them decay like 1/h^2 to 1/h^3) dominates;
   the peak is located on both sides by a parabola through the three highest points of a
-  0.05 %-spaced grid, whose vertex error is far below 0.2 %.
+  0.05 %-spaced grid, whose vertex error is far below 0.2 %. Reached: Jenkins 0.61 % and
+  0.11 % (H = 25 brings it to 0.01 %: truncation), 1-D contact with lift-off 0.10 % and
+  0.013 %.
 * Duffing, H = 5 against time integration: harmonics of a cubic decay geometrically
-  (x3/x1 ~ 3 %), so truncation at H = 5 leaves ~1e-5: amplitude within 0.2 %.
+  (x3/x1 ~ 3 %), so truncation at H = 5 leaves ~1e-5: amplitude within 0.2 % (reached
+  3.4e-4, the time integration's own error).
+* Hill stability: started 1 % off a point flagged unstable (middle branch of the Duffing
+  fold) the motion leaves for the two stable branches; started 1 % off the stable point at
+  the same frequency it returns to within 0.2 % (the HBM-vs-time-integration accuracy).
 * Limits (mu = 0, huge preload and mu): the contact force is exactly zero or exactly the
   stuck spring, so the FRF equals the closed-form linear one to the Newton tolerance
   (1e-7 relative to the peak).
@@ -162,7 +169,7 @@ def test_duffing_h1_turning_points(duffing_h1):
     found = sorted(vertex(A[i - 1:i + 2], w[i - 1:i + 2])[::-1] for i in turns)
     for (wf, Af), (we, Ae) in zip(found, [(w_lo, A_lo), (w_hi, A_hi)]):
         assert abs(wf / we - 1) < 1e-4, (wf, we)
-        assert abs(Af / Ae - 1) < 1e-3, (Af, Ae)   # A is flat at the turn: looser
+        assert abs(Af / Ae - 1) < 3e-3, (Af, Ae)   # omega(A) is flat there: A is looser
     # the solver flags a fold within one point of each turn
     flagged = np.flatnonzero(r.fold)
     assert flagged.size == 2, flagged
