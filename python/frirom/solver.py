@@ -320,6 +320,10 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
     else:
         complete = False
         message = f"stopped after max_points = {o.max_points} points"
+    if complete and points and points[-1].parameter != lam_end:
+        complete = False
+        message = (f"the solution curve turned back and left the range through "
+                   f"{points[-1].parameter:.6g} (start {lam_start:.6g})")
     name = "omega" if packed.mode == 1 else "load"
     out = FRF.from_points(points, packed.outputs, packed.group_names, parameter_name=name,
                           complete=complete, message=message,
