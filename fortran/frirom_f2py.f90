@@ -185,15 +185,7 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     if (linfo == 0 .and. (sys%n /= ny .or. sum(ginfo(2, :)) /= netot)) &
         call set_status(linfo, FRIROM_ERR_SIZE, msg, 'hbm_continue: ny or netot does not '// &
                         'match the model')
-    if (linfo == 0 .and. nmodes > 0) then
-        select type (sys)
-        type is (hbm_condensed)
-            call hbm_set_modes(sys, phi, wmodes, zmodes, linfo, msg)
-        class default
-            call set_status(linfo, FRIROM_ERR_PARAM, msg, 'modal superposition needs the '// &
-                            'condensed formulation')
-        end select
-    end if
+    if (linfo == 0 .and. nmodes > 0) call hbm_set_modes(sys, phi, wmodes, zmodes, linfo, msg)
     if (linfo /= 0) then
         info = linfo
         return

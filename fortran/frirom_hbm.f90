@@ -563,39 +563,45 @@ contains
     !> Use modal superposition for the receptances of a condensed system:
     !> H_h = Phi diag(1 / (w_r^2 - (h w)^2 + 2 i zeta_r w_r h w)) Phi^T over the given
     !> mass-normalised modes (truncated set: no residual flexibility).
-    subroutine hbm_set_modes(sys, phi, wm, zm, info, errmsg)
-        type(hbm_condensed), intent(inout) :: sys
+    subroutine hbm_set_modes(sysc, phi, wm, zm, info, errmsg)
+        class(hbm_system), intent(inout), target :: sysc  !! must be an hbm_condensed
         real(wp), intent(in) :: phi(:, :)   !! (ndof, nm)
         real(wp), intent(in) :: wm(:), zm(:) !! (nm) natural frequencies rad/s, ratios
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
         integer(ip) :: nm, h, r
         info = FRIROM_OK
-        nm = size(phi, 2)
-        if (size(phi, 1) /= sys%ndof .or. size(wm) /= nm .or. size(zm) /= nm .or. nm < 1) then
-            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'modes: phi (ndof, nm), omega and '// &
-                            'zeta (nm)')
-            return
-        end if
-        if (any(wm <= 0.0_wp) .or. any(zm < 0.0_wp) .or. .not. all(abs(phi) <= huge(1.0_wp))) &
-            then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'modes: need omega > 0, zeta >= 0 '// &
-                            'and finite shapes')
-            return
-        end if
-        sys%modal = .true.
-        sys%phi = phi
-        sys%wm = wm
-        sys%zm = zm
-        allocate (sys%dg(nm, 0:sys%nh), sys%qf(nm, 0:sys%nh))
-        do h = 0, sys%nh
-            do r = 1, nm
-                sys%qf(r, h) = sum(phi(:, r)*sys%fe0(:, 1))
-                if (h > 0) sys%qf(r, h) = cmplx(sum(phi(:, r)*sys%fe0(:, 2*h)), &
-                                                -sum(phi(:, r)*sys%fe0(:, 2*h + 1)), wp)
+        select type (sys => sysc)
+        type is (hbm_condensed)
+            nm = size(phi, 2)
+            if (size(phi, 1) /= sys%ndof .or. size(wm) /= nm .or. size(zm) /= nm .or. nm < 1) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'modes: phi (ndof, nm), omega and '// &
+                                'zeta (nm)')
+                return
+            end if
+            if (any(wm <= 0.0_wp) .or. any(zm < 0.0_wp) .or. .not. all(abs(phi) <= huge(1.0_wp))) &
+                then
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'modes: need omega > 0, zeta >= 0 '// &
+                                'and finite shapes')
+                return
+            end if
+            sys%modal = .true.
+            sys%phi = phi
+            sys%wm = wm
+            sys%zm = zm
+            allocate (sys%dg(nm, 0:sys%nh), sys%qf(nm, 0:sys%nh))
+            do h = 0, sys%nh
+                do r = 1, nm
+                    sys%qf(r, h) = sum(phi(:, r)*sys%fe0(:, 1))
+                    if (h > 0) sys%qf(r, h) = cmplx(sum(phi(:, r)*sys%fe0(:, 2*h)), &
+                                                    -sum(phi(:, r)*sys%fe0(:, 2*h + 1)), wp)
+                end do
             end do
-        end do
-        sys%w_cache = -1.0_wp
+            sys%w_cache = -1.0_wp
+        class default
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'modal superposition needs the '// &
+                            'condensed formulation')
+        end select
     end subroutine hbm_set_modes
 
     !> Receptance columns at w from the modes (see hbm_set_modes).
