@@ -110,13 +110,14 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
                         ci, cx, perm, nnl, nl, fe0, fe1, mode, omega_fix, ngroup, ginfo, nrows, &
                         nnzg, gp, gi, gx, npart, params, nw0, w0, nout, outdofs, ny, y0, lam0, &
                         tan0, start_mode, ds, ds_min, ds_max, lam_end, lam_lo, tol_r, tol_x, &
-                        tol_stall, max_iter, reuse, yscale, lscale, maxpts, netot, stability, ys, &
-                        lams, tans, iters, xo, states, hill_re, npts, finished, ds_out, timings, &
-                        info, msg)
+                        tol_stall, max_iter, reuse, yscale, lscale, maxpts, netot, stability, nmodes, &
+                        phi, wmodes, zmodes, ys, lams, tans, iters, xo, states, hill_re, npts, &
+                        finished, ds_out, timings, info, msg)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options
-    use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_run, N_TIMERS
+    use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
+                          hbm_run, N_TIMERS
     implicit none
     integer(4), intent(in) :: form, nh, nsamp, ndof, nnzk, nnzm, nnzc
     integer(4), intent(in) :: kp(ndof + 1), ki(nnzk), mp(ndof + 1), mi(nnzm), cp(ndof + 1), &
@@ -138,6 +139,9 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     real(8), intent(in) :: yscale, lscale
     integer(4), intent(in) :: maxpts, netot
     integer(4), intent(in) :: stability    !! 1: Hill stability of every point
+    integer(4), intent(in) :: nmodes       !! > 0: condensed receptances by modal superposition
+    real(8), intent(in) :: phi(ndof, max(nmodes, 1)), wmodes(max(nmodes, 1)), &
+                           zmodes(max(nmodes, 1))
     real(8), intent(out) :: ys(ny, maxpts), lams(maxpts), tans(ny + 1, maxpts)
     integer(4), intent(out) :: iters(maxpts)
     real(8), intent(out) :: xo(nout, 2*nh + 1, maxpts), states(3, netot, maxpts)
@@ -181,6 +185,7 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     if (linfo == 0 .and. (sys%n /= ny .or. sum(ginfo(2, :)) /= netot)) &
         call set_status(linfo, FRIROM_ERR_SIZE, msg, 'hbm_continue: ny or netot does not '// &
                         'match the model')
+    if (linfo == 0 .and. nmodes > 0) call hbm_set_modes(sys, phi, wmodes, zmodes, linfo, msg)
     if (linfo /= 0) then
         info = linfo
         return

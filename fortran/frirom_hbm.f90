@@ -27,7 +27,7 @@ module frirom_hbm
     implicit none
     private
     public :: csr_matrix, contact_group, contact_set, hbm_system, hbm_condensed, hbm_full, &
-              hbm_setup, hbm_run, hbm_hill, contact_eval, contact_assemble, HBM_FREQUENCY, HBM_LOAD, &
+              hbm_setup, hbm_set_modes, hbm_run, hbm_hill, contact_eval, contact_assemble, HBM_FREQUENCY, HBM_LOAD, &
               T_AFT, T_ASM, T_FACT, T_SOLVE, T_REC, N_EVAL, N_FACT, N_TIMERS
 
     integer(ip), parameter :: HBM_FREQUENCY = 1, HBM_LOAD = 2
@@ -104,6 +104,12 @@ module frirom_hbm
         real(wp), allocatable :: kc(:, :), jm(:, :)      !! (n, n) contact Jacobian, J
         integer(ip), allocatable :: ipiv(:)
         real(wp), allocatable :: xd(:, :), fd(:, :)      !! (nnl, nc)
+        !> modal superposition instead of factorising D_h (hbm_set_modes)
+        logical :: modal = .false.
+        real(wp), allocatable :: phi(:, :)               !! (ndof, nm) mass-normalised modes
+        real(wp), allocatable :: wm(:), zm(:)            !! (nm) rad/s, damping ratios
+        complex(wp), allocatable :: dg(:, :)             !! (nm, 0:nh) d g_r / d w
+        complex(wp), allocatable :: qf(:, :)             !! (nm, 0:nh) Phi^T fe0_h
     contains
         procedure :: eval => cond_eval
         procedure :: solve => cond_solve
@@ -552,8 +558,85 @@ contains
             call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: receptances/Jacobian')
             return
         end if
-        call zband_init(sys%d, sys%ndof, sys%bw, sys%bw, info, errmsg)
     end subroutine cond_init
+
+    !> Use modal superposition for the receptances of a condensed system:
+    !> H_h = Phi diag(1 / (w_r^2 - (h w)^2 + 2 i zeta_r w_r h w)) Phi^T over the given
+    !> mass-normalised modes (truncated set: no residual flexibility).
+    subroutine hbm_set_modes(sysc, phi, wm, zm, info, errmsg)
+        class(hbm_system), intent(inout), target :: sysc  !! must be an hbm_condensed
+        real(wp), intent(in) :: phi(:, :)   !! (ndof, nm)
+        real(wp), intent(in) :: wm(:), zm(:) !! (nm) natural frequencies rad/s, ratios
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        integer(ip) :: nm, h, r
+        info = FRIROM_OK
+        select type (sys => sysc)
+        type is (hbm_condensed)
+            nm = size(phi, 2)
+            if (size(phi, 1) /= sys%ndof .or. size(wm) /= nm .or. size(zm) /= nm .or. nm < 1) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'modes: phi (ndof, nm), omega and '// &
+                                'zeta (nm)')
+                return
+            end if
+            if (any(wm <= 0.0_wp) .or. any(zm < 0.0_wp) .or. .not. all(abs(phi) <= huge(1.0_wp))) &
+                then
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'modes: need omega > 0, zeta >= 0 '// &
+                                'and finite shapes')
+                return
+            end if
+            sys%modal = .true.
+            sys%phi = phi
+            sys%wm = wm
+            sys%zm = zm
+            allocate (sys%dg(nm, 0:sys%nh), sys%qf(nm, 0:sys%nh))
+            do h = 0, sys%nh
+                do r = 1, nm
+                    sys%qf(r, h) = sum(phi(:, r)*sys%fe0(:, 1))
+                    if (h > 0) sys%qf(r, h) = cmplx(sum(phi(:, r)*sys%fe0(:, 2*h)), &
+                                                    -sum(phi(:, r)*sys%fe0(:, 2*h + 1)), wp)
+                end do
+            end do
+            sys%w_cache = -1.0_wp
+        class default
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'modal superposition needs the '// &
+                            'condensed formulation')
+        end select
+    end subroutine hbm_set_modes
+
+    !> Receptance columns at w from the modes (see hbm_set_modes).
+    subroutine cond_receptance_modal(sys, w)
+        type(hbm_condensed), intent(inout) :: sys
+        real(wp), intent(in) :: w
+        integer(ip) :: h, j, nm
+        real(wp) :: hw, t0
+        complex(wp), allocatable :: g(:), tmp(:, :), q(:)
+        t0 = wtime()
+        nm = size(sys%wm)
+        allocate (g(nm), tmp(nm, sys%nnl), q(nm))
+        do h = 0, sys%nh
+            hw = h*w
+            g = 1.0_wp/cmplx(sys%wm**2 - hw**2, 2.0_wp*sys%zm*sys%wm*hw, wp)
+            sys%dg(:, h) = -g**2*cmplx(-2.0_wp*h*hw, 2.0_wp*sys%zm*sys%wm*h, wp)
+            do j = 1, sys%nnl
+                tmp(:, j) = g*sys%phi(sys%nl(j), :)
+            end do
+            sys%ymat(:, :, h) = matmul(sys%phi, tmp)
+            sys%ye0(:, h) = matmul(sys%phi, g*sys%qf(:, h))
+            do j = 1, nm
+                q(j) = sum(sys%phi(:, j)*sys%fe1(:, 1))
+                if (h > 0) q(j) = cmplx(sum(sys%phi(:, j)*sys%fe1(:, 2*h)), &
+                                        -sum(sys%phi(:, j)*sys%fe1(:, 2*h + 1)), wp)
+            end do
+            sys%ye1(:, h) = matmul(sys%phi, g*q)
+            do j = 1, sys%nnl
+                sys%ar(j, :, h) = real(sys%ymat(sys%nl(j), :, h), wp)
+                sys%ai(j, :, h) = aimag(sys%ymat(sys%nl(j), :, h))
+            end do
+        end do
+        sys%w_cache = w
+        sys%timers(T_REC) = sys%timers(T_REC) + wtime() - t0
+    end subroutine cond_receptance_modal
 
     !> Receptance columns D_h^-1 P^T and D_h^-1 fe at frequency w, h = 0..H.
     subroutine cond_receptance(sys, w, info, errmsg)
@@ -565,6 +648,15 @@ contains
         complex(wp), allocatable :: rhs(:, :)
         real(wp) :: hw, t0
         logical :: ok
+        info = FRIROM_OK
+        if (sys%modal) then
+            call cond_receptance_modal(sys, w)
+            return
+        end if
+        if (.not. allocated(sys%d%ab)) then
+            call zband_init(sys%d, sys%ndof, sys%bw, sys%bw, info, errmsg)
+            if (info /= 0) return
+        end if
         t0 = wtime()
         ndof = sys%ndof
         nnl = sys%nnl
@@ -684,6 +776,19 @@ contains
                     rh = rh + cmplx(this%xd(:, 1), 0.0_wp, wp)
                     r(1:nnl) = real(rh, wp)
                     rlam(1:nnl) = 0.0_wp
+                    cycle
+                end if
+                if (this%modal) then
+                    ! R = X - Phi_n diag(g) (Phi^T fe - Phi_n^T fc): dR/dw = -Phi_n dg q
+                    xe = -matmul(this%phi(this%nl, :), this%dg(:, h)*(this%qf(:, h) - &
+                                 matmul(transpose(this%phi(this%nl, :)), fc)))
+                    ca = 2*h
+                    cb = 2*h + 1
+                    rh = rh + cmplx(this%xd(:, ca), -this%xd(:, cb), wp)
+                    r(nnl*(ca - 1) + 1:nnl*ca) = real(rh, wp)
+                    r(nnl*(cb - 1) + 1:nnl*cb) = -aimag(rh)
+                    rlam(nnl*(ca - 1) + 1:nnl*ca) = real(xe, wp)
+                    rlam(nnl*(cb - 1) + 1:nnl*cb) = -aimag(xe)
                     cycle
                 end if
                 ! z = D^-1 (fe - P^T fc); dR/dw = Y^T D'(w) z, D' = i h C - 2 h^2 w M

@@ -298,6 +298,14 @@ contains
                 call newton_correct(sys, y1, lam1, yp, lp, cy, cl, fresh_opts, iters, info, &
                                     errmsg, have_fact)
             end if
+            if (info == 0 .and. .not. last) then
+                ! a corrector that wandered far from the predictor found another branch
+                if (sqrt(sum(((y1 - y)/opts%yscale)**2) + ((lam1 - lam)/opts%lscale)**2) > &
+                    3.0_wp*ds) then
+                    call set_status(info, FRIROM_ERR_NOCONV, errmsg, 'corrector converged '// &
+                                    'more than 3 steps away from the predictor')
+                end if
+            end if
             if (info /= 0) then
                 why = errmsg
                 have_fact = .false.

@@ -5,12 +5,14 @@
 program test_hbm
     use frirom_kinds, only: wp, ip
     use frirom_newton, only: cont_options, newton_correct
-    use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup
+    use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes
     implicit none
     integer(ip), parameter :: ndof = 4, nh = 3, nc = 2*nh + 1
     type(hbm_condensed) :: sc, scl
     type(hbm_full) :: sf, sfl, sbad, sfn
-    type(hbm_condensed) :: scn
+    type(hbm_condensed) :: scn, scm
+    real(wp) :: kd(ndof, ndof), md(ndof, ndof), wev(ndof), work(64)
+    integer(ip) :: k
     integer(ip) :: kp(ndof + 1), ki(10), mp(ndof + 1), mi(ndof), cp(ndof + 1), ci(10)
     real(wp) :: kx(10), mx(ndof), cx(10), fe0(ndof, nc), fe1(ndof, nc)
     integer(ip) :: perm(ndof), nl(3), ginfo(3, 1), gp(3), gi(3), outd(ndof)
@@ -75,6 +77,22 @@ program test_hbm
                    fe1, 1, 0.0_wp, reshape([2, 1, 2], [3, 1]), [1, 2, 3], [3, 4], &
                    [1.0_wp, 1.0_wp], [0.5_wp, 1.0_wp, 0.3_wp, 0.2_wp], [0.0_wp], outd, info, msg)
     call fd_check(sfn, 'full normal1d')
+    ! modal superposition receptances (all 4 modes, ratios 2 %): Jacobian and dR/dw
+    kd = 0.0_wp
+    md = 0.0_wp
+    do i = 1, ndof
+        md(i, i) = mx(i)
+        do k = kp(i), kp(i + 1) - 1
+            kd(i, ki(k)) = kx(k)
+        end do
+    end do
+    call dsygv(1, 'V', 'U', ndof, kd, ndof, md, ndof, wev, work, 64, info)
+    call check(info == 0, 'dsygv')
+    call hbm_setup(scm, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
+                   fe1, 1, 0.0_wp, ginfo, gp, gi, gx, params, w0, outd, info, msg)
+    call hbm_set_modes(scm, kd, sqrt(wev), [(0.02_wp, i = 1, ndof)], info, msg)
+    call check(info == 0, 'set modes: '//trim(msg))
+    call fd_check(scm, 'condensed modal')
     ! bad input is reported, not crashed on
     perm = [1, 1, 2, 3]
     call hbm_setup(sbad, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &

@@ -231,3 +231,42 @@ def test_hill_stability_duffing_middle_branch(form):
     r = frf(model, ex, 100.0, 155.0, SolverOptions(harmonics=3, samples=100, formulation=form,
                                                    stability=True), outputs=[0])
     assert r.complete and r.stable.all()
+
+
+@pytest.mark.parametrize("form", ["condensed", "banded"])
+def test_load_continuation_ends_on_the_frequency_solution(form):
+    """Continuation in the excitation level at fixed omega from 0 to 1 ends on the same
+    solution as the direct solve at that omega (on the resonant branch below the fold,
+    where the solution is unique); the static preload is kept fixed."""
+    from frirom.solver import load_curve
+    model, ex = friction_model()
+    o = SolverOptions(harmonics=3, samples=100, formulation=form, tol_residual=1e-11,
+                      tol_update=1e-11)
+    r = load_curve(model, ex, 130.0, 0.0, 1.0, o, outputs=[0, 5])
+    assert r.complete and r.parameter[-1] == 1.0 and r.parameter_name == "load"
+    assert np.all(r.omega == 130.0)
+    p = solve_point(model, ex, 130.0, o, outputs=[0, 5])
+    np.testing.assert_allclose(r.X[-1], p.X, rtol=0, atol=1e-8 * np.abs(p.X).max())
+    # at zero dynamic load the response is static only
+    assert np.abs(r.X[0][:, 1:]).max() <= 1e-12 * np.abs(p.X).max()
+
+
+def test_modal_superposition_with_all_modes_matches_banded():
+    """Condensed receptances from all modes with modal damping ratios are the exact
+    inverse of K + i h w C - (h w)^2 M when C is built from the same ratios: the answer
+    equals the banded formulation's (1e-8), along an FRF end point and a single point."""
+    model, ex = friction_model()
+    n = model.n_dof
+    model = Model(model.M, model.K, Damping.modal(np.linspace(0.01, 0.03, n)),
+                  model.contacts)
+    kw = dict(harmonics=3, samples=100, tol_residual=1e-11, tol_update=1e-11)
+    pb = solve_point(model, ex, 120.0, SolverOptions(formulation="banded", **kw))
+    pm = solve_point(model, ex, 120.0, SolverOptions(formulation="condensed", modes=n, **kw))
+    np.testing.assert_allclose(pm.X, pb.X, rtol=0, atol=1e-8 * np.abs(pb.X).max())
+    r = frf(model, ex, 100.0, 130.0, SolverOptions(formulation="condensed", modes=n, **kw),
+            outputs=np.arange(n))
+    assert r.complete
+    pe = solve_point(model, ex, 130.0, SolverOptions(formulation="banded", **kw))
+    np.testing.assert_allclose(r.X[-1], pe.X, rtol=0, atol=1e-8 * np.abs(pe.X).max())
+    with pytest.raises(frirom.ParameterError, match="modes"):
+        SolverOptions(formulation="banded", modes=3).check()

@@ -49,7 +49,10 @@ class SolverOptions:
     factorisation while Newton contracts by a factor 10 per iteration (a corrector that
     fails with reuse is retried with a fresh Jacobian at every iteration); batch: points
     per call into Fortran (sink granularity); stability: Hill's method at every point
-    (dense eigen-solve of size 2 n_dof (2H+1), up to 4000).
+    (dense eigen-solve of size 2 n_dof (2H+1), up to 4000); modes: condensed formulation
+    only, receptances by superposition of this many lowest modes (mass-normalised, damping
+    ratios from Damping.modal or the diagonal of Phi^T C Phi) instead of factorising the
+    dynamic stiffness at every frequency (truncation: no residual flexibility).
     """
 
     harmonics: int = 3
@@ -66,6 +69,7 @@ class SolverOptions:
     parameter: str = "frequency"
     reuse_jacobian: bool = False
     stability: bool = False
+    modes: int | None = None
     batch: int = 10
 
     def check(self) -> None:
@@ -88,6 +92,9 @@ class SolverOptions:
                 raise ParameterError(f"options.{nm}: expected a positive number, got {v}")
         if self.ds_min > self.ds_max:
             raise ParameterError("options.ds_min must not exceed options.ds_max")
+        if self.modes is not None and (self.modes < 1 or self.formulation != "condensed"):
+            raise ParameterError("options.modes: a positive number of modes, with "
+                                 "formulation 'condensed'")
         if self.max_iter < 1 or self.max_points < 1 or self.batch < 1:
             raise ParameterError("options.max_iter, max_points and batch must be >= 1")
 
@@ -104,6 +111,31 @@ def _csr(a: sp.csr_matrix):
     if idx.size == 0:     # f2py needs at least one entry
         idx, x = np.ones(1, np.int32), np.zeros(1)
     return a.indptr.astype(np.int32) + 1, idx, x
+
+
+def _modes(model: Model, nm: int):
+    """Lowest nm mass-normalised modes, natural frequencies (rad/s) and damping ratios."""
+    import scipy.linalg as sla
+    n = model.n_dof
+    if nm > n:
+        raise ParameterError(f"options.modes: {nm} modes for a model with {n} DoFs")
+    if n <= 3000 or nm > n // 2:
+        w2, phi = sla.eigh(model.K.toarray(), model.M.toarray(), subset_by_index=[0, nm - 1])
+    else:
+        from scipy.sparse.linalg import eigsh
+        w2, phi = eigsh(model.K.tocsc(), k=nm, M=model.M.tocsc(), sigma=0.0, which="LM")
+        order = np.argsort(w2)
+        w2, phi = w2[order], phi[:, order]
+        phi = phi / np.sqrt(np.einsum("ir,ir->r", phi, model.M @ phi))
+    if np.any(w2 <= 0):
+        raise ParameterError("options.modes: the model has rigid-body (zero-frequency) modes; "
+                             "modal superposition needs a constrained model")
+    w = np.sqrt(w2)
+    if model.damping.kind == "modal" and model.damping.zeta.size >= nm:
+        z = model.damping.zeta[:nm].copy()
+    else:
+        z = np.einsum("ir,ir->r", phi, model.C @ phi) / (2.0 * w)
+    return np.asfortranarray(phi), w, z
 
 
 class _Packed:
@@ -173,6 +205,11 @@ class _Packed:
         if np.any(self.outputs < 0) or np.any(self.outputs >= n):
             raise SizeError(f"outputs: DoF indices must be in 0..{n - 1}")
         self.ny = (self.nl.size if self.form == 1 else n) * self.nc
+        self.nmodes = 0
+        self.phi, self.wmodes, self.zmodes = np.zeros((n, 1)), np.ones(1), np.zeros(1)
+        if opts.modes:
+            self.phi, self.wmodes, self.zmodes = _modes(model, int(opts.modes))
+            self.nmodes = self.wmodes.size
 
     def call(self, y0, lam0, tan0, start_mode, ds, lam_end, lam_lo, yscale, lscale, maxpts,
              omega_fix=0.0):
@@ -184,7 +221,8 @@ class _Packed:
             self.ginfo, *self.G, self.params, self.w0, (self.outputs + 1).astype(np.int32),
             y0, lam0, tan0, start_mode, ds, o.ds_min, o.ds_max, lam_end, lam_lo,
             o.tol_residual, o.tol_update, o.tol_stall, o.max_iter, int(o.reuse_jacobian), yscale, lscale,
-            maxpts, max(self.ne_tot, 1), int(o.stability), nh=self.H, ndof=self.n_dof, nnl=self.nl.size or 1)
+            maxpts, max(self.ne_tot, 1), int(o.stability), self.nmodes,
+            np.asfortranarray(self.phi), self.wmodes, self.zmodes, nh=self.H, ndof=self.n_dof, nnl=self.nl.size or 1)
 
     def pad_start(self, y, H_from: int) -> np.ndarray:
         """Unknowns of a solution with H_from harmonics, extended or cut to this H."""
@@ -320,6 +358,10 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
     else:
         complete = False
         message = f"stopped after max_points = {o.max_points} points"
+    if complete and points and points[-1].parameter != lam_end:
+        complete = False
+        message = (f"the solution curve turned back and left the range through "
+                   f"{points[-1].parameter:.6g} (start {lam_start:.6g})")
     name = "omega" if packed.mode == 1 else "load"
     out = FRF.from_points(points, packed.outputs, packed.group_names, parameter_name=name,
                           complete=complete, message=message,
