@@ -1,6 +1,7 @@
 """frirom: nonlinear forced response of frictionally damped structures.
 
     frirom run DECK [--out DIR] [--resume]    forced response of a deck (docs/deck.md)
+    frirom demo [--out DIR]                   contact hysteresis loops and harmonics
 """
 
 from __future__ import annotations
@@ -30,12 +31,27 @@ def _add_run(sub) -> None:
     p.set_defaults(func=cmd_run)
 
 
+def _add_demo(sub) -> None:
+    demo = sub.add_parser("demo", help="hysteresis loops and harmonic content of contact "
+                                       "elements, plotted to PNG")
+    demo.add_argument("--out", type=Path, default=Path("results/demo"),
+                      help="output folder (default: results/demo)")
+    demo.set_defaults(func=_demo)
+
+
+def _demo(args) -> int:
+    from . import demo
+    demo.run(args.out)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="frirom", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"frirom {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     _add_run(sub)
+    _add_demo(sub)
     return parser
 
 
