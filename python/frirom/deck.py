@@ -14,7 +14,6 @@ DoFs are referred to by 0-based index into the matrices, or by label when the de
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -23,6 +22,14 @@ import scipy.io
 import scipy.sparse as sp
 
 from ._errors import InputError
+
+try:                                   # Python >= 3.11
+    import tomllib
+except ModuleNotFoundError:            # pragma: no cover - Python 3.10 with tomli
+    try:
+        import tomli as tomllib
+    except ModuleNotFoundError:
+        tomllib = None
 
 __all__ = ["Deck", "ContactSpec", "load_deck", "engine_order_loads", "read_matrix",
            "LAW_PARAMS", "MATRIX_FORMATS"]
@@ -269,6 +276,9 @@ class _Parser:
 
     def run(self) -> Deck:
         ctx = self.ctx
+        if tomllib is None:
+            raise InputError(f"{self.path}: reading a deck needs Python >= 3.11 (tomllib) "
+                             "or the 'tomli' package")
         try:
             with open(self.path, "rb") as fh:
                 raw = tomllib.load(fh)
