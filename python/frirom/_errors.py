@@ -53,6 +53,8 @@ _BY_CODE = {cls.code: cls for cls in (SizeError, ParameterError, NonFiniteError,
                                       SamplesError, ConvergenceError, SingularMatrixError)}
 _BY_CODE[11] = ParameterError      # unknown contact law
 _BY_CODE[12] = ConvergenceError    # hysteresis cycle did not close
+_BY_CODE[20] = ConvergenceError    # continuation stopped at the minimum step
+_BY_CODE[21] = ParameterError      # inconsistent model data (solver)
 
 
 def raise_for_status(info: int, message: str) -> None:
