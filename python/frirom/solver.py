@@ -220,9 +220,10 @@ class _Packed:
             np.asfortranarray(self.fe0), np.asfortranarray(self.fe1), self.mode, omega_fix,
             self.ginfo, *self.G, self.params, self.w0, (self.outputs + 1).astype(np.int32),
             y0, lam0, tan0, start_mode, ds, o.ds_min, o.ds_max, lam_end, lam_lo,
-            o.tol_residual, o.tol_update, o.tol_stall, o.max_iter, int(o.reuse_jacobian), yscale, lscale,
-            maxpts, max(self.ne_tot, 1), int(o.stability), self.nmodes,
-            np.asfortranarray(self.phi), self.wmodes, self.zmodes, nh=self.H, ndof=self.n_dof, nnl=self.nl.size or 1)
+            o.tol_residual, o.tol_update, o.tol_stall, o.max_iter, int(o.reuse_jacobian),
+            yscale, lscale, maxpts, max(self.ne_tot, 1), int(o.stability), self.nmodes,
+            np.asfortranarray(self.phi), self.wmodes, self.zmodes, nh=self.H,
+            ndof=self.n_dof, nnl=self.nl.size or 1)
 
     def pad_start(self, y, H_from: int) -> np.ndarray:
         """Unknowns of a solution with H_from harmonics, extended or cut to this H."""
