@@ -136,7 +136,10 @@ def test_results_files_and_resume(tmp_path):
     model, ex = duffing()
     o = SolverOptions(harmonics=3, samples=32, formulation="condensed",
                       tol_residual=1e-12, tol_update=1e-12)
-    full = frf(model, ex, 0.5, 2.0, o, outputs=[0])
+    got = []
+    full = frf(model, ex, 0.5, 2.0, o, outputs=[0], sink=got.append)
+    assert [p.omega for p in got] == list(full.omega)   # every point, in order, once
+    assert all(p.yscale > 0 for p in got)
     full.save_h5(tmp_path / "a.h5")
     full.save_csv(tmp_path / "a.csv")
     back = FRF.load(tmp_path / "a.h5")

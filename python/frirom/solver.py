@@ -274,6 +274,9 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
         tan0 = np.zeros(packed.ny + 1)
         mode, lam0 = 0, float(lam_start)
     else:
+        if isinstance(start, FRFPoint):
+            start = {"parameter": start.parameter, "unknowns": start.unknowns,
+                     "tangent": start.tangent, "yscale": start.yscale}
         y0 = packed.pad_start(start["unknowns"], H_start if H_start is not None else packed.H)
         lam0 = float(start.get("parameter", start.get("omega")))
         tan = start.get("tangent")
@@ -306,13 +309,14 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
         raise_for_status(info, msg.decode(errors="replace"))
         p = packed.points(res, omega_fix, time.perf_counter() - t0)[0]
         t0 = time.perf_counter()
-        points.append(p)
-        if sink is not None:
-            sink(p)
+        points.append(p)        # handed to sink once its tangent is known (next call)
         y0, skip_first = p.unknowns, True
     yscale = float(np.linalg.norm(y0)) or 1.0
     if mode == 1:
         prev_t = tan0[-1]
+        # keep the arc-length scaling the saved tangent was computed with
+        if start.get("yscale"):
+            yscale = float(start["yscale"])
     while len(points) < o.max_points:
         maxpts = min(o.batch, o.max_points - len(points)) + int(skip_first)
         res = packed.call(y0, lam0, tan0, mode, ds, lam_end, lam_lo, yscale, lscale,
@@ -322,10 +326,17 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
         npts, finished, ds_out, info, msg = res[7], res[8], res[9], res[11], res[12]
         _add_timings(timings, res[10])
         new = packed.points(res, omega_fix, t_call)
+        for p in new:
+            p.yscale = yscale
         if skip_first and new:
             prev_t = new[0].tangent[-1]
             points[-1].tangent = new[0].tangent
+            points[-1].yscale = yscale
+            if sink is not None:
+                sink(points[-1])
             new = new[1:]
+        elif skip_first and sink is not None:
+            sink(points[-1])
         skip_first = False
         for p in new:
             if prev_t is not None and prev_t != 0 and np.sign(p.tangent[-1]) != np.sign(prev_t):
