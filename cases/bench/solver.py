@@ -191,7 +191,7 @@ def main():
     results = {}
     for reuse in (True, False):
         o = SolverOptions(harmonics=3, samples=56, formulation="banded", max_points=100,
-                          ds_max=0.08, reuse_jacobian=reuse)
+                          ds_max=0.07, reuse_jacobian=reuse)
         t = time.perf_counter()
         r = frf(model, ex, 0.9 * w_res, 1.2 * w_res, o, outputs=[2])
         dt = time.perf_counter() - t
