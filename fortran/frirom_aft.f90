@@ -7,13 +7,15 @@
 !> to where it started (the cycle closes); forces back to harmonics by batched real FFTs.
 !> The Jacobian never touches O(N H^2) work: a force that depends on the same-sample
 !> displacement with a coefficient c_k contributes the matrix of multiplication by c,
-!> built from the 2H+1 trigonometric sums of c (one more batched FFT); dependence on an
-!> earlier sample (the slider, fixed at the last slip or lift-off sample "anchor") adds a
-!> rank-one term per stick segment. The 2-D law, whose slip direction remembers the past,
-!> propagates the slider tangent through the period instead.
+!> built from the 4H+1 trigonometric sums of c; c is constant over runs of samples
+!> (kt in stick, +-mu kn in slip, kn in contact), so the sums come from a prefix table
+!> in O(H) per run. Dependence on an earlier sample (the slider, fixed at the last slip
+!> or lift-off sample, the "anchor") adds a rank-one term per stick segment. The 2-D
+!> law, whose slip direction remembers the past, propagates the slider tangent instead.
 !>
-!> Cost per element: O(N) marching per period (usually 1-2 periods) plus a few real FFTs
-!> of length N; the Jacobian adds one to three FFTs and O(H^2) per stick segment.
+!> Cost per element: O(N) marching per period (usually 2 periods from a cold slider),
+!> one inverse and one forward real FFT of length N per direction, and for the Jacobian
+!> an O(N) scan plus O(H^2) per run and per stick segment.
 !>
 !> Choice of N: N >= 2H+1 is required. Friction laws are non-smooth, so the force
 !> harmonics converge like O(N^-2) once the sampling resolves the stick/slip transitions;
@@ -41,8 +43,6 @@ module frirom_aft
     integer(ip), parameter :: NDIR(NLAW) = [1, 2, 3, 1]
     integer(ip), parameter :: NPAR(NLAW) = [3, 4, 4, 2]
     integer(ip), parameter :: NSLIDER(NLAW) = [1, 1, 2, 0]
-    ! Output slot of the same-sample coefficient series of each law (after the forces).
-    integer(ip), parameter :: NSERIES(NLAW) = [1, 3, 2, 1]
 
     integer(ip), parameter :: DEFAULT_BATCH = 16
     real(wp), parameter :: DEFAULT_TOL = 1.0e-12_wp
@@ -52,8 +52,16 @@ module frirom_aft
     !> FFTW plans, buffers and per-batch work arrays. Owned by the caller (one per thread).
     type :: aft_plan
         type(fourier_plan) :: fp
-        integer(ip), allocatable :: state(:, :)      !! (N, nbatch) contact state per sample
-        real(wp), allocatable :: tangent(:, :, :)    !! (6, N, nbatch) 2-D slip tangents
+        integer(ip), allocatable :: state(:, :)      !! (nbatch, N) contact state per sample
+        real(wp), allocatable :: tangent(:, :, :)    !! (nbatch, 6, N) 2-D slip tangents
+        real(wp), allocatable :: par(:, :)           !! (nbatch, 4) parameters of the batch
+        real(wp), allocatable :: w(:, :), wstart(:, :)  !! (nbatch, 2) slider positions
+        real(wp), allocatable :: scale(:)            !! (nbatch) closure scale
+        integer(ip), allocatable :: closed_at(:)     !! (nbatch) period the cycle closed in
+        integer(ip), allocatable :: events(:)        !! (N) slip/lift-off samples of one element
+        integer(ip), allocatable :: anchor(:)        !! (nbatch) last slip/lift-off sample
+        integer(ip), allocatable :: anchor_state(:)  !! (nbatch) its state
+        real(wp), allocatable :: anchor_dtv(:)       !! (nbatch) its d ft / dv
         real(wp), allocatable :: dw(:, :), dw0(:, :) !! (2, 3(2H+1)) 2-D slider tangent
         real(wp), allocatable :: dft(:, :)           !! (2, 3(2H+1)) 2-D force tangent
     end type aft_plan
@@ -85,11 +93,14 @@ contains
         integer(ip), intent(in) :: nsamp                !! N
         integer(ip), intent(out) :: info
         character(len=*), intent(inout), optional :: errmsg
-        logical, intent(in), optional :: measure        !! FFTW_MEASURE (slower to plan)
+        logical, intent(in), optional :: measure        !! FFTW_MEASURE (default for N <= 4096;
+                                                        !! planning costs once per process and size)
         integer(ip), intent(in), optional :: nbatch     !! elements per batch (default 16)
         logical :: meas
         integer(ip) :: nb, nc
-        meas = .false.
+        ! FFTW_MEASURE pays for itself at the sizes Newton loops use; for very long
+        ! periods (N > 4096, accuracy studies) its planning time would dominate.
+        meas = nsamp <= 4096
         if (present(measure)) meas = measure
         nb = DEFAULT_BATCH
         if (present(nbatch)) nb = max(1_ip, nbatch)
@@ -98,14 +109,19 @@ contains
         if (info /= FRIROM_OK) return
         nb = plan%fp%nbatch
         nc = plan%fp%ncoef
-        allocate (plan%state(nsamp, nb), plan%tangent(6, nsamp, nb))
+        allocate (plan%state(nb, nsamp), plan%tangent(nb, 6, nsamp), plan%par(nb, 4))
+        allocate (plan%w(nb, 2), plan%wstart(nb, 2), plan%scale(nb), plan%closed_at(nb))
+        allocate (plan%anchor(nb), plan%anchor_state(nb), plan%anchor_dtv(nb), plan%events(nsamp))
         allocate (plan%dw(2, 3*nc), plan%dw0(2, 3*nc), plan%dft(2, 3*nc))
     end subroutine aft_plan_create
 
     subroutine aft_plan_destroy(plan)
         type(aft_plan), intent(inout) :: plan
         call fourier_plan_destroy(plan%fp)
-        if (allocated(plan%state)) deallocate (plan%state)
+        if (allocated(plan%state)) deallocate (plan%state, plan%par, plan%w, plan%wstart, &
+                                                  plan%scale, plan%closed_at)
+        if (allocated(plan%anchor)) deallocate (plan%anchor, plan%anchor_state, plan%anchor_dtv, &
+                                                   plan%events)
         if (allocated(plan%tangent)) deallocate (plan%tangent)
         if (allocated(plan%dw)) deallocate (plan%dw, plan%dw0, plan%dft)
     end subroutine aft_plan_destroy
@@ -157,30 +173,24 @@ contains
         nc = plan%fp%ncoef
         nb = plan%fp%nbatch
         np = nd
-        if (want_jac) np = nd + NSERIES(law)
         nfail = 0
         if (want_jac) jac = 0.0_wp
 
         do e0 = 1, ne, nb
             m = min(nb, ne - e0 + 1)
-            do d = 1, nd
-                do j = 1, m
-                    call load_harmonics(plan%fp, d, j, x(:, d, e0 + j - 1))
-                end do
-                call exec_c2r(plan%fp, d)
-            end do
+            call time_batch(plan, law, x, params, w0, e0, m, tl, mp)
             do j = 1, m
                 e = e0 + j - 1
-                call march_closed(plan, law, j, params(:, e), w0(:, e), tl, mp, nper)
+                nper = plan%closed_at(j)
                 if (nper > mp .and. nfail == 0) then
                     nfail = e
                     write (buf, '(a,i0,a,i0,a)') 'element ', e - 1 + base, ': not closed after ', &
                         mp, ' periods'
                 end if
                 if (present(periods)) periods(e) = min(nper, mp)
-                if (want_jac) call fill_series(plan, law, j, params(:, e))
-                if (present(states)) call state_fractions(plan%state(:, j), states(:, e))
+                if (present(states)) call state_fractions(plan%state(j, :), states(:, e))
             end do
+            if (want_jac) call fill_series(plan, law, m)
             do s = 1, np
                 call exec_r2c(plan%fp, s)
             end do
@@ -223,7 +233,7 @@ contains
         integer(ip), intent(in), optional :: max_periods
         integer(ip), intent(in), optional :: index_base
         real(wp), allocatable :: fh(:, :, :)
-        integer(ip) :: ne, nd, nb, e0, m, j, e, d, nper, mp, base
+        integer(ip) :: ne, nd, nb, e0, m, j, e, d, mp, base
         real(wp) :: tl
 
         allocate (fh(size(x, 1), size(x, 2), size(x, 3)))
@@ -246,23 +256,17 @@ contains
         nb = plan%fp%nbatch
         do e0 = 1, ne, nb
             m = min(nb, ne - e0 + 1)
-            do d = 1, nd
-                do j = 1, m
-                    call load_harmonics(plan%fp, d, j, x(:, d, e0 + j - 1))
-                end do
-                call exec_c2r(plan%fp, d)
-            end do
+            call time_batch(plan, law, x, params, w0, e0, m, tl, mp)
             do j = 1, m
                 e = e0 + j - 1
-                call march_closed(plan, law, j, params(:, e), w0(:, e), tl, mp, nper)
-                if (nper > mp .and. info == FRIROM_OK) then
+                if (plan%closed_at(j) > mp .and. info == FRIROM_OK) then
                     info = FRIROM_ERR_NOCLOSE
                     if (present(errmsg)) write (errmsg, '(a,a,i0)') &
                         frirom_status_message(info), ': element ', e - 1 + base
                 end if
                 do d = 1, nd
-                    xt(:, d, e) = plan%fp%rin(:, j, d)
-                    ft(:, d, e) = plan%fp%rout(:, j, d)
+                    xt(:, d, e) = plan%fp%rin(j, :, d)
+                    ft(:, d, e) = plan%fp%rout(j, :, d)
                 end do
             end do
         end do
@@ -376,70 +380,131 @@ contains
         end select
     end subroutine check_params
 
-    !> March batch column j period after period until the slider closes its cycle; the
-    !> last period's forces (output slots 1..ndir), states and tangents stay in the plan.
-    !> nper = periods marched, or max_periods + 1 when the cycle did not close.
-    subroutine march_closed(plan, law, j, p, w0, tol, max_periods, nper)
+    !> Elements e0..e0+m-1: displacement harmonics to time samples (input slots), then
+    !> the law marched until their cycles close (see march_closed).
+    subroutine time_batch(plan, law, x, params, w0, e0, m, tol, max_periods)
         type(aft_plan), intent(inout) :: plan
-        integer(ip), intent(in) :: law, j
-        real(wp), intent(in) :: p(:), w0(:), tol
+        integer(ip), intent(in) :: law, e0, m, max_periods
+        real(wp), intent(in) :: x(:, :, :), params(:, :), w0(:, :), tol
+        integer(ip) :: d, j
+        do d = 1, NDIR(law)
+            call clear_input(plan%fp, d)
+            do j = 1, m
+                call load_harmonics(plan%fp, d, j, x(:, d, e0 + j - 1))
+            end do
+            call exec_c2r(plan%fp, d)
+        end do
+        call march_closed(plan, law, m, params(:, e0:e0 + m - 1), w0(:, e0:e0 + m - 1), tol, &
+                          max_periods)
+    end subroutine time_batch
+
+    !> March the first m elements of the batch period after period until every slider
+    !> closes its cycle; the last period's forces (output slots 1..ndir), states and
+    !> tangents stay in the plan. closed_at(j) = period element j closed in, or
+    !> max_periods + 1. Elements that closed earlier repeat their closed cycle exactly.
+    subroutine march_closed(plan, law, m, p, w0, tol, max_periods)
+        type(aft_plan), intent(inout) :: plan
+        integer(ip), intent(in) :: law, m
+        real(wp), intent(in) :: p(:, :)    !! (npar, m)
+        real(wp), intent(in) :: w0(:, :)   !! (nslider, m)
+        real(wp), intent(in) :: tol
         integer(ip), intent(in) :: max_periods
-        integer(ip), intent(out) :: nper
-        real(wp) :: w(2), wstart(2), scale
-        integer(ip) :: ns, d
-        associate (rin => plan%fp%rin, rout => plan%fp%rout, st => plan%state(:, j))
+        integer(ip) :: ns, d, j, i, nper
+        associate (rin => plan%fp%rin, rout => plan%fp%rout, st => plan%state(1:m, :), &
+                   w => plan%w(1:m, :), par => plan%par(1:m, :))
             ns = NSLIDER(law)
+            do i = 1, NPAR(law)
+                par(:, i) = p(i, :)
+            end do
+            plan%anchor(1:m) = 0
             if (law == LAW_CUBIC) then
-                call cubic_spring(rin(:, j, 1), p(1), p(2), rout(:, j, 1), rout(:, j, 2))
+                call cubic_spring(rin(1:m, :, 1), spread(par(:, 1), 2, plan%fp%nsamp), &
+                                  spread(par(:, 2), 2, plan%fp%nsamp), rout(1:m, :, 1), &
+                                  rout(1:m, :, 2))
                 st = STATE_STICK
-                nper = 1
+                plan%closed_at(1:m) = 1
                 return
             end if
             w = 0.0_wp
-            w(1:ns) = w0(1:ns)
-            scale = tiny(1.0_wp)
-            do d = 1, NDIR(law)
-                scale = max(scale, maxval(abs(rin(:, j, d))))
+            do i = 1, ns
+                w(:, i) = w0(i, :)
             end do
-            scale = max(scale, maxval(abs(w(1:ns))))
+            do j = 1, m
+                plan%scale(j) = max(tiny(1.0_wp), maxval(abs(w(j, 1:ns))))
+                do d = 1, NDIR(law)
+                    plan%scale(j) = max(plan%scale(j), maxval(abs(rin(j, :, d))))
+                end do
+            end do
+            plan%closed_at(1:m) = max_periods + 1
             do nper = 1, max_periods
-                wstart = w
+                plan%wstart(1:m, :) = w
                 select case (law)
                 case (LAW_JENKINS)
-                    call jenkins_march(rin(:, j, 1), p(1), p(2), p(3), w(1), rout(:, j, 1), st)
+                    call jenkins_march(rin(1:m, :, 1), par(:, 1), par(:, 2), par(:, 3), w(:, 1), &
+                                       rout(1:m, :, 1), st)
                 case (LAW_NORMAL1D)
-                    call friction1d_march(rin(:, j, 1), rin(:, j, 2), p(1), p(2), p(3), p(4), &
-                                          w(1), rout(:, j, 1), rout(:, j, 2), st, rout(:, j, 4))
+                    call friction1d_march(rin(1:m, :, 1), rin(1:m, :, 2), par(:, 1), par(:, 2), &
+                                          par(:, 3), par(:, 4), w(:, 1), rout(1:m, :, 1), &
+                                          rout(1:m, :, 2), st, rout(1:m, :, 4))
                 case (LAW_NORMAL2D)
-                    call friction2d_march(rin(:, j, 1), rin(:, j, 2), rin(:, j, 3), p(1), p(2), &
-                                          p(3), p(4), w, rout(:, j, 1), rout(:, j, 2), &
-                                          rout(:, j, 3), st, plan%tangent(:, :, j))
+                    call friction2d_march(rin(1:m, :, 1), rin(1:m, :, 2), rin(1:m, :, 3), &
+                                          par(:, 1), par(:, 2), par(:, 3), par(:, 4), w, &
+                                          rout(1:m, :, 1), rout(1:m, :, 2), rout(1:m, :, 3), &
+                                          st, plan%tangent(1:m, :, :))
                 end select
-                if (maxval(abs(w(1:ns) - wstart(1:ns))) <= tol*scale) return
+                call record_anchors(plan, law, m)
+                do j = 1, m
+                    if (plan%closed_at(j) > max_periods) then
+                        if (maxval(abs(w(j, 1:ns) - plan%wstart(j, 1:ns))) <= tol*plan%scale(j)) &
+                            plan%closed_at(j) = nper
+                    end if
+                end do
+                if (all(plan%closed_at(1:m) <= max_periods)) return
             end do
-            nper = max_periods + 1
         end associate
     end subroutine march_closed
+
+    !> Remember the last slip or lift-off sample of the period just marched: a contact that
+    !> slips while the march settles and then sticks for good keeps its slider where that
+    !> sample left it, so the mean force still depends on the displacement there.
+    pure subroutine record_anchors(plan, law, m)
+        type(aft_plan), intent(inout) :: plan
+        integer(ip), intent(in) :: law, m
+        integer(ip) :: j, k
+        do j = 1, m
+            do k = plan%fp%nsamp, 1, -1
+                if (plan%state(j, k) /= STATE_STICK) then
+                    plan%anchor(j) = k
+                    plan%anchor_state(j) = plan%state(j, k)
+                    plan%anchor_dtv(j) = 0.0_wp
+                    if (law == LAW_NORMAL1D) plan%anchor_dtv(j) = plan%fp%rout(j, k, 4)
+                    exit
+                end if
+            end do
+        end do
+    end subroutine record_anchors
 
     !> Same-sample coefficient series of the Jacobian, written after the forces:
     !> Jenkins slot 2 = kt [stick]; normal1d slot 3 = kt [stick], slot 4 = d ft/dv (the
     !> march wrote it), slot 5 = kn [contact]; normal2d slot 4 = kt [stick], slot 5 = kn
     !> [contact]; cubic slot 2 = df/du (the spring wrote it).
-    pure subroutine fill_series(plan, law, j, p)
+    pure subroutine fill_series(plan, law, m)
         type(aft_plan), intent(inout) :: plan
-        integer(ip), intent(in) :: law, j
-        real(wp), intent(in) :: p(:)
-        associate (rout => plan%fp%rout, st => plan%state(:, j))
-            select case (law)
-            case (LAW_JENKINS)
-                rout(:, j, 2) = merge(p(1), 0.0_wp, st == STATE_STICK)
-            case (LAW_NORMAL1D)
-                rout(:, j, 3) = merge(p(1), 0.0_wp, st == STATE_STICK)
-                rout(:, j, 5) = merge(p(2), 0.0_wp, st /= STATE_LIFTOFF)
-            case (LAW_NORMAL2D)
-                rout(:, j, 4) = merge(p(1), 0.0_wp, st == STATE_STICK)
-                rout(:, j, 5) = merge(p(2), 0.0_wp, st /= STATE_LIFTOFF)
-            end select
+        integer(ip), intent(in) :: law, m
+        integer(ip) :: k
+        associate (rout => plan%fp%rout, st => plan%state, par => plan%par)
+            do k = 1, plan%fp%nsamp
+                select case (law)
+                case (LAW_JENKINS)
+                    rout(1:m, k, 2) = merge(par(1:m, 1), 0.0_wp, st(1:m, k) == STATE_STICK)
+                case (LAW_NORMAL1D)
+                    rout(1:m, k, 3) = merge(par(1:m, 1), 0.0_wp, st(1:m, k) == STATE_STICK)
+                    rout(1:m, k, 5) = merge(par(1:m, 2), 0.0_wp, st(1:m, k) /= STATE_LIFTOFF)
+                case (LAW_NORMAL2D)
+                    rout(1:m, k, 4) = merge(par(1:m, 1), 0.0_wp, st(1:m, k) == STATE_STICK)
+                    rout(1:m, k, 5) = merge(par(1:m, 2), 0.0_wp, st(1:m, k) /= STATE_LIFTOFF)
+                end select
+            end do
         end associate
     end subroutine fill_series
 
@@ -451,76 +516,126 @@ contains
         frac(3) = real(count(st == STATE_LIFTOFF), wp)/real(size(st), wp)
     end subroutine state_fractions
 
-    !> Add the multiplication matrix of the series in output slot `slot` to the block at
-    !> (r0, c0) of jac.
+    !> Add the multiplication matrix of the series of element j in output slot `slot`
+    !> (time samples, not transformed) to the block at (r0, c0) of jac.
     pure subroutine jac_diagonal(plan, j, slot, jac, r0, c0)
         type(aft_plan), intent(in) :: plan
         integer(ip), intent(in) :: j, slot, r0, c0
         real(wp), intent(inout) :: jac(:, :)
         real(wp) :: cm(0:2*plan%fp%nharm), sm(0:2*plan%fp%nharm)
-        call trig_sums(plan%fp, slot, j, cm, sm)
+        call run_trig_sums(plan%fp, plan%fp%rout(j, :, slot), cm, sm)
         call toeplitz_add(plan%fp%nharm, plan%fp%nsamp, cm, sm, jac, r0, c0)
     end subroutine jac_diagonal
 
     !> Jacobian of the Jenkins (normal = .false.) or 1-D normal-load element.
     !> Stick samples after anchor a: f_t(k) = kt (u_k - u_a) + f_t(a), where f_t(a) =
-    !> s mu kn v_a at a slip anchor and 0 at a lift-off anchor; slip: f_t(k) = s mu (n0 + kn v_k);
-    !> f_n(k) = n0 + kn v_k in contact. The anchor of the first stick samples is the last
-    !> anchor of the period, since the cycle is closed.
-    pure subroutine jac_friction1d(plan, j, kt, normal, jac)
-        type(aft_plan), intent(in) :: plan
+    !> s mu (n0 + kn v_a) at a slip anchor and 0 at a lift-off anchor; slip: f_t(k) =
+    !> s mu (n0 + kn v_k); f_n(k) = n0 + kn v_k in contact. The anchor of the first stick
+    !> samples is the last anchor of the period, since the cycle is closed.
+    subroutine jac_friction1d(plan, j, kt, normal, jac)
+        type(aft_plan), intent(inout) :: plan
         integer(ip), intent(in) :: j
         real(wp), intent(in) :: kt
         logical, intent(in) :: normal
         real(wp), intent(inout) :: jac(:, :)  !! (nd nc, nd nc)
-        integer(ip) :: n, nc, k, a, last, step, i1, i2, c
-        real(wp) :: g(plan%fp%ncoef), dtv
+        integer(ip) :: n, nc, nh, k, k0, a, nev, i, i1, i2, c
+        real(wp) :: g(plan%fp%ncoef), dtv, kn
+        real(wp), dimension(0:2*plan%fp%nharm) :: ctu, stu, ctv, stv, cnv, snv
         n = plan%fp%nsamp
         nc = plan%fp%ncoef
-        associate (st => plan%state(:, j), bas => plan%fp%basis)
-            if (normal) then
-                call jac_diagonal(plan, j, 3_ip, jac, 0_ip, 0_ip)     ! d ft / du, stick
-                call jac_diagonal(plan, j, 4_ip, jac, 0_ip, nc)       ! d ft / dv, slip
-                call jac_diagonal(plan, j, 5_ip, jac, nc, nc)         ! d fn / dv, contact
-            else
-                call jac_diagonal(plan, j, 2_ip, jac, 0_ip, 0_ip)
-            end if
-            last = 0
-            do k = n, 1, -1
-                if (st(k) /= STATE_STICK) then
-                    last = k
-                    exit
-                end if
-            end do
-            if (last == 0) return   ! stuck all cycle: the slider never moved
-            a = last
-            do step = 1, n
-                k = mod(last + step - 1, n) + 1
-                if (st(k) == STATE_STICK) cycle
-                ! stick segment a+1 .. k-1 (cyclic), anchored at a
-                i1 = mod(a, n) + 1
-                i2 = k - 1
-                if (i2 == 0) i2 = n
-                if (i1 /= k) then
-                    call segment_sum(plan%fp, i1, i2, g)
-                    do c = 1, nc
-                        jac(1:nc, c) = jac(1:nc, c) - kt*bas(a, c)*g
-                    end do
-                    if (normal .and. st(a) == STATE_SLIP) then
-                        dtv = plan%fp%rout(a, j, 4)
-                        do c = 1, nc
-                            jac(1:nc, nc + c) = jac(1:nc, nc + c) + dtv*bas(a, c)*g
-                        end do
+        nh = plan%fp%nharm
+        kn = plan%par(j, 2)
+        ctu = 0.0_wp; stu = 0.0_wp; ctv = 0.0_wp; stv = 0.0_wp; cnv = 0.0_wp; snv = 0.0_wp
+        associate (st => plan%state, bas => plan%fp%basis, ev => plan%events, &
+                   dtvs => plan%fp%rout(j, :, 4))
+            ! One pass: runs of equal state (and slip sign) give the trig sums of the
+            ! same-sample series kt [stick], d ft/dv [slip], kn [contact]; events are the
+            ! slip and lift-off samples that anchor the following stick segments.
+            nev = 0
+            k0 = 1
+            do k = 1, n + 1
+                if (k <= n) then
+                    if (st(j, k) /= STATE_STICK) then
+                        nev = nev + 1
+                        ev(nev) = k
+                    end if
+                    if (st(j, k) == st(j, k0)) then
+                        if (.not. (normal .and. st(j, k) == STATE_SLIP)) cycle
+                        if (dtvs(k) == dtvs(k0)) cycle
                     end if
                 end if
-                a = k
+                select case (st(j, k0))
+                case (STATE_STICK)
+                    call add_run(kt, k0, k - 1, ctu, stu)
+                    if (normal) call add_run(kn, k0, k - 1, cnv, snv)
+                case (STATE_SLIP)
+                    if (normal) then
+                        call add_run(dtvs(k0), k0, k - 1, ctv, stv)
+                        call add_run(kn, k0, k - 1, cnv, snv)
+                    end if
+                end select
+                k0 = k
+            end do
+            call toeplitz_add(nh, n, ctu, stu, jac, 0_ip, 0_ip)
+            if (normal) then
+                call toeplitz_add(nh, n, ctv, stv, jac, 0_ip, nc)
+                call toeplitz_add(nh, n, cnv, snv, jac, nc, nc)
+            end if
+            if (nev == 0) then
+                ! Stuck all cycle. If the slider moved while the march settled, every
+                ! sample is anchored there: the whole-period sum of P is the mean row.
+                a = plan%anchor(j)
+                if (a == 0) return
+                jac(1, 1:nc) = jac(1, 1:nc) - kt*bas(a, :)
+                if (normal .and. plan%anchor_state(j) == STATE_SLIP) &
+                    jac(1, nc + 1:2*nc) = jac(1, nc + 1:2*nc) + plan%anchor_dtv(j)*bas(a, :)
+                return
+            end if
+            do i = 1, nev
+                ! stick segment after event a, up to the next event (cyclic)
+                a = ev(i)
+                i1 = mod(a, n) + 1
+                if (i < nev) then
+                    i2 = ev(i + 1) - 1
+                else
+                    i2 = ev(1) - 1
+                    if (i2 == 0) i2 = n
+                end if
+                if ((i < nev .and. i2 < i1) .or. (i == nev .and. i1 == ev(1))) cycle
+                call segment_sum(plan%fp, i1, i2, g)
+                do c = 1, nc
+                    jac(1:nc, c) = jac(1:nc, c) - kt*bas(a, c)*g
+                end do
+                if (normal .and. st(j, a) == STATE_SLIP) then
+                    dtv = dtvs(a)
+                    do c = 1, nc
+                        jac(1:nc, nc + c) = jac(1:nc, nc + c) + dtv*bas(a, c)*g
+                    end do
+                end if
             end do
         end associate
+    contains
+        !> C_m, S_m += value * sums of cos(m tau), sin(m tau) over samples k1..k2.
+        pure subroutine add_run(value, k1, k2, cm, sm)
+            real(wp), intent(in) :: value
+            integer(ip), intent(in) :: k1, k2
+            real(wp), intent(inout) :: cm(0:), sm(0:)
+            integer(ip) :: m
+            associate (pre => plan%fp%prefix)
+                cm(0) = cm(0) + value*real(k2 - k1 + 1, wp)
+                do m = 1, 2*nh
+                    cm(m) = cm(m) + value*(pre(2*m, k2) - pre(2*m, k1 - 1))
+                    sm(m) = sm(m) + value*(pre(2*m + 1, k2) - pre(2*m + 1, k1 - 1))
+                end do
+            end associate
+        end subroutine add_run
     end subroutine jac_friction1d
 
     !> Jacobian of the 2-D element. The slip direction depends on the whole history, so
     !> the slider tangent dw (2 x 3(2H+1)) is propagated through the period, repeated until
     !> it closes (slip contracts it; lift-off resets it), then once more accumulating.
+    !> A contact that slips while the march settles and then sticks all cycle is treated
+    !> as a fixed slider (its mean-force row ignores the settling slip, unlike the 1-D laws).
     subroutine jac_friction2d(plan, j, kt, tol, max_periods, jac)
         type(aft_plan), intent(inout) :: plan
         integer(ip), intent(in) :: j, max_periods
@@ -531,7 +646,7 @@ contains
         call jac_diagonal(plan, j, 4_ip, jac, 0_ip, 0_ip)       ! d f1/du1, stick
         call jac_diagonal(plan, j, 4_ip, jac, nc, nc)           ! d f2/du2, stick
         call jac_diagonal(plan, j, 5_ip, jac, 2*nc, 2*nc)       ! d fn/dv, contact
-        if (all(plan%state(:, j) == STATE_STICK)) return
+        if (all(plan%state(j, :) == STATE_STICK)) return
         plan%dw = 0.0_wp
         do pass = 1, max_periods
             plan%dw0 = plan%dw
@@ -556,7 +671,7 @@ contains
         logical :: open_seg
         n = plan%fp%nsamp
         nc = plan%fp%ncoef
-        associate (st => plan%state(:, j), tg => plan%tangent(:, :, j), bas => plan%fp%basis, &
+        associate (st => plan%state(j, :), tg => plan%tangent(j, :, :), bas => plan%fp%basis, &
                    wgt => plan%fp%weight, dw => plan%dw, dft => plan%dft)
             gsum = 0.0_wp
             open_seg = .false.

@@ -10,6 +10,7 @@ module frirom_status
               FRIROM_ERR_SAMPLES, FRIROM_ERR_ALLOC, FRIROM_ERR_FFTW, FRIROM_ERR_LAPACK, &
               FRIROM_ERR_ARPACK, FRIROM_ERR_NOCONV, FRIROM_ERR_SINGULAR, FRIROM_ERR_LAW, &
               FRIROM_ERR_NOCLOSE, FRIROM_ERR_CONT, FRIROM_ERR_MODEL
+    public :: FRIROM_ERR_FACTOR
 
     ! General codes 1-19; solver codes from 20; reduction codes from 40.
     integer(ip), parameter :: FRIROM_OK = 0
@@ -27,6 +28,8 @@ module frirom_status
     integer(ip), parameter :: FRIROM_ERR_NOCLOSE = 12
     integer(ip), parameter :: FRIROM_ERR_CONT = 20
     integer(ip), parameter :: FRIROM_ERR_MODEL = 21
+    ! Reduction codes.
+    integer(ip), parameter :: FRIROM_ERR_FACTOR = 40
 
 contains
 
@@ -65,6 +68,8 @@ contains
             msg = 'continuation stopped: the corrector failed at the minimum step'
         case (FRIROM_ERR_MODEL)
             msg = 'inconsistent model data'
+        case (FRIROM_ERR_FACTOR)
+            msg = 'sparse factorisation failed'
         case default
             msg = 'unknown status code'
         end select

@@ -266,6 +266,13 @@ JAC_CASES = {
                       {"kt": KT, "kn": KT, "mu": MU, "n0": 80.0}, 1),
     "normal2d-mixed": ("normal2d", None, {"kt": KT, "kn": 0.8 * KT, "mu": 0.4, "n0": 60.0}, None),
     "normal2d-ellipse": ("normal2d", None, {"kt": KT, "kn": KT, "mu": MU, "n0": 100.0}, 1),
+    # large mean: slips while the march settles, then sticks for good (slider set by the
+    # settling slip, so the mean force depends on the displacement there)
+    "jenkins-settles": ("jenkins", lambda: single_harmonic(1e-4) + np.eye(7)[0] * 1e-3,
+                        [KT, MU, FN0], 0),
+    "normal1d-settles": ("normal1d", lambda: np.stack([single_harmonic(1e-4)[0, 0] + np.eye(7)[0] * 1e-3,
+                                                       np.eye(7)[0] * 1e-4])[None],
+                         {"kt": KT, "kn": KT, "mu": MU, "n0": 80.0}, 0),
     "cubic": ("cubic", lambda: single_harmonic(0.3) + single_harmonic(0.1, 3), [1.0, 4.0], None),
 }
 

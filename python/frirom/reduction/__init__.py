@@ -1,0 +1,1 @@
+"""Model reduction: eigen-solves, Craig-Bampton CMS, interface reduction."""
