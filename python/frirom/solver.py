@@ -25,6 +25,8 @@ from .model import LAW_CODES, Excitation, Model
 from .results import FRF, FRFPoint, amplitude_max
 
 FORMULATIONS = {"condensed": 1, "banded": 2}
+#: Largest Hill eigenproblem (2 n_dof (2H+1)) computed; above it stability is skipped.
+HILL_MAX = 4000
 #: Names of the Fortran timers/counters returned with each run (seconds, counts).
 TIMER_NAMES = ("aft", "assembly", "factorization", "solve", "receptance", "evaluations",
                "factorizations", "fortran_total")
@@ -205,6 +207,12 @@ class _Packed:
         if np.any(self.outputs < 0) or np.any(self.outputs >= n):
             raise SizeError(f"outputs: DoF indices must be in 0..{n - 1}")
         self.ny = (self.nl.size if self.form == 1 else n) * self.nc
+        self.stability = bool(opts.stability)
+        if self.stability and 2 * n * self.nc > HILL_MAX:
+            warnings.warn(f"frirom: Hill stability skipped: its dense eigenproblem would have "
+                          f"size 2 n_dof (2H+1) = {2 * n * self.nc} > {HILL_MAX}",
+                          RuntimeWarning, stacklevel=3)
+            self.stability = False
         self.nmodes = 0
         self.phi, self.wmodes, self.zmodes = np.zeros((n, 1)), np.ones(1), np.zeros(1)
         if opts.modes:
@@ -221,7 +229,7 @@ class _Packed:
             self.ginfo, *self.G, self.params, self.w0, (self.outputs + 1).astype(np.int32),
             y0, lam0, tan0, start_mode, ds, o.ds_min, o.ds_max, lam_end, lam_lo,
             o.tol_residual, o.tol_update, o.tol_stall, o.max_iter, int(o.reuse_jacobian),
-            yscale, lscale, maxpts, max(self.ne_tot, 1), int(o.stability), self.nmodes,
+            yscale, lscale, maxpts, max(self.ne_tot, 1), int(self.stability), self.nmodes,
             np.asfortranarray(self.phi), self.wmodes, self.zmodes, nh=self.H,
             ndof=self.n_dof, nnl=self.nl.size or 1)
 
@@ -257,7 +265,7 @@ class _Packed:
                                 unknowns=ys[:, k].copy(), tangent=tans[:, k].copy(), X=X,
                                 amp_max=amplitude_max(X), state_fractions=st,
                                 iterations=int(iters[k]), time_s=t_call / max(npts, 1),
-                                stable=bool(hill_re[k] <= 1e-9 * max(abs(om), 1.0)),
+                                stable=bool(hill_re[k] <= 1e-7 * max(abs(om), 1.0)),
                                 floquet_max_re=float(hill_re[k])))
         return pts
 
@@ -377,7 +385,7 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
     name = "omega" if packed.mode == 1 else "load"
     out = FRF.from_points(points, packed.outputs, packed.group_names, parameter_name=name,
                           complete=complete, message=message,
-                          stability_computed=bool(packed.opts.stability))
+                          stability_computed=packed.stability)
     out.timings = timings
     if keep_unknowns and points:
         out._last_unknowns = points[-1].unknowns
@@ -392,6 +400,7 @@ def _homotopy_start(packed: _Packed, omega: float):
     lp.__dict__.update(packed.__dict__)
     lp.opts = o
     lp.mode = 2
+    lp.stability = False
     fe = packed.fe0
     mask = np.zeros(packed.nc, bool)
     mask[1:] = True
