@@ -69,7 +69,7 @@ class SolverOptions:
     ds_max: float = 0.1
     max_points: int = 2000
     parameter: str = "frequency"
-    reuse_jacobian: bool = False
+    reuse_jacobian: bool = True
     stability: bool = False
     modes: int | None = None
     batch: int = 10
