@@ -137,7 +137,8 @@ def main():
     sizes = [10, 30, 100] if args.quick else [10, 100, 300, 1000, 3000]
     harms = [1, 3] if args.quick else [1, 3, 5, 7]
     print()
-    print("time per Newton iteration (solve_point from the linear solution; s/iter = Fortran time / iterations)")
+    print("time per Newton iteration (solve_point from the linear solution; "
+          "s/iter = Fortran time / iterations)")
     hdr = (f"{'form':>9} {'contacts':>8} {'H':>2} {'unknowns':>8} {'iter':>4} {'s/iter':>9} "
            f"{'AFT':>5} {'asm':>5} {'fact':>5} {'solve':>5} {'recep':>5} {'GF/s':>6} "
            f"{'%dgemm':>6}")
