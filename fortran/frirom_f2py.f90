@@ -110,9 +110,9 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
                         ci, cx, perm, nnl, nl, fe0, fe1, mode, omega_fix, ngroup, ginfo, nrows, &
                         nnzg, gp, gi, gx, npart, params, nw0, w0, nout, outdofs, ny, y0, lam0, &
                         tan0, start_mode, ds, ds_min, ds_max, lam_end, lam_lo, tol_r, tol_x, &
-                        tol_stall, max_iter, reuse, yscale, lscale, maxpts, netot, stability, nmodes, &
-                        phi, wmodes, zmodes, ys, lams, tans, iters, xo, states, hill_re, npts, &
-                        finished, ds_out, timings, info, msg)
+                        tol_stall, max_iter, reuse, yscale, lscale, maxpts, netot, stability, &
+                        nmodes, phi, wmodes, zmodes, ys, lams, tans, iters, xo, states, hill_re, &
+                        npts, finished, ds_out, timings, info, msg)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options

@@ -27,7 +27,8 @@ module frirom_hbm
     implicit none
     private
     public :: csr_matrix, contact_group, contact_set, hbm_system, hbm_condensed, hbm_full, &
-              hbm_setup, hbm_set_modes, hbm_run, hbm_hill, contact_eval, contact_assemble, HBM_FREQUENCY, HBM_LOAD, &
+              hbm_setup, hbm_set_modes, hbm_run, hbm_hill, contact_eval, contact_assemble, &
+              HBM_FREQUENCY, HBM_LOAD, &
               T_AFT, T_ASM, T_FACT, T_SOLVE, T_REC, N_EVAL, N_FACT, N_TIMERS
 
     integer(ip), parameter :: HBM_FREQUENCY = 1, HBM_LOAD = 2
@@ -505,9 +506,8 @@ contains
                                             else
                                                 i1 = c1 + nc*(iperm(gg%i(k1)) - 1)
                                                 i2 = c2 + nc*(iperm(gg%i(k2)) - 1)
-                                                call band_add(kb, i1, i2, v* &
-                                                    gr%jac(c1 + nc*(d1 - 1), c2 + nc*(d2 - 1), e), &
-                                                    ok)
+                                                call band_add(kb, i1, i2, v*gr%jac(c1 + &
+                                                    nc*(d1 - 1), c2 + nc*(d2 - 1), e), ok)
                                             end if
                                         end do
                                     end do
@@ -575,14 +575,14 @@ contains
         type is (hbm_condensed)
             nm = size(phi, 2)
             if (size(phi, 1) /= sys%ndof .or. size(wm) /= nm .or. size(zm) /= nm .or. nm < 1) then
-                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'modes: phi (ndof, nm), omega and '// &
-                                'zeta (nm)')
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'modes: phi (ndof, nm), '// &
+                                'omega and zeta (nm)')
                 return
             end if
             if (any(wm <= 0.0_wp) .or. any(zm < 0.0_wp) .or. .not. all(abs(phi) <= huge(1.0_wp))) &
                 then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'modes: need omega > 0, zeta >= 0 '// &
-                                'and finite shapes')
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'modes: need omega > 0, '// &
+                                'zeta >= 0 and finite shapes')
                 return
             end if
             sys%modal = .true.

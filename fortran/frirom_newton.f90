@@ -76,7 +76,7 @@ contains
     !> cy.(y - yp)/yscale + cl (lam - lp)/lscale = 0 (cy = 0, cl = 1 fixes lam = lp;
     !> cy, cl = tangent gives pseudo-arc-length). y, lam enter as the start, leave solved.
     subroutine newton_correct(sys, y, lam, yp, lp, cy, cl, opts, iters, info, errmsg, &
-                              have_fact)
+                              have_fact, nfact)
         class(nl_system), intent(inout) :: sys
         real(wp), intent(inout) :: y(:)       !! (n) start in, solution out
         real(wp), intent(inout) :: lam        !! start in, solution out
@@ -87,6 +87,7 @@ contains
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
         logical, intent(inout) :: have_fact   !! a usable factorisation exists (in/out)
+        integer(ip), intent(out), optional :: nfact  !! Jacobian factorisations made
         real(wp), allocatable :: r(:), rlam(:), ab(:, :), y1(:), r1(:), dy(:), rlam1(:)
         real(wp) :: rref, rn, g, denom, dlam, alpha, phi0, phi1, rn1, rref1, g1, lam1, dxn
         real(wp) :: rate
@@ -103,6 +104,7 @@ contains
         allocate (r(n), rlam(n), ab(n, 2), y1(n), r1(n), dy(n), rlam1(n))
         rate = 1.0_wp
         fresh = .not. (have_fact .and. opts%reuse_jac)
+        if (present(nfact)) nfact = merge(1, 0, fresh)
         call sys%eval(y, lam, r, rref, fresh, rlam, info, errmsg)
         if (info /= 0) return
         have_fact = .true.
@@ -114,6 +116,7 @@ contains
                 call sys%eval(y, lam, r, rref, .true., rlam, info, errmsg)
                 if (info /= 0) return
                 fresh = .true.
+                if (present(nfact)) nfact = nfact + 1
             else if (k > 1) then
                 fresh = .false.
             end if
@@ -241,7 +244,7 @@ contains
         real(wp) :: lam1, lp, dirn, frac, cl
         integer(ip) :: n, iters
         logical :: last, jumped
-        integer(ip) :: nfail
+        integer(ip) :: nfail, nf, effort
         real(wp) :: ds_fail0
         type(cont_options) :: fresh_opts
         character(len=len(errmsg)) :: why
@@ -288,7 +291,7 @@ contains
             y1 = yp
             lam1 = lp
             call newton_correct(sys, y1, lam1, yp, lp, cy, cl, opts, iters, info, errmsg, &
-                                have_fact)
+                                have_fact, nf)
             if (info /= 0 .and. opts%reuse_jac) then
                 ! chord steps can stall where a contact changes state: retry the same step
                 ! with a fresh Jacobian at every iteration before shrinking it
@@ -296,7 +299,7 @@ contains
                 lam1 = lp
                 have_fact = .false.
                 call newton_correct(sys, y1, lam1, yp, lp, cy, cl, fresh_opts, iters, info, &
-                                    errmsg, have_fact)
+                                    errmsg, have_fact, nf)
             end if
             if (info == 0 .and. .not. last) then
                 ! a corrector that wandered far from the predictor found another branch
@@ -347,9 +350,13 @@ contains
             lout(npts) = lam
             tout(:, npts) = t
             itout(npts) = iters
-            if (iters <= opts%iter_target - 1) then
+            ! step control on the work done: Newton iterations, or with Jacobian reuse the
+            ! factorisations (chord iterations are cheap)
+            effort = iters
+            if (opts%reuse_jac) effort = min(iters, 2*nf)
+            if (effort <= opts%iter_target - 1) then
                 ds = min(1.6_wp*ds, opts%ds_max)
-            else if (iters > opts%iter_target + 2) then
+            else if (effort > opts%iter_target + 2) then
                 ds = max(0.6_wp*ds, opts%ds_min)
             end if
             if (last .or. (lam - lam_lo)*dirn < 0.0_wp) then

@@ -141,7 +141,8 @@ contains
         do k = 1, m
             iperm(perm(k)) = k
         end do
-        print '(a,i0,a,i0)', 'grid bandwidth natural ', bw0, ', RCM ', band_width(p, idx(:c), iperm)
+        print '(a,i0,a,i0)', 'grid bandwidth natural ', bw0, ', RCM ', &
+            band_width(p, idx(:c), iperm)
         call check(band_width(p, idx(:c), iperm) <= ny + 1, 'RCM bandwidth of a grid')
     end subroutine rcm_grid
 

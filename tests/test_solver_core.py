@@ -136,7 +136,10 @@ def test_results_files_and_resume(tmp_path):
     model, ex = duffing()
     o = SolverOptions(harmonics=3, samples=32, formulation="condensed",
                       tol_residual=1e-12, tol_update=1e-12)
-    full = frf(model, ex, 0.5, 2.0, o, outputs=[0])
+    got = []
+    full = frf(model, ex, 0.5, 2.0, o, outputs=[0], sink=got.append)
+    assert [p.omega for p in got] == list(full.omega)   # every point, in order, once
+    assert all(p.yscale > 0 for p in got)
     full.save_h5(tmp_path / "a.h5")
     full.save_csv(tmp_path / "a.csv")
     back = FRF.load(tmp_path / "a.h5")
@@ -270,3 +273,16 @@ def test_modal_superposition_with_all_modes_matches_banded():
     np.testing.assert_allclose(r.X[-1], pe.X, rtol=0, atol=1e-8 * np.abs(pe.X).max())
     with pytest.raises(frirom.ParameterError, match="modes"):
         SolverOptions(formulation="banded", modes=3).check()
+
+
+def test_stability_skipped_with_warning_when_too_large():
+    n = 400
+    M, K = chain(n, 1.0, np.ones(n))
+    G = sp.csr_matrix(([1.0], ([0], [n - 1])), shape=(1, n))
+    model = Model(M, K, Damping.rayleigh(0.01, 0.0), [ContactGroup("cubic", G, [[0, 0.1]])])
+    F = np.zeros((n, 2), complex)
+    F[0, 1] = 0.01
+    with pytest.warns(RuntimeWarning, match="Hill stability skipped"):
+        r = frf(model, Excitation(F), 0.05, 0.06, SolverOptions(harmonics=3, samples=16,
+                formulation="banded", stability=True, max_points=3), outputs=[0])
+    assert not r.stability_computed

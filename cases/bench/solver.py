@@ -137,7 +137,8 @@ def main():
     sizes = [10, 30, 100] if args.quick else [10, 100, 300, 1000, 3000]
     harms = [1, 3] if args.quick else [1, 3, 5, 7]
     print()
-    print("time per Newton iteration (solve_point from the linear solution, no J reuse)")
+    print("time per Newton iteration (solve_point from the linear solution; "
+          "s/iter = Fortran time / iterations)")
     hdr = (f"{'form':>9} {'contacts':>8} {'H':>2} {'unknowns':>8} {'iter':>4} {'s/iter':>9} "
            f"{'AFT':>5} {'asm':>5} {'fact':>5} {'solve':>5} {'recep':>5} {'GF/s':>6} "
            f"{'%dgemm':>6}")
@@ -183,7 +184,7 @@ def main():
             print(f"  {form:>9} reuse={reuse!s:5} points {len(r):3d} {dt:7.2f} s "
                   f"({dt / max(len(r), 1):.3f} s/pt) factorizations {int(tm['factorizations'])}"
                   f" evaluations {int(tm['evaluations'])} complete={r.complete}")
-    # headline: 100 points (capped) from 0.8 x the stuck resonance, through the slipping peak
+    # headline: 100 points (capped) from 0.9 x the stuck resonance, through the slipping peak
     nb_final = 100 if args.quick else 1000
     model, ex = bladed_disk(nb_final)
     w_res = resonance(nb_final)
@@ -191,9 +192,9 @@ def main():
     results = {}
     for reuse in (True, False):
         o = SolverOptions(harmonics=3, samples=56, formulation="banded", max_points=100,
-                          ds_max=0.04, reuse_jacobian=reuse)
+                          ds_max=0.07, reuse_jacobian=reuse)
         t = time.perf_counter()
-        r = frf(model, ex, 0.8 * w_res, 1.2 * w_res, o, outputs=[2])
+        r = frf(model, ex, 0.9 * w_res, 1.2 * w_res, o, outputs=[2])
         dt = time.perf_counter() - t
         tm = r.timings
         tot = tm["fortran_total"]
@@ -204,7 +205,7 @@ def main():
               f"iterations/point, {int(tm['factorizations'])} factorisations, {dt:.1f} s; "
               f"AFT {tm['aft'] / tot:.0%}, assembly {tm['assembly'] / tot:.0%}, "
               f"factorisation {tm['factorization'] / tot:.0%}, solves {tm['solve'] / tot:.0%}")
-    n_pts, dt = results[False]
+    n_pts, dt = results[True]
     print(f"seconds for a {n_pts}-point FRF with {nb_final} contact DoFs and H = 3 (default "
           f"options): {dt:.1f}")
 

@@ -39,6 +39,7 @@ class FRFPoint:
     fold: bool = False
     stable: bool = True
     floquet_max_re: float = 0.0  #: largest real part of the Floquet exponents, 1/s
+    yscale: float = 0.0     #: scale of the unknowns in the arc length the tangent refers to
 
 
 @dataclass
@@ -206,6 +207,7 @@ class FRFWriter:
             f.create_dataset(name, data=v)
         f.attrs["last_parameter"] = p.parameter
         f.attrs["last_omega"] = p.omega
+        f.attrs["last_yscale"] = p.yscale
         f.flush()
 
     def close(self, complete: bool = True, message: str = "") -> None:
@@ -223,7 +225,8 @@ class FRFWriter:
 
     @staticmethod
     def resume_point(path) -> dict:
-        """{'parameter', 'omega', 'unknowns', 'tangent'} of the last point in the file."""
+        """{'parameter', 'omega', 'unknowns', 'tangent', 'yscale'} of the last point in the
+        file: the `start` argument of frirom.solver.frf."""
         import h5py
         with h5py.File(path, "r") as f:
             if "last_unknowns" not in f:
@@ -231,4 +234,5 @@ class FRFWriter:
             return {"parameter": float(f.attrs["last_parameter"]),
                     "omega": float(f.attrs["last_omega"]),
                     "unknowns": f["last_unknowns"][...],
-                    "tangent": f["last_tangent"][...]}
+                    "tangent": f["last_tangent"][...],
+                    "yscale": float(f.attrs.get("last_yscale", 0.0))}

@@ -25,6 +25,8 @@ from .model import LAW_CODES, Excitation, Model
 from .results import FRF, FRFPoint, amplitude_max
 
 FORMULATIONS = {"condensed": 1, "banded": 2}
+#: Largest Hill eigenproblem (2 n_dof (2H+1)) computed; above it stability is skipped.
+HILL_MAX = 4000
 #: Names of the Fortran timers/counters returned with each run (seconds, counts).
 TIMER_NAMES = ("aft", "assembly", "factorization", "solve", "receptance", "evaluations",
                "factorizations", "fortran_total")
@@ -67,7 +69,7 @@ class SolverOptions:
     ds_max: float = 0.1
     max_points: int = 2000
     parameter: str = "frequency"
-    reuse_jacobian: bool = False
+    reuse_jacobian: bool = True
     stability: bool = False
     modes: int | None = None
     batch: int = 10
@@ -205,6 +207,12 @@ class _Packed:
         if np.any(self.outputs < 0) or np.any(self.outputs >= n):
             raise SizeError(f"outputs: DoF indices must be in 0..{n - 1}")
         self.ny = (self.nl.size if self.form == 1 else n) * self.nc
+        self.stability = bool(opts.stability)
+        if self.stability and 2 * n * self.nc > HILL_MAX:
+            warnings.warn(f"frirom: Hill stability skipped: its dense eigenproblem would have "
+                          f"size 2 n_dof (2H+1) = {2 * n * self.nc} > {HILL_MAX}",
+                          RuntimeWarning, stacklevel=3)
+            self.stability = False
         self.nmodes = 0
         self.phi, self.wmodes, self.zmodes = np.zeros((n, 1)), np.ones(1), np.zeros(1)
         if opts.modes:
@@ -220,9 +228,10 @@ class _Packed:
             np.asfortranarray(self.fe0), np.asfortranarray(self.fe1), self.mode, omega_fix,
             self.ginfo, *self.G, self.params, self.w0, (self.outputs + 1).astype(np.int32),
             y0, lam0, tan0, start_mode, ds, o.ds_min, o.ds_max, lam_end, lam_lo,
-            o.tol_residual, o.tol_update, o.tol_stall, o.max_iter, int(o.reuse_jacobian), yscale, lscale,
-            maxpts, max(self.ne_tot, 1), int(o.stability), self.nmodes,
-            np.asfortranarray(self.phi), self.wmodes, self.zmodes, nh=self.H, ndof=self.n_dof, nnl=self.nl.size or 1)
+            o.tol_residual, o.tol_update, o.tol_stall, o.max_iter, int(o.reuse_jacobian),
+            yscale, lscale, maxpts, max(self.ne_tot, 1), int(self.stability), self.nmodes,
+            np.asfortranarray(self.phi), self.wmodes, self.zmodes, nh=self.H,
+            ndof=self.n_dof, nnl=self.nl.size or 1)
 
     def pad_start(self, y, H_from: int) -> np.ndarray:
         """Unknowns of a solution with H_from harmonics, extended or cut to this H."""
@@ -256,7 +265,7 @@ class _Packed:
                                 unknowns=ys[:, k].copy(), tangent=tans[:, k].copy(), X=X,
                                 amp_max=amplitude_max(X), state_fractions=st,
                                 iterations=int(iters[k]), time_s=t_call / max(npts, 1),
-                                stable=bool(hill_re[k] <= 1e-9 * max(abs(om), 1.0)),
+                                stable=bool(hill_re[k] <= 1e-7 * max(abs(om), 1.0)),
                                 floquet_max_re=float(hill_re[k])))
         return pts
 
@@ -273,6 +282,9 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
         tan0 = np.zeros(packed.ny + 1)
         mode, lam0 = 0, float(lam_start)
     else:
+        if isinstance(start, FRFPoint):
+            start = {"parameter": start.parameter, "unknowns": start.unknowns,
+                     "tangent": start.tangent, "yscale": start.yscale}
         y0 = packed.pad_start(start["unknowns"], H_start if H_start is not None else packed.H)
         lam0 = float(start.get("parameter", start.get("omega")))
         tan = start.get("tangent")
@@ -305,13 +317,14 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
         raise_for_status(info, msg.decode(errors="replace"))
         p = packed.points(res, omega_fix, time.perf_counter() - t0)[0]
         t0 = time.perf_counter()
-        points.append(p)
-        if sink is not None:
-            sink(p)
+        points.append(p)        # handed to sink once its tangent is known (next call)
         y0, skip_first = p.unknowns, True
     yscale = float(np.linalg.norm(y0)) or 1.0
     if mode == 1:
         prev_t = tan0[-1]
+        # keep the arc-length scaling the saved tangent was computed with
+        if start.get("yscale"):
+            yscale = float(start["yscale"])
     while len(points) < o.max_points:
         maxpts = min(o.batch, o.max_points - len(points)) + int(skip_first)
         res = packed.call(y0, lam0, tan0, mode, ds, lam_end, lam_lo, yscale, lscale,
@@ -321,10 +334,17 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
         npts, finished, ds_out, info, msg = res[7], res[8], res[9], res[11], res[12]
         _add_timings(timings, res[10])
         new = packed.points(res, omega_fix, t_call)
+        for p in new:
+            p.yscale = yscale
         if skip_first and new:
             prev_t = new[0].tangent[-1]
             points[-1].tangent = new[0].tangent
+            points[-1].yscale = yscale
+            if sink is not None:
+                sink(points[-1])
             new = new[1:]
+        elif skip_first and sink is not None:
+            sink(points[-1])
         skip_first = False
         for p in new:
             if prev_t is not None and prev_t != 0 and np.sign(p.tangent[-1]) != np.sign(prev_t):
@@ -365,7 +385,7 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
     name = "omega" if packed.mode == 1 else "load"
     out = FRF.from_points(points, packed.outputs, packed.group_names, parameter_name=name,
                           complete=complete, message=message,
-                          stability_computed=bool(packed.opts.stability))
+                          stability_computed=packed.stability)
     out.timings = timings
     if keep_unknowns and points:
         out._last_unknowns = points[-1].unknowns
@@ -380,6 +400,7 @@ def _homotopy_start(packed: _Packed, omega: float):
     lp.__dict__.update(packed.__dict__)
     lp.opts = o
     lp.mode = 2
+    lp.stability = False
     fe = packed.fe0
     mask = np.zeros(packed.nc, bool)
     mask[1:] = True
