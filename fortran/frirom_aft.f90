@@ -136,9 +136,12 @@ contains
     !> The march repeats until the slider closes its cycle to tol (relative to the
     !> displacement amplitude) or max_periods is reached (FRIROM_ERR_NOCLOSE, with the
     !> forces of the last period). periods(e): periods marched; states(:, e): fraction of
-    !> samples in stick, slip and lift-off.
+    !> samples in stick, slip and lift-off; slider(:, e): slider position with which the
+    !> closed cycle starts (= where it ends, after the last sample). A continuation passes slider back as the next point's w0, so that
+    !> a contact entering stick-all-cycle keeps the slider where it last slipped (the
+    !> stuck state is not unique; history decides it) instead of jumping back to w0.
     subroutine aft_eval(plan, law, x, params, w0, f, info, errmsg, jac, periods, states, &
-                        tol, max_periods, index_base)
+                        tol, max_periods, index_base, slider)
         type(aft_plan), intent(inout) :: plan
         integer(ip), intent(in) :: law                !! LAW_*
         real(wp), intent(in) :: x(:, :, :)            !! (2H+1, ndir, ne), m
@@ -153,13 +156,14 @@ contains
         real(wp), intent(in), optional :: tol             !! closure tolerance (1e-12)
         integer(ip), intent(in), optional :: max_periods  !! (200)
         integer(ip), intent(in), optional :: index_base   !! element numbering in messages
+        real(wp), intent(out), optional :: slider(:, :)   !! (nslider, ne), m
         integer(ip) :: ne, nd, nc, nb, e0, m, j, e, d, s, np, nper, nfail, base, mp
         real(wp) :: tl
         logical :: want_jac
         character(len=200) :: buf
 
         call check_call(plan, law, x, params, w0, f, info, errmsg, jac, periods, states, &
-                        index_base)
+                        index_base, slider)
         if (info /= FRIROM_OK) return
         tl = DEFAULT_TOL
         if (present(tol)) tl = tol
@@ -189,6 +193,8 @@ contains
                 end if
                 if (present(periods)) periods(e) = min(nper, mp)
                 if (present(states)) call state_fractions(plan%state(j, :), states(:, e))
+                if (present(slider) .and. NSLIDER(law) > 0) &
+                    slider(1:NSLIDER(law), e) = plan%w(j, 1:NSLIDER(law))
             end do
             if (want_jac) call fill_series(plan, law, m)
             do s = 1, np
@@ -274,7 +280,7 @@ contains
 
     !> Shapes, law and parameters of an AFT call, checked before any work.
     subroutine check_call(plan, law, x, params, w0, f, info, errmsg, jac, periods, states, &
-                          index_base)
+                          index_base, slider)
         type(aft_plan), intent(in) :: plan
         integer(ip), intent(in) :: law
         real(wp), intent(in) :: x(:, :, :), params(:, :), w0(:, :), f(:, :, :)
@@ -284,6 +290,7 @@ contains
         integer(ip), intent(in), optional :: periods(:)
         real(wp), intent(in), optional :: states(:, :)
         integer(ip), intent(in), optional :: index_base
+        real(wp), intent(in), optional :: slider(:, :)
         integer(ip) :: ne, nc, nd, e, base
         character(len=200) :: buf, why
 
@@ -332,6 +339,12 @@ contains
         if (present(states)) then
             if (size(states, 1) /= 3 .or. size(states, 2) /= ne) then
                 call set_status(info, FRIROM_ERR_SIZE, errmsg, 'states must be (3, ne)')
+                return
+            end if
+        end if
+        if (present(slider)) then
+            if (size(slider, 1) < NSLIDER(law) .or. size(slider, 2) /= ne) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'slider must be (nslider, ne)')
                 return
             end if
         end if

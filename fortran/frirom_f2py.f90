@@ -19,7 +19,7 @@ end subroutine status_message
 !> Shapes: x, f (2H+1, ndir, ne); params (npar, ne); w0 (nsl, ne) with nsl >= 1;
 !> jac (nj, nj, nje) with nj = ndir(2H+1) and nje = ne, or nje = 0 for no Jacobian.
 subroutine aft_eval(law, nharm, nsamp, ndir, npar, nsl, ne, nj, nje, x, params, w0, tol, &
-                    max_periods, f, jac, periods, states, info, msg)
+                    max_periods, f, jac, periods, states, slider, info, msg)
     use frirom_kinds, only: wp, ip
     use frirom_aft, only: aft_plan, aft_plan_create, aft_plan_destroy, &
                           frirom_aft_eval => aft_eval
@@ -28,7 +28,7 @@ subroutine aft_eval(law, nharm, nsamp, ndir, npar, nsl, ne, nj, nje, x, params, 
     real(8), intent(in) :: x(2*nharm + 1, ndir, ne), params(npar, ne), w0(nsl, ne), tol
     real(8), intent(out) :: f(2*nharm + 1, ndir, ne), jac(nj, nj, nje)
     integer(4), intent(out) :: periods(ne)
-    real(8), intent(out) :: states(3, ne)
+    real(8), intent(out) :: states(3, ne), slider(nsl, ne)
     integer(4), intent(out) :: info
     character(len=512), intent(out) :: msg
     type(aft_plan) :: plan
@@ -37,16 +37,19 @@ subroutine aft_eval(law, nharm, nsamp, ndir, npar, nsl, ne, nj, nje, x, params, 
     f = 0.0d0
     periods = 0
     states = 0.0d0
+    slider = 0.0d0
     call aft_plan_create(plan, int(nharm, ip), int(nsamp, ip), st, msg)
     if (st == 0) then
         if (nje > 0) then
             call frirom_aft_eval(plan, int(law, ip), x, params, w0, f, st, msg, jac=jac, &
                                  periods=per, states=states, tol=real(tol, wp), &
-                                 max_periods=int(max_periods, ip), index_base=0_ip)
+                                 max_periods=int(max_periods, ip), index_base=0_ip, &
+                                 slider=slider)
         else
             call frirom_aft_eval(plan, int(law, ip), x, params, w0, f, st, msg, periods=per, &
                                  states=states, tol=real(tol, wp), &
-                                 max_periods=int(max_periods, ip), index_base=0_ip)
+                                 max_periods=int(max_periods, ip), index_base=0_ip, &
+                                 slider=slider)
         end if
         periods = per
     end if

@@ -346,3 +346,24 @@ def test_bad_initial_slider_shape():
 def test_parameter_dict_names_checked():
     with pytest.raises(frirom.ParameterError, match="missing parameter"):
         contact.aft("jenkins", single_harmonic(1e-3), {"kt": KT, "mu": MU}, 64)
+
+
+def test_slider_of_the_closed_cycle_carries_history():
+    """A contact that slipped and then sticks keeps its slider: marching the stuck cycle
+    from the returned slider reproduces it with no transient (1 period), and the stuck
+    element's mean force is kt (a0 - slider) exactly."""
+    p = {"kt": KT, "mu": MU, "fn0": FN0}
+    big = single_harmonic(1e-3)                         # slips: slider ends on +-0.7 mm
+    r1 = contact.aft("jenkins", big, p, 256)
+    assert r1.slider.shape == (1, 1)
+    slip_w = r1.slider[0, 0]
+    # the slider entering the cycle: where the last sample (u rising to its maximum,
+    # slipping forward) left it, u(tau_N) - mu N / kt
+    assert slip_w == pytest.approx(1e-3 * np.cos(2 * np.pi / 256) - MU * FN0 / KT, rel=1e-12)
+    small = single_harmonic(1e-4)                       # would stick from any slider
+    r2 = contact.aft("jenkins", small, p, 256, w0=r1.slider)
+    assert r2.periods[0] == 1 and r2.states[0, 0] == 1.0
+    assert r2.slider[0, 0] == pytest.approx(slip_w, rel=1e-15)
+    assert r2.forces[0, 0, 0] == pytest.approx(-KT * slip_w, rel=1e-12)
+    r3 = contact.aft("jenkins", small, p, 256)          # from the default slider instead
+    assert r3.forces[0, 0, 0] == pytest.approx(0.0, abs=1e-12)

@@ -79,6 +79,7 @@ class AftResult:
     jacobian: np.ndarray | None   #: (n_elem, n_dir*(2H+1), n_dir*(2H+1)), N/m
     periods: np.ndarray           #: (n_elem,) periods marched until the cycle closed
     states: np.ndarray            #: (n_elem, 3) fractions of samples in stick, slip, lift-off
+    slider: np.ndarray            #: (n_elem, n_slider) slider entering the closed cycle, m
 
 
 def get_law(law: str | Law) -> Law:
@@ -161,7 +162,9 @@ def aft(law: str | Law, x, params, n_samples: int = DEFAULT_SAMPLES, w0=None,
     params : dict of per-law parameters (scalars or (n_elem,) arrays) or an
         (n_elem, n_par) array in the order of ``LAWS[law].parameters``.
     n_samples : time samples per period N (>= 2H+1; 256 recommended).
-    w0 : initial slider positions (n_elem, n_slider), default 0 (see module doc).
+    w0 : initial slider positions (n_elem, n_slider), default 0 (see module doc). Along a
+        continuation pass the previous point's ``result.slider``: a contact that enters
+        stick-all-cycle then keeps its slider where it last slipped.
     jacobian : also return d forces / d x.
     tol : the march stops when the slider returns to its start within tol times the
         displacement amplitude.
@@ -169,13 +172,14 @@ def aft(law: str | Law, x, params, n_samples: int = DEFAULT_SAMPLES, w0=None,
     """
     law, xf, p, w, h, n_elem = _prepare(law, x, params, n_samples, w0)
     nj = law.n_dir * (2 * h + 1)
-    f, jac, periods, states, info, msg = _kernels.aft_eval(
+    f, jac, periods, states, slider, info, msg = _kernels.aft_eval(
         law.code, n_samples, nj, n_elem if jacobian else 0, xf, p, w, float(tol),
         int(max_periods))
     raise_for_status(info, f"{law.name} AFT: " + msg.decode(errors="replace").strip())
     return AftResult(forces=np.transpose(f, (2, 1, 0)),
                      jacobian=np.transpose(jac, (2, 0, 1)) if jacobian else None,
-                     periods=np.asarray(periods), states=np.asarray(states).T)
+                     periods=np.asarray(periods), states=np.asarray(states).T,
+                     slider=np.asarray(slider).T[:, :law.n_slider])
 
 
 def time_histories(law: str | Law, x, params, n_samples: int = DEFAULT_SAMPLES, w0=None,
