@@ -349,21 +349,22 @@ def test_parameter_dict_names_checked():
 
 
 def test_slider_of_the_closed_cycle_carries_history():
-    """A contact that slipped and then sticks keeps its slider: marching the stuck cycle
-    from the returned slider reproduces it with no transient (1 period), and the stuck
-    element's mean force is kt (a0 - slider) exactly."""
+    """Crossing the stick boundary as a continuation does: a cycle that just slips
+    (A = 0.35 mm, stick limit mu N / kt = 0.3 mm) leaves its slider offset; the next, smaller
+    cycle (0.2 mm) marched from that slider sticks at once (1 period, no transient), keeps
+    the slider, and its mean force is -kt * slider exactly; from the default slider the
+    mean would be 0, the jump a continuation must not see."""
     p = {"kt": KT, "mu": MU, "fn0": FN0}
-    big = single_harmonic(1e-3)                         # slips: slider ends on +-0.7 mm
-    r1 = contact.aft("jenkins", big, p, 256)
-    assert r1.slider.shape == (1, 1)
+    r1 = contact.aft("jenkins", single_harmonic(0.35e-3), p, 256)
+    assert r1.slider.shape == (1, 1) and r1.states[0, 1] > 0
     slip_w = r1.slider[0, 0]
     # the slider entering the cycle: where the last sample (u rising to its maximum,
     # slipping forward) left it, u(tau_N) - mu N / kt
-    assert slip_w == pytest.approx(1e-3 * np.cos(2 * np.pi / 256) - MU * FN0 / KT, rel=1e-12)
-    small = single_harmonic(1e-4)                       # would stick from any slider
+    assert slip_w == pytest.approx(0.35e-3 * np.cos(2 * np.pi / 256) - MU * FN0 / KT, rel=1e-12)
+    small = single_harmonic(0.2e-3)
     r2 = contact.aft("jenkins", small, p, 256, w0=r1.slider)
     assert r2.periods[0] == 1 and r2.states[0, 0] == 1.0
     assert r2.slider[0, 0] == pytest.approx(slip_w, rel=1e-15)
     assert r2.forces[0, 0, 0] == pytest.approx(-KT * slip_w, rel=1e-12)
-    r3 = contact.aft("jenkins", small, p, 256)          # from the default slider instead
+    r3 = contact.aft("jenkins", small, p, 256)
     assert r3.forces[0, 0, 0] == pytest.approx(0.0, abs=1e-12)
