@@ -15,7 +15,238 @@ end subroutine status_message
 
 ! ---- contact laws and AFT ----------------------------------------------------------
 
+!> AFT forces (and Jacobian when nje = ne) of ne elements of one law; see frirom_aft.
+!> Shapes: x, f (2H+1, ndir, ne); params (npar, ne); w0 (nsl, ne) with nsl >= 1;
+!> jac (nj, nj, nje) with nj = ndir(2H+1) and nje = ne, or nje = 0 for no Jacobian.
+subroutine aft_eval(law, nharm, nsamp, ndir, npar, nsl, ne, nj, nje, x, params, w0, tol, &
+                    max_periods, f, jac, periods, states, slider, info, msg)
+    use frirom_kinds, only: wp, ip
+    use frirom_aft, only: aft_plan, aft_plan_create, aft_plan_destroy, &
+                          frirom_aft_eval => aft_eval
+    implicit none
+    integer(4), intent(in) :: law, nharm, nsamp, ndir, npar, nsl, ne, nj, nje, max_periods
+    real(8), intent(in) :: x(2*nharm + 1, ndir, ne), params(npar, ne), w0(nsl, ne), tol
+    real(8), intent(out) :: f(2*nharm + 1, ndir, ne), jac(nj, nj, nje)
+    integer(4), intent(out) :: periods(ne)
+    real(8), intent(out) :: states(3, ne), slider(nsl, ne)
+    integer(4), intent(out) :: info
+    character(len=512), intent(out) :: msg
+    type(aft_plan) :: plan
+    integer(ip) :: st, per(ne)
+    msg = ''
+    f = 0.0d0
+    periods = 0
+    states = 0.0d0
+    slider = 0.0d0
+    call aft_plan_create(plan, int(nharm, ip), int(nsamp, ip), st, msg)
+    if (st == 0) then
+        if (nje > 0) then
+            call frirom_aft_eval(plan, int(law, ip), x, params, w0, f, st, msg, jac=jac, &
+                                 periods=per, states=states, tol=real(tol, wp), &
+                                 max_periods=int(max_periods, ip), index_base=0_ip, &
+                                 slider=slider)
+        else
+            call frirom_aft_eval(plan, int(law, ip), x, params, w0, f, st, msg, periods=per, &
+                                 states=states, tol=real(tol, wp), &
+                                 max_periods=int(max_periods, ip), index_base=0_ip, &
+                                 slider=slider)
+        end if
+        periods = per
+    end if
+    call aft_plan_destroy(plan)
+    info = st
+end subroutine aft_eval
+
+!> Time histories of the closed cycle: xt, ft (nsamp, ndir, ne); see frirom_aft.
+subroutine aft_time(law, nharm, nsamp, ndir, npar, nsl, ne, x, params, w0, tol, max_periods, &
+                    xt, ft, info, msg)
+    use frirom_kinds, only: wp, ip
+    use frirom_aft, only: aft_plan, aft_plan_create, aft_plan_destroy, &
+                          frirom_aft_time => aft_time
+    implicit none
+    integer(4), intent(in) :: law, nharm, nsamp, ndir, npar, nsl, ne, max_periods
+    real(8), intent(in) :: x(2*nharm + 1, ndir, ne), params(npar, ne), w0(nsl, ne), tol
+    real(8), intent(out) :: xt(nsamp, ndir, ne), ft(nsamp, ndir, ne)
+    integer(4), intent(out) :: info
+    character(len=512), intent(out) :: msg
+    type(aft_plan) :: plan
+    integer(ip) :: st
+    msg = ''
+    xt = 0.0d0
+    ft = 0.0d0
+    call aft_plan_create(plan, int(nharm, ip), int(nsamp, ip), st, msg)
+    if (st == 0) call frirom_aft_time(plan, int(law, ip), x, params, w0, xt, ft, st, msg, &
+                                      tol=real(tol, wp), max_periods=int(max_periods, ip), &
+                                      index_base=0_ip)
+    call aft_plan_destroy(plan)
+    info = st
+end subroutine aft_time
+
 ! ---- harmonic balance solver -------------------------------------------------------
+
+!> Reverse Cuthill-McKee order of a symmetric pattern (CSR, 1-based): perm(k) = node at k.
+subroutine hbm_rcm(n, nnz, indptr, indices, perm, info, msg)
+    use frirom_kinds, only: ip
+    use frirom_banded, only: rcm_order
+    implicit none
+    integer(4), intent(in) :: n, nnz
+    integer(4), intent(in) :: indptr(n + 1), indices(nnz)
+    integer(4), intent(out) :: perm(n)
+    integer(4), intent(out) :: info
+    character(len=512), intent(out) :: msg
+    integer(ip) :: linfo
+    msg = ''
+    call rcm_order(indptr, indices, perm, linfo, msg)
+    info = linfo
+end subroutine hbm_rcm
+
+!> Harmonic balance solve and pseudo-arc-length continuation (frirom_hbm hbm_run).
+!> form: 1 condensed, 2 full banded. K, M, C: CSR, 1-based, ndof x ndof, symmetric.
+!> perm: RCM order of the DoFs. nl: nonlinear DoFs (condensed). fe0, fe1: real harmonic
+!> excitation (ndof, 2H+1) (frequency mode: fe0; load mode: fe0 + lam fe1 at omega_fix).
+!> ginfo(3, ngroup): law, n_elem, n_dir; G rows group by group, element, direction (CSR over
+!> the full DoFs); params (npar, ne) and w0 (nslider, ne) per group, concatenated.
+!> start_mode: 0 solve at lam0 from y0 then continue, 1 resume from (y0, lam0, tan0),
+!> 2 solve at lam0 only. Outputs: npts points; timings: AFT, assembly, factorisation, solve,
+!> receptances (s), residual evaluations, factorisations, total (s).
+subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, mx, nnzc, cp, &
+                        ci, cx, perm, nnl, nl, fe0, fe1, mode, omega_fix, ngroup, ginfo, nrows, &
+                        nnzg, gp, gi, gx, npart, params, nw0, w0, nout, outdofs, ny, y0, lam0, &
+                        tan0, start_mode, ds, ds_min, ds_max, lam_end, lam_lo, tol_r, tol_x, &
+                        tol_stall, max_iter, reuse, yscale, lscale, maxpts, netot, stability, &
+                        nmodes, phi, wmodes, zmodes, ys, lams, tans, iters, xo, states, hill_re, &
+                        npts, finished, ds_out, timings, info, msg)
+    use frirom_kinds, only: wp, ip
+    use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
+    use frirom_newton, only: cont_options
+    use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
+                          hbm_run, N_TIMERS
+    implicit none
+    integer(4), intent(in) :: form, nh, nsamp, ndof, nnzk, nnzm, nnzc
+    integer(4), intent(in) :: kp(ndof + 1), ki(nnzk), mp(ndof + 1), mi(nnzm), cp(ndof + 1), &
+                              ci(nnzc)
+    real(8), intent(in) :: kx(nnzk), mx(nnzm), cx(nnzc)
+    integer(4), intent(in) :: perm(ndof), nnl, nl(nnl)
+    real(8), intent(in) :: fe0(ndof, 2*nh + 1), fe1(ndof, 2*nh + 1)
+    integer(4), intent(in) :: mode
+    real(8), intent(in) :: omega_fix
+    integer(4), intent(in) :: ngroup, ginfo(3, ngroup), nrows, nnzg, gp(nrows + 1), gi(nnzg)
+    real(8), intent(in) :: gx(nnzg)
+    integer(4), intent(in) :: npart, nw0
+    real(8), intent(in) :: params(npart), w0(nw0)
+    integer(4), intent(in) :: nout, outdofs(nout), ny
+    real(8), intent(in) :: y0(ny), lam0, tan0(ny + 1)
+    integer(4), intent(in) :: start_mode
+    real(8), intent(in) :: ds, ds_min, ds_max, lam_end, lam_lo, tol_r, tol_x, tol_stall
+    integer(4), intent(in) :: max_iter, reuse
+    real(8), intent(in) :: yscale, lscale
+    integer(4), intent(in) :: maxpts, netot
+    integer(4), intent(in) :: stability    !! 1: Hill stability of every point
+    integer(4), intent(in) :: nmodes       !! > 0: condensed receptances by modal superposition
+    real(8), intent(in) :: phi(ndof, max(nmodes, 1)), wmodes(max(nmodes, 1)), &
+                           zmodes(max(nmodes, 1))
+    real(8), intent(out) :: ys(ny, maxpts), lams(maxpts), tans(ny + 1, maxpts)
+    integer(4), intent(out) :: iters(maxpts)
+    real(8), intent(out) :: xo(nout, 2*nh + 1, maxpts), states(3, netot, maxpts)
+    real(8), intent(out) :: hill_re(maxpts)   !! max real part of the Floquet exponents, 1/s
+    integer(4), intent(out) :: npts, finished
+    real(8), intent(out) :: ds_out, timings(8)
+    integer(4), intent(out) :: info
+    character(len=512), intent(out) :: msg
+    class(hbm_system), allocatable :: sys
+    type(cont_options) :: opts
+    real(wp), allocatable :: y(:), t(:)
+    real(wp) :: lam, dsl
+    integer(ip) :: linfo, np, itl(maxpts)
+    integer(8) :: c0, c1, rate
+    logical :: fin
+    call system_clock(c0, rate)
+    msg = ''
+    info = 0
+    npts = 0
+    finished = 0
+    ds_out = ds
+    timings = 0.0d0
+    ys = 0.0d0
+    lams = 0.0d0
+    tans = 0.0d0
+    iters = 0
+    xo = 0.0d0
+    states = 0.0d0
+    if (form == 1) then
+        allocate (hbm_condensed :: sys)
+    else if (form == 2) then
+        allocate (hbm_full :: sys)
+    else
+        call set_status(linfo, FRIROM_ERR_PARAM, msg, 'formulation must be 1 (condensed) '// &
+                        'or 2 (banded)')
+        info = linfo
+        return
+    end if
+    call hbm_setup(sys, nh, nsamp, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
+                   fe1, mode, omega_fix, ginfo, gp, gi, gx, params, w0, outdofs, linfo, msg)
+    if (linfo == 0 .and. (sys%n /= ny .or. sum(ginfo(2, :)) /= netot)) &
+        call set_status(linfo, FRIROM_ERR_SIZE, msg, 'hbm_continue: ny or netot does not '// &
+                        'match the model')
+    if (linfo == 0 .and. nmodes > 0) call hbm_set_modes(sys, phi, wmodes, zmodes, linfo, msg)
+    if (linfo /= 0) then
+        info = linfo
+        return
+    end if
+    opts%tol_r = tol_r
+    opts%tol_x = tol_x
+    opts%tol_stall = tol_stall
+    opts%max_iter = max_iter
+    opts%reuse_jac = reuse /= 0
+    opts%yscale = yscale
+    opts%lscale = lscale
+    opts%ds = ds
+    opts%ds_min = ds_min
+    opts%ds_max = ds_max
+    opts%lam_end = lam_end
+    opts%max_points = maxpts
+    y = y0
+    t = tan0
+    lam = lam0
+    dsl = ds
+    hill_re = 0.0d0
+    if (stability /= 0) then
+        call hbm_run(sys, start_mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itl, xo, &
+                     states, np, fin, linfo, msg, hill_re)
+    else
+        call hbm_run(sys, start_mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itl, xo, &
+                     states, np, fin, linfo, msg)
+    end if
+    npts = np
+    iters = itl
+    finished = merge(1, 0, fin)
+    ds_out = dsl
+    info = linfo
+    timings(1:N_TIMERS - 1) = sys%timers(1:N_TIMERS - 1)
+    call system_clock(c1)
+    timings(8) = real(c1 - c0, 8)/real(rate, 8)
+end subroutine hbm_continue
+
+!> GFLOP/s of the dgemm the library links (reps products of n x n matrices), for benchmarks
+!> that compare factorisation rates with the BLAS actually used.
+subroutine hbm_dgemm_rate(n, reps, gflops)
+    implicit none
+    integer(4), intent(in) :: n, reps
+    real(8), intent(out) :: gflops
+    real(8), allocatable :: a(:, :), b(:, :), c(:, :)
+    integer(8) :: c0, c1, rate
+    integer(4) :: k
+    allocate (a(n, n), b(n, n), c(n, n))
+    call random_number(a)
+    call random_number(b)
+    call dgemm('N', 'N', n, n, n, 1.0d0, a, n, b, n, 0.0d0, c, n)
+    call system_clock(c0, rate)
+    do k = 1, reps
+        call dgemm('N', 'N', n, n, n, 1.0d0, a, n, b, n, 0.0d0, c, n)
+    end do
+    call system_clock(c1)
+    gflops = 2.0d0*real(n, 8)**3*reps/max(real(c1 - c0, 8)/real(rate, 8), 1.0d-9)/1.0d9
+end subroutine hbm_dgemm_rate
 
 ! ---- reduction: eigen-solves, Craig-Bampton, interface reduction -------------------
 

@@ -9,7 +9,7 @@ module frirom_status
     public :: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, FRIROM_ERR_NONFINITE, &
               FRIROM_ERR_SAMPLES, FRIROM_ERR_ALLOC, FRIROM_ERR_FFTW, FRIROM_ERR_LAPACK, &
               FRIROM_ERR_ARPACK, FRIROM_ERR_NOCONV, FRIROM_ERR_SINGULAR, FRIROM_ERR_LAW, &
-              FRIROM_ERR_NOCLOSE
+              FRIROM_ERR_NOCLOSE, FRIROM_ERR_CONT, FRIROM_ERR_MODEL
     public :: FRIROM_ERR_FACTOR
 
     ! General codes 1-19; solver codes from 20; reduction codes from 40.
@@ -26,6 +26,8 @@ module frirom_status
     integer(ip), parameter :: FRIROM_ERR_SINGULAR = 10
     integer(ip), parameter :: FRIROM_ERR_LAW = 11
     integer(ip), parameter :: FRIROM_ERR_NOCLOSE = 12
+    integer(ip), parameter :: FRIROM_ERR_CONT = 20
+    integer(ip), parameter :: FRIROM_ERR_MODEL = 21
     ! Reduction codes.
     integer(ip), parameter :: FRIROM_ERR_FACTOR = 40
 
@@ -62,6 +64,10 @@ contains
             msg = 'unknown contact law'
         case (FRIROM_ERR_NOCLOSE)
             msg = 'hysteresis cycle did not close within the allowed number of periods'
+        case (FRIROM_ERR_CONT)
+            msg = 'continuation stopped: the corrector failed at the minimum step'
+        case (FRIROM_ERR_MODEL)
+            msg = 'inconsistent model data'
         case (FRIROM_ERR_FACTOR)
             msg = 'sparse factorisation failed'
         case default

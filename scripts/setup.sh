@@ -24,4 +24,7 @@ python3 -m venv .venv
 # Editable install: meson-python rebuilds the Fortran core on import when sources change.
 .venv/bin/python -m pip install -q --no-build-isolation -Cbuild-dir=build/py -e .
 
+# The main job: the forced response of a blade with a platform friction damper (bundled
+# deck), written to results/joint/; then the contact-element demo into results/demo/.
+.venv/bin/frirom run cases/joint/joint.toml --out results/joint
 .venv/bin/frirom demo --out results/demo

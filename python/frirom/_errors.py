@@ -51,13 +51,15 @@ class SingularMatrixError(NumericalError):
 
 _BY_CODE = {cls.code: cls for cls in (SizeError, ParameterError, NonFiniteError,
                                       SamplesError, ConvergenceError, SingularMatrixError)}
+_BY_CODE[11] = ParameterError      # unknown contact law
+_BY_CODE[12] = ConvergenceError    # hysteresis cycle did not close
+_BY_CODE[20] = ConvergenceError    # continuation stopped at the minimum step
+_BY_CODE[21] = ParameterError      # inconsistent model data (solver)
 
 
 def raise_for_status(info: int, message: str) -> None:
     """Raise the exception class of a nonzero Fortran status, with Fortran's message."""
     if info == 0:
         return
-    cls = _BY_CODE.get(int(info))
-    if cls is None:
-        cls = InputError if 1 <= info < 20 and info in (11,) else NumericalError
+    cls = _BY_CODE.get(int(info), NumericalError)
     raise cls(message.strip() or f"frirom status {info}", code=int(info))

@@ -1,19 +1,161 @@
-"""The ``frirom`` command line."""
+"""frirom: nonlinear forced response of frictionally damped structures.
+
+    frirom run DECK [--out DIR] [--resume]    forced response of a deck (docs/deck.md)
+    frirom demo [--out DIR]                   contact hysteresis loops and harmonics
+"""
 
 from __future__ import annotations
 
 import argparse
+import shutil
 import sys
+import time
+from pathlib import Path
 
 from . import __version__
-from ._errors import FriromError
+from ._errors import FriromError, InputError
+
+
+def _add_run(sub) -> None:
+    p = sub.add_parser(
+        "run", help="compute the forced response of a deck",
+        description="Compute the forced response (FRF) described by a TOML deck. Points are "
+        "appended to OUT/frf.h5 as they converge (an interrupted run continues with "
+        "--resume); at the end OUT/frf.csv, OUT/frf.png and OUT/states.png are written.")
+    p.add_argument("deck", type=Path, help="the TOML deck (see docs/deck.md)")
+    p.add_argument("--out", type=Path, default=None,
+                   help="output folder (default: results/<deck name>)")
+    p.add_argument("--resume", action="store_true",
+                   help="continue the run stored in OUT/frf.h5 from its last point")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_run)
+
+
+def _add_demo(sub) -> None:
+    demo = sub.add_parser("demo", help="hysteresis loops and harmonic content of contact "
+                                       "elements, plotted to PNG")
+    demo.add_argument("--out", type=Path, default=Path("results/demo"),
+                      help="output folder (default: results/demo)")
+    demo.set_defaults(func=_demo)
+
+
+def _demo(args) -> int:
+    from . import demo
+    demo.run(args.out)
+    return 0
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="frirom", description=__doc__)
+    parser = argparse.ArgumentParser(prog="frirom", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"frirom {__version__}")
-    parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    _add_run(sub)
+    _add_demo(sub)
     return parser
+
+
+class _Progress:
+    """tqdm bar over the frequency range (the furthest frequency reached so far)."""
+
+    def __init__(self, deck, quiet: bool):
+        from tqdm import tqdm
+        from .plots import frequency_axis
+        self._axis = lambda w: float(frequency_axis(w, deck.frequency_unit)[0])
+        self.f0 = self._axis(deck.omega_start)
+        self.f1 = self._axis(deck.omega_end)
+        unit = "Hz" if deck.frequency_unit == "hz" else "rad/s"
+        self.bar = tqdm(total=round(abs(self.f1 - self.f0), 6), unit=unit, disable=quiet,
+                        dynamic_ncols=True, file=sys.stderr, mininterval=0.2,
+                        bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} " + unit +
+                        " [{elapsed}<{remaining}{postfix}]", desc=deck.path.name)
+        self.points = 0
+        self.done = 0.0
+
+    def update(self, point) -> None:
+        self.points += 1
+        f = self._axis(point.omega)
+        reach = min(max((f - self.f0) / (self.f1 - self.f0), 0.0), 1.0) * self.bar.total
+        if reach > self.done:
+            self.bar.update(reach - self.done)
+            self.done = reach
+        self.bar.set_postfix_str(f"{self.points} pts, f={f:.2f}, "
+                                 f"amp={float(point.amp_max[0]):.3g}", refresh=False)
+
+    def close(self) -> None:
+        self.bar.close()
+
+
+def cmd_run(args) -> int:
+    from .deck import load_deck
+    from .plots import plot_frf, plot_states
+    from .results import FRF, FRFWriter
+    from .solver import frf
+
+    deck = load_deck(args.deck)
+    out = args.out if args.out is not None else Path("results") / deck.path.stem
+    out.mkdir(parents=True, exist_ok=True)
+    h5 = out / "frf.h5"
+    names = [c.name for c in deck.contacts]
+    start = None
+    if args.resume:
+        if not h5.is_file():
+            raise InputError(f"{h5}: nothing to resume (run without --resume first)")
+        previous = FRF.load(h5)
+        if previous.complete:
+            print(f"frirom: {h5} is already complete ({len(previous)} points); "
+                  "rewriting the CSV and plots", file=sys.stderr)
+        else:
+            start = FRFWriter.resume_point(h5)
+    else:
+        shutil.copyfile(deck.path, out / "deck.toml")
+
+    model, excitation, options = deck.model(), deck.excitation(), deck.options()
+    if start is not None or not args.resume:
+        writer = FRFWriter(h5, deck.outputs, names, deck.harmonics, append=args.resume)
+        progress = _Progress(deck, args.quiet)
+
+        def sink(point):
+            writer.append(point)
+            progress.update(point)
+
+        t0 = time.perf_counter()
+        try:
+            result = frf(model, excitation, deck.omega_start, deck.omega_end, options,
+                         outputs=deck.outputs, sink=sink, start=start)
+        except KeyboardInterrupt:
+            progress.close()
+            writer.close(complete=False, message="interrupted")
+            print(f"frirom: interrupted; {h5} keeps every converged point: continue with "
+                  f"`frirom run {args.deck} --out {out} --resume`", file=sys.stderr)
+            return 130
+        except BaseException as exc:
+            progress.close()
+            writer.close(complete=False, message=f"{type(exc).__name__}: {exc}")
+            raise
+        progress.close()
+        writer.close(complete=result.complete, message=result.message)
+        elapsed = time.perf_counter() - t0
+        if not result.complete:
+            print(f"frirom: the run stopped early: {result.message}; the points computed "
+                  f"are in {h5}", file=sys.stderr)
+    else:
+        elapsed = 0.0
+
+    full = FRF.load(h5)
+    if deck.csv:
+        full.save_csv(out / "frf.csv")
+    written = [h5] + ([out / "frf.csv"] if deck.csv else [])
+    if deck.plot and len(full) > 0:
+        written.append(plot_frf(full, out / "frf.png", output_names=deck.output_names,
+                                unit=deck.frequency_unit, title=deck.title))
+        if deck.contacts:
+            written.append(plot_states(full, out / "states.png", contact_names=names,
+                                       unit=deck.frequency_unit,
+                                       title=f"{deck.title}: contact states"))
+    print(f"frirom: {len(full)} points in {elapsed:.1f} s; wrote "
+          + ", ".join(str(p) for p in written))
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,0 +1,368 @@
+!> Newton's method with the analytical Jacobian and pseudo-arc-length continuation on an
+!> abstract nonlinear system R(y, lam) = 0 (lam: frequency or load parameter).
+!>
+!> The system (an extension of nl_system) evaluates R, factorises dR/dy and gives dR/dlam;
+!> this module owns the iteration: bordered Newton corrector with backtracking, residual
+!> and update tests that are relative (the same in N and mN), Jacobian reuse while the
+!> iteration contracts fast, tangent predictor, adaptive step, turning points, retries.
+module frirom_newton
+    use frirom_kinds, only: wp, ip
+    use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, &
+                             FRIROM_ERR_NOCONV, FRIROM_ERR_NONFINITE, FRIROM_ERR_CONT, &
+                             set_status
+    implicit none
+    private
+    public :: nl_system, cont_options, newton_correct, cont_tangent, cont_run
+
+    !> A nonlinear system R(y, lam) = 0 with n unknowns y and one parameter lam.
+    type, abstract :: nl_system
+        integer(ip) :: n = 0       !! number of unknowns y
+    contains
+        procedure(eval_iface), deferred :: eval
+        procedure(solve_iface), deferred :: solve
+    end type nl_system
+
+    abstract interface
+        !> Residual r = R(y, lam), its reference magnitude rref (the test is
+        !> ||r|| <= tol_r rref) and rlam = dR/dlam. When jac is true, also factorise
+        !> J = dR/dy for `solve`.
+        subroutine eval_iface(this, y, lam, r, rref, jac, rlam, info, errmsg)
+            import :: nl_system, wp, ip
+            class(nl_system), intent(inout) :: this
+            real(wp), intent(in) :: y(:)        !! (n) unknowns
+            real(wp), intent(in) :: lam         !! parameter
+            real(wp), intent(out) :: r(:)       !! (n) residual
+            real(wp), intent(out) :: rref       !! reference magnitude of the residual
+            logical, intent(in) :: jac          !! factorise dR/dy
+            real(wp), intent(out) :: rlam(:)    !! (n) dR/dlam
+            integer(ip), intent(out) :: info
+            character(len=*), intent(inout) :: errmsg
+        end subroutine eval_iface
+        !> Overwrite the columns of b with J^-1 b, J from the last eval with jac.
+        subroutine solve_iface(this, b, info, errmsg)
+            import :: nl_system, wp, ip
+            class(nl_system), intent(inout) :: this
+            real(wp), intent(inout) :: b(:, :)  !! (n, nrhs)
+            integer(ip), intent(out) :: info
+            character(len=*), intent(inout) :: errmsg
+        end subroutine solve_iface
+    end interface
+
+    !> Newton and continuation settings. Arc length is measured in scaled variables
+    !> (y / yscale, lam / lscale), so ds is dimensionless.
+    type :: cont_options
+        real(wp) :: tol_r = 1.0e-10_wp   !! ||R|| / rref below this ...
+        real(wp) :: tol_x = 1.0e-9_wp    !! ... and ||dy|| / max(||y||, yscale) below this
+        !> after max_iter, a residual that stagnated below this is accepted: at a contact
+        !> state change inside one time sample R is not differentiable and Newton can cycle
+        !> between the two sides at a level far below the AFT discretisation error
+        real(wp) :: tol_stall = 0.0_wp
+        integer(ip) :: max_iter = 25     !! Newton iterations per corrector
+        logical :: reuse_jac = .true.    !! keep a factorisation while iterations contract
+        real(wp) :: reuse_rate = 0.1_wp  !! contraction factor below which J is kept
+        real(wp) :: yscale = 1.0_wp      !! typical size of y (e.g. linear response norm)
+        real(wp) :: lscale = 1.0_wp      !! typical size of lam (e.g. frequency range)
+        real(wp) :: ds = 0.01_wp         !! initial arc-length step
+        real(wp) :: ds_min = 1.0e-6_wp
+        real(wp) :: ds_max = 0.1_wp
+        integer(ip) :: iter_target = 4   !! steps grow below, shrink above this
+        real(wp) :: lam_end = 1.0_wp     !! continuation stops at this parameter value
+        integer(ip) :: max_points = 1000 !! points per call
+    end type cont_options
+
+contains
+
+    !> Bordered Newton corrector: solve R(y, lam) = 0 together with the linear constraint
+    !> cy.(y - yp)/yscale + cl (lam - lp)/lscale = 0 (cy = 0, cl = 1 fixes lam = lp;
+    !> cy, cl = tangent gives pseudo-arc-length). y, lam enter as the start, leave solved.
+    subroutine newton_correct(sys, y, lam, yp, lp, cy, cl, opts, iters, info, errmsg, &
+                              have_fact, nfact)
+        class(nl_system), intent(inout) :: sys
+        real(wp), intent(inout) :: y(:)       !! (n) start in, solution out
+        real(wp), intent(inout) :: lam        !! start in, solution out
+        real(wp), intent(in) :: yp(:), lp     !! (n), predicted point of the constraint
+        real(wp), intent(in) :: cy(:), cl     !! (n), constraint direction (scaled)
+        type(cont_options), intent(in) :: opts
+        integer(ip), intent(out) :: iters     !! Newton iterations used
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        logical, intent(inout) :: have_fact   !! a usable factorisation exists (in/out)
+        integer(ip), intent(out), optional :: nfact  !! Jacobian factorisations made
+        real(wp), allocatable :: r(:), rlam(:), ab(:, :), y1(:), r1(:), dy(:), rlam1(:)
+        real(wp) :: rref, rn, g, denom, dlam, alpha, phi0, phi1, rn1, rref1, g1, lam1, dxn
+        real(wp) :: rate
+        logical :: fresh
+        character(len=120) :: buf
+        integer(ip) :: n, k
+        n = sys%n
+        info = FRIROM_OK
+        iters = 0
+        if (size(y) /= n .or. size(yp) /= n .or. size(cy) /= n) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'newton_correct: y, yp, cy need n')
+            return
+        end if
+        allocate (r(n), rlam(n), ab(n, 2), y1(n), r1(n), dy(n), rlam1(n))
+        rate = 1.0_wp
+        fresh = .not. (have_fact .and. opts%reuse_jac)
+        if (present(nfact)) nfact = merge(1, 0, fresh)
+        call sys%eval(y, lam, r, rref, fresh, rlam, info, errmsg)
+        if (info /= 0) return
+        have_fact = .true.
+        rn = norm2(r)/max(rref, tiny(1.0_wp))
+        g = dot_product(cy, y - yp)/opts%yscale + cl*(lam - lp)/opts%lscale
+        do k = 1, opts%max_iter
+            iters = k
+            if (k > 1 .and. (.not. opts%reuse_jac .or. rate > opts%reuse_rate)) then
+                call sys%eval(y, lam, r, rref, .true., rlam, info, errmsg)
+                if (info /= 0) return
+                fresh = .true.
+                if (present(nfact)) nfact = nfact + 1
+            else if (k > 1) then
+                fresh = .false.
+            end if
+            ab(:, 1) = -r
+            ab(:, 2) = rlam
+            call sys%solve(ab, info, errmsg)
+            if (info /= 0) return
+            denom = cl/opts%lscale - dot_product(cy, ab(:, 2))/opts%yscale
+            if (abs(denom) < tiny(1.0_wp)) then
+                call set_status(info, FRIROM_ERR_NOCONV, errmsg, &
+                                'newton_correct: constraint parallel to the solution curve')
+                return
+            end if
+            dlam = (-g - dot_product(cy, ab(:, 1))/opts%yscale)/denom
+            dy = ab(:, 1) - dlam*ab(:, 2)
+            if (.not. (all(abs(dy) <= huge(1.0_wp)) .and. abs(dlam) <= huge(1.0_wp))) then
+                call set_status(info, FRIROM_ERR_NONFINITE, errmsg, &
+                                'newton_correct: non-finite Newton update')
+                return
+            end if
+            ! backtracking on the merit ||R||^2/rref^2 + g^2
+            phi0 = rn**2 + g**2
+            alpha = 1.0_wp
+            do
+                y1 = y + alpha*dy
+                lam1 = lam + alpha*dlam
+                call sys%eval(y1, lam1, r1, rref1, .false., rlam1, info, errmsg)
+                if (info /= 0) return
+                rn1 = norm2(r1)/max(rref1, tiny(1.0_wp))
+                g1 = dot_product(cy, y1 - yp)/opts%yscale + cl*(lam1 - lp)/opts%lscale
+                phi1 = rn1**2 + g1**2
+                if (phi1 <= (1.0_wp - 1.0e-4_wp*alpha)*phi0 .or. alpha < 0.06_wp) exit
+                if (.not. (phi1 <= huge(1.0_wp)) .and. alpha < 0.06_wp) exit
+                alpha = 0.5_wp*alpha
+            end do
+            if (.not. (phi1 <= huge(1.0_wp))) then
+                call set_status(info, FRIROM_ERR_NONFINITE, errmsg, &
+                                'newton_correct: residual not finite along the update')
+                return
+            end if
+            dxn = alpha*max(norm2(dy)/max(norm2(y1), opts%yscale), &
+                            abs(dlam)/opts%lscale)
+            rate = sqrt(phi1/max(phi0, tiny(1.0_wp)))
+            y = y1
+            lam = lam1
+            r = r1
+            rlam = rlam1
+            rref = rref1
+            rn = rn1
+            g = g1
+            ! converged: residual and update small; or the residual at round-off level
+            ! (near-singular J, e.g. gross slip, can keep the update above tol_x there)
+            if (rn <= opts%tol_r .and. abs(g) <= max(opts%tol_x, 1.0e-12_wp) .and. &
+                (dxn <= opts%tol_x .or. rn <= 100.0_wp*epsilon(1.0_wp))) return
+        end do
+        if (rn <= opts%tol_stall .and. abs(g) <= max(opts%tol_x, 1.0e-12_wp)) return
+        call set_status(info, FRIROM_ERR_NOCONV, errmsg, 'newton_correct: no convergence')
+        write (buf, '(a,i0,a,es9.2,a,es9.2)') ' in ', opts%max_iter, &
+            ' iterations, |R|/rref = ', rn, ', update = ', dxn
+        errmsg = trim(errmsg)//trim(buf)
+    end subroutine newton_correct
+
+    !> Unit tangent (scaled variables) of the solution curve at a converged point, oriented
+    !> along `tprev` (or along increasing lam * sgn when tprev is zero). Leaves the
+    !> factorisation of J at this point in the system, for the next corrector.
+    subroutine cont_tangent(sys, y, lam, opts, tprev, sgn, t, info, errmsg)
+        class(nl_system), intent(inout) :: sys
+        real(wp), intent(in) :: y(:), lam
+        type(cont_options), intent(in) :: opts
+        real(wp), intent(in) :: tprev(:)      !! (n+1) previous tangent, or zeros
+        real(wp), intent(in) :: sgn           !! direction of lam when tprev is zero
+        real(wp), intent(out) :: t(:)         !! (n+1) unit tangent (y/yscale, lam/lscale)
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        real(wp), allocatable :: r(:), rlam(:), b(:, :)
+        real(wp) :: rref, nrm
+        integer(ip) :: n
+        n = sys%n
+        allocate (r(n), rlam(n), b(n, 1))
+        call sys%eval(y, lam, r, rref, .true., rlam, info, errmsg)
+        if (info /= 0) return
+        b(:, 1) = rlam
+        call sys%solve(b, info, errmsg)
+        if (info /= 0) return
+        ! dy/dlam = -J^-1 dR/dlam, in scaled variables
+        t(1:n) = -b(:, 1)*opts%lscale/opts%yscale
+        t(n + 1) = 1.0_wp
+        nrm = norm2(t)
+        if (.not. (nrm <= huge(1.0_wp))) then
+            call set_status(info, FRIROM_ERR_NONFINITE, errmsg, 'cont_tangent: J singular?')
+            return
+        end if
+        t = t/nrm
+        if (any(tprev /= 0.0_wp)) then
+            if (dot_product(t, tprev) < 0.0_wp) t = -t
+        else
+            if (t(n + 1)*sgn < 0.0_wp) t = -t
+        end if
+    end subroutine cont_tangent
+
+    !> Pseudo-arc-length continuation from a converged point (y, lam) with tangent t,
+    !> until lam reaches opts%lam_end (the last point is solved at lam_end exactly), the
+    !> curve leaves the range through lam_lo, or max_points points were made. A failed
+    !> corrector is retried with half the step; below ds_min the run stops with
+    !> FRIROM_ERR_CONT and every point made so far stays in the outputs.
+    subroutine cont_run(sys, y, lam, t, ds, lam_lo, opts, yout, lout, tout, itout, npts, &
+                        finished, info, errmsg, have_fact)
+        class(nl_system), intent(inout) :: sys
+        real(wp), intent(inout) :: y(:)        !! (n) start point in, last point out
+        real(wp), intent(inout) :: lam
+        real(wp), intent(inout) :: t(:)        !! (n+1) tangent in/out
+        real(wp), intent(inout) :: ds          !! step in/out (adapted)
+        real(wp), intent(in) :: lam_lo         !! stop if the curve turns back past this
+        type(cont_options), intent(in) :: opts
+        real(wp), intent(out) :: yout(:, :)    !! (n, max_points) converged points
+        real(wp), intent(out) :: lout(:)       !! (max_points)
+        real(wp), intent(out) :: tout(:, :)    !! (n+1, max_points) tangents
+        integer(ip), intent(out) :: itout(:)   !! (max_points) Newton iterations
+        integer(ip), intent(out) :: npts       !! points made
+        logical, intent(out) :: finished       !! lam_end (or lam_lo) reached
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        logical, intent(inout) :: have_fact    !! the system holds J at (y, lam) (in/out)
+        real(wp), allocatable :: y1(:), yp(:), t1(:), cy(:)
+        real(wp) :: lam1, lp, dirn, frac, cl
+        integer(ip) :: n, iters
+        logical :: last, jumped
+        integer(ip) :: nfail, nf, effort
+        real(wp) :: ds_fail0
+        type(cont_options) :: fresh_opts
+        character(len=len(errmsg)) :: why
+        character(len=120) :: buf
+        n = sys%n
+        info = FRIROM_OK
+        npts = 0
+        finished = .false.
+        if (size(y) /= n .or. size(t) /= n + 1 .or. size(yout, 1) /= n .or. &
+            size(tout, 1) /= n + 1 .or. size(yout, 2) < opts%max_points .or. &
+            size(lout) < opts%max_points .or. size(itout) < opts%max_points) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'cont_run: array sizes')
+            return
+        end if
+        if (.not. (ds > 0.0_wp .and. opts%ds_min > 0.0_wp .and. opts%ds_max >= opts%ds_min)) &
+            then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'cont_run: need 0 < ds_min <= '// &
+                            'ds_max and ds > 0')
+            return
+        end if
+        allocate (y1(n), yp(n), t1(n + 1), cy(n))
+        dirn = sign(1.0_wp, opts%lam_end - lam_lo)
+        jumped = .false.
+        nfail = 0
+        ds_fail0 = ds
+        fresh_opts = opts
+        fresh_opts%reuse_jac = .false.
+        do while (npts < opts%max_points)
+            ds = min(max(ds, opts%ds_min), opts%ds_max)
+            yp = y + ds*t(1:n)*opts%yscale
+            lp = lam + ds*t(n + 1)*opts%lscale
+            last = (lp - opts%lam_end)*dirn >= 0.0_wp
+            if (last) then
+                ! land on lam_end: fixed-parameter corrector from the interpolated predictor
+                frac = (opts%lam_end - lam)/(lp - lam)
+                yp = y + frac*(yp - y)
+                lp = opts%lam_end
+                cy = 0.0_wp
+                cl = 1.0_wp
+            else
+                cy = t(1:n)
+                cl = t(n + 1)
+            end if
+            y1 = yp
+            lam1 = lp
+            call newton_correct(sys, y1, lam1, yp, lp, cy, cl, opts, iters, info, errmsg, &
+                                have_fact, nf)
+            if (info /= 0 .and. opts%reuse_jac) then
+                ! chord steps can stall where a contact changes state: retry the same step
+                ! with a fresh Jacobian at every iteration before shrinking it
+                y1 = yp
+                lam1 = lp
+                have_fact = .false.
+                call newton_correct(sys, y1, lam1, yp, lp, cy, cl, fresh_opts, iters, info, &
+                                    errmsg, have_fact, nf)
+            end if
+            if (info == 0 .and. .not. last) then
+                ! a corrector that wandered far from the predictor found another branch
+                if (sqrt(sum(((y1 - y)/opts%yscale)**2) + ((lam1 - lam)/opts%lscale)**2) > &
+                    3.0_wp*ds) then
+                    call set_status(info, FRIROM_ERR_NOCONV, errmsg, 'corrector converged '// &
+                                    'more than 3 steps away from the predictor')
+                end if
+            end if
+            if (info /= 0) then
+                why = errmsg
+                have_fact = .false.
+                nfail = nfail + 1
+                if (nfail == 1) ds_fail0 = ds
+                if ((nfail == 5 .or. ds <= opts%ds_min*1.000001_wp) .and. .not. jumped) then
+                    ! a discontinuity or kink of R (a contact entering stick-all-cycle, a
+                    ! state change inside one sample) stalls Newton at any small step: try
+                    ! once to step over it with a larger step
+                    jumped = .true.
+                    ds = min(max(4.0_wp*ds_fail0, 0.1_wp*opts%ds_max), opts%ds_max)
+                    info = FRIROM_OK
+                    cycle
+                end if
+                if (ds <= opts%ds_min*1.000001_wp) then
+                    call set_status(info, FRIROM_ERR_CONT, errmsg, 'continuation stopped')
+                    write (buf, '(a,es12.5,a,es9.2,a)') ' at parameter ', lam, &
+                        ' with step ', ds, ' at its minimum; last corrector: '
+                    errmsg = trim(errmsg)//trim(buf)//' '//trim(why)
+                    return
+                end if
+                info = FRIROM_OK
+                ds = 0.5_wp*ds
+                cycle
+            end if
+            call cont_tangent(sys, y1, lam1, opts, t, dirn, t1, info, errmsg)
+            if (info /= 0) then
+                have_fact = .false.
+                return
+            end if
+            have_fact = .true.
+            jumped = .false.
+            nfail = 0
+            npts = npts + 1
+            y = y1
+            lam = lam1
+            t = t1
+            yout(:, npts) = y
+            lout(npts) = lam
+            tout(:, npts) = t
+            itout(npts) = iters
+            ! step control on the work done: Newton iterations, or with Jacobian reuse the
+            ! factorisations (chord iterations are cheap)
+            effort = iters
+            if (opts%reuse_jac) effort = min(iters, 2*nf)
+            if (effort <= opts%iter_target - 1) then
+                ds = min(1.6_wp*ds, opts%ds_max)
+            else if (effort > opts%iter_target + 2) then
+                ds = max(0.6_wp*ds, opts%ds_min)
+            end if
+            if (last .or. (lam - lam_lo)*dirn < 0.0_wp) then
+                finished = .true.
+                return
+            end if
+        end do
+    end subroutine cont_run
+end module frirom_newton

@@ -1,0 +1,616 @@
+"""The frirom input deck: a TOML file naming the matrices, damping, excitation, contacts,
+harmonics, frequency range, continuation options and outputs (see docs/deck.md).
+
+``load_deck(path)`` reads and checks the whole deck, loads the matrix files and returns a
+:class:`Deck` holding plain numpy/scipy data; ``Deck.model()``, ``Deck.excitation()`` and
+``Deck.options()`` build the solver's objects from it. Every malformed field raises
+:class:`frirom.InputError` naming the deck file, the TOML key path (``contacts[2].mu``)
+and what was expected.
+
+DoFs are referred to by 0-based index into the matrices, or by label when the deck names a
+``dof_labels`` file (one label per line, in matrix order).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import scipy.io
+import scipy.sparse as sp
+
+from ._errors import InputError
+
+try:                                   # Python >= 3.11
+    import tomllib
+except ModuleNotFoundError:            # pragma: no cover - Python 3.10 with tomli
+    try:
+        import tomli as tomllib
+    except ModuleNotFoundError:
+        tomllib = None
+
+__all__ = ["Deck", "ContactSpec", "load_deck", "engine_order_loads", "read_matrix",
+           "LAW_PARAMS", "MATRIX_FORMATS"]
+
+#: law -> (local direction names, parameter names, number of slider coordinates)
+LAW_PARAMS = {
+    "jenkins": (("u",), ("kt", "mu", "fn0"), 1),
+    "normal1d": (("u", "v"), ("kt", "kn", "mu", "n0"), 1),
+    "normal2d": (("u1", "u2", "v"), ("kt", "kn", "mu", "n0"), 2),
+    "cubic": (("u",), ("k1", "k3"), 0),
+}
+
+#: parameters that must be >= 0 (n0 may be negative: an initial gap)
+_NONNEGATIVE = {"kt", "kn", "mu", "fn0"}
+
+MATRIX_FORMATS = ("mtx",)
+
+_FREQ_UNITS = {"hz": 2.0 * math.pi, "rad/s": 1.0}
+
+
+class _Ctx:
+    """Builds InputErrors that name the deck file and the key path."""
+
+    def __init__(self, path: Path):
+        self.path = path
+
+    def error(self, key: str, expected: str, got=None) -> InputError:
+        msg = f"{self.path}: {key}: expected {expected}"
+        if got is not None:
+            shown = repr(got)
+            if len(shown) > 80:
+                shown = shown[:77] + "..."
+            msg += f", got {shown}"
+        return InputError(msg)
+
+
+def _table(ctx, d, key, required=True):
+    parts = key.split(".")
+    v = d.get(parts[-1]) if isinstance(d, dict) else None
+    if v is None:
+        if required:
+            raise ctx.error(key, "a table [" + key + "]")
+        return {}
+    if not isinstance(v, dict):
+        raise ctx.error(key, "a table", v)
+    return v
+
+
+def _unknown(ctx, d: dict, allowed, prefix: str):
+    for k in d:
+        if k not in allowed:
+            where = f"{prefix}.{k}" if prefix else k
+            raise ctx.error(where, "one of the known keys " + ", ".join(sorted(allowed))
+                            + " (unknown key)")
+
+
+def _num(ctx, d, name, key, *, default=None, required=False, positive=False,
+         nonneg=False, integer=False, minimum=None):
+    if name not in d:
+        if required:
+            raise ctx.error(key, "a number (missing)")
+        return default
+    v = d[name]
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise ctx.error(key, "an integer" if integer else "a number", v)
+    if integer and not isinstance(v, int):
+        raise ctx.error(key, "an integer", v)
+    if not math.isfinite(v):
+        raise ctx.error(key, "a finite number", v)
+    if positive and v <= 0:
+        raise ctx.error(key, "a positive number", v)
+    if nonneg and v < 0:
+        raise ctx.error(key, "a number >= 0", v)
+    if minimum is not None and v < minimum:
+        raise ctx.error(key, f"a number >= {minimum}", v)
+    return v
+
+
+def _str(ctx, d, name, key, *, default=None, required=False, choices=None):
+    if name not in d:
+        if required:
+            raise ctx.error(key, "a string (missing)" if not choices else
+                            "one of " + ", ".join(repr(c) for c in choices) + " (missing)")
+        return default
+    v = d[name]
+    if not isinstance(v, str):
+        raise ctx.error(key, "a string", v)
+    if choices is not None and v.lower() not in choices:
+        raise ctx.error(key, "one of " + ", ".join(repr(c) for c in choices), v)
+    return v.lower() if choices is not None else v
+
+
+def _bool(ctx, d, name, key, default):
+    if name not in d:
+        return default
+    v = d[name]
+    if not isinstance(v, bool):
+        raise ctx.error(key, "true or false", v)
+    return v
+
+
+def read_matrix(path: Path, fmt: str, what: str, deck_path: Path | None = None):
+    """Read one matrix file as scipy CSR; ``fmt`` is one of :data:`MATRIX_FORMATS`."""
+    where = f"{deck_path}: " if deck_path else ""
+    if fmt != "mtx":
+        raise InputError(f"{where}model.format: expected one of {MATRIX_FORMATS}, got {fmt!r}")
+    if not path.is_file():
+        raise InputError(f"{where}{what}: matrix file {path} does not exist")
+    try:
+        A = scipy.io.mmread(str(path))
+    except Exception as exc:     # scipy raises ValueError/IndexError/... for bad files
+        raise InputError(f"{path}: not a readable MatrixMarket file ({what}): {exc}") from exc
+    A = sp.csr_matrix(A, dtype=float) if not sp.issparse(A) else A.tocsr().astype(float)
+    if A.shape[0] != A.shape[1]:
+        raise InputError(f"{path}: {what} must be square, got shape {A.shape}")
+    if not np.all(np.isfinite(A.data)):
+        raise InputError(f"{path}: {what} has non-finite entries")
+    return A
+
+
+@dataclass
+class ContactSpec:
+    """One contact group as read from the deck (no solver objects)."""
+
+    name: str
+    law: str
+    G: sp.csr_matrix          # (n_elem*n_dir, n_dof)
+    params: np.ndarray        # (n_elem, n_par)
+    w0: np.ndarray | None     # (n_elem, n_slider) or None
+
+
+@dataclass
+class Deck:
+    """A checked deck. Frequencies in rad/s; F complex (n_dof, H+1); continuation steps
+    are the solver's dimensionless arc-length steps."""
+
+    path: Path
+    title: str
+    M: sp.csr_matrix
+    K: sp.csr_matrix
+    damping: dict             # {'type': 'rayleigh', 'alpha':, 'beta':} | modal | matrix
+    F: np.ndarray
+    contacts: list
+    harmonics: int
+    samples: int | None       # None: the solver's default
+    formulation: str
+    omega_start: float
+    omega_end: float
+    frequency_unit: str
+    continuation: dict
+    solver: dict
+    outputs: list             # DoF indices
+    output_names: list
+    dof_labels: list | None = None
+    plot: bool = True
+    csv: bool = True
+    raw: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def n_dof(self) -> int:
+        return self.M.shape[0]
+
+    # ---- builders of the solver's objects (python/frirom/model.py, solver.py) ----
+    def damping_object(self):
+        from .model import Damping
+        d = self.damping
+        if d["type"] == "rayleigh":
+            return Damping.rayleigh(d["alpha"], d["beta"])
+        if d["type"] == "modal":
+            return Damping.modal(d["zeta"])
+        return Damping.matrix(d["C"])
+
+    def model(self):
+        from .model import ContactGroup, Model
+        groups = [ContactGroup(law=c.law, G=c.G, params=c.params, w0=c.w0, name=c.name)
+                  for c in self.contacts]
+        return Model(self.M, self.K, self.damping_object(), groups,
+                     dof_labels=self.dof_labels)
+
+    def excitation(self):
+        from .model import Excitation
+        return Excitation(self.F)
+
+    def options(self):
+        """The solver's SolverOptions from the [solver] and [continuation] tables."""
+        from .solver import SolverOptions
+        kw = {"harmonics": self.harmonics, "samples": self.samples,
+              "formulation": self.formulation}
+        for key, name in (("tol_residual", "tol_residual"), ("tol_update", "tol_update"),
+                          ("max_iterations", "max_iter"), ("stability", "stability")):
+            if key in self.solver:
+                kw[name] = self.solver[key]
+        for key, name in (("step", "ds"), ("min_step", "ds_min"), ("max_step", "ds_max")):
+            if key in self.continuation:
+                kw[name] = self.continuation[key]
+        if "max_points" in self.continuation:
+            kw["max_points"] = self.continuation["max_points"]
+        opts = SolverOptions(**kw)
+        if opts.ds_min > opts.ds_max or not opts.ds_min <= opts.ds <= opts.ds_max:
+            # keep the user's steps consistent with the solver's defaults for the others
+            lo, hi = min(opts.ds_min, opts.ds), max(opts.ds_max, opts.ds)
+            opts.ds_min, opts.ds_max = lo, hi
+        return opts
+
+
+def engine_order_loads(n_dof: int, dofs, eo: int, n_sectors: int, amplitude: complex,
+                       harmonic: int = 1, H: int = 1) -> np.ndarray:
+    """Complex loads (n_dof, H+1) of an engine-order travelling wave.
+
+    ``dofs``: one DoF index per sector (or one list of DoFs per sector, all loaded alike);
+    sector s gets amplitude * exp(-i 2 pi eo s / n_sectors) on harmonic ``harmonic``, so
+    that f_s(t) = |A| cos(h omega t + arg A - 2 pi eo s / n_sectors): sector s lags sector
+    0 by 2 pi eo s / n_sectors (a forward travelling wave for eo > 0).
+    """
+    F = np.zeros((n_dof, H + 1), complex)
+    for s, d in enumerate(dofs):
+        phase = np.exp(-2j * np.pi * eo * s / n_sectors)
+        for j in np.atleast_1d(d):
+            F[int(j), harmonic] += amplitude * phase
+    return F
+
+
+class _Parser:
+    def __init__(self, path: Path):
+        self.path = path
+        self.ctx = _Ctx(path)
+        self.base = path.parent
+
+    def dof(self, v, key, n_dof, labels):
+        if isinstance(v, bool):
+            raise self.ctx.error(key, "a DoF index (integer) or label (string)", v)
+        if isinstance(v, int):
+            if not 0 <= v < n_dof:
+                raise self.ctx.error(key, f"a DoF index in 0..{n_dof - 1}", v)
+            return v
+        if isinstance(v, str):
+            if labels is None:
+                raise self.ctx.error(key, "a DoF index (labels need model.dof_labels)", v)
+            try:
+                return labels.index(v)
+            except ValueError:
+                raise self.ctx.error(key, "a DoF label listed in model.dof_labels", v) from None
+        raise self.ctx.error(key, "a DoF index (integer) or label (string)", v)
+
+    def run(self) -> Deck:
+        ctx = self.ctx
+        if tomllib is None:
+            raise InputError(f"{self.path}: reading a deck needs Python >= 3.11 (tomllib) "
+                             "or the 'tomli' package")
+        try:
+            with open(self.path, "rb") as fh:
+                raw = tomllib.load(fh)
+        except FileNotFoundError:
+            raise InputError(f"{self.path}: deck file does not exist") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise InputError(f"{self.path}: not valid TOML: {exc}") from None
+        _unknown(ctx, raw, {"title", "model", "damping", "excitation", "contacts", "solver",
+                            "frequency", "continuation", "outputs"}, "")
+        title = _str(ctx, raw, "title", "title", default=self.path.stem)
+
+        # ---- model ----
+        mdl = _table(ctx, raw, "model")
+        _unknown(ctx, mdl, {"format", "mass", "stiffness", "dof_labels"}, "model")
+        fmt = _str(ctx, mdl, "format", "model.format", default="mtx", choices=MATRIX_FORMATS)
+        M = read_matrix(self.file(mdl, "mass", "model.mass"), fmt, "model.mass", self.path)
+        K = read_matrix(self.file(mdl, "stiffness", "model.stiffness"), fmt,
+                        "model.stiffness", self.path)
+        if M.shape != K.shape:
+            raise ctx.error("model.stiffness", f"a matrix of the mass matrix's shape "
+                            f"{M.shape}", K.shape)
+        n = M.shape[0]
+        if np.any(M.diagonal() <= 0):
+            i = int(np.argmax(M.diagonal() <= 0))
+            raise ctx.error("model.mass", f"a mass matrix with a positive diagonal "
+                            f"(DoF {i} has {M.diagonal()[i]})")
+        for A, key in ((M, "model.mass"), (K, "model.stiffness")):
+            asym = abs(A - A.T).max() if A.nnz else 0.0
+            if asym > 1e-8 * max(abs(A).max(), 1e-300):
+                raise ctx.error(key, "a symmetric matrix", f"max |A - A^T| = {asym:.3g}")
+        labels = None
+        if "dof_labels" in mdl:
+            lp = self.file(mdl, "dof_labels", "model.dof_labels")
+            labels = [s.strip() for s in lp.read_text().splitlines() if s.strip()]
+            if len(labels) != n:
+                raise ctx.error("model.dof_labels", f"{n} labels (one per line, matrix "
+                                f"order) in {lp}", f"{len(labels)} labels")
+            if len(set(labels)) != n:
+                raise ctx.error("model.dof_labels", f"unique labels in {lp}")
+
+        # ---- solver ----
+        sol = _table(ctx, raw, "solver")
+        _unknown(ctx, sol, {"harmonics", "samples", "formulation", "tol_residual",
+                            "tol_update", "max_iterations", "stability"}, "solver")
+        H = _num(ctx, sol, "harmonics", "solver.harmonics", required=True, integer=True,
+                 minimum=1)
+        N = _num(ctx, sol, "samples", "solver.samples", integer=True)
+        if N is not None and N < 2 * H + 1:
+            raise ctx.error("solver.samples", f"an integer >= 2*harmonics+1 = {2 * H + 1}", N)
+        form = _str(ctx, sol, "formulation", "solver.formulation", default="condensed",
+                    choices=("condensed", "banded"))
+        solver = {}
+        for k in ("tol_residual", "tol_update"):
+            v = _num(ctx, sol, k, f"solver.{k}", positive=True)
+            if v is not None:
+                solver[k] = float(v)
+        v = _num(ctx, sol, "max_iterations", "solver.max_iterations", integer=True, minimum=1)
+        if v is not None:
+            solver["max_iterations"] = v
+        solver["stability"] = _bool(ctx, sol, "stability", "solver.stability", True)
+
+        # ---- damping ----
+        damp = _table(ctx, raw, "damping")
+        dtype = _str(ctx, damp, "type", "damping.type", required=True,
+                     choices=("rayleigh", "modal", "matrix"))
+        if dtype == "rayleigh":
+            _unknown(ctx, damp, {"type", "alpha", "beta"}, "damping")
+            damping = {"type": "rayleigh",
+                       "alpha": float(_num(ctx, damp, "alpha", "damping.alpha", default=0.0,
+                                           nonneg=True)),
+                       "beta": float(_num(ctx, damp, "beta", "damping.beta", default=0.0,
+                                          nonneg=True))}
+        elif dtype == "modal":
+            _unknown(ctx, damp, {"type", "zeta"}, "damping")
+            z = damp.get("zeta")
+            if isinstance(z, (int, float)) and not isinstance(z, bool):
+                zeta = _num(ctx, damp, "zeta", "damping.zeta", nonneg=True)
+                if zeta >= 1:
+                    raise ctx.error("damping.zeta", "a damping ratio in [0, 1)", zeta)
+                zeta = np.full(n, float(zeta))
+            elif isinstance(z, list) and z:
+                zeta = np.array([_num(ctx, {"z": zi}, "z", f"damping.zeta[{i}]", nonneg=True)
+                                 for i, zi in enumerate(z)], float)
+                if np.any(zeta >= 1):
+                    i = int(np.argmax(zeta >= 1))
+                    raise ctx.error(f"damping.zeta[{i}]", "a damping ratio in [0, 1)", z[i])
+                if zeta.size > n:
+                    raise ctx.error("damping.zeta", f"at most {n} modal ratios", zeta.size)
+            else:
+                raise ctx.error("damping.zeta", "a damping ratio or a list of ratios "
+                                "(one per mode, lowest first)", z)
+            damping = {"type": "modal", "zeta": zeta}
+        else:
+            _unknown(ctx, damp, {"type", "file"}, "damping")
+            C = read_matrix(self.file(damp, "file", "damping.file"), fmt, "damping.file",
+                            self.path)
+            if C.shape != M.shape:
+                raise ctx.error("damping.file", f"a matrix of shape {M.shape}", C.shape)
+            damping = {"type": "matrix", "C": C}
+
+        # ---- excitation ----
+        exc = _table(ctx, raw, "excitation")
+        _unknown(ctx, exc, {"load", "engine_order"}, "excitation")
+        F = np.zeros((n, H + 1), complex)
+        loads = exc.get("load", [])
+        if not isinstance(loads, list):
+            raise ctx.error("excitation.load", "an array of tables [[excitation.load]]", loads)
+        for i, ld in enumerate(loads):
+            key = f"excitation.load[{i}]"
+            if not isinstance(ld, dict):
+                raise ctx.error(key, "a table", ld)
+            _unknown(ctx, ld, {"dof", "harmonic", "amplitude", "phase"}, key)
+            if "dof" not in ld:
+                raise ctx.error(f"{key}.dof", "a DoF index or label (missing)")
+            d = self.dof(ld["dof"], f"{key}.dof", n, labels)
+            h = _num(ctx, ld, "harmonic", f"{key}.harmonic", default=1, integer=True,
+                     minimum=0)
+            if h > H:
+                raise ctx.error(f"{key}.harmonic", f"a harmonic in 0..solver.harmonics={H}", h)
+            amp = _num(ctx, ld, "amplitude", f"{key}.amplitude", required=True)
+            ph = _num(ctx, ld, "phase", f"{key}.phase", default=0.0)
+            if h == 0 and ph not in (0, 0.0):
+                raise ctx.error(f"{key}.phase", "0 for a static load (harmonic 0)", ph)
+            F[d, h] += amp * np.exp(1j * np.deg2rad(ph))
+        eos = exc.get("engine_order", [])
+        if isinstance(eos, dict):
+            eos = [eos]
+        if not isinstance(eos, list):
+            raise ctx.error("excitation.engine_order", "an array of tables", eos)
+        for i, eo in enumerate(eos):
+            key = f"excitation.engine_order[{i}]"
+            if not isinstance(eo, dict):
+                raise ctx.error(key, "a table", eo)
+            _unknown(ctx, eo, {"eo", "dofs", "n_sectors", "amplitude", "phase", "harmonic"},
+                     key)
+            order = _num(ctx, eo, "eo", f"{key}.eo", required=True, integer=True)
+            dofs = eo.get("dofs")
+            if not isinstance(dofs, list) or not dofs:
+                raise ctx.error(f"{key}.dofs", "a non-empty list: one DoF (or list of DoFs) "
+                                "per sector", dofs)
+            sect = []
+            for s, ds in enumerate(dofs):
+                if isinstance(ds, list):
+                    sect.append([self.dof(v, f"{key}.dofs[{s}][{j}]", n, labels)
+                                 for j, v in enumerate(ds)])
+                else:
+                    sect.append(self.dof(ds, f"{key}.dofs[{s}]", n, labels))
+            ns = _num(ctx, eo, "n_sectors", f"{key}.n_sectors", default=len(dofs),
+                      integer=True, minimum=1)
+            h = _num(ctx, eo, "harmonic", f"{key}.harmonic", default=1, integer=True,
+                     minimum=1)
+            if h > H:
+                raise ctx.error(f"{key}.harmonic", f"a harmonic in 1..solver.harmonics={H}", h)
+            amp = _num(ctx, eo, "amplitude", f"{key}.amplitude", required=True)
+            ph = _num(ctx, eo, "phase", f"{key}.phase", default=0.0)
+            F += engine_order_loads(n, sect, order, ns, amp * np.exp(1j * np.deg2rad(ph)),
+                                    harmonic=h, H=H)
+        if not np.any(F[:, 1:]):
+            raise ctx.error("excitation", "at least one load on a harmonic >= 1 "
+                            "([[excitation.load]] or [[excitation.engine_order]])")
+
+        # ---- contacts ----
+        cons = raw.get("contacts", [])
+        if not isinstance(cons, list):
+            raise ctx.error("contacts", "an array of tables [[contacts]]", cons)
+        contacts = [self.contact(c, f"contacts[{i}]", n, labels) for i, c in enumerate(cons)]
+        names = [c.name for c in contacts]
+        for i, nm in enumerate(names):
+            if nm in names[:i]:
+                raise ctx.error(f"contacts[{i}].name", "a name not used by another contact", nm)
+
+        # ---- frequency ----
+        fr = _table(ctx, raw, "frequency")
+        _unknown(ctx, fr, {"start", "end", "unit"}, "frequency")
+        unit = _str(ctx, fr, "unit", "frequency.unit", default="hz", choices=tuple(_FREQ_UNITS))
+        f0 = _num(ctx, fr, "start", "frequency.start", required=True, positive=True)
+        f1 = _num(ctx, fr, "end", "frequency.end", required=True, positive=True)
+        if f1 == f0:
+            raise ctx.error("frequency.end", "a frequency different from frequency.start", f1)
+        scale = _FREQ_UNITS[unit]
+
+        # ---- continuation ----
+        con = _table(ctx, raw, "continuation", required=False)
+        _unknown(ctx, con, {"step", "min_step", "max_step", "max_points"}, "continuation")
+        cont = {}
+        for k in ("step", "min_step", "max_step"):
+            v = _num(ctx, con, k, f"continuation.{k}", positive=True)
+            if v is not None:
+                cont[k] = float(v)
+        if "min_step" in cont and "max_step" in cont and cont["min_step"] > cont["max_step"]:
+            raise ctx.error("continuation.min_step", "a value <= continuation.max_step",
+                            con["min_step"])
+        v = _num(ctx, con, "max_points", "continuation.max_points", integer=True, minimum=2)
+        if v is not None:
+            cont["max_points"] = v
+
+        # ---- outputs ----
+        out = _table(ctx, raw, "outputs")
+        _unknown(ctx, out, {"dofs", "plot", "csv"}, "outputs")
+        od = out.get("dofs")
+        if not isinstance(od, list) or not od:
+            raise ctx.error("outputs.dofs", "a non-empty list of DoF indices or labels", od)
+        outputs = [self.dof(v, f"outputs.dofs[{i}]", n, labels) for i, v in enumerate(od)]
+        onames = [labels[i] if labels else f"dof{i}" for i in outputs]
+
+        return Deck(path=self.path, title=title, M=M, K=K, damping=damping, F=F,
+                    contacts=contacts, harmonics=H, samples=N, formulation=form,
+                    omega_start=f0 * scale, omega_end=f1 * scale, frequency_unit=unit,
+                    continuation=cont, solver=solver, outputs=outputs, output_names=onames,
+                    dof_labels=labels, plot=_bool(ctx, out, "plot", "outputs.plot", True),
+                    csv=_bool(ctx, out, "csv", "outputs.csv", True), raw=raw)
+
+    def file(self, d, name, key) -> Path:
+        v = d.get(name)
+        if not isinstance(v, str) or not v:
+            raise self.ctx.error(key, "a file name (relative to the deck's folder)", v)
+        p = Path(v)
+        return p if p.is_absolute() else self.base / p
+
+    def contact(self, c, key, n, labels) -> ContactSpec:
+        ctx = self.ctx
+        if not isinstance(c, dict):
+            raise ctx.error(key, "a table [[contacts]]", c)
+        law = _str(ctx, c, "law", f"{key}.law", required=True, choices=tuple(LAW_PARAMS))
+        dirs, pnames, nsl = LAW_PARAMS[law]
+        ndir = len(dirs)
+        _unknown(ctx, c, {"name", "law", "elements", "directions", "w0"} | set(pnames), key)
+        name = _str(ctx, c, "name", f"{key}.name", default=key)
+        els = c.get("elements")
+        if not isinstance(els, list) or not els:
+            raise ctx.error(f"{key}.elements", "a non-empty list of {a = ..., b = ...} "
+                            "tables", els)
+        ne = len(els)
+        # local frame: directions (ndir vectors, node-DoF length) shared or per element
+        dv = c.get("directions")
+        rows, cols, vals = [], [], []
+        for e, el in enumerate(els):
+            ek = f"{key}.elements[{e}]"
+            if not isinstance(el, dict):
+                raise ctx.error(ek, "a table {a = [DoFs], b = [DoFs] | \"ground\"}", el)
+            _unknown(ctx, el, {"a", "b", "directions"}, ek)
+            a = self.node(el.get("a"), f"{ek}.a", n, labels, allow_ground=False)
+            b = self.node(el.get("b", "ground"), f"{ek}.b", n, labels, allow_ground=True)
+            if b is not None and len(b) != len(a):
+                raise ctx.error(f"{ek}.b", f"{len(a)} DoFs like {ek}.a, or \"ground\"", b)
+            if b is not None and set(a) & set(b):
+                raise ctx.error(f"{ek}.b", f"DoFs different from {ek}.a", b)
+            frame = el.get("directions", dv)
+            fk = f"{ek}.directions" if "directions" in el else f"{key}.directions"
+            if frame is None:
+                if len(a) == ndir:
+                    frame = np.eye(ndir).tolist()
+                else:
+                    raise ctx.error(f"{key}.directions", f"{ndir} direction vectors "
+                                    f"({', '.join(dirs)}) of length {len(a)} (node DoFs)")
+            D = self.frame(frame, fk, ndir, len(a), dirs)
+            for d in range(ndir):
+                for j in range(len(a)):
+                    if D[d, j] != 0.0:
+                        rows.append(e * ndir + d)
+                        cols.append(a[j])
+                        vals.append(D[d, j])
+                        if b is not None:
+                            rows.append(e * ndir + d)
+                            cols.append(b[j])
+                            vals.append(-D[d, j])
+        G = sp.csr_matrix((vals, (rows, cols)), shape=(ne * ndir, n))
+        params = np.empty((ne, len(pnames)))
+        for j, p in enumerate(pnames):
+            params[:, j] = self.per_element(c, p, f"{key}.{p}", ne, required=True,
+                                            nonneg=p in _NONNEGATIVE)
+        if law in ("jenkins", "normal1d", "normal2d") and np.any(params[:, 0] <= 0):
+            raise ctx.error(f"{key}.kt", "a positive tangential stiffness (N/m)")
+        w0 = None
+        if "w0" in c:
+            if nsl == 0:
+                raise ctx.error(f"{key}.w0", f"no initial slider for law {law!r} "
+                                "(it has none)")
+            w0 = np.repeat(self.per_element(c, "w0", f"{key}.w0", ne)[:, None], nsl, axis=1)
+        return ContactSpec(name=name, law=law, G=G, params=params, w0=w0)
+
+    def node(self, v, key, n, labels, allow_ground):
+        if v is None:
+            raise self.ctx.error(key, "a DoF or list of DoFs (missing)")
+        if isinstance(v, str) and v.lower() == "ground":
+            if allow_ground:
+                return None
+            raise self.ctx.error(key, "DoFs (only side b may be \"ground\")", v)
+        items = v if isinstance(v, list) else [v]
+        if not items:
+            raise self.ctx.error(key, "a non-empty list of DoFs", v)
+        return [self.dof(x, f"{key}[{i}]" if isinstance(v, list) else key, n, labels)
+                for i, x in enumerate(items)]
+
+    def frame(self, frame, key, ndir, nd, dirs):
+        if not isinstance(frame, list) or len(frame) != ndir:
+            raise self.ctx.error(key, f"{ndir} direction vectors ({', '.join(dirs)})", frame)
+        D = np.empty((ndir, nd))
+        for d, vec in enumerate(frame):
+            if (not isinstance(vec, list) or len(vec) != nd
+                    or any(isinstance(x, bool) or not isinstance(x, (int, float))
+                           for x in vec)):
+                raise self.ctx.error(f"{key}[{d}]", f"a list of {nd} numbers (one per node "
+                                     "DoF)", vec)
+            D[d] = vec
+            nrm = np.linalg.norm(D[d])
+            if not np.isfinite(nrm) or nrm == 0.0:
+                raise self.ctx.error(f"{key}[{d}]", "a non-zero finite vector", vec)
+            D[d] /= nrm
+        return D
+
+    def per_element(self, c, p, key, ne, required=False, nonneg=False):
+        if p not in c:
+            if required:
+                raise self.ctx.error(key, f"a number or a list of {ne} numbers (missing)")
+            return np.zeros(ne)
+        v = c[p]
+        vals = v if isinstance(v, list) else [v] * ne
+        if len(vals) != ne:
+            raise self.ctx.error(key, f"a number or a list of {ne} numbers (one per element)",
+                                 v)
+        out = np.empty(ne)
+        for i, x in enumerate(vals):
+            k = f"{key}[{i}]" if isinstance(v, list) else key
+            if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+                raise self.ctx.error(k, "a finite number", x)
+            if nonneg and x < 0:
+                raise self.ctx.error(k, "a number >= 0", x)
+            out[i] = x
+        return out
+
+
+def load_deck(path) -> Deck:
+    """Read and check a deck file; raises :class:`frirom.InputError` on any bad field."""
+    return _Parser(Path(path)).run()

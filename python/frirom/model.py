@@ -1,0 +1,268 @@
+"""The structural model the solver works on: matrices, damping, contacts and excitation.
+
+Units are the user's (consistent SI recommended: N, m, kg, s). Every check raises a
+:class:`frirom.InputError` subclass naming the field and what was expected.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from ._errors import NonFiniteError, ParameterError, SizeError
+
+#: Laws known to the AFT kernel: number of local directions, parameter names, sliders.
+LAWS = {
+    "jenkins": (1, ("kt", "mu", "fn0"), 1),
+    "normal1d": (2, ("kt", "kn", "mu", "n0"), 1),
+    "normal2d": (3, ("kt", "kn", "mu", "n0"), 2),
+    "cubic": (1, ("k1", "k3"), 0),
+}
+LAW_CODES = {"jenkins": 1, "normal1d": 2, "normal2d": 3, "cubic": 4}
+
+
+def _as_matrix(a, name: str, n: int | None = None) -> sp.csr_matrix:
+    """A square real matrix as CSR, checked for shape and finite values."""
+    try:
+        m = sp.csr_matrix(a, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ParameterError(f"{name}: expected a real square matrix ({exc})") from None
+    if m.ndim != 2 or m.shape[0] != m.shape[1]:
+        raise SizeError(f"{name}: expected a square matrix, got shape {m.shape}")
+    if n is not None and m.shape[0] != n:
+        raise SizeError(f"{name}: expected shape ({n}, {n}), got {m.shape}")
+    if not np.all(np.isfinite(m.data)):
+        raise NonFiniteError(f"{name}: contains NaN or Inf")
+    m.sum_duplicates()
+    m.eliminate_zeros()
+    return m
+
+
+def _check_symmetric(m: sp.csr_matrix, name: str) -> None:
+    scale = abs(m).max() if m.nnz else 0.0
+    if m.nnz and abs(m - m.T).max() > 1e-10 * scale:
+        raise ParameterError(f"{name}: must be symmetric (max |A - A^T| = "
+                             f"{abs(m - m.T).max():.3g}, max |A| = {scale:.3g})")
+
+
+@dataclass
+class Damping:
+    """Linear viscous damping: a matrix C, Rayleigh C = alpha M + beta K, or modal
+    damping ratios zeta (one per mode, lowest modes first; C = M Phi diag(2 zeta w) Phi^T M
+    over those modes, Phi mass-normalised).
+
+    Build with :meth:`matrix`, :meth:`rayleigh` or :meth:`modal`.
+    """
+
+    kind: str
+    C: object = None
+    alpha: float = 0.0
+    beta: float = 0.0
+    zeta: np.ndarray | None = None
+
+    @classmethod
+    def matrix(cls, C) -> "Damping":
+        return cls("matrix", C=C)
+
+    @classmethod
+    def rayleigh(cls, alpha: float = 0.0, beta: float = 0.0) -> "Damping":
+        """C = alpha M + beta K; alpha in 1/s, beta in s, both >= 0."""
+        for nm, v in (("alpha", alpha), ("beta", beta)):
+            if not np.isfinite(v) or v < 0:
+                raise ParameterError(f"damping.{nm}: expected a finite value >= 0, got {v}")
+        return cls("rayleigh", alpha=float(alpha), beta=float(beta))
+
+    @classmethod
+    def modal(cls, zeta) -> "Damping":
+        """zeta: (n_modes,) damping ratios in [0, 1) of the lowest n_modes modes."""
+        z = np.atleast_1d(np.asarray(zeta, dtype=float))
+        if z.ndim != 1 or z.size == 0:
+            raise SizeError("damping.zeta: expected a 1-D array of ratios, one per mode")
+        if not np.all(np.isfinite(z)) or np.any(z < 0) or np.any(z >= 1):
+            raise ParameterError("damping.zeta: ratios must be finite and in [0, 1)")
+        return cls("modal", zeta=z)
+
+    def assemble(self, M: sp.csr_matrix, K: sp.csr_matrix) -> sp.csr_matrix:
+        """The damping matrix C for these M and K."""
+        n = M.shape[0]
+        if self.kind == "matrix":
+            C = _as_matrix(self.C, "damping.C", n)
+            _check_symmetric(C, "damping.C")
+            return C
+        if self.kind == "rayleigh":
+            return (self.alpha * M + self.beta * K).tocsr()
+        if self.kind == "modal":
+            import scipy.linalg as sla
+            nm = self.zeta.size
+            if nm > n:
+                raise SizeError(f"damping.zeta: {nm} ratios for a model with {n} DoFs")
+            w2, phi = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, nm - 1])
+            w = np.sqrt(np.maximum(w2, 0.0))
+            mp = M @ phi
+            return sp.csr_matrix((mp * (2.0 * self.zeta * w)) @ mp.T)
+        raise ParameterError(f"damping.kind: unknown kind {self.kind!r}")
+
+
+@dataclass
+class ContactGroup:
+    """Contact elements sharing one law.
+
+    G: (n_elem*n_dir, n_dof) sparse; row e*n_dir + d gives local relative displacement d of
+    element e from the model's coordinates. params: (n_elem, n_par) in the law's order
+    (see LAWS). w0: (n_elem, n_slider) initial slider positions or None (zeros).
+    """
+
+    law: str
+    G: object
+    params: np.ndarray
+    w0: np.ndarray | None = None
+    name: str = "contact"
+
+    def __post_init__(self):
+        if self.law not in LAWS:
+            raise ParameterError(f"contact {self.name!r}: law {self.law!r} unknown; expected "
+                                 f"one of {sorted(LAWS)}")
+        ndir, names, nsl = LAWS[self.law]
+        try:
+            self.G = sp.csr_matrix(self.G, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise ParameterError(f"contact {self.name!r}: G is not a matrix ({exc})") from None
+        if self.G.shape[0] % ndir:
+            raise SizeError(f"contact {self.name!r}: G has {self.G.shape[0]} rows, not a "
+                            f"multiple of the {ndir} directions of law {self.law!r}")
+        ne = self.G.shape[0] // ndir
+        if ne == 0:
+            raise SizeError(f"contact {self.name!r}: no element (G has no rows)")
+        if not np.all(np.isfinite(self.G.data)):
+            raise NonFiniteError(f"contact {self.name!r}: G contains NaN or Inf")
+        p = np.asarray(self.params, dtype=float)
+        if p.ndim == 1 and p.size == len(names):
+            p = np.tile(p, (ne, 1))
+        if p.shape != (ne, len(names)):
+            raise SizeError(f"contact {self.name!r}: params must have shape ({ne}, "
+                            f"{len(names)}) for columns {names}, got {p.shape}")
+        if not np.all(np.isfinite(p)):
+            raise NonFiniteError(f"contact {self.name!r}: params contain NaN or Inf")
+        col = dict(zip(names, p.T))
+        for nm in ("kt", "kn"):
+            if nm in col and np.any(col[nm] <= 0):
+                raise ParameterError(f"contact {self.name!r}: {nm} must be > 0 (N/m)")
+        if "mu" in col and np.any(col["mu"] < 0):
+            raise ParameterError(f"contact {self.name!r}: mu must be >= 0")
+        if "fn0" in col and np.any(col["fn0"] < 0):
+            raise ParameterError(f"contact {self.name!r}: fn0 must be >= 0 (N)")
+        if "k1" in col and np.any(col["k1"] < 0):
+            raise ParameterError(f"contact {self.name!r}: k1 must be >= 0 (N/m)")
+        self.params = p
+        if self.w0 is None:
+            self.w0 = np.zeros((ne, nsl))
+        else:
+            w0 = np.asarray(self.w0, dtype=float)
+            if w0.shape != (ne, nsl):
+                raise SizeError(f"contact {self.name!r}: w0 must have shape ({ne}, {nsl}), "
+                                f"got {w0.shape}")
+            if not np.all(np.isfinite(w0)):
+                raise NonFiniteError(f"contact {self.name!r}: w0 contains NaN or Inf")
+            self.w0 = w0
+
+    @property
+    def n_dir(self) -> int:
+        return LAWS[self.law][0]
+
+    @property
+    def n_elem(self) -> int:
+        return self.G.shape[0] // self.n_dir
+
+
+@dataclass
+class Model:
+    """M x'' + C x' + K x + sum_g G_g^T f_g(G_g x) = f_e(t).
+
+    M, K: (n_dof, n_dof) sparse or dense, symmetric, M positive definite; damping: Damping;
+    contacts: list of ContactGroup; dof_labels: optional names of the DoFs.
+    """
+
+    M: object
+    K: object
+    damping: Damping = field(default_factory=lambda: Damping.rayleigh(0.0, 0.0))
+    contacts: list = field(default_factory=list)
+    dof_labels: list | None = None
+
+    def __post_init__(self):
+        self.M = _as_matrix(self.M, "M")
+        n = self.M.shape[0]
+        self.K = _as_matrix(self.K, "K", n)
+        _check_symmetric(self.M, "M")
+        _check_symmetric(self.K, "K")
+        d = self.M.diagonal()
+        if np.any(d <= 0):
+            raise ParameterError(f"M: diagonal entry {int(np.argmin(d))} is {d.min():.3g}; "
+                                 "a mass matrix must be positive definite")
+        if n <= 2000:
+            try:
+                np.linalg.cholesky(self.M.toarray())
+            except np.linalg.LinAlgError:
+                raise ParameterError("M: not positive definite (Cholesky failed)") from None
+        if not isinstance(self.damping, Damping):
+            raise ParameterError("damping: expected a frirom.model.Damping")
+        self.C = self.damping.assemble(self.M, self.K)
+        if not isinstance(self.contacts, (list, tuple)):
+            raise ParameterError("contacts: expected a list of ContactGroup")
+        for g in self.contacts:
+            if not isinstance(g, ContactGroup):
+                raise ParameterError("contacts: every entry must be a ContactGroup")
+            if g.G.shape[1] != n:
+                raise SizeError(f"contact {g.name!r}: G has {g.G.shape[1]} columns, the "
+                                f"model has {n} DoFs")
+        if self.dof_labels is not None and len(self.dof_labels) != n:
+            raise SizeError(f"dof_labels: {len(self.dof_labels)} labels for {n} DoFs")
+
+    @property
+    def n_dof(self) -> int:
+        return self.M.shape[0]
+
+    def nonlinear_dofs(self) -> np.ndarray:
+        """Sorted DoFs in the column support of all contact G (0-based)."""
+        cols = [np.unique(g.G.indices) for g in self.contacts]
+        if not cols:
+            return np.zeros(0, dtype=int)
+        return np.unique(np.concatenate(cols))
+
+
+@dataclass
+class Excitation:
+    """f_e(t) = Re sum_h F[:, h] exp(i h omega t); F complex (n_dof, H_F + 1), column 0 a
+    real static load (preload). Harmonics above the solver's H are ignored (with a check
+    that they are zero), missing ones are zero."""
+
+    F: np.ndarray
+
+    def __post_init__(self):
+        F = np.asarray(self.F)
+        if F.ndim == 1:
+            F = np.stack([np.zeros_like(F), F], axis=1)
+        if F.ndim != 2 or F.shape[1] < 1:
+            raise SizeError(f"excitation.F: expected (n_dof, H+1), got shape {F.shape}")
+        F = F.astype(complex)
+        if not np.all(np.isfinite(F)):
+            raise NonFiniteError("excitation.F: contains NaN or Inf")
+        if np.any(F[:, 0].imag != 0):
+            raise ParameterError("excitation.F: column 0 is the static load and must be real")
+        self.F = F
+
+    def real_harmonic(self, n_dof: int, H: int) -> np.ndarray:
+        """(n_dof, 2H+1) real harmonic coefficients [a0, a1, b1, ...] of f_e."""
+        if self.F.shape[0] != n_dof:
+            raise SizeError(f"excitation.F: {self.F.shape[0]} rows for a model with {n_dof} "
+                            "DoFs")
+        if self.F.shape[1] > H + 1 and np.any(self.F[:, H + 1:] != 0):
+            raise ParameterError(f"excitation.F: harmonics above H = {H} are nonzero; raise "
+                                 "the solver's harmonics")
+        out = np.zeros((n_dof, 2 * H + 1))
+        out[:, 0] = self.F[:, 0].real
+        for h in range(1, min(H, self.F.shape[1] - 1) + 1):
+            out[:, 2 * h - 1] = self.F[:, h].real
+            out[:, 2 * h] = -self.F[:, h].imag
+        return out

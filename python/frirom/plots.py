@@ -1,0 +1,123 @@
+"""PNG plots of a forced response (matplotlib, Agg backend; the CLI calls these).
+
+Both functions take an FRF-like object with ``omega`` (n_pts,) rad/s, ``amp_max``
+(n_pts, n_out), ``stable`` (n_pts,) bool, ``fold`` (n_pts,) bool and
+``state_fractions`` (n_pts, n_groups, 3) (stick, slip, lift-off).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+__all__ = ["plot_frf", "plot_states", "frequency_axis"]
+
+_UNITS = {"hz": (1.0 / (2.0 * np.pi), "frequency [Hz]"),
+          "rad/s": (1.0, "frequency [rad/s]")}
+
+
+def frequency_axis(omega, unit: str = "hz"):
+    """Frequencies in the plot unit and the axis label; omega in rad/s."""
+    scale, label = _UNITS[unit.lower()]
+    return np.asarray(omega, float) * scale, label
+
+
+def _runs(mask):
+    """Index ranges [i0, i1) of consecutive equal values of a boolean array."""
+    mask = np.asarray(mask, bool)
+    if mask.size == 0:
+        return []
+    cuts = np.flatnonzero(np.diff(mask.astype(np.int8))) + 1
+    starts = np.r_[0, cuts]
+    ends = np.r_[cuts, mask.size]
+    return [(int(a), int(b), bool(mask[a])) for a, b in zip(starts, ends)]
+
+
+def plot_frf(frf, path, *, output_names=None, unit: str = "hz", title: str | None = None,
+             amplitude_unit: str = "m", log: bool | None = None) -> Path:
+    """Max amplitude over a period against frequency, one curve per output.
+
+    Stable stretches are solid, unstable dashed (Hill's method, ``frf.stable``); folds
+    (``frf.fold``) are marked with a black diamond. Returns the PNG path.
+    """
+    path = Path(path)
+    f, xlabel = frequency_axis(frf.omega, unit)
+    amp = np.asarray(frf.amp_max, float)
+    if amp.ndim == 1:
+        amp = amp[:, None]
+    stable = (np.ones(f.size, bool) if getattr(frf, "stable", None) is None
+              else np.asarray(frf.stable, bool))
+    fold = (np.zeros(f.size, bool) if getattr(frf, "fold", None) is None
+            else np.asarray(frf.fold, bool))
+    names = output_names or [f"output {j}" for j in range(amp.shape[1])]
+    fig, ax = plt.subplots(figsize=(7.5, 4.6), dpi=130)
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for j in range(amp.shape[1]):
+        col = colors[j % len(colors)]
+        for a, b, st in _runs(stable):
+            # join each stretch to the next point so the curve has no gaps
+            sl = slice(a, min(b + 1, f.size))
+            ax.plot(f[sl], amp[sl, j], color=col, lw=1.6 if st else 1.2,
+                    ls="-" if st else "--",
+                    label=names[j] if a == 0 else None)
+        if fold.any():
+            ax.plot(f[fold], amp[fold, j], "D", color="k", ms=4.5, zorder=5,
+                    label="fold" if j == 0 else None)
+    if log is None:
+        pos = amp[amp > 0]
+        log = pos.size > 0 and pos.max() / pos.min() > 30.0
+    if log:
+        ax.set_yscale("log")
+    if not stable.all():
+        ax.plot([], [], color="0.3", ls="--", label="unstable (Hill)")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(f"max amplitude over a period [{amplitude_unit}]")
+    ax.set_title(title or "Forced response")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
+def plot_states(frf, path, *, contact_names=None, unit: str = "hz",
+                title: str | None = None) -> Path:
+    """Fraction of the period each contact group spends in stick, slip and lift-off
+    against frequency (stacked areas, one panel per group). Returns the PNG path."""
+    path = Path(path)
+    f, xlabel = frequency_axis(frf.omega, unit)
+    sf = np.asarray(frf.state_fractions, float)
+    if sf.ndim == 2:
+        sf = sf[:, None, :]
+    ng = sf.shape[1]
+    names = contact_names or [f"contact {g}" for g in range(ng)]
+    fig, axes = plt.subplots(max(ng, 1), 1, figsize=(7.5, 1.2 + 2.0 * max(ng, 1)), dpi=130,
+                             sharex=True, squeeze=False)
+    # along a continuation path the frequency can turn back: plot against the point order
+    # mapped to frequency only when it is monotone
+    mono = np.all(np.diff(f) > 0) or np.all(np.diff(f) < 0)
+    xs = f if mono else np.arange(f.size)
+    order = np.argsort(xs) if mono else slice(None)
+    colors = ("#2b8cbe", "#f39c12", "#c0392b")
+    for g in range(ng):
+        ax = axes[g, 0]
+        ax.stackplot(xs[order], *(sf[order, g, k] for k in range(3)), colors=colors,
+                     labels=("stick", "slip", "lift-off"), alpha=0.85)
+        ax.set_ylim(0.0, 1.0)
+        ax.set_ylabel("fraction of period")
+        ax.set_title(names[g], fontsize=9, loc="left")
+        ax.grid(True, alpha=0.3)
+    axes[0, 0].legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8, ncol=3,
+                      frameon=False, borderaxespad=0.2)
+    axes[-1, 0].set_xlabel(xlabel if mono else "point along the continuation path")
+    fig.suptitle(title or "Contact states", fontsize=11)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path

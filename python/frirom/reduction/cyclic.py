@@ -1,0 +1,312 @@
+"""Cyclic symmetry: one sector of a tuned rotor solved for a harmonic index (nodal diameter).
+
+Sector s of an N-sector rotor moves as x_s = Q^s x_0 exp(i k s alpha), alpha = 2 pi / N,
+Q the rotation by alpha about the rotor axis. The sector's right (dependent) boundary is the
+left boundary of the next sector, so x_right = exp(i k alpha) Q x_left: the projection T(k)
+keeps every DoF but the right boundary (y = x without x_right, x = T y) and the sector's
+matrices become the Hermitian pair T^H K T, T^H M T (:meth:`CyclicSector.matrices`; a real
+form of twice the size is also available). For k = 0 and k = N/2 they are real.
+
+Right-boundary nodes must not be constrained unless their left partner is fully constrained
+too (ccx has the same rule for the dependent cyclic surface). DoFs missing from the
+matrices (removed by boundary conditions) are zero.
+
+:func:`tran_reduce` reduces the left-boundary DoFs of the projected sector with interface
+modes (Tran 2001): the lowest eigenvectors of the boundary-condensed pair. Engine-order
+travelling-wave excitation: :meth:`CyclicSector.travelling_wave_load` and
+:meth:`CyclicSector.expand`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from scipy.spatial import cKDTree
+
+from .._errors import InputError, NumericalError, SingularMatrixError, SizeError
+from .multistage import cylindrical_frame
+
+__all__ = ["CyclicSector", "cyclic_sector", "axis_rotation", "tran_reduce"]
+
+
+def axis_rotation(angle: float, axis=(0.0, 0.0, 1.0)) -> np.ndarray:
+    """(3, 3) rotation by ``angle`` [rad] about ``axis`` (right-hand rule)."""
+    a = np.asarray(axis, dtype=float)
+    a = a / np.linalg.norm(a)
+    c, s = np.cos(angle), np.sin(angle)
+    ax = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    return c * np.eye(3) + s * ax + (1 - c) * np.outer(a, a)
+
+
+@dataclass
+class CyclicSector:
+    """A sector with matched cyclic boundaries.
+
+    n_dof: size of the sector's matrices; n_sectors: N; left, right: (n_b, 3) model DoF
+    indices (global x, y, z; -1 = constrained) of matched boundary nodes, right = left
+    rotated by +alpha; axis, origin: the rotor axis; node_pairs: (n_b, 2) optional node ids;
+    dependent: 'right' (default) or 'left', the boundary eliminated by the constraint
+    (ccx's slave surface), x_right = exp(i k alpha) Q x_left either way.
+    """
+
+    n_dof: int
+    n_sectors: int
+    left: np.ndarray
+    right: np.ndarray
+    axis: np.ndarray
+    origin: np.ndarray
+    node_pairs: np.ndarray | None = None
+    dependent: str = "right"
+
+    def __post_init__(self):
+        self.left = np.asarray(self.left, dtype=np.int64).reshape(-1, 3)
+        self.right = np.asarray(self.right, dtype=np.int64).reshape(-1, 3)
+        if self.left.shape != self.right.shape:
+            raise SizeError(f"CyclicSector: left {self.left.shape} and right "
+                            f"{self.right.shape} boundary DoFs differ in shape")
+        if self.n_sectors < 2:
+            raise InputError(f"CyclicSector: n_sectors must be >= 2, got {self.n_sectors}")
+        both = np.concatenate([self.left.ravel(), self.right.ravel()])
+        both = both[both >= 0]
+        if both.size and both.max() >= self.n_dof:
+            raise SizeError(f"CyclicSector: boundary DoF {both.max()} >= n_dof {self.n_dof}")
+        if np.unique(both).size != both.size:
+            raise InputError("CyclicSector: a DoF is on both boundaries or repeated")
+        if self.dependent not in ("right", "left"):
+            raise InputError(f"CyclicSector: dependent must be 'right' or 'left', got "
+                             f"{self.dependent!r}")
+        side = 1 if self.dependent == "right" else 0
+        self._dep, self._ind = ((self.right, self.left) if side else (self.left, self.right))
+        for p in range(len(self._dep)):
+            if np.any(self._dep[p] < 0) and not np.all(self._ind[p] < 0):
+                node = "" if self.node_pairs is None else f" (node {self.node_pairs[p, side]})"
+                raise InputError(f"CyclicSector: {self.dependent}-boundary pair {p}{node} is "
+                                 "constrained but its partner is not: nodes with boundary "
+                                 "conditions must not lie on the dependent "
+                                 f"({self.dependent}) cyclic surface")
+        self.Q = axis_rotation(2 * np.pi / self.n_sectors, self.axis)
+        dep = self._dep[self._dep >= 0]
+        self.independent = np.setdiff1d(np.arange(self.n_dof), dep)
+
+    @property
+    def alpha(self) -> float:
+        return 2 * np.pi / self.n_sectors
+
+    @property
+    def boundary(self) -> np.ndarray:
+        """Indices into the projected DoFs y of the kept (independent) boundary DoFs."""
+        ind = self._ind[self._ind >= 0]
+        return np.searchsorted(self.independent, np.sort(ind))
+
+    def projection(self, k: int) -> sp.csr_matrix:
+        """T(k): (n_dof, n_indep) complex, x = T y with y = x[independent]."""
+        n_i = self.independent.size
+        col = -np.ones(self.n_dof, dtype=np.int64)
+        col[self.independent] = np.arange(n_i)
+        dep, ind = self._dep, self._ind
+        if self.dependent == "right":
+            ph, Qd = np.exp(1j * k * self.alpha), self.Q
+        else:
+            ph, Qd = np.exp(-1j * k * self.alpha), self.Q.T
+        rows = [self.independent]
+        cols = [np.arange(n_i)]
+        vals = [np.ones(n_i, dtype=complex)]
+        for c in range(3):
+            for cp in range(3):
+                ok = (dep[:, c] >= 0) & (ind[:, cp] >= 0)
+                if abs(Qd[c, cp]) < 1e-15 or not ok.any():
+                    continue
+                rows.append(dep[ok, c])
+                cols.append(col[ind[ok, cp]])
+                vals.append(np.full(ok.sum(), ph * Qd[c, cp]))
+        return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows),
+                                                     np.concatenate(cols))),
+                             shape=(self.n_dof, n_i))
+
+    def matrices(self, K, M, k: int, real: bool = False):
+        """Projected pair for harmonic index k: Hermitian (n_indep,)^2, sparse.
+
+        real=True returns the real symmetric form [[Re, -Im], [Im, Re]] of twice the size
+        (every eigenvalue doubled) for real-only solvers; for k = 0 and k = N/2 the pair is
+        real already and returned once.
+        """
+        if K.shape != (self.n_dof, self.n_dof) or M.shape != K.shape:
+            raise SizeError(f"CyclicSector.matrices: K {K.shape}, M {M.shape}, expected "
+                            f"({self.n_dof}, {self.n_dof})")
+        T = self.projection(k)
+        Kk = (T.conj().T @ sp.csr_matrix(K) @ T).tocsr()
+        Mk = (T.conj().T @ sp.csr_matrix(M) @ T).tocsr()
+        if self._is_real(k):
+            return sp.csr_matrix(Kk.real), sp.csr_matrix(Mk.real)
+        if real:
+            return _real_form(Kk), _real_form(Mk)
+        return Kk, Mk
+
+    def _is_real(self, k: int) -> bool:
+        return (k % self.n_sectors) == 0 or (2 * k) % self.n_sectors == 0
+
+    def frequencies(self, K, M, k: int, n_modes: int, sigma: float = 0.0,
+                    method: str = "auto") -> np.ndarray:
+        """Lowest ``n_modes`` natural frequencies [Hz] of harmonic index k (each once).
+
+        method: 'dense' (LAPACK), 'arpack' (shift-invert about sigma [rad^2/s^2] on the
+        sparse Hermitian pair) or 'auto' (dense up to 4000 DoFs).
+        """
+        Kk, Mk = self.matrices(K, M, k)
+        lam = _eigvals(Kk, Mk, n_modes, sigma, method)
+        return np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi)
+
+    def travelling_wave_load(self, f0, engine_order: int, sign: int = -1):
+        """Sector load of an engine-order travelling wave, f_s = Q^s f0 exp(sign i EO s alpha).
+
+        f0: (n_dof,) complex load on sector 0's DoFs (amplitude and phase per DoF); sign:
+        -1 (default, the deck's convention: sector s lags by 2 pi EO s / N, a wave that
+        travels forward, in +theta, under Re(. exp(i omega t))) or +1. Returns the harmonic
+        index k = sign EO mod N of the response and the projected load T(k)^H f0 (n_indep,).
+        The response of sector s follows from :meth:`expand` with the same k.
+        """
+        f0 = np.asarray(f0)
+        if f0.shape != (self.n_dof,):
+            raise SizeError(f"travelling_wave_load: f0 must be ({self.n_dof},), got "
+                            f"{f0.shape}")
+        if sign not in (-1, 1):
+            raise InputError(f"travelling_wave_load: sign must be -1 or +1, got {sign}")
+        k = (sign * int(engine_order)) % self.n_sectors
+        return k, self.projection(k).conj().T @ f0
+
+    def expand(self, y, k: int, sector: int, node_dofs=None) -> np.ndarray:
+        """Displacements of sector ``sector`` from the solution y of harmonic index k.
+
+        y: (n_indep,) complex; node_dofs: (n_nodes, 3) DoF indices of the x, y, z
+        displacements of the sector's nodes (-1 = constrained), whose components are rotated
+        by Q^s (other DoFs, e.g. modal coordinates, only take the phase). Returns (n_dof,)
+        complex in the layout of sector 0's DoFs, for the rotated nodes of sector s:
+        Q^s x_0 exp(i k s alpha); the physical response is Re(x exp(i omega t)).
+        """
+        x = (self.projection(k) @ np.asarray(y)) * np.exp(1j * k * sector * self.alpha)
+        if node_dofs is None:
+            return x
+        nd = np.asarray(node_dofs, dtype=np.int64).reshape(-1, 3)
+        Qs = np.linalg.matrix_power(self.Q, sector % self.n_sectors)
+        v = np.where(nd >= 0, x[np.maximum(nd, 0)], 0.0)
+        w = v @ Qs.T
+        out = x.copy()
+        ok = nd >= 0
+        out[nd[ok]] = w[ok]
+        return out
+
+
+def _real_form(A):
+    A = sp.csr_matrix(A)
+    return sp.bmat([[A.real, -A.imag], [A.imag, A.real]]).tocsr()
+
+
+def _eigvals(Kk, Mk, n_modes, sigma=0.0, method="auto"):
+    n = Kk.shape[0]
+    if n_modes < 1 or n_modes > n:
+        raise InputError(f"n_modes must lie in 1..{n}, got {n_modes}")
+    if method not in ("auto", "dense", "arpack"):
+        raise InputError(f"method must be 'auto', 'dense' or 'arpack', got {method!r}")
+    if method == "dense" or (method == "auto" and (n <= 4000 or n_modes > n // 4)):
+        try:
+            return sla.eigh(Kk.toarray(), Mk.toarray(), eigvals_only=True,
+                            subset_by_index=[0, n_modes - 1])
+        except (np.linalg.LinAlgError, ValueError) as exc:
+            raise NumericalError(f"cyclic eigen-solve failed ({exc})") from exc
+    try:
+        w = spla.eigsh(Kk.tocsc(), k=n_modes, M=Mk.tocsc(), sigma=sigma,
+                       return_eigenvectors=False)
+    except (RuntimeError, spla.ArpackError) as exc:
+        raise NumericalError(f"cyclic eigen-solve (ARPACK shift-invert) failed ({exc})"
+                             ) from exc
+    return np.sort(w.real)
+
+
+def cyclic_sector(coords_left, dofs_left, coords_right, dofs_right, n_sectors: int,
+                  n_dof: int, origin=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0), tol=None,
+                  nodes_left=None, nodes_right=None, dependent="right") -> CyclicSector:
+    """Match the right-boundary nodes to the left ones rotated by +2 pi / N about the axis.
+
+    coords_*: (n_b, 3) node coordinates; dofs_*: (n_b, 3) model DoF indices of their x, y,
+    z displacements (-1 where constrained); dependent: 'right' or 'left' (ccx's slave
+    surface), the boundary the constraint eliminates. tol: matching distance (default 1e-6 x the
+    largest distance to the axis origin). InputError names the first unmatched node.
+    """
+    cl = np.asarray(coords_left, float).reshape(-1, 3)
+    cr = np.asarray(coords_right, float).reshape(-1, 3)
+    if len(cl) != len(cr):
+        raise InputError(f"cyclic_sector: {len(cl)} left and {len(cr)} right boundary nodes: "
+                         "the cyclic boundaries must have matching meshes")
+    o = np.asarray(origin, float)
+    Q = axis_rotation(2 * np.pi / n_sectors, axis)
+    cylindrical_frame(axis)                        # validates the axis
+    if tol is None:
+        tol = 1e-6 * max(np.abs(cl - o).max(), np.abs(cr - o).max(), 1e-300)
+    rot = (cl - o) @ Q.T + o
+    dist, j = cKDTree(cr).query(rot)
+    bad = np.nonzero(dist > tol)[0]
+    names_l = np.arange(len(cl)) if nodes_left is None else np.asarray(nodes_left)
+    names_r = np.arange(len(cr)) if nodes_right is None else np.asarray(nodes_right)
+    if bad.size:
+        p = int(bad[0])
+        raise InputError(f"cyclic_sector: left-boundary node {names_l[p]} rotated by "
+                         f"{360.0 / n_sectors:.6g} deg lies {dist[p]:.3g} from the nearest "
+                         f"right-boundary node (tolerance {tol:.3g}): boundaries do not match")
+    if np.unique(j).size != j.size:
+        raise InputError("cyclic_sector: two left nodes map to the same right node")
+    pairs = np.column_stack([names_l, names_r[j]])
+    return CyclicSector(n_dof=int(n_dof), n_sectors=int(n_sectors),
+                        left=np.asarray(dofs_left).reshape(-1, 3),
+                        right=np.asarray(dofs_right).reshape(-1, 3)[j],
+                        axis=np.asarray(axis, float), origin=o, node_pairs=pairs,
+                        dependent=dependent)
+
+
+def tran_reduce(Kk, Mk, boundary, n_modes: int):
+    """Reduce the boundary DoFs of a projected sector with Tran's interface modes.
+
+    Kk, Mk: (n, n) Hermitian pair of one harmonic index (sparse or dense, complex or real);
+    boundary: indices (into the projected DoFs) of the remaining cyclic-boundary DoFs;
+    n_modes: interface modes kept. The modes are the lowest eigenvectors of the pair
+    statically condensed on the boundary (the constraint modes' characteristic modes).
+    Returns (K_r, M_r dense (n_modes + n - n_b)^2, R sparse (n, n_r), eigenvalues of the
+    condensed pair); x = R x_r with x_r = [interface modal coordinates, other DoFs].
+    """
+    Ks = sp.csr_matrix(Kk)
+    Ms = sp.csr_matrix(Mk)
+    n = Ks.shape[0]
+    b = np.asarray(boundary, dtype=np.int64).ravel()
+    if b.size == 0 or b.min() < 0 or b.max() >= n or np.unique(b).size != b.size:
+        raise InputError(f"tran_reduce: boundary must be distinct indices in 0..{n - 1}")
+    if not 1 <= n_modes <= b.size:
+        raise InputError(f"tran_reduce: n_modes must lie in 1..{b.size}, got {n_modes}")
+    s = np.setdiff1d(np.arange(n), b)
+    kbb = Ks[b][:, b].toarray()
+    mbb = Ms[b][:, b].toarray()
+    kbs = Ks[b][:, s]
+    if s.size and kbs.nnz:
+        try:
+            lu = spla.splu(Ks[s][:, s].tocsc())
+        except RuntimeError as exc:
+            raise SingularMatrixError(f"tran_reduce: interior stiffness singular ({exc})")
+        psi = -lu.solve(kbs.conj().T.toarray().astype(Ks.dtype))
+        msb = Ms[s][:, b]
+        kc = kbb + kbs @ psi
+        mc = mbb + msb.conj().T @ psi + psi.conj().T @ msb + psi.conj().T @ (Ms[s][:, s] @ psi)
+    else:
+        kc, mc = kbb, mbb
+    kc = 0.5 * (kc + kc.conj().T)
+    mc = 0.5 * (mc + mc.conj().T)
+    lam, phi = sla.eigh(kc, mc, subset_by_index=[0, n_modes - 1])
+    rr, cc = np.nonzero(phi)
+    rows = np.concatenate([b[rr], s])
+    cols = np.concatenate([cc, n_modes + np.arange(s.size)])
+    vals = np.concatenate([phi[rr, cc], np.ones(s.size)])
+    R = sp.csr_matrix((vals, (rows, cols)), shape=(n, n_modes + s.size))
+    Kr = (R.conj().T @ Ks @ R).toarray()
+    Mr = (R.conj().T @ Ms @ R).toarray()
+    return 0.5 * (Kr + Kr.conj().T), 0.5 * (Mr + Mr.conj().T), R, lam

@@ -1,0 +1,238 @@
+"""Forced response results: the FRF object, its HDF5/CSV files, and an appending HDF5
+writer for long runs that can be reopened to resume."""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ._errors import InputError
+
+
+def amplitude_max(X: np.ndarray, n_time: int | None = None) -> np.ndarray:
+    """max over one period of |x(t)| for real harmonic coefficients X (..., 2H+1)."""
+    H = (X.shape[-1] - 1) // 2
+    n_time = n_time or max(64, 16 * (2 * H + 1))
+    tau = 2 * np.pi * np.arange(n_time) / n_time
+    basis = np.ones((2 * H + 1, n_time))
+    for h in range(1, H + 1):
+        basis[2 * h - 1] = np.cos(h * tau)
+        basis[2 * h] = np.sin(h * tau)
+    return np.abs(X @ basis).max(axis=-1)
+
+
+@dataclass
+class FRFPoint:
+    """One converged point of a continuation run (what `sink` receives)."""
+
+    omega: float            #: excitation frequency, rad/s
+    parameter: float        #: continuation parameter (omega, or the load factor)
+    unknowns: np.ndarray    #: (n_unknowns,) solver unknowns (formulation dependent)
+    tangent: np.ndarray     #: (n_unknowns+1,) unit tangent in scaled variables
+    X: np.ndarray           #: (n_out, 2H+1) harmonics at the output DoFs
+    amp_max: np.ndarray     #: (n_out,) max over the period of |x(t)|
+    state_fractions: np.ndarray  #: (n_groups, 3) stick, slip, lift-off
+    iterations: int
+    time_s: float
+    fold: bool = False
+    stable: bool = True
+    floquet_max_re: float = 0.0  #: largest real part of the Floquet exponents, 1/s
+    yscale: float = 0.0     #: scale of the unknowns in the arc length the tangent refers to
+
+
+@dataclass
+class FRF:
+    """Frequency (or load) response at the output DoFs.
+
+    omega (n_pts,) rad/s; parameter (n_pts,) the continuation parameter; X (n_pts, n_out,
+    2H+1) real harmonic coefficients [a0, a1, b1, ...]; amp_max (n_pts, n_out);
+    state_fractions (n_pts, n_groups, 3) stick/slip/lift-off; stable, fold (n_pts,) bool;
+    iterations (n_pts,) int; time_s (n_pts,) s.
+    """
+
+    omega: np.ndarray
+    X: np.ndarray
+    amp_max: np.ndarray
+    state_fractions: np.ndarray
+    stable: np.ndarray
+    fold: np.ndarray
+    iterations: np.ndarray
+    time_s: np.ndarray
+    parameter: np.ndarray | None = None
+    output_dofs: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    group_names: list = field(default_factory=list)
+    parameter_name: str = "omega"
+    complete: bool = True
+    message: str = ""
+    stability_computed: bool = False
+    #: Fortran time split of the run: aft, assembly, factorization, solve, receptance (s),
+    #: evaluations, factorizations (counts), fortran_total (s)
+    timings: dict = field(default_factory=dict)
+
+    @property
+    def harmonics(self) -> int:
+        return (self.X.shape[-1] - 1) // 2
+
+    def __len__(self) -> int:
+        return self.omega.size
+
+    @classmethod
+    def from_points(cls, points: list, output_dofs, group_names, parameter_name="omega",
+                    **kw) -> "FRF":
+        def stack(name, shape_tail, dtype=float):
+            if not points:
+                return np.zeros((0,) + shape_tail, dtype=dtype)
+            return np.array([getattr(p, name) for p in points], dtype=dtype)
+        n_out = len(output_dofs)
+        nc = points[0].X.shape[1] if points else 1
+        return cls(omega=stack("omega", ()), parameter=stack("parameter", ()),
+                   X=stack("X", (n_out, nc)), amp_max=stack("amp_max", (n_out,)),
+                   state_fractions=stack("state_fractions", (len(group_names), 3)),
+                   stable=stack("stable", (), bool), fold=stack("fold", (), bool),
+                   iterations=stack("iterations", (), int), time_s=stack("time_s", ()),
+                   output_dofs=np.asarray(output_dofs, dtype=int),
+                   group_names=list(group_names), parameter_name=parameter_name, **kw)
+
+    # ---- files ------------------------------------------------------------------------
+    _ARRAYS = ("omega", "parameter", "X", "amp_max", "state_fractions", "stable", "fold",
+               "iterations", "time_s", "output_dofs")
+
+    def save_h5(self, path) -> None:
+        """Write every array and the run status to an HDF5 file."""
+        import h5py
+        with h5py.File(path, "w") as f:
+            for name in self._ARRAYS:
+                v = getattr(self, name)
+                f.create_dataset(name, data=np.asarray(v if v is not None else self.omega))
+            f.attrs["group_names"] = np.array(self.group_names, dtype="S")
+            f.attrs["parameter_name"] = self.parameter_name
+            f.attrs["complete"] = self.complete
+            f.attrs["message"] = self.message
+            f.attrs["stability_computed"] = self.stability_computed
+
+    def save_csv(self, path) -> None:
+        """One row per point: omega, parameter, stable, fold, iterations, time, max amplitude
+        per output DoF, state fractions per group."""
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            head = ["omega_rad_s", self.parameter_name, "stable", "fold", "iterations",
+                    "time_s"]
+            head += [f"amp_max_dof{d}" for d in self.output_dofs]
+            for g in self.group_names:
+                head += [f"{g}_stick", f"{g}_slip", f"{g}_liftoff"]
+            w.writerow(head)
+            par = self.parameter if self.parameter is not None else self.omega
+            for i in range(len(self)):
+                row = [repr(float(self.omega[i])), repr(float(par[i])), int(self.stable[i]),
+                       int(self.fold[i]), int(self.iterations[i]), f"{self.time_s[i]:.6g}"]
+                row += [repr(float(a)) for a in self.amp_max[i]]
+                row += [f"{s:.6g}" for s in self.state_fractions[i].ravel()]
+                w.writerow(row)
+
+    @classmethod
+    def load(cls, path) -> "FRF":
+        """Read a file written by save_h5 or by FRFWriter."""
+        import h5py
+        try:
+            f = h5py.File(path, "r")
+        except OSError as exc:
+            raise InputError(f"{path}: cannot open as HDF5 ({exc})") from None
+        with f:
+            missing = [n for n in cls._ARRAYS if n not in f]
+            if missing:
+                raise InputError(f"{path}: not a frirom FRF file (missing {missing})")
+            kw = {n: f[n][...] for n in cls._ARRAYS}
+            kw["stable"] = kw["stable"].astype(bool)
+            kw["fold"] = kw["fold"].astype(bool)
+            return cls(**kw,
+                       group_names=[s.decode() for s in f.attrs.get("group_names", [])],
+                       parameter_name=str(f.attrs.get("parameter_name", "omega")),
+                       complete=bool(f.attrs.get("complete", True)),
+                       message=str(f.attrs.get("message", "")),
+                       stability_computed=bool(f.attrs.get("stability_computed", False)))
+
+
+class FRFWriter:
+    """Append points to an HDF5 file as they come (resizable datasets, flushed per point).
+
+    The file also keeps the solver unknowns and tangent of the last point, so a run that
+    stopped can resume: ``FRFWriter.resume_point(path)`` gives the `start` argument of
+    :func:`frirom.solver.frf`. Use as the `sink` of frf (``sink=writer.append``).
+    """
+
+    def __init__(self, path, output_dofs, group_names, harmonics: int,
+                 parameter_name: str = "omega", append: bool = False):
+        import h5py
+        self.path = path
+        mode = "a" if append else "w"
+        self.f = h5py.File(path, mode)
+        nc = 2 * harmonics + 1
+        n_out = len(output_dofs)
+        ng = len(group_names)
+        if "omega" not in self.f:
+            def mk(name, tail, dtype=float):
+                self.f.create_dataset(name, shape=(0,) + tail, maxshape=(None,) + tail,
+                                      dtype=dtype, chunks=(64,) + tail)
+            mk("omega", ())
+            mk("parameter", ())
+            mk("X", (n_out, nc))
+            mk("amp_max", (n_out,))
+            mk("state_fractions", (ng, 3))
+            mk("stable", (), bool)
+            mk("fold", (), bool)
+            mk("iterations", (), int)
+            mk("time_s", ())
+            self.f.create_dataset("output_dofs", data=np.asarray(output_dofs, dtype=int))
+            self.f.attrs["group_names"] = np.array(list(group_names), dtype="S")
+            self.f.attrs["parameter_name"] = parameter_name
+            self.f.attrs["complete"] = False
+            self.f.attrs["message"] = "running"
+        elif self.f["X"].shape[1:] != (n_out, nc):
+            raise InputError(f"{path}: existing file has X of shape {self.f['X'].shape[1:]}"
+                             f", this run makes {(n_out, nc)}")
+
+    def append(self, p: FRFPoint) -> None:
+        f = self.f
+        n = f["omega"].shape[0]
+        for name in ("omega", "parameter", "X", "amp_max", "state_fractions", "stable",
+                     "fold", "iterations", "time_s"):
+            d = f[name]
+            d.resize(n + 1, axis=0)
+            d[n] = getattr(p, name)
+        for name, v in (("last_unknowns", p.unknowns), ("last_tangent", p.tangent)):
+            if name in f:
+                del f[name]
+            f.create_dataset(name, data=v)
+        f.attrs["last_parameter"] = p.parameter
+        f.attrs["last_omega"] = p.omega
+        f.attrs["last_yscale"] = p.yscale
+        f.flush()
+
+    def close(self, complete: bool = True, message: str = "") -> None:
+        if self.f:
+            self.f.attrs["complete"] = complete
+            self.f.attrs["message"] = message
+            self.f.close()
+            self.f = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close(complete=exc[0] is None, message="" if exc[0] is None else str(exc[1]))
+
+    @staticmethod
+    def resume_point(path) -> dict:
+        """{'parameter', 'omega', 'unknowns', 'tangent', 'yscale'} of the last point in the
+        file: the `start` argument of frirom.solver.frf."""
+        import h5py
+        with h5py.File(path, "r") as f:
+            if "last_unknowns" not in f:
+                raise InputError(f"{path}: no point to resume from")
+            return {"parameter": float(f.attrs["last_parameter"]),
+                    "omega": float(f.attrs["last_omega"]),
+                    "unknowns": f["last_unknowns"][...],
+                    "tangent": f["last_tangent"][...],
+                    "yscale": float(f.attrs.get("last_yscale", 0.0))}

@@ -1,0 +1,185 @@
+"""The TOML deck: the bundled case loads, and every malformed field raises InputError
+naming the deck, the key path and what was expected."""
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from frirom import InputError
+from frirom.deck import engine_order_loads, load_deck
+
+ROOT = Path(__file__).resolve().parents[1]
+JOINT = ROOT / "cases" / "joint"
+BASE = (JOINT / "joint.toml").read_text()
+
+
+@pytest.fixture
+def deckdir(tmp_path):
+    for f in ("M.mtx", "K.mtx", "dofs.txt"):
+        shutil.copy(JOINT / f, tmp_path / f)
+    return tmp_path
+
+
+def write(deckdir, text):
+    p = deckdir / "case.toml"
+    p.write_text(text)
+    return p
+
+
+def test_joint_deck_loads():
+    d = load_deck(JOINT / "joint.toml")
+    assert d.n_dof == 5 and d.harmonics == 5 and d.samples == 64
+    assert d.F[4, 1] == 2.0 and np.count_nonzero(d.F) == 1
+    c = d.contacts[0]
+    assert c.law == "jenkins" and c.G.shape == (1, 5)
+    assert np.allclose(c.G.toarray(), [[np.cos(np.pi / 6), 0.5, 0, 0, 0]])
+    assert np.allclose(c.params, [[1e7, 0.5, 100.0]])
+    assert d.outputs == [4, 0, 1] and d.output_names[0] == "tip:x"
+    assert np.isclose(d.omega_start, 2 * np.pi * 400) and np.isclose(d.omega_end,
+                                                                     2 * np.pi * 520)
+    assert d.continuation == {"step": 0.02, "max_step": 0.04, "max_points": 1000}
+    assert d.solver["stability"] is True
+
+
+def test_normal1d_frame_and_solver_objects(deckdir):
+    text = BASE.replace('law = "jenkins"', 'law = "normal1d"').replace(
+        "directions = [ [0.8660254037844386, 0.5] ]",
+        "directions = [ [0.8660254037844386, 0.5], [-0.5, 0.8660254037844386] ]").replace(
+        "fn0 = 100.0", "kn = 2.0e7\nn0 = 100.0\nw0 = 1e-6")
+    d = load_deck(write(deckdir, text))
+    c = d.contacts[0]
+    Gd = c.G.toarray()
+    assert c.law == "normal1d" and np.allclose(Gd @ Gd.T, np.eye(2))   # orthonormal frame
+    assert np.allclose(c.params, [[1e7, 2e7, 0.5, 100.0]]) and np.allclose(c.w0, 1e-6)
+    model, exc, opts = d.model(), d.excitation(), d.options()
+    assert model.n_dof == 5 and model.contacts[0].name == "damper"
+    assert exc.F.shape == (5, 6)
+    assert opts.harmonics == 5 and opts.samples == 64 and opts.ds_max == 0.04
+    assert opts.stability
+
+
+def test_node_to_node_element_and_engine_order(deckdir):
+    text = BASE.replace('b = "ground"', 'b = ["blade_low:x", "blade_mid:x"]')
+    text = text.replace("[[excitation.load]]", """[[excitation.engine_order]]
+eo = 1
+dofs = [2, 3, 4]
+amplitude = 1.0
+
+[[excitation.load]]""")
+    d = load_deck(write(deckdir, text))
+    G = d.contacts[0].G.toarray()
+    assert np.allclose(G[:, 2:4], -G[:, :2])
+    ph = np.angle(d.F[[2, 3], 1])
+    assert np.allclose(ph, [0.0, -2 * np.pi / 3])
+    assert np.isclose(d.F[4, 1], 2.0 + np.exp(-4j * np.pi / 3))
+
+
+def test_engine_order_loads_pattern():
+    F = engine_order_loads(6, [0, 2, 4], eo=2, n_sectors=3, amplitude=2.0)
+    assert np.allclose(F[[0, 2, 4], 1], 2.0 * np.exp(-2j * np.pi * 2 * np.arange(3) / 3))
+
+
+BAD = [
+    # (replace this, with that, the key path and words expected in the message)
+    ('harmonics = 5', 'harmonics = 0', "solver.harmonics", ">= 1"),
+    ('harmonics = 5', 'harmonics = "five"', "solver.harmonics", "integer"),
+    ('samples = 64', 'samples = 8', "solver.samples", ">= 2*harmonics+1"),
+    ('formulation = "condensed"', 'formulation = "dense"', "solver.formulation", "banded"),
+    ('mu = 0.5', 'mu = -0.5', "contacts[0].mu", ">= 0"),
+    ('mu = 0.5', 'mu = [0.5, 0.4]', "contacts[0].mu", "1 numbers"),
+    ('mu = 0.5                      # friction coefficient\n', '', "contacts[0].mu",
+     "missing"),
+    ('kt = 1.0e7', 'kt = 0.0', "contacts[0].kt", "positive"),
+    ('law = "jenkins"', 'law = "coulomb"', "contacts[0].law", "normal1d"),
+    ('fn0 = 100.0', 'n0 = 100.0', "contacts[0].n0", "unknown key"),
+    ('dof = "tip:x"', 'dof = "tip:z"', "excitation.load[0].dof", "label"),
+    ('dof = "tip:x"', 'dof = 7', "excitation.load[0].dof", "0..4"),
+    ('harmonic = 1\namp', 'harmonic = 9\namp', "excitation.load[0].harmonic", "0..solver"),
+    ('amplitude = 2.0 ', 'amplitud = 2.0 ', "excitation.load[0].amplitud", "unknown key"),
+    ('start = 400.0', 'start = -400.0', "frequency.start", "positive"),
+    ('unit = "Hz"', 'unit = "rpm"', "frequency.unit", "hz"),
+    ('mass = "M.mtx"', 'mass = "nothere.mtx"', "model.mass", "does not exist"),
+    ('format = "mtx"', 'format = "op4"', "model.format", "mtx"),
+    ('type = "modal"', 'type = "hysteretic"', "damping.type", "rayleigh"),
+    ('zeta = 0.003', 'zeta = 1.5', "damping.zeta", "[0, 1)"),
+    ('directions = [ [0.8660254037844386, 0.5] ]',
+     'directions = [ [0.8660254037844386, 0.5], [-0.5, 0.8660254037844386] ]',
+     "contacts[0].directions", "1 direction"),
+    ('directions = [ [0.8660254037844386, 0.5] ]', 'directions = [ [0.0, 0.0] ]',
+     "contacts[0].directions[0]", "non-zero"),
+    ('directions = [ [0.8660254037844386, 0.5] ]', 'directions = [ [1.0, 0.5, 0.1] ]',
+     "contacts[0].directions[0]", "2 numbers"),
+    ('b = "ground"', 'b = ["tip:x"]', "contacts[0].elements[0].b", "2 DoFs"),
+    ('b = "ground"', 'b = ["platform:x", "tip:x"]', "contacts[0].elements[0].b",
+     "different"),
+    ('dofs = ["tip:x", "platform:x", "platform:y"]', 'dofs = []', "outputs.dofs",
+     "non-empty"),
+    ('max_step = 0.04', 'max_step = 0.04\nmin_step = 0.5', "continuation.min_step",
+     "max_step"),
+    ('formulation = "condensed"', 'formulation = "condensed"\nstability = 1',
+     "solver.stability", "true or false"),
+    ('[solver]', '[solvers]', "solvers", "unknown key"),
+]
+
+
+@pytest.mark.parametrize("old,new,key,words", BAD, ids=[b[2] + ":" + b[1][:20] for b in BAD])
+def test_malformed_field_names_key(deckdir, old, new, key, words):
+    assert old in BASE
+    path = write(deckdir, BASE.replace(old, new, 1))
+    with pytest.raises(InputError) as info:
+        load_deck(path)
+    msg = str(info.value)
+    assert str(path) in msg and key in msg and words in msg, msg
+
+
+def test_bad_toml_and_bad_matrix(deckdir):
+    p = write(deckdir, BASE.replace("[solver]", "[solver"))
+    with pytest.raises(InputError, match="not valid TOML"):
+        load_deck(p)
+    (deckdir / "M.mtx").write_text("%%MatrixMarket matrix coordinate real general\n5 5 1\n"
+                                   "1 1 nonsense\n")
+    with pytest.raises(InputError, match="M.mtx"):
+        load_deck(write(deckdir, BASE))
+    with pytest.raises(InputError, match="does not exist"):
+        load_deck(deckdir / "none.toml")
+
+
+def test_nonsymmetric_stiffness(deckdir):
+    (deckdir / "K.mtx").write_text("%%MatrixMarket matrix coordinate real general\n5 5 6\n"
+                                   "1 1 1e6\n2 2 1e6\n3 3 1e6\n4 4 1e6\n5 5 1e6\n1 2 5e5\n")
+    with pytest.raises(InputError, match="model.stiffness.*symmetric"):
+        load_deck(write(deckdir, BASE))
+
+
+def test_bladed_disk_engine_order_travelling_wave():
+    """The tuned 12-sector disk under engine order 2 answers with a travelling wave, also
+    with the friction dampers slipping: every blade tip has the same amplitude and sector
+    s lags sector 0 by 2 pi 2 s / 12 (cyclic symmetry; checks the engine-order loads, the
+    node-to-node contacts and the solver together)."""
+    from frirom.solver import frf
+    d = load_deck(ROOT / "cases" / "bladed_disk" / "bladed_disk.toml")
+    assert len(d.contacts[0].G.toarray()) == 12
+    tips = [d.dof_labels.index(f"s{s}:tip") for s in range(12)]
+    r = frf(d.model(), d.excitation(), 2 * np.pi * 800, 2 * np.pi * 860, d.options(),
+            outputs=tips)
+    assert r.complete, r.message
+    assert r.state_fractions[:, 0, 1].max() > 0.2          # the dampers slip
+    X1 = r.X[:, :, 1] - 1j * r.X[:, :, 2]                 # (n_pts, 12)
+    lag = np.exp(-2j * np.pi * 2 * np.arange(12) / 12)
+    err = np.abs(X1 - X1[:, :1] * lag).max() / np.abs(X1).max()
+    assert err < 1e-8, err
+    assert np.allclose(r.amp_max, r.amp_max[:, :1], rtol=1e-8)
+
+
+def test_per_element_frames_and_parameters(deckdir):
+    text = BASE.replace(
+        'elements = [ { a = ["platform:x", "platform:y"], b = "ground" } ]',
+        'elements = [ { a = ["platform:x", "platform:y"] },\n'
+        '             { a = ["platform:x", "platform:y"], b = "ground", '
+        'directions = [[0.0, 2.0]] } ]').replace("mu = 0.5 ", "mu = [0.5, 0.2] ")
+    d = load_deck(write(deckdir, text))
+    G = d.contacts[0].G.toarray()
+    assert np.allclose(G[0, :2], [np.cos(np.pi / 6), 0.5]) and np.allclose(G[1, :2], [0, 1])
+    assert np.allclose(d.contacts[0].params[:, 1], [0.5, 0.2])

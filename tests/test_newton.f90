@@ -1,0 +1,122 @@
+!> frirom_newton: continuation of the closed-form curve lam = y1^3 - 3 y1, y2 = y1^2 from
+!> lam = -4 to lam = 4 through its two turning points (y1 = -1, lam = 2 and y1 = 1,
+!> lam = -2), with a dense 2x2 system extending nl_system.
+module newton_test_system
+    use frirom_kinds, only: wp, ip
+    use frirom_newton, only: nl_system
+    implicit none
+    type, extends(nl_system) :: cubic_curve
+        real(wp) :: j(2, 2) = 0.0_wp
+        integer :: nfact = 0
+    contains
+        procedure :: eval => cc_eval
+        procedure :: solve => cc_solve
+    end type cubic_curve
+contains
+    subroutine cc_eval(this, y, lam, r, rref, jac, rlam, info, errmsg)
+        class(cubic_curve), intent(inout) :: this
+        real(wp), intent(in) :: y(:), lam
+        real(wp), intent(out) :: r(:), rref, rlam(:)
+        logical, intent(in) :: jac
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        info = 0
+        r(1) = y(1)**3 - 3*y(1) - lam
+        r(2) = y(2) - y(1)**2
+        rref = max(abs(lam), abs(y(1)**3), 1.0_wp)
+        rlam = [-1.0_wp, 0.0_wp]
+        if (jac) then
+            this%j = reshape([3*y(1)**2 - 3, -2*y(1), 0.0_wp, 1.0_wp], [2, 2])
+            this%nfact = this%nfact + 1
+        end if
+        if (.false.) errmsg = ''
+    end subroutine cc_eval
+    subroutine cc_solve(this, b, info, errmsg)
+        class(cubic_curve), intent(inout) :: this
+        real(wp), intent(inout) :: b(:, :)
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        ! lower triangular 2x2
+        info = 0
+        if (this%j(1, 1) == 0.0_wp) then
+            info = 10
+            errmsg = 'singular'
+            return
+        end if
+        b(1, :) = b(1, :)/this%j(1, 1)
+        b(2, :) = (b(2, :) - this%j(2, 1)*b(1, :))/this%j(2, 2)
+    end subroutine cc_solve
+end module newton_test_system
+
+program test_newton
+    use frirom_kinds, only: wp, ip
+    use frirom_newton, only: cont_options, newton_correct, cont_tangent, cont_run
+    use newton_test_system
+    implicit none
+    type(cubic_curve) :: s
+    type(cont_options) :: o
+    real(wp) :: y(2), lam, t(3), ds, yout(2, 500), lout(500), tout(3, 500), y1ref
+    integer(ip) :: it(500), npts, info, k, iters, nfold
+    logical :: fin, hf
+    character(len=256) :: msg
+    s%n = 2
+    msg = ''
+    o%lam_end = 4.0_wp
+    o%lscale = 8.0_wp
+    o%yscale = 2.0_wp
+    o%ds = 0.05_wp
+    o%ds_max = 0.05_wp
+    o%max_points = 500
+    o%tol_r = 1.0e-12_wp
+    o%tol_x = 1.0e-10_wp
+    ! start on the lower branch at lam = -4 (y1 = -2.1958...)
+    y = [-2.0_wp, 4.0_wp]
+    lam = -4.0_wp
+    hf = .false.
+    call newton_correct(s, y, lam, y, lam, [0.0_wp, 0.0_wp], 1.0_wp, o, iters, info, msg, hf)
+    call check(info == 0, 'first point: '//trim(msg))
+    call check(abs(y(1)**3 - 3*y(1) + 4.0_wp) < 1.0e-11_wp, 'first point on the curve')
+    call cont_tangent(s, y, lam, o, [0.0_wp, 0.0_wp, 0.0_wp], 1.0_wp, t, info, msg)
+    ds = o%ds
+    call cont_run(s, y, lam, t, ds, -4.5_wp, o, yout, lout, tout, it, npts, fin, info, msg, hf)
+    call check(info == 0 .and. fin, 'continuation reached lam_end: '//trim(msg))
+    nfold = 0
+    do k = 1, npts
+        call check(abs(yout(1, k)**3 - 3*yout(1, k) - lout(k)) < 1.0e-9_wp*max(abs(lout(k)), &
+                   1.0_wp), 'every point on the curve')
+        call check(abs(yout(2, k) - yout(1, k)**2) < 1.0e-9_wp, 'second unknown')
+        if (k > 1) then
+            if (tout(3, k)*tout(3, k - 1) < 0.0_wp) nfold = nfold + 1
+        end if
+    end do
+    ! the root of y^3 - 3y - 4 = 0 by Cardano
+    y1ref = (2.0_wp + sqrt(3.0_wp))**(1.0_wp/3.0_wp) + (2.0_wp - sqrt(3.0_wp))**(1.0_wp/3.0_wp)
+    print '(a,i0,a,i0,a,es10.2)', 'points ', npts, ', folds ', nfold, ', |y1_end - ref| ', &
+        abs(yout(1, npts) - y1ref)
+    call check(nfold == 2, 'two turning points passed')
+    call check(lout(npts) == 4.0_wp, 'last point exactly at lam_end')
+    call check(abs(yout(1, npts) - y1ref) < 1.0e-10_wp, 'end on the upper branch')
+    call check(maxval(lout(1:npts)) < 2.0_wp + 1.0e-9_wp .or. yout(1, npts) > 1.0_wp, &
+               'branch order')
+    ! a failing corrector at the minimum step stops with a diagnostic, keeping points
+    o%max_iter = 1
+    o%ds_min = 0.04_wp
+    o%tol_r = 1.0e-300_wp
+    y = yout(:, 10)
+    lam = lout(10)
+    t = tout(:, 10)
+    ds = 0.05_wp
+    call cont_run(s, y, lam, t, ds, -4.5_wp, o, yout, lout, tout, it, npts, fin, info, msg, hf)
+    call check(info == 20 .and. npts == 0 .and. index(msg, 'stopped') > 0, &
+               'stop diagnostic: '//trim(msg))
+    print '(a)', 'test_newton: all checks passed'
+contains
+    subroutine check(cond, what)
+        logical, intent(in) :: cond
+        character(len=*), intent(in) :: what
+        if (.not. cond) then
+            print '(a)', 'FAILED: '//what
+            error stop 1
+        end if
+    end subroutine check
+end program test_newton

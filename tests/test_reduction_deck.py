@@ -1,0 +1,158 @@
+"""The [reduction] deck: FE files -> CB -> GSI/MS -> cached reduced model."""
+
+import os
+import shutil
+import sys
+from pathlib import Path
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from _lattices import tuned_rotor
+from frirom._errors import InputError
+from frirom.io import read_calculix, write_calculix_matrices
+from frirom.reduction.deck import load_reduction_deck
+from frirom.reduction.interface import contact_matrix, stick_stiffness
+from frirom.reduction.multistage import harmonic_indices
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "models"))
+import block  # noqa: E402
+
+GSI_DECK = """
+[fe_model]
+format = "calculix"
+job = "block"
+
+[reduction]
+interface = "IFACE"
+active = ["ACTIVE"]
+fixed_interface_modes = 30
+
+[reduction.interface_modes]
+method = "gsi"
+free = 6
+stick = 6
+
+[[reduction.pairs]]
+name = "end"
+a = "IFACE"
+b = "ground"
+normal = [1.0, 0.0, 0.0]
+kt = {kt}
+kn = 8.0e8
+
+[solver]
+harmonics = {h}
+"""
+
+
+@pytest.fixture(scope="module")
+def block_dir(tmp_path_factory):
+    if shutil.which("ccx") is None:
+        pytest.skip("ccx not installed")
+    out = tmp_path_factory.mktemp("deckblock")
+    block.run_ccx(block.write_block_deck(out / "block.inp", 10, 3, 3, n_ref_modes=0))
+    return out
+
+
+def _write(path, text):
+    path.write_text(text)
+    return path
+
+
+def test_gsi_deck_builds_composes_and_caches(block_dir):
+    deck = _write(block_dir / "joint.toml", GSI_DECK.format(kt="2.0e8", h=3))
+    rom = load_reduction_deck(deck)
+    fe = read_calculix(block_dir / "block")
+    n_act = fe.dof_indices("ACTIVE").size
+    assert rom.K.shape == (12 + n_act + 30,) * 2 and not rom.from_cache
+    # the composed map reproduces the reduced matrices and the contact map
+    assert np.linalg.norm(rom.T.T @ (fe.K @ rom.T) - rom.K) < 1e-9 * np.linalg.norm(rom.K)
+    assert np.linalg.norm(rom.T.T @ (fe.M @ rom.T) - rom.M) < 1e-9 * np.linalg.norm(rom.M)
+    G = rom.contact_matrix("end")
+    g_fe = contact_matrix(rom.pairs["end"], fe.n_dof)
+    assert abs(G - sp.csr_matrix(g_fe @ rom.T)).max() < 1e-12 * abs(G).max()
+    assert G.shape == (3 * fe.node_sets["IFACE"].size, rom.K.shape[0])
+    i = rom.dof_index(f"N{fe.node_sets['ACTIVE'][0]}:UZ")
+    assert np.isclose(rom.T[fe.dof_indices("ACTIVE", directions=(3,))[0], i], 1.0)
+    # stuck frequencies of the ROM close to the FE model's (CB 30 + 12 GSI modes)
+    ks = stick_stiffness(rom.pairs["end"], fe.n_dof)
+    lam_fe = sla.eigh((fe.K + ks).toarray(), fe.M.toarray(), eigvals_only=True,
+                      subset_by_index=[0, 4])
+    kr = rom.K + (G.T @ sp.diags(rom.pairs["end"].stiffness.ravel()) @ G).toarray()
+    lam = sla.eigh(kr, rom.M, eigvals_only=True, subset_by_index=[0, 4])
+    assert np.all(lam >= lam_fe * (1 - 1e-9)) and np.abs(np.sqrt(lam / lam_fe) - 1).max() < 1e-2
+    # nonlinear/solver data changed only: reused; stick stiffness changed: rebuilt
+    deck = _write(block_dir / "joint.toml", GSI_DECK.format(kt="2.0e8", h=7))
+    again = load_reduction_deck(deck)
+    assert again.from_cache and np.array_equal(again.K, rom.K)
+    deck = _write(block_dir / "joint.toml", GSI_DECK.format(kt="3.0e8", h=7))
+    other = load_reduction_deck(deck)
+    assert not other.from_cache and not np.allclose(other.K, rom.K)
+
+
+def test_deck_errors_name_the_key(block_dir):
+    good = GSI_DECK.format(kt="2.0e8", h=3)
+    cases = [
+        (good.replace('method = "gsi"', 'method = "pod"'),
+         "reduction.interface_modes.method: expected 'none', 'gsi' or 'ms'"),
+        (good.replace("free = 6", "free = -1"), "reduction.interface_modes.free"),
+        (good.replace("fixed_interface_modes = 30", "fixed_modes = 30"),
+         "reduction.fixed_modes: expected one of the known keys"),
+        (good.replace('a = "IFACE"', 'a = "NOPE"'), "reduction.pairs[0]: unknown node set"),
+        (good.replace('format = "calculix"', 'format = "nastran"'), "fe_model.format"),
+        (good.replace("kn = 8.0e8", "kn = -1.0"), "reduction.pairs[0].kn: expected a number > 0"),
+    ]
+    for text, msg in cases:
+        deck = _write(block_dir / "bad.toml", text)
+        with pytest.raises(InputError) as exc:
+            load_reduction_deck(deck)
+        assert msg in str(exc.value) and "bad.toml" in str(exc.value), str(exc.value)
+
+
+def test_ms_deck_on_a_rotor_is_exact_for_its_engine_order(tmp_path):
+    """A tuned lattice rotor written as ccx matrix files + an .inp with nodes and sets,
+    reduced through the deck with MS for EO 2: exact for an EO-2 travelling wave."""
+    r = tuned_rotor(axis=(0.0, 0.0, 1.0), origin=(0.0, 0.0, 0.0))
+    n_nodes = len(r["coords"])
+    ids = np.arange(1, n_nodes + 1)
+    dofs = np.column_stack([np.repeat(ids, 3), np.tile([1, 2, 3], n_nodes)])
+    write_calculix_matrices(tmp_path / "rotor", r["K"], r["M"], dofs)
+    with open(tmp_path / "rotor.inp", "w") as fh:
+        fh.write("*NODE\n")
+        for i, (x, y, z) in zip(ids, r["coords"]):
+            fh.write(f"{i}, {x:.17g}, {y:.17g}, {z:.17g}\n")
+        for name, nodes in (("FLANGE", r["iface_nodes"] + 1), ("TIPS", r["tips"] + 1)):
+            fh.write(f"*NSET, NSET={name}\n")
+            fh.write("\n".join(str(v) for v in nodes) + "\n")
+    deck = _write(tmp_path / "rotor.toml", """
+[fe_model]
+format = "calculix"
+job = "rotor"
+
+[reduction]
+interface = "FLANGE"
+active = "TIPS"
+
+[reduction.interface_modes]
+method = "ms"
+sectors = 7
+engine_orders = [2]
+""")
+    rom = load_reduction_deck(deck)
+    n_if = 3 * r["iface_nodes"].size
+    idx = harmonic_indices(2, 7, 21)
+    assert rom.K.shape[0] == r["K"].shape[0] - n_if + 2 * idx.size * 9
+    f = np.zeros(r["K"].shape[0], complex)
+    for s, tip in enumerate(r["tips"]):
+        th = 2 * np.pi * s / 7
+        f[r["dofs"][tip]] = np.array([np.cos(th), np.sin(th), 0.4]) * np.exp(-2j * th)
+    om = 1500.0
+    K, M = r["K"].toarray(), r["M"].toarray()
+    x = np.linalg.solve(K * (1 + 0.01j) - om**2 * M, f)
+    y = np.linalg.solve(rom.K * (1 + 0.01j) - om**2 * rom.M, rom.T.T @ f)
+    assert np.linalg.norm(rom.expand(y) - x) < 1e-10 * np.linalg.norm(x)
