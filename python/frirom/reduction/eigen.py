@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .._errors import InputError, raise_for_status
+from .._errors import InputError, NonFiniteError, raise_for_status
 
 
 def _upper_coo(A, name):
@@ -49,6 +49,9 @@ def eigsh_shift_invert(K, M, n_modes: int, sigma: float = 0.0, rhs=None, tol: fl
         raise InputError(f"K {K.shape} and M {M.shape} must be square and of one size")
     if n_modes < 0 or (n_modes > 0 and n_modes >= n - 1):
         raise InputError(f"n_modes = {n_modes}: expected 0 <= n_modes <= n - 2 = {n - 2}")
+    for A, name in ((K, "K"), (M, "M")):
+        if not np.all(np.isfinite(A.data)):
+            raise NonFiniteError(f"{name} holds NaN or Inf")
     from .. import _kernels
 
     kr, kc, kv = _upper_coo(K, "K")
