@@ -115,7 +115,7 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
                         tan0, start_mode, ds, ds_min, ds_max, lam_end, lam_lo, tol_r, tol_x, &
                         tol_stall, max_iter, reuse, yscale, lscale, maxpts, netot, stability, &
                         nmodes, phi, wmodes, zmodes, ys, lams, tans, iters, xo, states, hill_re, &
-                        npts, finished, ds_out, timings, info, msg)
+                        sliders, npts, finished, ds_out, timings, njump, info, msg)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options
@@ -149,6 +149,10 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     integer(4), intent(out) :: iters(maxpts)
     real(8), intent(out) :: xo(nout, 2*nh + 1, maxpts), states(3, netot, maxpts)
     real(8), intent(out) :: hill_re(maxpts)   !! max real part of the Floquet exponents, 1/s
+    !> contact history each point leaves: the sliders its closed cycles start with, in the
+    !> layout of w0 (the w0 to restart a run from that point)
+    real(8), intent(out) :: sliders(nw0, maxpts)
+    integer(4), intent(out) :: njump          !! steps taken over a stalled corrector
     integer(4), intent(out) :: npts, finished
     real(8), intent(out) :: ds_out, timings(8)
     integer(4), intent(out) :: info
@@ -173,6 +177,8 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     iters = 0
     xo = 0.0d0
     states = 0.0d0
+    sliders = 0.0d0
+    njump = 0
     if (form == 1) then
         allocate (hbm_condensed :: sys)
     else if (form == 2) then
@@ -212,11 +218,12 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     hill_re = 0.0d0
     if (stability /= 0) then
         call hbm_run(sys, start_mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itl, xo, &
-                     states, np, fin, linfo, msg, hill_re)
+                     states, np, fin, linfo, msg, hill_re, sliders=sliders)
     else
         call hbm_run(sys, start_mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itl, xo, &
-                     states, np, fin, linfo, msg)
+                     states, np, fin, linfo, msg, sliders=sliders)
     end if
+    njump = sys%njump
     npts = np
     iters = itl
     finished = merge(1, 0, fin)

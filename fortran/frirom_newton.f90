@@ -17,9 +17,11 @@ module frirom_newton
     !> A nonlinear system R(y, lam) = 0 with n unknowns y and one parameter lam.
     type, abstract :: nl_system
         integer(ip) :: n = 0       !! number of unknowns y
+        integer(ip) :: njump = 0   !! steps cont_run took over a stalled corrector (counter)
     contains
         procedure(eval_iface), deferred :: eval
         procedure(solve_iface), deferred :: solve
+        procedure :: accept => nl_accept
     end type nl_system
 
     abstract interface
@@ -71,6 +73,20 @@ module frirom_newton
     end type cont_options
 
 contains
+
+    !> Called once per converged point (y, lam), before its tangent is computed: a system
+    !> with history (friction sliders) updates the state that R depends on here, so that
+    !> R(y) stays one deterministic function during each corrector. Default: nothing.
+    subroutine nl_accept(this, y, lam, info, errmsg)
+        class(nl_system), intent(inout) :: this
+        real(wp), intent(in) :: y(:)        !! (n) converged unknowns
+        real(wp), intent(in) :: lam         !! converged parameter
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        info = FRIROM_OK
+        if (.false.) errmsg = ''
+        if (.false.) this%n = size(y) + int(lam)
+    end subroutine nl_accept
 
     !> Bordered Newton corrector: solve R(y, lam) = 0 together with the linear constraint
     !> cy.(y - yp)/yscale + cl (lam - lp)/lscale = 0 (cy = 0, cl = 1 fixes lam = lp;
@@ -319,6 +335,7 @@ contains
                     ! state change inside one sample) stalls Newton at any small step: try
                     ! once to step over it with a larger step
                     jumped = .true.
+                    sys%njump = sys%njump + 1
                     ds = min(max(4.0_wp*ds_fail0, 0.1_wp*opts%ds_max), opts%ds_max)
                     info = FRIROM_OK
                     cycle
@@ -334,7 +351,8 @@ contains
                 ds = 0.5_wp*ds
                 cycle
             end if
-            call cont_tangent(sys, y1, lam1, opts, t, dirn, t1, info, errmsg)
+            call sys%accept(y1, lam1, info, errmsg)
+            if (info == 0) call cont_tangent(sys, y1, lam1, opts, t, dirn, t1, info, errmsg)
             if (info /= 0) then
                 have_fact = .false.
                 return
