@@ -77,6 +77,9 @@ module frirom_hbm
         type(contact_set) :: cs
         type(aft_plan) :: plan
         real(wp) :: timers(N_TIMERS) = 0.0_wp
+        !> accept carries the contact history (sliders) from point to point; .false.
+        !> restarts every AFT call from the w0 given at setup
+        logical :: carry = .true.
     contains
         procedure(outputs_iface), deferred :: outputs
         procedure :: accept => hbm_accept
@@ -551,7 +554,7 @@ contains
         integer(ip) :: i, nc
         info = FRIROM_OK
         if (.false.) info = int(lam)
-        if (size(this%cs%grp) == 0) return
+        if (size(this%cs%grp) == 0 .or. .not. this%carry) return
         nc = this%nc
         select type (this)
         type is (hbm_condensed)

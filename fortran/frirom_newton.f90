@@ -17,7 +17,6 @@ module frirom_newton
     !> A nonlinear system R(y, lam) = 0 with n unknowns y and one parameter lam.
     type, abstract :: nl_system
         integer(ip) :: n = 0       !! number of unknowns y
-        integer(ip) :: njump = 0   !! steps cont_run took over a stalled corrector (counter)
     contains
         procedure(eval_iface), deferred :: eval
         procedure(solve_iface), deferred :: solve
@@ -259,9 +258,8 @@ contains
         real(wp), allocatable :: y1(:), yp(:), t1(:), cy(:)
         real(wp) :: lam1, lp, dirn, frac, cl
         integer(ip) :: n, iters
-        logical :: last, jumped
-        integer(ip) :: nfail, nf, effort
-        real(wp) :: ds_fail0
+        logical :: last
+        integer(ip) :: nf, effort
         type(cont_options) :: fresh_opts
         character(len=len(errmsg)) :: why
         character(len=120) :: buf
@@ -283,9 +281,6 @@ contains
         end if
         allocate (y1(n), yp(n), t1(n + 1), cy(n))
         dirn = sign(1.0_wp, opts%lam_end - lam_lo)
-        jumped = .false.
-        nfail = 0
-        ds_fail0 = ds
         fresh_opts = opts
         fresh_opts%reuse_jac = .false.
         do while (npts < opts%max_points)
@@ -328,18 +323,6 @@ contains
             if (info /= 0) then
                 why = errmsg
                 have_fact = .false.
-                nfail = nfail + 1
-                if (nfail == 1) ds_fail0 = ds
-                if ((nfail == 5 .or. ds <= opts%ds_min*1.000001_wp) .and. .not. jumped) then
-                    ! a discontinuity or kink of R (a contact entering stick-all-cycle, a
-                    ! state change inside one sample) stalls Newton at any small step: try
-                    ! once to step over it with a larger step
-                    jumped = .true.
-                    sys%njump = sys%njump + 1
-                    ds = min(max(4.0_wp*ds_fail0, 0.1_wp*opts%ds_max), opts%ds_max)
-                    info = FRIROM_OK
-                    cycle
-                end if
                 if (ds <= opts%ds_min*1.000001_wp) then
                     call set_status(info, FRIROM_ERR_CONT, errmsg, 'continuation stopped')
                     write (buf, '(a,es12.5,a,es9.2,a)') ' at parameter ', lam, &
@@ -358,8 +341,6 @@ contains
                 return
             end if
             have_fact = .true.
-            jumped = .false.
-            nfail = 0
             npts = npts + 1
             y = y1
             lam = lam1

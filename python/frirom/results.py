@@ -55,8 +55,7 @@ class FRF:
     2H+1) real harmonic coefficients [a0, a1, b1, ...]; amp_max (n_pts, n_out);
     state_fractions (n_pts, n_groups, 3) stick/slip/lift-off; stable, fold (n_pts,) bool;
     iterations (n_pts,) int; time_s (n_pts,) s; slider (n_pts, n_slider_total) the contact
-    history each point leaves (FRFPoint.slider; None in files written before it was kept);
-    jumps: steps the continuation took over a corrector that stalled (0 on a traced curve).
+    history each point leaves (FRFPoint.slider; None in files written before it was kept).
     """
 
     omega: np.ndarray
@@ -75,7 +74,6 @@ class FRF:
     message: str = ""
     stability_computed: bool = False
     slider: np.ndarray | None = None
-    jumps: int = 0
     #: Fortran time split of the run: aft, assembly, factorization, solve, receptance (s),
     #: evaluations, factorizations (counts), fortran_total (s)
     timings: dict = field(default_factory=dict)
@@ -119,7 +117,6 @@ class FRF:
                 f.create_dataset(name, data=np.asarray(v if v is not None else self.omega))
             if self.slider is not None:
                 f.create_dataset("slider", data=np.asarray(self.slider, dtype=float))
-            f.attrs["jumps"] = self.jumps
             f.attrs["group_names"] = np.array(self.group_names, dtype="S")
             f.attrs["parameter_name"] = self.parameter_name
             f.attrs["complete"] = self.complete
@@ -165,7 +162,7 @@ class FRF:
             if kw["slider"] is not None and kw["slider"].shape[0] != kw["omega"].shape[0]:
                 raise InputError(f"{path}: 'slider' has {kw['slider'].shape[0]} rows for "
                                  f"{kw['omega'].shape[0]} points")
-            return cls(**kw, jumps=int(f.attrs.get("jumps", 0)),
+            return cls(**kw,
                        group_names=[s.decode() for s in f.attrs.get("group_names", [])],
                        parameter_name=str(f.attrs.get("parameter_name", "omega")),
                        complete=bool(f.attrs.get("complete", True)),

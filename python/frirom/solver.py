@@ -52,7 +52,10 @@ class SolverOptions:
     factorisation while Newton contracts by a factor 10 per iteration (a corrector that
     fails with reuse is retried with a fresh Jacobian at every iteration); batch: points
     per call into Fortran (sink granularity); stability: Hill's method at every point
-    (dense eigen-solve of size 2 n_dof (2H+1), up to 4000); modes: condensed formulation
+    (dense eigen-solve of size 2 n_dof (2H+1), up to 4000); history: carry the contact
+    history along the curve (each point starts its sliders where the previous converged
+    point's closed cycles left them; False restarts every point from the model's w0, which
+    makes a contact stuck all cycle snap back to it); modes: condensed formulation
     only, receptances by superposition of this many lowest modes (mass-normalised, damping
     ratios from Damping.modal or the diagonal of Phi^T C Phi) instead of factorising the
     dynamic stiffness at every frequency (truncation: no residual flexibility).
@@ -72,6 +75,7 @@ class SolverOptions:
     parameter: str = "frequency"
     reuse_jacobian: bool = True
     stability: bool = False
+    history: bool = True
     modes: int | None = None
     batch: int = 10
 
@@ -249,13 +253,13 @@ class _Packed:
             y0, lam0, tan0, start_mode, ds, o.ds_min, o.ds_max, lam_end, lam_lo,
             o.tol_residual, o.tol_update, o.tol_stall, o.max_iter, int(o.reuse_jacobian),
             yscale, lscale, maxpts, max(self.ne_tot, 1), int(self.stability), self.nmodes,
-            np.asfortranarray(self.phi), self.wmodes, self.zmodes, nh=self.H,
+            np.asfortranarray(self.phi), self.wmodes, self.zmodes, int(o.history), nh=self.H,
             ndof=self.n_dof, nnl=self.nl.size or 1)
         r = SimpleNamespace(**dict(zip(
             ("ys", "lams", "tans", "iters", "xo", "states", "hill_re", "sliders", "npts",
-             "finished", "ds_out", "timings", "njump", "info", "msg"), res)))
+             "finished", "ds_out", "timings", "info", "msg"), res)))
         r.msg = r.msg.decode(errors="replace")
-        if r.npts > 0 and self.nw:
+        if r.npts > 0 and self.nw and o.history:
             self.w0 = r.sliders[:self.nw, r.npts - 1].copy()
         return r
 
@@ -303,7 +307,6 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
     lscale = abs(lam_end - lam_start) or 1.0
     points, message, complete = [], "", True
     timings: dict = {}
-    njump = 0
     t0 = time.perf_counter()
     if start is None:
         y0 = np.zeros(packed.ny)
@@ -360,7 +363,6 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
         t_call = time.perf_counter() - t0
         t0 = time.perf_counter()
         finished, ds_out, info = res.finished, res.ds_out, res.info
-        njump += int(res.njump)
         _add_timings(timings, res.timings)
         new = packed.points(res, omega_fix, t_call)
         for p in new:
@@ -416,7 +418,6 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
                           complete=complete, message=message,
                           stability_computed=packed.stability)
     out.timings = timings
-    out.jumps = njump
     if keep_unknowns and points:
         out._last_unknowns = points[-1].unknowns
         out._last_slider = points[-1].slider
