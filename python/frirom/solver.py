@@ -386,6 +386,11 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
                 sink(p)
         if info != 0:
             message = res.msg.strip()
+            if info == 20 and packed.nw and o.n_samples < 256:
+                message += (f" [each contact state switch at one of the N = {o.n_samples} "
+                            "AFT samples puts a corner in the solution curve, which the "
+                            "continuation cannot always turn; with lift-off or stick-slip "
+                            "raise the samples (256 recommended)]")
             if not points:
                 raise_for_status(info, message)
             complete = False
