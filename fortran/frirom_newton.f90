@@ -259,9 +259,7 @@ contains
         real(wp) :: lam1, lp, dirn, frac, cl
         integer(ip) :: n, iters
         logical :: last
-        integer(ip) :: nf, effort, turned
-        real(wp) :: probe
-        real(wp), allocatable :: tc(:), tz(:)
+        integer(ip) :: nf, effort
         type(cont_options) :: fresh_opts
         character(len=len(errmsg)) :: why
         character(len=120) :: buf
@@ -281,9 +279,7 @@ contains
                             'ds_max and ds > 0')
             return
         end if
-        allocate (y1(n), yp(n), t1(n + 1), cy(n), tc(n + 1), tz(n + 1))
-        tz = 0.0_wp
-        turned = 0
+        allocate (y1(n), yp(n), t1(n + 1), cy(n))
         dirn = sign(1.0_wp, opts%lam_end - lam_lo)
         fresh_opts = opts
         fresh_opts%reuse_jac = .false.
@@ -327,36 +323,6 @@ contains
             if (info /= 0) then
                 why = errmsg
                 have_fact = .false.
-                if (ds <= opts%ds_min*1.000001_wp .and. turned < 3) then
-                    ! A corner of the solution curve: R is only piecewise smooth (a contact
-                    ! state switching at one AFT time sample, lift-off onset), and the
-                    ! tangent of the piece the last point lies on leads where no solution
-                    ! is, at any step. Try the tangent of the piece beyond (from the
-                    ! Jacobian a little way ahead) both ways, then the non-smooth fold
-                    ! (y goes on, lam turns back).
-                    turned = turned + 1
-                    probe = 10.0_wp*opts%ds_min
-                    info = FRIROM_OK
-                    if (turned == 1) tc = t
-                    if (turned <= 2) then
-                        yp = y + probe*tc(1:n)*opts%yscale
-                        lp = lam + probe*tc(n + 1)*opts%lscale
-                        call cont_tangent(sys, yp, lp, opts, tz, dirn, t1, info, errmsg)
-                        if (info == 0) then
-                            if (dot_product(t1(1:n), tc(1:n)) < 0.0_wp) t1 = -t1
-                            if (turned == 2) t1 = -t1
-                        end if
-                    else
-                        t1 = tc
-                        t1(n + 1) = -tc(n + 1)
-                    end if
-                    if (info == 0) then
-                        t = t1
-                        ds = probe
-                        cycle
-                    end if
-                    info = FRIROM_ERR_NOCONV
-                end if
                 if (ds <= opts%ds_min*1.000001_wp) then
                     call set_status(info, FRIROM_ERR_CONT, errmsg, 'continuation stopped')
                     write (buf, '(a,es12.5,a,es9.2,a)') ' at parameter ', lam, &
@@ -375,7 +341,6 @@ contains
                 return
             end if
             have_fact = .true.
-            turned = 0
             npts = npts + 1
             y = y1
             lam = lam1

@@ -144,3 +144,4 @@ def test_formulations_and_load_continuation_carry_the_same_history(sweeps):
     assert np.abs(p.X[0] - r.X[-1, 0]).max() < 1e-8 * np.abs(r.X[-1]).max()
     q = solve_point(model(), Excitation(F), r.omega[-1], options())
     assert abs(q.X[0, 0] - r.X[-1, 0, 0]) > 1e-2
+

@@ -386,11 +386,11 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
                 sink(p)
         if info != 0:
             message = res.msg.strip()
-            if info == 20 and packed.nw and o.n_samples < 256:
-                message += (f" [each contact state switch at one of the N = {o.n_samples} "
-                            "AFT samples puts a corner in the solution curve, which the "
-                            "continuation cannot always turn; with lift-off or stick-slip "
-                            "raise the samples (256 recommended)]")
+            if info == 20 and packed.nw:
+                message += (" [with friction contacts this is usually a corner of the "
+                            "solution curve: a contact state switching at one of the "
+                            f"N = {o.n_samples} AFT samples, e.g. lift-off onset; more "
+                            "samples (256 recommended) make the corners milder]")
             if not points:
                 raise_for_status(info, message)
             complete = False
