@@ -145,3 +145,54 @@ def test_formulations_and_load_continuation_carry_the_same_history(sweeps):
     q = solve_point(model(), Excitation(F), r.omega[-1], options())
     assert abs(q.X[0, 0] - r.X[-1, 0, 0]) > 1e-2
 
+
+
+def test_resume_restores_history_and_reads_files_from_before(tmp_path):
+    """A run stopped in the stuck range after the resonance resumes with the slider it
+    stopped at: the resumed points equal the uninterrupted run's. A file written before
+    the history was kept (no 'slider', 'last_slider') still loads (slider None), resumes
+    with a warning from w0 (re-solving its last point first: with another history it is no
+    solution, and continuing from it stalls), and appending to it marks the old points'
+    history unknown (NaN)."""
+    import h5py
+
+    from frirom.results import FRF, FRFWriter
+
+    full = frf(model(), Excitation(F), 0.5, 2.5, options())
+    stuck = full.state_fractions[:, 0, 0] == 1.0
+    n_stop = int(np.flatnonzero(np.diff(stuck.astype(int)))[-1]) + 4   # stuck, slider != 0
+    path = tmp_path / "run.h5"
+    w = FRFWriter(path, [0], ["jenkins"], H)
+    frf(model(), Excitation(F), 0.5, 2.5, options(max_points=n_stop), outputs=[0],
+        sink=w.append)
+    w.close(complete=False)
+    start = FRFWriter.resume_point(path)
+    assert start["slider"][0] == full.slider[n_stop - 1, 0] != 0.0
+    w = FRFWriter(path, [0], ["jenkins"], H, append=True)
+    rest = frf(model(), Excitation(F), 0.5, 2.5, options(), outputs=[0], sink=w.append,
+               start=start)
+    w.close()
+    assert rest.complete and np.all(rest.state_fractions[:, 0, 0] == 1.0)
+    saved = FRF.load(path)
+    n = len(saved)
+    assert n == n_stop + len(rest) and saved.slider.shape == (n, 1)
+    assert np.all(saved.slider[n_stop:] == full.slider[n_stop])
+    # the stuck balance with that slider: the same mean displacement as the full run
+    assert np.allclose(saved.X[n_stop:, 0, 0], full.X[-1, 0, 0], rtol=1e-9, atol=0)
+    assert saved.omega[-1] == full.omega[-1]
+
+    # the same file as written before this change
+    with h5py.File(path, "a") as f:
+        del f["slider"], f["last_slider"]
+    old = FRF.load(path)
+    assert old.slider is None and len(old) == n
+    with pytest.warns(RuntimeWarning, match="before frirom kept the contact history"):
+        start = FRFWriter.resume_point(path)
+    assert start["slider"] is None
+    w = FRFWriter(path, [0], ["jenkins"], H, append=True)
+    more = frf(model(), Excitation(F), 0.5, 2.6, options(), outputs=[0], sink=w.append,
+               start=start)
+    w.close()
+    back = FRF.load(path)
+    assert np.all(np.isnan(back.slider[:n])) and np.all(np.isfinite(back.slider[n:]))
+    assert len(back) == n + len(more)

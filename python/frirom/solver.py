@@ -321,7 +321,10 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
         y0 = packed.pad_start(start["unknowns"], H_start if H_start is not None else packed.H)
         lam0 = float(start.get("parameter", start.get("omega")))
         tan = start.get("tangent")
-        if tan is None or H_start not in (None, packed.H):
+        # without the history the point was computed with (a file from before it was
+        # kept), the saved point need not solve the equations: re-solve it first
+        unknown_history = packed.nw and o.history and start.get("slider") is None
+        if tan is None or H_start not in (None, packed.H) or unknown_history:
             mode, tan0 = 0, np.zeros(packed.ny + 1)   # re-solve, then continue
         else:
             mode, tan0 = 1, np.asarray(tan, dtype=float)
