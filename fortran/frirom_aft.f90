@@ -165,12 +165,7 @@ contains
         call check_call(plan, law, x, params, w0, f, info, errmsg, jac, periods, states, &
                         index_base, slider)
         if (info /= FRIROM_OK) return
-        tl = DEFAULT_TOL
-        if (present(tol)) tl = tol
-        mp = DEFAULT_MAX_PERIODS
-        if (present(max_periods)) mp = max_periods
-        base = 1
-        if (present(index_base)) base = index_base
+        call defaults(tol, max_periods, index_base, tl, mp, base)
         want_jac = present(jac)
         nd = NDIR(law)
         ne = size(x, 3)
@@ -251,12 +246,7 @@ contains
             call set_status(info, FRIROM_ERR_SIZE, errmsg, 'xt and ft must be (N, ndir, ne)')
             return
         end if
-        tl = DEFAULT_TOL
-        if (present(tol)) tl = tol
-        mp = DEFAULT_MAX_PERIODS
-        if (present(max_periods)) mp = max_periods
-        base = 1
-        if (present(index_base)) base = index_base
+        call defaults(tol, max_periods, index_base, tl, mp, base)
         nd = NDIR(law)
         ne = size(x, 3)
         nb = plan%fp%nbatch
@@ -277,6 +267,20 @@ contains
             end do
         end do
     end subroutine aft_time
+
+    !> The optional settings of an AFT call, or their defaults.
+    pure subroutine defaults(tol, max_periods, index_base, tl, mp, base)
+        real(wp), intent(in), optional :: tol
+        integer(ip), intent(in), optional :: max_periods, index_base
+        real(wp), intent(out) :: tl
+        integer(ip), intent(out) :: mp, base
+        tl = DEFAULT_TOL
+        if (present(tol)) tl = tol
+        mp = DEFAULT_MAX_PERIODS
+        if (present(max_periods)) mp = max_periods
+        base = 1
+        if (present(index_base)) base = index_base
+    end subroutine defaults
 
     !> Shapes, law and parameters of an AFT call, checked before any work.
     subroutine check_call(plan, law, x, params, w0, f, info, errmsg, jac, periods, states, &
