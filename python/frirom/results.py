@@ -43,7 +43,8 @@ class FRFPoint:
     yscale: float = 0.0     #: scale of the unknowns in the arc length the tangent refers to
     #: (n_slider_total,) contact history this point leaves: the slider each element's closed
     #: cycle starts with, groups concatenated, (n_elem, n_slider) row-major per group (the
-    #: w0 a run restarted from this point needs; a contact stuck all cycle keeps it)
+    #: w0 a run restarted from this point needs; a contact stuck all cycle keeps it).
+    #: With SolverOptions(history=False) it is the w0 every point started from.
     slider: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
