@@ -114,8 +114,8 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
                         nnzg, gp, gi, gx, npart, params, nw0, w0, nout, outdofs, ny, y0, lam0, &
                         tan0, start_mode, ds, ds_min, ds_max, lam_end, lam_lo, tol_r, tol_x, &
                         tol_stall, max_iter, reuse, yscale, lscale, maxpts, netot, stability, &
-                        nmodes, phi, wmodes, zmodes, ys, lams, tans, iters, xo, states, hill_re, &
-                        npts, finished, ds_out, timings, info, msg)
+                        nmodes, phi, wmodes, zmodes, history, ys, lams, tans, iters, xo, states, hill_re, &
+                        sliders, npts, finished, ds_out, timings, info, msg)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options
@@ -143,12 +143,16 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     integer(4), intent(in) :: maxpts, netot
     integer(4), intent(in) :: stability    !! 1: Hill stability of every point
     integer(4), intent(in) :: nmodes       !! > 0: condensed receptances by modal superposition
+    integer(4), intent(in) :: history      !! 1: carry contact sliders from point to point
     real(8), intent(in) :: phi(ndof, max(nmodes, 1)), wmodes(max(nmodes, 1)), &
                            zmodes(max(nmodes, 1))
     real(8), intent(out) :: ys(ny, maxpts), lams(maxpts), tans(ny + 1, maxpts)
     integer(4), intent(out) :: iters(maxpts)
     real(8), intent(out) :: xo(nout, 2*nh + 1, maxpts), states(3, netot, maxpts)
     real(8), intent(out) :: hill_re(maxpts)   !! max real part of the Floquet exponents, 1/s
+    !> contact history each point leaves: the sliders its closed cycles start with, in the
+    !> layout of w0 (the w0 to restart a run from that point)
+    real(8), intent(out) :: sliders(nw0, maxpts)
     integer(4), intent(out) :: npts, finished
     real(8), intent(out) :: ds_out, timings(8)
     integer(4), intent(out) :: info
@@ -173,6 +177,7 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     iters = 0
     xo = 0.0d0
     states = 0.0d0
+    sliders = 0.0d0
     if (form == 1) then
         allocate (hbm_condensed :: sys)
     else if (form == 2) then
@@ -193,6 +198,7 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
         info = linfo
         return
     end if
+    sys%carry = history /= 0
     opts%tol_r = tol_r
     opts%tol_x = tol_x
     opts%tol_stall = tol_stall
@@ -212,10 +218,10 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     hill_re = 0.0d0
     if (stability /= 0) then
         call hbm_run(sys, start_mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itl, xo, &
-                     states, np, fin, linfo, msg, hill_re)
+                     states, np, fin, linfo, msg, hill_re, sliders=sliders)
     else
         call hbm_run(sys, start_mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itl, xo, &
-                     states, np, fin, linfo, msg)
+                     states, np, fin, linfo, msg, sliders=sliders)
     end if
     npts = np
     iters = itl

@@ -27,7 +27,8 @@ module frirom_hbm
     implicit none
     private
     public :: csr_matrix, contact_group, contact_set, hbm_system, hbm_condensed, hbm_full, &
-              hbm_setup, hbm_set_modes, hbm_run, hbm_hill, contact_eval, contact_assemble, &
+              hbm_setup, hbm_set_modes, hbm_run, hbm_hill, hbm_sliders, contact_eval, &
+              contact_assemble, &
               HBM_FREQUENCY, HBM_LOAD, &
               T_AFT, T_ASM, T_FACT, T_SOLVE, T_REC, N_EVAL, N_FACT, N_TIMERS
 
@@ -76,8 +77,12 @@ module frirom_hbm
         type(contact_set) :: cs
         type(aft_plan) :: plan
         real(wp) :: timers(N_TIMERS) = 0.0_wp
+        !> accept carries the contact history (sliders) from point to point; .false.
+        !> restarts every AFT call from the w0 given at setup
+        logical :: carry = .true.
     contains
         procedure(outputs_iface), deferred :: outputs
+        procedure :: accept => hbm_accept
     end type hbm_system
 
     abstract interface
@@ -418,8 +423,9 @@ contains
     end subroutine hbm_setup
 
     !> Forces fd(ncol, nc) = G^T f(G xd) of all contact groups, and their local Jacobians
-    !> (kept in the groups) when jac is true.
-    subroutine contact_eval(cs, plan, xd, fd, jac, info, errmsg)
+    !> (kept in the groups) when jac is true. With carry, each group's w0 becomes the slider
+    !> its closed cycle at xd starts with (the history the next point inherits).
+    subroutine contact_eval(cs, plan, xd, fd, jac, info, errmsg, carry)
         type(contact_set), intent(inout) :: cs
         type(aft_plan), intent(inout) :: plan
         real(wp), intent(in) :: xd(:, :)    !! (ncol, nc) harmonics of the columns
@@ -427,8 +433,13 @@ contains
         logical, intent(in) :: jac
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
+        logical, intent(in), optional :: carry
         integer(ip) :: g, e, d, row, k
+        real(wp), allocatable :: wnew(:, :)
+        logical :: upd
         info = FRIROM_OK
+        upd = .false.
+        if (present(carry)) upd = carry
         fd = 0.0_wp
         do g = 1, size(cs%grp)
             associate (gr => cs%grp(g), gg => cs%g)
@@ -441,7 +452,14 @@ contains
                         end do
                     end do
                 end do
-                if (jac) then
+                if (upd) then
+                    allocate (wnew, mold=gr%w0)
+                    wnew = gr%w0
+                    call aft_eval(plan, gr%law, gr%x, gr%params, gr%w0, gr%f, info, errmsg, &
+                                  states=gr%states, slider=wnew)
+                    if (info == 0) gr%w0 = wnew
+                    deallocate (wnew)
+                else if (jac) then
                     call aft_eval(plan, gr%law, gr%x, gr%params, gr%w0, gr%f, info, errmsg, &
                                   jac=gr%jac, states=gr%states)
                 else
@@ -521,6 +539,52 @@ contains
         if (.not. ok) call set_status(info, FRIROM_ERR_MODEL, errmsg, &
                                       'contact_assemble: entry outside the band')
     end subroutine contact_assemble
+
+    !> Accept a converged point: every contact group's initial slider becomes the slider of
+    !> the closed cycle at y, so the following points continue from this point's contact
+    !> history (a contact entering stick-all-cycle keeps the slider where it last slipped).
+    !> Within one corrector w0 stays fixed, so R(y) and its Jacobian stay consistent.
+    subroutine hbm_accept(this, y, lam, info, errmsg)
+        class(hbm_system), intent(inout) :: this
+        real(wp), intent(in) :: y(:)
+        real(wp), intent(in) :: lam
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        real(wp), allocatable :: xd(:, :), fd(:, :)
+        integer(ip) :: i, nc
+        info = FRIROM_OK
+        if (.false.) info = int(lam)
+        if (size(this%cs%grp) == 0 .or. .not. this%carry) return
+        nc = this%nc
+        select type (this)
+        type is (hbm_condensed)
+            xd = reshape(y, [this%nnl, nc])
+        class default
+            allocate (xd(this%ndof, nc))
+            do i = 1, this%ndof
+                xd(i, :) = y(nc*(this%iperm(i) - 1) + 1:nc*this%iperm(i))
+            end do
+        end select
+        allocate (fd(size(xd, 1), nc))
+        call contact_eval(this%cs, this%plan, xd, fd, .false., info, errmsg, carry=.true.)
+    end subroutine hbm_accept
+
+    !> The initial sliders of all groups, (nslider, ne) per group concatenated (the layout
+    !> of hbm_setup's w0); w must hold at least that many values, the rest is left alone.
+    subroutine hbm_sliders(sys, w)
+        class(hbm_system), intent(in) :: sys
+        real(wp), intent(inout) :: w(:)
+        integer(ip) :: g, k, nsl
+        k = 0
+        do g = 1, size(sys%cs%grp)
+            associate (gr => sys%cs%grp(g))
+                nsl = law_nslider(gr%law)
+                if (nsl == 0) cycle
+                w(k + 1:k + nsl*gr%ne) = reshape(gr%w0(1:nsl, :), [nsl*gr%ne])
+                k = k + nsl*gr%ne
+            end associate
+        end do
+    end subroutine hbm_sliders
 
     !> Frequency and load factor of the excitation at parameter lam.
     pure subroutine freq_load(sys, lam, w, s)
@@ -1216,7 +1280,7 @@ contains
     !> fixed lam. Each point stores y, lam, tangent, Newton iterations, output harmonics
     !> and contact state fractions. On a failure every point already made is kept (npts).
     subroutine hbm_run(sys, start_mode, y, lam, t, ds, lam_lo, opts, ys, lams, tans, iters, &
-                       xo, states, npts, finished, info, errmsg, hill_re)
+                       xo, states, npts, finished, info, errmsg, hill_re, sliders)
         class(hbm_system), intent(inout) :: sys
         integer(ip), intent(in) :: start_mode
         real(wp), intent(inout) :: y(:), lam, t(:), ds
@@ -1234,6 +1298,8 @@ contains
         character(len=*), intent(inout) :: errmsg
         real(wp), intent(out), optional :: hill_re(:)  !! (maxpts) max Re of the Floquet
                                                         !! exponents (only when present)
+        real(wp), intent(inout), optional :: sliders(:, :)  !! (nw, maxpts) the contact
+                                !! history each point leaves (hbm_sliders layout)
         type(cont_options) :: o1
         real(wp), allocatable :: zero(:), yb(:, :), lb(:), tb(:, :), t0(:)
         integer(ip) :: it, n1, maxpts, ib(1)
@@ -1254,6 +1320,8 @@ contains
             have_fact = .false.
             call newton_correct(sys, y, lam, y, lam, zero, 1.0_wp, opts, it, info, errmsg, &
                                 have_fact)
+            if (info /= 0) return
+            call sys%accept(y, lam, info, errmsg)
             if (info /= 0) return
             t0 = 0.0_wp
             call cont_tangent(sys, y, lam, opts, t0, sign(1.0_wp, opts%lam_end - lam), t, &
@@ -1291,6 +1359,7 @@ contains
             lams(npts) = lam
             tans(:, npts) = t
             iters(npts) = itn
+            if (present(sliders)) call hbm_sliders(sys, sliders(:, npts))
             call sys%outputs(y, lam, xo(:, :, npts), info, errmsg)
             if (info /= 0) return
             if (present(hill_re)) then

@@ -20,6 +20,7 @@ module frirom_newton
     contains
         procedure(eval_iface), deferred :: eval
         procedure(solve_iface), deferred :: solve
+        procedure :: accept => nl_accept
     end type nl_system
 
     abstract interface
@@ -71,6 +72,20 @@ module frirom_newton
     end type cont_options
 
 contains
+
+    !> Called once per converged point (y, lam), before its tangent is computed: a system
+    !> with history (friction sliders) updates the state that R depends on here, so that
+    !> R(y) stays one deterministic function during each corrector. Default: nothing.
+    subroutine nl_accept(this, y, lam, info, errmsg)
+        class(nl_system), intent(inout) :: this
+        real(wp), intent(in) :: y(:)        !! (n) converged unknowns
+        real(wp), intent(in) :: lam         !! converged parameter
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        info = FRIROM_OK
+        if (.false.) errmsg = ''
+        if (.false.) this%n = size(y) + int(lam)
+    end subroutine nl_accept
 
     !> Bordered Newton corrector: solve R(y, lam) = 0 together with the linear constraint
     !> cy.(y - yp)/yscale + cl (lam - lp)/lscale = 0 (cy = 0, cl = 1 fixes lam = lp;
@@ -243,9 +258,8 @@ contains
         real(wp), allocatable :: y1(:), yp(:), t1(:), cy(:)
         real(wp) :: lam1, lp, dirn, frac, cl
         integer(ip) :: n, iters
-        logical :: last, jumped
-        integer(ip) :: nfail, nf, effort
-        real(wp) :: ds_fail0
+        logical :: last
+        integer(ip) :: nf, effort
         type(cont_options) :: fresh_opts
         character(len=len(errmsg)) :: why
         character(len=120) :: buf
@@ -267,9 +281,6 @@ contains
         end if
         allocate (y1(n), yp(n), t1(n + 1), cy(n))
         dirn = sign(1.0_wp, opts%lam_end - lam_lo)
-        jumped = .false.
-        nfail = 0
-        ds_fail0 = ds
         fresh_opts = opts
         fresh_opts%reuse_jac = .false.
         do while (npts < opts%max_points)
@@ -312,17 +323,6 @@ contains
             if (info /= 0) then
                 why = errmsg
                 have_fact = .false.
-                nfail = nfail + 1
-                if (nfail == 1) ds_fail0 = ds
-                if ((nfail == 5 .or. ds <= opts%ds_min*1.000001_wp) .and. .not. jumped) then
-                    ! a discontinuity or kink of R (a contact entering stick-all-cycle, a
-                    ! state change inside one sample) stalls Newton at any small step: try
-                    ! once to step over it with a larger step
-                    jumped = .true.
-                    ds = min(max(4.0_wp*ds_fail0, 0.1_wp*opts%ds_max), opts%ds_max)
-                    info = FRIROM_OK
-                    cycle
-                end if
                 if (ds <= opts%ds_min*1.000001_wp) then
                     call set_status(info, FRIROM_ERR_CONT, errmsg, 'continuation stopped')
                     write (buf, '(a,es12.5,a,es9.2,a)') ' at parameter ', lam, &
@@ -334,14 +334,13 @@ contains
                 ds = 0.5_wp*ds
                 cycle
             end if
-            call cont_tangent(sys, y1, lam1, opts, t, dirn, t1, info, errmsg)
+            call sys%accept(y1, lam1, info, errmsg)
+            if (info == 0) call cont_tangent(sys, y1, lam1, opts, t, dirn, t1, info, errmsg)
             if (info /= 0) then
                 have_fact = .false.
                 return
             end if
             have_fact = .true.
-            jumped = .false.
-            nfail = 0
             npts = npts + 1
             y = y1
             lam = lam1

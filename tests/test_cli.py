@@ -71,11 +71,15 @@ def test_resume_continues_an_interrupted_run(deck, tmp_path):
     assert np.all(np.diff(r.omega) > 0)               # no repeated point at the joins
     assert r.omega[0] == ref.omega[0] and r.omega[-1] == pytest.approx(ref.omega[-1])
     # every stored point, also those after each resume, is a solution of the deck: solve
-    # it afresh (from the linear solution) at a spread of the stored frequencies
+    # it afresh (from the linear solution, with the contact history stored with the point:
+    # a damper stuck all cycle keeps the slider where it last slipped) at a spread of the
+    # stored frequencies
     d = load_deck(deck)
     model, exc, opts = d.model(), d.excitation(), d.options()
+    assert r.slider.shape == (len(r), 1) and np.all(np.isfinite(r.slider))
     for i in np.linspace(0, len(r) - 1, 12).astype(int):
-        p = solve_point(model, exc, r.omega[i], opts, outputs=d.outputs)
+        p = solve_point(model, exc, r.omega[i], opts, outputs=d.outputs,
+                        start={"slider": r.slider[i]})
         assert np.allclose(p.amp_max, r.amp_max[i], rtol=1e-6), i
 
 

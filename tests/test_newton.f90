@@ -8,11 +8,28 @@ module newton_test_system
     type, extends(nl_system) :: cubic_curve
         real(wp) :: j(2, 2) = 0.0_wp
         integer :: nfact = 0
+        integer :: naccept = 0            !! accepted points (accept hook calls)
+        real(wp) :: worst_accept = 0.0_wp !! largest |R| at an accepted point
+        real(wp) :: lam_accept = 0.0_wp   !! parameter of the last accepted point
     contains
         procedure :: eval => cc_eval
         procedure :: solve => cc_solve
+        procedure :: accept => cc_accept
     end type cubic_curve
 contains
+    !> The hook must see every converged point once, at the converged (y, lam).
+    subroutine cc_accept(this, y, lam, info, errmsg)
+        class(cubic_curve), intent(inout) :: this
+        real(wp), intent(in) :: y(:), lam
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        info = 0
+        this%naccept = this%naccept + 1
+        this%lam_accept = lam
+        this%worst_accept = max(this%worst_accept, abs(y(1)**3 - 3*y(1) - lam)/max(abs(lam), &
+                                1.0_wp))
+        if (.false.) errmsg = ''
+    end subroutine cc_accept
     subroutine cc_eval(this, y, lam, r, rref, jac, rlam, info, errmsg)
         class(cubic_curve), intent(inout) :: this
         real(wp), intent(in) :: y(:), lam
@@ -80,6 +97,9 @@ program test_newton
     ds = o%ds
     call cont_run(s, y, lam, t, ds, -4.5_wp, o, yout, lout, tout, it, npts, fin, info, msg, hf)
     call check(info == 0 .and. fin, 'continuation reached lam_end: '//trim(msg))
+    call check(s%naccept == npts .and. s%lam_accept == lout(npts), &
+               'accept hook called once per point, at the converged point')
+    call check(s%worst_accept < 1.0e-9_wp, 'accepted points are on the curve')
     nfold = 0
     do k = 1, npts
         call check(abs(yout(1, k)**3 - 3*yout(1, k) - lout(k)) < 1.0e-9_wp*max(abs(lout(k)), &

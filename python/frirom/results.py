@@ -4,6 +4,7 @@ writer for long runs that can be reopened to resume."""
 from __future__ import annotations
 
 import csv
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -40,6 +41,11 @@ class FRFPoint:
     stable: bool = True
     floquet_max_re: float = 0.0  #: largest real part of the Floquet exponents, 1/s
     yscale: float = 0.0     #: scale of the unknowns in the arc length the tangent refers to
+    #: (n_slider_total,) contact history this point leaves: the slider each element's closed
+    #: cycle starts with, groups concatenated, (n_elem, n_slider) row-major per group (the
+    #: w0 a run restarted from this point needs; a contact stuck all cycle keeps it).
+    #: With SolverOptions(history=False) it is the w0 every point started from.
+    slider: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 @dataclass
@@ -49,7 +55,8 @@ class FRF:
     omega (n_pts,) rad/s; parameter (n_pts,) the continuation parameter; X (n_pts, n_out,
     2H+1) real harmonic coefficients [a0, a1, b1, ...]; amp_max (n_pts, n_out);
     state_fractions (n_pts, n_groups, 3) stick/slip/lift-off; stable, fold (n_pts,) bool;
-    iterations (n_pts,) int; time_s (n_pts,) s.
+    iterations (n_pts,) int; time_s (n_pts,) s; slider (n_pts, n_slider_total) the contact
+    history each point leaves (FRFPoint.slider; None in files written before it was kept).
     """
 
     omega: np.ndarray
@@ -67,6 +74,7 @@ class FRF:
     complete: bool = True
     message: str = ""
     stability_computed: bool = False
+    slider: np.ndarray | None = None
     #: Fortran time split of the run: aft, assembly, factorization, solve, receptance (s),
     #: evaluations, factorizations (counts), fortran_total (s)
     timings: dict = field(default_factory=dict)
@@ -92,6 +100,8 @@ class FRF:
                    state_fractions=stack("state_fractions", (len(group_names), 3)),
                    stable=stack("stable", (), bool), fold=stack("fold", (), bool),
                    iterations=stack("iterations", (), int), time_s=stack("time_s", ()),
+                   slider=(np.array([p.slider for p in points], dtype=float) if points
+                           else np.zeros((0, 0))),
                    output_dofs=np.asarray(output_dofs, dtype=int),
                    group_names=list(group_names), parameter_name=parameter_name, **kw)
 
@@ -106,6 +116,8 @@ class FRF:
             for name in self._ARRAYS:
                 v = getattr(self, name)
                 f.create_dataset(name, data=np.asarray(v if v is not None else self.omega))
+            if self.slider is not None:
+                f.create_dataset("slider", data=np.asarray(self.slider, dtype=float))
             f.attrs["group_names"] = np.array(self.group_names, dtype="S")
             f.attrs["parameter_name"] = self.parameter_name
             f.attrs["complete"] = self.complete
@@ -146,6 +158,11 @@ class FRF:
             kw = {n: f[n][...] for n in cls._ARRAYS}
             kw["stable"] = kw["stable"].astype(bool)
             kw["fold"] = kw["fold"].astype(bool)
+            # files written before the contact history was kept have no slider
+            kw["slider"] = f["slider"][...] if "slider" in f else None
+            if kw["slider"] is not None and kw["slider"].shape[0] != kw["omega"].shape[0]:
+                raise InputError(f"{path}: 'slider' has {kw['slider'].shape[0]} rows for "
+                                 f"{kw['omega'].shape[0]} points")
             return cls(**kw,
                        group_names=[s.decode() for s in f.attrs.get("group_names", [])],
                        parameter_name=str(f.attrs.get("parameter_name", "omega")),
@@ -196,12 +213,24 @@ class FRFWriter:
     def append(self, p: FRFPoint) -> None:
         f = self.f
         n = f["omega"].shape[0]
+        sl = np.asarray(p.slider, dtype=float).ravel()
+        if "slider" not in f:
+            # points already in a file from before the history was kept: unknown (NaN)
+            f.create_dataset("slider", data=np.full((n, sl.size), np.nan),
+                             maxshape=(None, sl.size),
+                             chunks=(64, sl.size) if sl.size else True)
+        elif f["slider"].shape[1] != sl.size:
+            raise InputError(f"{self.path}: existing file keeps {f['slider'].shape[1]} "
+                             f"sliders per point, this run has {sl.size}")
+        f["slider"].resize(n + 1, axis=0)
+        f["slider"][n] = sl
         for name in ("omega", "parameter", "X", "amp_max", "state_fractions", "stable",
                      "fold", "iterations", "time_s"):
             d = f[name]
             d.resize(n + 1, axis=0)
             d[n] = getattr(p, name)
-        for name, v in (("last_unknowns", p.unknowns), ("last_tangent", p.tangent)):
+        for name, v in (("last_unknowns", p.unknowns), ("last_tangent", p.tangent),
+                        ("last_slider", sl)):
             if name in f:
                 del f[name]
             f.create_dataset(name, data=v)
@@ -225,14 +254,22 @@ class FRFWriter:
 
     @staticmethod
     def resume_point(path) -> dict:
-        """{'parameter', 'omega', 'unknowns', 'tangent', 'yscale'} of the last point in the
-        file: the `start` argument of frirom.solver.frf."""
+        """{'parameter', 'omega', 'unknowns', 'tangent', 'yscale', 'slider'} of the last
+        point in the file: the `start` argument of frirom.solver.frf. A file written before
+        the contact history was kept gives slider None (the run resumes from the model's
+        w0, with a warning: a contact stuck all cycle there may settle differently)."""
         import h5py
         with h5py.File(path, "r") as f:
             if "last_unknowns" not in f:
                 raise InputError(f"{path}: no point to resume from")
+            slider = f["last_slider"][...] if "last_slider" in f else None
+            if slider is None:
+                warnings.warn(f"{path}: written before frirom kept the contact history "
+                              "(sliders); resuming from the model's initial sliders w0",
+                              RuntimeWarning, stacklevel=2)
             return {"parameter": float(f.attrs["last_parameter"]),
                     "omega": float(f.attrs["last_omega"]),
                     "unknowns": f["last_unknowns"][...],
                     "tangent": f["last_tangent"][...],
-                    "yscale": float(f.attrs.get("last_yscale", 0.0))}
+                    "yscale": float(f.attrs.get("last_yscale", 0.0)),
+                    "slider": slider}

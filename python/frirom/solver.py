@@ -15,6 +15,7 @@ from __future__ import annotations
 import time
 import warnings
 from dataclasses import dataclass
+from types import SimpleNamespace
 
 import numpy as np
 import scipy.sparse as sp
@@ -51,7 +52,10 @@ class SolverOptions:
     factorisation while Newton contracts by a factor 10 per iteration (a corrector that
     fails with reuse is retried with a fresh Jacobian at every iteration); batch: points
     per call into Fortran (sink granularity); stability: Hill's method at every point
-    (dense eigen-solve of size 2 n_dof (2H+1), up to 4000); modes: condensed formulation
+    (dense eigen-solve of size 2 n_dof (2H+1), up to 4000); history: carry the contact
+    history along the curve (each point starts its sliders where the previous converged
+    point's closed cycles left them; False restarts every point from the model's w0, which
+    makes a contact stuck all cycle snap back to it); modes: condensed formulation
     only, receptances by superposition of this many lowest modes (mass-normalised, damping
     ratios from Damping.modal or the diagonal of Phi^T C Phi) instead of factorising the
     dynamic stiffness at every frequency (truncation: no residual flexibility).
@@ -71,6 +75,7 @@ class SolverOptions:
     parameter: str = "frequency"
     reuse_jacobian: bool = True
     stability: bool = False
+    history: bool = True
     modes: int | None = None
     batch: int = 10
 
@@ -181,7 +186,9 @@ class _Packed:
             self.params = np.concatenate([g.params.ravel() for g in groups])
             w0 = [g.w0.ravel() for g in groups]
             self.w0 = np.concatenate(w0) if sum(a.size for a in w0) else np.zeros(1)
+            self.nw = int(sum(a.size for a in w0))
         else:
+            self.nw = 0
             G = sp.csr_matrix((0, n))
             self.ginfo = np.zeros((3, 0), np.int32, order="F")
             self.params, self.w0 = np.zeros(1), np.zeros(1)
@@ -219,19 +226,42 @@ class _Packed:
             self.phi, self.wmodes, self.zmodes = _modes(model, int(opts.modes))
             self.nmodes = self.wmodes.size
 
+    def set_history(self, slider) -> None:
+        """Initial sliders of all contact elements (the history of the point a run starts
+        from; the layout of FRFPoint.slider); None keeps the model's w0."""
+        if slider is None:
+            return
+        slider = np.asarray(slider, dtype=float).ravel()
+        if slider.size != self.nw:
+            raise SizeError(f"start.slider: {slider.size} values, the model's contact "
+                            f"elements have {self.nw} sliders")
+        if not np.all(np.isfinite(slider)):
+            raise ParameterError("start.slider: contains NaN or Inf")
+        if self.nw:
+            self.w0 = slider.copy()
+
     def call(self, y0, lam0, tan0, start_mode, ds, lam_end, lam_lo, yscale, lscale, maxpts,
              omega_fix=0.0):
+        """One hbm_continue call from the current contact history self.w0; the history
+        the last point leaves becomes self.w0 for the next call."""
         o = self.opts
         nl = (self.nl + 1).astype(np.int32) if self.nl.size else np.ones(1, np.int32)
-        return _kernels.hbm_continue(
+        res = _kernels.hbm_continue(
             self.form, o.n_samples, *self.K, *self.M, *self.C, self.perm, nl,
             np.asfortranarray(self.fe0), np.asfortranarray(self.fe1), self.mode, omega_fix,
             self.ginfo, *self.G, self.params, self.w0, (self.outputs + 1).astype(np.int32),
             y0, lam0, tan0, start_mode, ds, o.ds_min, o.ds_max, lam_end, lam_lo,
             o.tol_residual, o.tol_update, o.tol_stall, o.max_iter, int(o.reuse_jacobian),
             yscale, lscale, maxpts, max(self.ne_tot, 1), int(self.stability), self.nmodes,
-            np.asfortranarray(self.phi), self.wmodes, self.zmodes, nh=self.H,
+            np.asfortranarray(self.phi), self.wmodes, self.zmodes, int(o.history), nh=self.H,
             ndof=self.n_dof, nnl=self.nl.size or 1)
+        r = SimpleNamespace(**dict(zip(
+            ("ys", "lams", "tans", "iters", "xo", "states", "hill_re", "sliders", "npts",
+             "finished", "ds_out", "timings", "info", "msg"), res)))
+        r.msg = r.msg.decode(errors="replace")
+        if r.npts > 0 and self.nw and o.history:
+            self.w0 = r.sliders[:self.nw, r.npts - 1].copy()
+        return r
 
     def pad_start(self, y, H_from: int) -> np.ndarray:
         """Unknowns of a solution with H_from harmonics, extended or cut to this H."""
@@ -250,8 +280,8 @@ class _Packed:
         return out
 
     def points(self, res, omega_fix, t_call):
-        (ys, lams, tans, iters, xo, states, hill_re, npts, finished, ds_out, timings, info,
-         msg) = res
+        ys, lams, tans, iters, xo = res.ys, res.lams, res.tans, res.iters, res.xo
+        states, hill_re, npts = res.states, res.hill_re, res.npts
         pts = []
         for k in range(npts):
             st = np.zeros((len(self.group_sizes), 3))
@@ -266,7 +296,8 @@ class _Packed:
                                 amp_max=amplitude_max(X), state_fractions=st,
                                 iterations=int(iters[k]), time_s=t_call / max(npts, 1),
                                 stable=bool(hill_re[k] <= 1e-7 * max(abs(om), 1.0)),
-                                floquet_max_re=float(hill_re[k])))
+                                floquet_max_re=float(hill_re[k]),
+                                slider=res.sliders[:self.nw, k].copy()))
         return pts
 
 
@@ -284,11 +315,16 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
     else:
         if isinstance(start, FRFPoint):
             start = {"parameter": start.parameter, "unknowns": start.unknowns,
-                     "tangent": start.tangent, "yscale": start.yscale}
+                     "tangent": start.tangent, "yscale": start.yscale,
+                     "slider": start.slider}
+        packed.set_history(start.get("slider"))
         y0 = packed.pad_start(start["unknowns"], H_start if H_start is not None else packed.H)
         lam0 = float(start.get("parameter", start.get("omega")))
         tan = start.get("tangent")
-        if tan is None or H_start not in (None, packed.H):
+        # without the history the point was computed with (a file from before it was
+        # kept), the saved point need not solve the equations: re-solve it first
+        unknown_history = packed.nw and o.history and start.get("slider") is None
+        if tan is None or H_start not in (None, packed.H) or unknown_history:
             mode, tan0 = 0, np.zeros(packed.ny + 1)   # re-solve, then continue
         else:
             mode, tan0 = 1, np.asarray(tan, dtype=float)
@@ -304,17 +340,15 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
         # the converged point, one Newton iteration) computes the tangent in that scaling.
         res = packed.call(y0, lam0, tan0, 2, ds, lam_end, lam_lo, 1e-300, lscale, 1,
                           omega_fix)
-        info, msg = res[11], res[12]
-        _add_timings(timings, res[10])
-        if info != 0 and packed.mode == 1 and start is None:
+        _add_timings(timings, res.timings)
+        if res.info != 0 and packed.mode == 1 and start is None:
             # Newton from the linear solution failed (strong slip or lift-off): reach the
             # first point by continuation in the excitation level from the static state.
             y_h = _homotopy_start(packed, lam0)
             if y_h is not None:
                 res = packed.call(y_h, lam0, tan0, 2, ds, lam_end, lam_lo, 1e-300, lscale,
                                   1, omega_fix)
-                info, msg = res[11], res[12]
-        raise_for_status(info, msg.decode(errors="replace"))
+        raise_for_status(res.info, res.msg)
         p = packed.points(res, omega_fix, time.perf_counter() - t0)[0]
         t0 = time.perf_counter()
         points.append(p)        # handed to sink once its tangent is known (next call)
@@ -331,8 +365,8 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
                           maxpts, omega_fix)
         t_call = time.perf_counter() - t0
         t0 = time.perf_counter()
-        npts, finished, ds_out, info, msg = res[7], res[8], res[9], res[11], res[12]
-        _add_timings(timings, res[10])
+        finished, ds_out, info = res.finished, res.ds_out, res.info
+        _add_timings(timings, res.timings)
         new = packed.points(res, omega_fix, t_call)
         for p in new:
             p.yscale = yscale
@@ -354,7 +388,12 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
             if sink is not None:
                 sink(p)
         if info != 0:
-            message = msg.decode(errors="replace").strip()
+            message = res.msg.strip()
+            if info == 20 and packed.nw:
+                message += (" [with friction contacts this is usually a corner of the "
+                            "solution curve: a contact state switching at one of the "
+                            f"N = {o.n_samples} AFT samples, e.g. lift-off onset; more "
+                            "samples (256 recommended) make the corners milder]")
             if not points:
                 raise_for_status(info, message)
             complete = False
@@ -389,15 +428,17 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
     out.timings = timings
     if keep_unknowns and points:
         out._last_unknowns = points[-1].unknowns
+        out._last_slider = points[-1].slider
     return out
 
 
 def _homotopy_start(packed: _Packed, omega: float):
     """Unknowns at omega reached by load continuation of the dynamic excitation from 0 to
-    1 (None if that fails too)."""
+    1 (None if that fails too); packed.w0 becomes the contact history that path leaves."""
     o = SolverOptions(**{**packed.opts.__dict__, "parameter": "load"})
     lp = _Packed.__new__(_Packed)
     lp.__dict__.update(packed.__dict__)
+    lp.w0 = packed.w0.copy()
     lp.opts = o
     lp.mode = 2
     lp.stability = False
@@ -414,6 +455,7 @@ def _homotopy_start(packed: _Packed, omega: float):
         return None
     if not r.complete or not r.parameter.size or r.parameter[-1] != 1.0:
         return None
+    packed.set_history(r._last_slider)
     return r._last_unknowns
 
 
@@ -464,30 +506,37 @@ def solve_point(model: Model, excitation: Excitation, omega: float,
                 options: SolverOptions | None = None, outputs=None, start=None,
                 start_harmonics: int | None = None) -> FRFPoint:
     """The periodic response at one frequency omega (rad/s), Newton from the linear
-    solution, or from start['unknowns'] (of a solution with start_harmonics harmonics,
-    default options.harmonics; padded with zeros). If Newton from the linear solution
-    fails, the point is reached by continuation in the excitation level."""
+    solution, or from start (an FRFPoint, or a dict with 'unknowns' of a solution with
+    start_harmonics harmonics, default options.harmonics, padded with zeros, and/or
+    'slider', the contact history to start from: FRFPoint.slider; without 'unknowns'
+    Newton starts from the linear solution). Without a slider the model's w0 is the
+    history. If Newton from the linear solution fails, the point is
+    reached by continuation in the excitation level. The returned point's slider is the
+    history it leaves (pass the point as the next start to follow a path)."""
     options = options or SolverOptions()
     options = SolverOptions(**{**options.__dict__, "parameter": "frequency"})
     if not (np.isfinite(omega) and omega > 0):
         raise ParameterError(f"omega: expected a positive frequency in rad/s, got {omega}")
     packed = _Packed(model, excitation, options, outputs)
-    y0 = np.zeros(packed.ny) if start is None else packed.pad_start(
+    if isinstance(start, FRFPoint):
+        start = {"unknowns": start.unknowns, "slider": start.slider}
+    if start is not None:
+        packed.set_history(start.get("slider"))
+    cold = start is None or start.get("unknowns") is None
+    y0 = np.zeros(packed.ny) if cold else packed.pad_start(
         start["unknowns"], options.harmonics if start_harmonics is None else start_harmonics)
     t0 = time.perf_counter()
     res = packed.call(y0, float(omega), np.zeros(packed.ny + 1), 2, options.ds,
                       float(omega) * 1.1, 0.0, 1e-300, float(omega), 1)
-    info, msg = res[11], res[12]
-    if info != 0 and start is None:
+    if res.info != 0 and cold:
         # Newton from the linear solution failed: continuation in the excitation level
         y_h = _homotopy_start(packed, float(omega))
         if y_h is not None:
             res = packed.call(y_h, float(omega), np.zeros(packed.ny + 1), 2, options.ds,
                               float(omega) * 1.1, 0.0, 1e-300, float(omega), 1)
-            info, msg = res[11], res[12]
-    raise_for_status(info, msg.decode(errors="replace"))
+    raise_for_status(res.info, res.msg)
     pt = packed.points(res, 0.0, time.perf_counter() - t0)[0]
     pt.output_dofs = packed.outputs
     pt.timings = {}
-    _add_timings(pt.timings, res[10])
+    _add_timings(pt.timings, res.timings)
     return pt
