@@ -73,6 +73,11 @@ def plot_frf(frf, path, *, output_names=None, unit: str = "hz", title: str | Non
         log = pos.size > 0 and pos.max() / pos.min() > 30.0
     if log:
         ax.set_yscale("log")
+        # a DoF that stays at round-off (a stuck or symmetric direction) would stretch
+        # the axis over twenty decades: show six below the largest amplitude
+        pos = amp[amp > 0]
+        if pos.size:
+            ax.set_ylim(bottom=max(pos.min(), 1e-6 * pos.max()) / 2)
     if not stable.all():
         ax.plot([], [], color="0.3", ls="--", label="unstable (Hill)")
     ax.set_xlabel(xlabel)
