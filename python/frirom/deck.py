@@ -666,11 +666,13 @@ class _Parser:
         return out
 
     def add_load(self, F, ref, h, amp, key):
+        """Add a load to F (n, H+1); with [fe_model] a node set loads each of its nodes."""
         if not self.fe:
             F[ref, h] += amp
             return
         try:
-            F[:, h] += amp * self.rom.load_row(*self.fe_node(ref, key))
+            for node in self.fe_nodes(ref, key):
+                F[:, h] += amp * self.rom.load_row(node, ref[1])
         except InputError as exc:
             raise InputError(f"{self.path}: {key}: {exc}") from None
 
@@ -686,20 +688,23 @@ class _Parser:
                                  "interface modes)", ref[2])
         return self.rom.labels.index(lab)
 
+    def fe_nodes(self, ref, key):
+        """Node ids of a parsed "NODE:DIR" reference (a node, or every node of a set)."""
+        node, _, text = ref
+        if not isinstance(node, str):
+            return [node]
+        ids = self.rom.node_sets.get(node.upper())
+        if ids is None:
+            raise self.ctx.error(key, "a node id or a node set name (known sets: "
+                                 + ", ".join(sorted(self.rom.node_sets)) + ")", text)
+        return [int(i) for i in ids]
+
     def fe_node(self, ref, key):
-        """(node id, direction) of a parsed "NODE:DIR" reference, sets resolved."""
-        node, d, text = ref
-        if isinstance(node, str):
-            ids = self.rom.node_sets.get(node.upper())
-            if ids is None:
-                raise self.ctx.error(key, "a node id or the name of a one-node set (known "
-                                     "sets: " + ", ".join(sorted(self.rom.node_sets)) + ")",
-                                     text)
-            if len(ids) != 1:
-                raise self.ctx.error(key, f"a node set of one node (set {node} has "
-                                     f"{len(ids)})", text)
-            node = int(ids[0])
-        return node, d
+        """(node id, direction) of a reference that must name one node."""
+        nodes = self.fe_nodes(ref, key)
+        if len(nodes) != 1:
+            raise self.ctx.error(key, f"one node (set {ref[0]} has {len(nodes)})", ref[2])
+        return nodes[0], ref[1]
 
     def dof(self, v, key):
         """A DoF reference: with [model] the 0-based index (int) or the label; with
@@ -712,7 +717,7 @@ class _Parser:
                     node = node[1:]
                 if dn is not None and node:
                     return (int(node) if node.isdigit() else node, dn, v)
-            raise self.ctx.error(key, "a DoF \"NODE:DIR\": a node id or one-node set name, "
+            raise self.ctx.error(key, "a DoF \"NODE:DIR\": a node id or node set name, "
                                  "and x, y, z (or UX..ROTZ, 1..6)", v)
         n_dof, labels = self.n, self.labels
         if isinstance(v, bool):
