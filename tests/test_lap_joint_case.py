@@ -15,7 +15,6 @@ At the case's own size and H = 3, cases/lap_joint/convergence.py gives the same 
 """
 
 import os
-import re
 import shutil
 import sys
 from pathlib import Path
@@ -31,22 +30,18 @@ from frirom.results import FRF
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE = ROOT / "cases" / "lap_joint"
+sys.path.insert(0, str(CASE))
 
 
 def small(n_modes: int | None, mu: str = "0.3") -> str:
     """The case's deck, small; n_modes None: CB only (no interface reduction)."""
-    text = (CASE / "lap_joint.toml").read_text()
-    text = text.replace('dof = "ACTIVE:z"\namplitude = 20.0', 'dof = "ACTIVE:z"\namplitude = 12.0')
-    text = text.replace("amplitude = 20.0", "amplitude = 32.0").replace(
-        "amplitude = -20.0", "amplitude = -32.0").replace("n0 = 20.0", "n0 = 32.0")
-    text = text.replace("harmonics = 3", "harmonics = 1").replace("samples = 32", "samples = 16")
-    text = text.replace("start = 700.0", "start = 825.0").replace("end = 1000.0", "end = 880.0")
-    text = text.replace("mu = 0.3", f"mu = {mu}")
-    if n_modes is None:
-        text = text.replace('method = "gsi"', 'method = "none"')
-        return re.sub(r"\n(free|stick) = \d+", "", text)
-    text = re.sub(r"\nfree = \d+", f"\nfree = {n_modes // 2}", text)
-    return re.sub(r"\nstick = \d+", f"\nstick = {n_modes // 2}", text)
+    from convergence import deck_text
+    return deck_text(n_modes, 1, [
+        ('dof = "ACTIVE:z"\namplitude = 20.0', 'dof = "ACTIVE:z"\namplitude = 12.0'),
+        ("amplitude = 20.0", "amplitude = 32.0"), ("amplitude = -20.0", "amplitude = -32.0"),
+        ("n0 = 20.0", "n0 = 32.0"), ("samples = 32", "samples = 16"),
+        ("start = 700.0", "start = 825.0"), ("end = 1000.0", "end = 880.0"),
+        ("mu = 0.3", f"mu = {mu}")])
 
 
 @pytest.fixture(scope="module")
@@ -54,7 +49,6 @@ def case(tmp_path_factory):
     if shutil.which("ccx") is None:
         pytest.skip("ccx not installed")
     pytest.importorskip("gmsh")
-    sys.path.insert(0, str(CASE))
     import make_lap_joint
     out = tmp_path_factory.mktemp("lap_case")
     make_lap_joint.make(out, size=0.012)

@@ -24,9 +24,14 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 
-def deck_text(n_modes: int | None, harmonics: int) -> str:
+def deck_text(n_modes: int | None, harmonics: int = 3, changes=()) -> str:
+    """The case's deck with n_modes GSI modes (half free, half stick; None: CB only, no
+    interface reduction), H = harmonics, and the text replacements ``changes``."""
     text = (HERE / "lap_joint.toml").read_text()
-    text = text.replace("harmonics = 3", f"harmonics = {harmonics}")
+    for old, new in [("harmonics = 3", f"harmonics = {harmonics}"), *changes]:
+        if old not in text:
+            raise ValueError(f"lap_joint.toml has no {old!r}")
+        text = text.replace(old, new)
     if n_modes is None:
         text = text.replace('method = "gsi"', 'method = "none"')
         return re.sub(r"\n(free|stick) = \d+", "", text)
