@@ -150,6 +150,10 @@ def test_deck_errors_name_the_key(block_dir):
         (good.replace("[reduction]", "[model]\nmass = 'M.mtx'\n\n[reduction]"),
          "model: expected either [model]"),
         (good.replace("[[contacts]]", "[[reduction.pairs]]"), "reduction.pairs: expected no"),
+        (good.replace('interface = "IFACE"\nactive = ["ACTIVE"]', 'interface = "ACTIVE"'),
+         "is not in the node sets of reduction.interface"),
+        (good.replace("normal = [1.0, 0.0, 0.0]", "normal = [1.0, 0.0, 0.0]\n"
+                      "tangent = [2.0, 0.0, 0.0]"), "contacts[0]: local_frames: a tangent"),
         (good.replace('type = "modal"', 'type = "matrix"').replace("zeta = 0.01",
                                                                    'file = "C.mtx"'),
          "damping.type: expected 'rayleigh' or 'modal' with [fe_model]"),
