@@ -108,7 +108,7 @@ def test_gsi_on_gmsh_lap_joint(tmp_path, capsys):
     (ROM_II). The stuck and free interface FRFs of ROM_II converge to ROM_I's."""
     pytest.importorskip("gmsh")
     import lap_joint
-    from frirom.reduction.deck import pairs_from_node_sets
+    from frirom.reduction.rom import pairs_from_node_sets
 
     job = block.run_ccx(lap_joint.write_lap_joint_deck(tmp_path / "lap.inp", size=0.008,
                                                        n_ref_modes=0))

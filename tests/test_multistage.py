@@ -283,7 +283,7 @@ def fe_stage(tmp_path_factory):
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "models"))
     import bladed_sector
     from frirom.io import read_calculix
-    from frirom.reduction.deck import pairs_from_node_sets
+    from frirom.reduction.rom import pairs_from_node_sets
     out = tmp_path_factory.mktemp("stage")
     deck = bladed_sector.write_stage_deck(out, 12)
     m = read_calculix(bladed_sector.run_ccx(deck, expect=(".sti", ".mas", ".dof")))

@@ -1,4 +1,5 @@
-"""The [reduction] deck: FE files -> CB -> GSI/MS -> cached reduced model."""
+"""Decks with [fe_model] + [reduction]: FE files -> CB -> GSI/MS -> cached reduced model,
+contacts on node sets, loads and outputs by node."""
 
 import os
 import shutil
@@ -15,7 +16,7 @@ import scipy.sparse as sp
 from _lattices import tuned_rotor
 from frirom._errors import InputError
 from frirom.io import read_calculix, write_calculix_matrices
-from frirom.reduction.deck import load_reduction_deck
+from frirom.deck import load_deck
 from frirom.reduction.interface import contact_matrix, stick_stiffness
 from frirom.reduction.multistage import harmonic_indices
 
@@ -37,16 +38,34 @@ method = "gsi"
 free = 6
 stick = 6
 
-[[reduction.pairs]]
+[[contacts]]
 name = "end"
+law = "normal2d"
 a = "IFACE"
 b = "ground"
 normal = [1.0, 0.0, 0.0]
 kt = {kt}
 kn = 8.0e8
+mu = {mu}
+n0 = 100.0
+
+[damping]
+type = "modal"
+zeta = 0.01
+
+[[excitation.load]]
+dof = "ACTIVE:z"
+amplitude = 1.0
 
 [solver]
 harmonics = {h}
+
+[frequency]
+start = 100.0
+end = 200.0
+
+[outputs]
+dofs = ["ACTIVE:z", "ACTIVE:x"]
 """
 
 
@@ -65,8 +84,9 @@ def _write(path, text):
 
 
 def test_gsi_deck_builds_composes_and_caches(block_dir):
-    deck = _write(block_dir / "joint.toml", GSI_DECK.format(kt="2.0e8", h=3))
-    rom = load_reduction_deck(deck)
+    deck = _write(block_dir / "joint.toml", GSI_DECK.format(kt="2.0e8", h=3, mu=0.5))
+    d = load_deck(deck)
+    rom = d.reduced
     fe = read_calculix(block_dir / "block")
     n_act = fe.dof_indices("ACTIVE").size
     assert rom.K.shape == (12 + n_act + 30,) * 2 and not rom.from_cache
@@ -79,6 +99,14 @@ def test_gsi_deck_builds_composes_and_caches(block_dir):
     assert G.shape == (3 * fe.node_sets["IFACE"].size, rom.K.shape[0])
     i = rom.dof_index(f"N{fe.node_sets['ACTIVE'][0]}:UZ")
     assert np.isclose(rom.T[fe.dof_indices("ACTIVE", directions=(3,))[0], i], 1.0)
+    # the deck's contacts, loads and outputs are the physical ones seen through T
+    c = d.contacts[0]
+    assert c.law == "normal2d" and abs(c.G - G).max() == 0.0
+    assert c.params.shape == (fe.node_sets["IFACE"].size, 4) and np.all(c.params[:, 2] == 0.5)
+    iz = fe.dof_indices("ACTIVE", directions=(3,))[0]
+    assert np.allclose(d.F[:, 1], rom.T[iz]) and not np.any(d.F[:, 0])
+    assert d.outputs[0] == i and d.output_names == ["ACTIVE:z", "ACTIVE:x"]
+    assert "built" in d.log[0] and d.model().n_dof == rom.K.shape[0]
     # stuck frequencies of the ROM close to the FE model's (CB 30 + 12 GSI modes)
     ks = stick_stiffness(rom.pairs["end"], fe.n_dof)
     lam_fe = sla.eigh((fe.K + ks).toarray(), fe.M.toarray(), eigvals_only=True,
@@ -87,30 +115,53 @@ def test_gsi_deck_builds_composes_and_caches(block_dir):
     lam = sla.eigh(kr, rom.M, eigvals_only=True, subset_by_index=[0, 4])
     assert np.all(lam >= lam_fe * (1 - 1e-9)) and np.abs(np.sqrt(lam / lam_fe) - 1).max() < 1e-2
     # nonlinear/solver data changed only: reused; stick stiffness changed: rebuilt
-    deck = _write(block_dir / "joint.toml", GSI_DECK.format(kt="2.0e8", h=7))
-    again = load_reduction_deck(deck)
+    deck = _write(block_dir / "joint.toml", GSI_DECK.format(kt="2.0e8", h=7, mu=0.3))
+    again = load_deck(deck).reduced
     assert again.from_cache and np.array_equal(again.K, rom.K)
-    deck = _write(block_dir / "joint.toml", GSI_DECK.format(kt="3.0e8", h=7))
-    other = load_reduction_deck(deck)
+    assert "not recomputed" in load_deck(deck).log[0]
+    deck = _write(block_dir / "joint.toml", GSI_DECK.format(kt="3.0e8", h=7, mu=0.3))
+    other = load_deck(deck).reduced
     assert not other.from_cache and not np.allclose(other.K, rom.K)
 
 
 def test_deck_errors_name_the_key(block_dir):
-    good = GSI_DECK.format(kt="2.0e8", h=3)
+    good = GSI_DECK.format(kt="2.0e8", h=3, mu=0.5)
     cases = [
         (good.replace('method = "gsi"', 'method = "pod"'),
-         "reduction.interface_modes.method: expected 'none', 'gsi' or 'ms'"),
+         "reduction.interface_modes.method: expected one of 'none', 'gsi', 'ms'"),
         (good.replace("free = 6", "free = -1"), "reduction.interface_modes.free"),
         (good.replace("fixed_interface_modes = 30", "fixed_modes = 30"),
          "reduction.fixed_modes: expected one of the known keys"),
-        (good.replace('a = "IFACE"', 'a = "NOPE"'), "reduction.pairs[0]: unknown node set"),
+        (good.replace('a = "IFACE"', 'a = "NOPE"'), "contacts[0]: unknown node set"),
         (good.replace('format = "calculix"', 'format = "nastran"'), "fe_model.format"),
-        (good.replace("kn = 8.0e8", "kn = -1.0"), "reduction.pairs[0].kn: expected a number > 0"),
+        (good.replace('job = "block"', 'job = "blob"'), "fe_model.job: expected a job name"),
+        (good.replace("kn = 8.0e8", "kn = -1.0"), "contacts[0].kn: expected a number >= 0"),
+        (good.replace("mu = 0.5", "mu = [0.5]"), "contacts[0].mu: expected a number"),
+        (good.replace("normal = [1.0, 0.0, 0.0]", 'normal = "up"'),
+         "contacts[0].normal: expected one of 'axial'"),
+        (good.replace('dof = "ACTIVE:z"', 'dof = "ACTIVE:w"'),
+         "excitation.load[0].dof: expected a DoF \"NODE:DIR\""),
+        (good.replace('dof = "ACTIVE:z"', 'dof = "TIP:z"'),
+         "excitation.load[0].dof: expected a node id or a node set name"),
+        (good.replace('dofs = ["ACTIVE:z", "ACTIVE:x"]', 'dofs = ["ACTIVE:z", "IFACE:x"]'),
+         "outputs.dofs[1]: expected one node (set IFACE has"),
+        (good.replace('dofs = ["ACTIVE:z", "ACTIVE:x"]', 'dofs = ["2:z"]'),
+         "outputs.dofs[0]: expected a DoF kept by the reduction"),
+        (good.replace("[reduction]", "[model]\nmass = 'M.mtx'\n\n[reduction]"),
+         "model: expected either [model]"),
+        (good.replace("[[contacts]]", "[[reduction.pairs]]"), "reduction.pairs: expected no"),
+        (good.replace('interface = "IFACE"\nactive = ["ACTIVE"]', 'interface = "ACTIVE"'),
+         "is not in the node sets of reduction.interface"),
+        (good.replace("normal = [1.0, 0.0, 0.0]", "normal = [1.0, 0.0, 0.0]\n"
+                      "tangent = [2.0, 0.0, 0.0]"), "contacts[0]: local_frames: a tangent"),
+        (good.replace('type = "modal"', 'type = "matrix"').replace("zeta = 0.01",
+                                                                   'file = "C.mtx"'),
+         "damping.type: expected 'rayleigh' or 'modal' with [fe_model]"),
     ]
     for text, msg in cases:
         deck = _write(block_dir / "bad.toml", text)
         with pytest.raises(InputError) as exc:
-            load_reduction_deck(deck)
+            load_deck(deck)
         assert msg in str(exc.value) and "bad.toml" in str(exc.value), str(exc.value)
 
 
@@ -126,7 +177,8 @@ def test_ms_deck_on_a_rotor_is_exact_for_its_engine_order(tmp_path):
         fh.write("*NODE\n")
         for i, (x, y, z) in zip(ids, r["coords"]):
             fh.write(f"{i}, {x:.17g}, {y:.17g}, {z:.17g}\n")
-        for name, nodes in (("FLANGE", r["iface_nodes"] + 1), ("TIPS", r["tips"] + 1)):
+        for name, nodes in (("FLANGE", r["iface_nodes"] + 1), ("TIPS", r["tips"] + 1),
+                            ("TIP0", r["tips"][:1] + 1)):
             fh.write(f"*NSET, NSET={name}\n")
             fh.write("\n".join(str(v) for v in nodes) + "\n")
     deck = _write(tmp_path / "rotor.toml", """
@@ -142,8 +194,28 @@ active = "TIPS"
 method = "ms"
 sectors = 7
 engine_orders = [2]
+
+[damping]
+type = "rayleigh"
+
+[[excitation.load]]
+dof = "TIP0:x"
+amplitude = 1.0
+
+[solver]
+harmonics = 1
+
+[frequency]
+start = 100.0
+end = 200.0
+
+[outputs]
+dofs = ["TIP0:x"]
 """)
-    rom = load_reduction_deck(deck)
+    d = load_deck(deck)
+    rom = d.reduced
+    tip0 = r["tips"][0]
+    assert d.outputs == [rom.dof_index(f"N{tip0 + 1}:UX")]
     n_if = 3 * r["iface_nodes"].size
     idx = harmonic_indices(2, 7, 21)
     assert rom.K.shape[0] == r["K"].shape[0] - n_if + 2 * idx.size * 9

@@ -93,6 +93,8 @@ def cmd_run(args) -> int:
     from .solver import frf
 
     deck = load_deck(args.deck)
+    for line in deck.log:
+        print(f"frirom: {line}")
     out = args.out if args.out is not None else Path("results") / deck.path.stem
     out.mkdir(parents=True, exist_ok=True)
     h5 = out / "frf.h5"
@@ -111,6 +113,8 @@ def cmd_run(args) -> int:
         shutil.copyfile(deck.path, out / "deck.toml")
 
     model, excitation, options = deck.model(), deck.excitation(), deck.options()
+    print(f"frirom: {model.n_dof} coordinates, {len(model.nonlinear_dofs())} in contact, "
+          f"{sum(g.n_elem for g in model.contacts)} contact elements, H = {deck.harmonics}")
     if start is not None or not args.resume:
         writer = FRFWriter(h5, deck.outputs, names, deck.harmonics, append=args.resume)
         progress = _Progress(deck, args.quiet)

@@ -1,14 +1,18 @@
-"""The frirom input deck: a TOML file naming the matrices, damping, excitation, contacts,
-harmonics, frequency range, continuation options and outputs (see docs/deck.md).
+"""The frirom input deck: one TOML file, one parser (see docs/deck.md).
 
-``load_deck(path)`` reads and checks the whole deck, loads the matrix files and returns a
-:class:`Deck` holding plain numpy/scipy data; ``Deck.model()``, ``Deck.excitation()`` and
-``Deck.options()`` build the solver's objects from it. Every malformed field raises
-:class:`frirom.InputError` naming the deck file, the TOML key path (``contacts[2].mu``)
-and what was expected.
+A deck names the structure either as assembled matrices used as they are (``[model]``,
+MatrixMarket, DoFs by index or label) or as FE matrices to reduce (``[fe_model]`` with
+``[reduction]``: Craig-Bampton, GSI or multi-stage interface modes, cached), then the
+damping, excitation, contacts, harmonics, frequency range, continuation options and
+outputs. With ``[fe_model]``, contacts join node sets (pairs matched by coordinates, local
+frame from a normal), and excitation and outputs name FE nodes and directions
+(``"ACTIVE:z"``, ``"1234:UX"``): the reduced coordinates never appear in a deck.
 
-DoFs are referred to by 0-based index into the matrices, or by label when the deck names a
-``dof_labels`` file (one label per line, in matrix order).
+``load_deck(path)`` checks every field before any computation, then loads the matrices
+(and builds or reuses the reduced model) and returns a :class:`Deck` holding plain
+numpy/scipy data; ``Deck.model()``, ``Deck.excitation()`` and ``Deck.options()`` build the
+solver's objects from it. Every malformed field raises :class:`frirom.InputError` naming
+the deck file, the TOML key path (``contacts[2].mu``) and what was expected.
 """
 
 from __future__ import annotations
@@ -48,6 +52,10 @@ _NONNEGATIVE = {"kt", "kn", "mu", "fn0"}
 MATRIX_FORMATS = ("mtx",)
 
 _FREQ_UNITS = {"hz": 2.0 * math.pi, "rad/s": 1.0}
+
+#: direction names of FE DoFs ("NODE:DIR" references) -> direction number
+_DIR_NUMBERS = {"x": 1, "y": 2, "z": 3, "ux": 1, "uy": 2, "uz": 3, "rotx": 4, "roty": 5,
+                "rotz": 6, "1": 1, "2": 2, "3": 3, "4": 4, "5": 5, "6": 6}
 
 
 class _Ctx:
@@ -187,6 +195,8 @@ class Deck:
     plot: bool = True
     csv: bool = True
     raw: dict = field(default_factory=dict, repr=False)
+    reduced: object = None    # frirom.reduction.rom.ReducedModel with [fe_model]
+    log: list = field(default_factory=list)   # what the reduction did (built / reused)
 
     @property
     def n_dof(self) -> int:
@@ -198,6 +208,10 @@ class Deck:
         d = self.damping
         if d["type"] == "rayleigh":
             return Damping.rayleigh(d["alpha"], d["beta"])
+        if d["type"] == "modal" and self.reduced is not None:
+            # the ratios of the reduced model's own modes (python/frirom/reduction/damping.py)
+            from .reduction.damping import modal_damping
+            return Damping.matrix(modal_damping(self.K, self.M, d["zeta"])[0])
         if d["type"] == "modal":
             return Damping.modal(d["zeta"])
         return Damping.matrix(d["C"])
@@ -252,27 +266,30 @@ def engine_order_loads(n_dof: int, dofs, eo: int, n_sectors: int, amplitude: com
     return F
 
 
+@dataclass
+class _NodeSetContact:
+    """A contact between node sets as read from a deck with [fe_model]."""
+
+    name: str
+    law: str
+    a: str
+    b: str | None
+    normal: object
+    tangent: tuple | None
+    tol: float | None
+    params: np.ndarray        # (n_par,)
+    w0: np.ndarray | None     # (n_slider,)
+    stick: tuple              # (kt, kn) of the full-stick interface modes
+    key: str
+
+
 class _Parser:
     def __init__(self, path: Path):
         self.path = path
         self.ctx = _Ctx(path)
         self.base = path.parent
-
-    def dof(self, v, key, n_dof, labels):
-        if isinstance(v, bool):
-            raise self.ctx.error(key, "a DoF index (integer) or label (string)", v)
-        if isinstance(v, int):
-            if not 0 <= v < n_dof:
-                raise self.ctx.error(key, f"a DoF index in 0..{n_dof - 1}", v)
-            return v
-        if isinstance(v, str):
-            if labels is None:
-                raise self.ctx.error(key, "a DoF index (labels need model.dof_labels)", v)
-            try:
-                return labels.index(v)
-            except ValueError:
-                raise self.ctx.error(key, "a DoF label listed in model.dof_labels", v) from None
-        raise self.ctx.error(key, "a DoF index (integer) or label (string)", v)
+        self.fe = False
+        self.n = self.labels = self.rom = None
 
     def run(self) -> Deck:
         ctx = self.ctx
@@ -284,40 +301,29 @@ class _Parser:
                 raw = tomllib.load(fh)
         except FileNotFoundError:
             raise InputError(f"{self.path}: deck file does not exist") from None
+        except OSError as exc:
+            raise InputError(f"{self.path}: cannot read the deck ({exc.strerror})") from None
         except tomllib.TOMLDecodeError as exc:
             raise InputError(f"{self.path}: not valid TOML: {exc}") from None
-        _unknown(ctx, raw, {"title", "model", "damping", "excitation", "contacts", "solver",
-                            "frequency", "continuation", "outputs"}, "")
+        _unknown(ctx, raw, {"title", "model", "fe_model", "reduction", "damping", "excitation",
+                            "contacts", "solver", "frequency", "continuation", "outputs"}, "")
         title = _str(ctx, raw, "title", "title", default=self.path.stem)
 
-        # ---- model ----
-        mdl = _table(ctx, raw, "model")
-        _unknown(ctx, mdl, {"format", "mass", "stiffness", "dof_labels"}, "model")
-        fmt = _str(ctx, mdl, "format", "model.format", default="mtx", choices=MATRIX_FORMATS)
-        M = read_matrix(self.file(mdl, "mass", "model.mass"), fmt, "model.mass", self.path)
-        K = read_matrix(self.file(mdl, "stiffness", "model.stiffness"), fmt,
-                        "model.stiffness", self.path)
-        if M.shape != K.shape:
-            raise ctx.error("model.stiffness", f"a matrix of the mass matrix's shape "
-                            f"{M.shape}", K.shape)
-        n = M.shape[0]
-        if np.any(M.diagonal() <= 0):
-            i = int(np.argmax(M.diagonal() <= 0))
-            raise ctx.error("model.mass", f"a mass matrix with a positive diagonal "
-                            f"(DoF {i} has {M.diagonal()[i]})")
-        for A, key in ((M, "model.mass"), (K, "model.stiffness")):
-            asym = abs(A - A.T).max() if A.nnz else 0.0
-            if asym > 1e-8 * max(abs(A).max(), 1e-300):
-                raise ctx.error(key, "a symmetric matrix", f"max |A - A^T| = {asym:.3g}")
-        labels = None
-        if "dof_labels" in mdl:
-            lp = self.file(mdl, "dof_labels", "model.dof_labels")
-            labels = [s.strip() for s in lp.read_text().splitlines() if s.strip()]
-            if len(labels) != n:
-                raise ctx.error("model.dof_labels", f"{n} labels (one per line, matrix "
-                                f"order) in {lp}", f"{len(labels)} labels")
-            if len(set(labels)) != n:
-                raise ctx.error("model.dof_labels", f"unique labels in {lp}")
+        # ---- structure: [model] (matrices as they are) or [fe_model] + [reduction] ----
+        if "fe_model" in raw or "reduction" in raw:
+            if "model" in raw:
+                raise ctx.error("model", "either [model] (matrices used as they are) or "
+                                "[fe_model] + [reduction] (FE matrices to reduce), not both")
+            source = self.fe_model(_table(ctx, raw, "fe_model"))
+            spec = self.reduction(_table(ctx, raw, "reduction"))
+            self.fe = True
+            M = K = labels = None
+            n = None
+        else:
+            M, K, labels = self.matrices(_table(ctx, raw, "model"))
+            n = M.shape[0]
+            self.fe = False
+        self.n, self.labels = n, labels
 
         # ---- solver ----
         sol = _table(ctx, raw, "solver")
@@ -340,111 +346,14 @@ class _Parser:
             solver["max_iterations"] = v
         solver["stability"] = _bool(ctx, sol, "stability", "solver.stability", True)
 
-        # ---- damping ----
-        damp = _table(ctx, raw, "damping")
-        dtype = _str(ctx, damp, "type", "damping.type", required=True,
-                     choices=("rayleigh", "modal", "matrix"))
-        if dtype == "rayleigh":
-            _unknown(ctx, damp, {"type", "alpha", "beta"}, "damping")
-            damping = {"type": "rayleigh",
-                       "alpha": float(_num(ctx, damp, "alpha", "damping.alpha", default=0.0,
-                                           nonneg=True)),
-                       "beta": float(_num(ctx, damp, "beta", "damping.beta", default=0.0,
-                                          nonneg=True))}
-        elif dtype == "modal":
-            _unknown(ctx, damp, {"type", "zeta"}, "damping")
-            z = damp.get("zeta")
-            if isinstance(z, (int, float)) and not isinstance(z, bool):
-                zeta = _num(ctx, damp, "zeta", "damping.zeta", nonneg=True)
-                if zeta >= 1:
-                    raise ctx.error("damping.zeta", "a damping ratio in [0, 1)", zeta)
-                zeta = np.full(n, float(zeta))
-            elif isinstance(z, list) and z:
-                zeta = np.array([_num(ctx, {"z": zi}, "z", f"damping.zeta[{i}]", nonneg=True)
-                                 for i, zi in enumerate(z)], float)
-                if np.any(zeta >= 1):
-                    i = int(np.argmax(zeta >= 1))
-                    raise ctx.error(f"damping.zeta[{i}]", "a damping ratio in [0, 1)", z[i])
-                if zeta.size > n:
-                    raise ctx.error("damping.zeta", f"at most {n} modal ratios", zeta.size)
-            else:
-                raise ctx.error("damping.zeta", "a damping ratio or a list of ratios "
-                                "(one per mode, lowest first)", z)
-            damping = {"type": "modal", "zeta": zeta}
-        else:
-            _unknown(ctx, damp, {"type", "file"}, "damping")
-            C = read_matrix(self.file(damp, "file", "damping.file"), fmt, "damping.file",
-                            self.path)
-            if C.shape != M.shape:
-                raise ctx.error("damping.file", f"a matrix of shape {M.shape}", C.shape)
-            damping = {"type": "matrix", "C": C}
-
-        # ---- excitation ----
-        exc = _table(ctx, raw, "excitation")
-        _unknown(ctx, exc, {"load", "engine_order"}, "excitation")
-        F = np.zeros((n, H + 1), complex)
-        loads = exc.get("load", [])
-        if not isinstance(loads, list):
-            raise ctx.error("excitation.load", "an array of tables [[excitation.load]]", loads)
-        for i, ld in enumerate(loads):
-            key = f"excitation.load[{i}]"
-            if not isinstance(ld, dict):
-                raise ctx.error(key, "a table", ld)
-            _unknown(ctx, ld, {"dof", "harmonic", "amplitude", "phase"}, key)
-            if "dof" not in ld:
-                raise ctx.error(f"{key}.dof", "a DoF index or label (missing)")
-            d = self.dof(ld["dof"], f"{key}.dof", n, labels)
-            h = _num(ctx, ld, "harmonic", f"{key}.harmonic", default=1, integer=True,
-                     minimum=0)
-            if h > H:
-                raise ctx.error(f"{key}.harmonic", f"a harmonic in 0..solver.harmonics={H}", h)
-            amp = _num(ctx, ld, "amplitude", f"{key}.amplitude", required=True)
-            ph = _num(ctx, ld, "phase", f"{key}.phase", default=0.0)
-            if h == 0 and ph not in (0, 0.0):
-                raise ctx.error(f"{key}.phase", "0 for a static load (harmonic 0)", ph)
-            F[d, h] += amp * np.exp(1j * np.deg2rad(ph))
-        eos = exc.get("engine_order", [])
-        if isinstance(eos, dict):
-            eos = [eos]
-        if not isinstance(eos, list):
-            raise ctx.error("excitation.engine_order", "an array of tables", eos)
-        for i, eo in enumerate(eos):
-            key = f"excitation.engine_order[{i}]"
-            if not isinstance(eo, dict):
-                raise ctx.error(key, "a table", eo)
-            _unknown(ctx, eo, {"eo", "dofs", "n_sectors", "amplitude", "phase", "harmonic"},
-                     key)
-            order = _num(ctx, eo, "eo", f"{key}.eo", required=True, integer=True)
-            dofs = eo.get("dofs")
-            if not isinstance(dofs, list) or not dofs:
-                raise ctx.error(f"{key}.dofs", "a non-empty list: one DoF (or list of DoFs) "
-                                "per sector", dofs)
-            sect = []
-            for s, ds in enumerate(dofs):
-                if isinstance(ds, list):
-                    sect.append([self.dof(v, f"{key}.dofs[{s}][{j}]", n, labels)
-                                 for j, v in enumerate(ds)])
-                else:
-                    sect.append(self.dof(ds, f"{key}.dofs[{s}]", n, labels))
-            ns = _num(ctx, eo, "n_sectors", f"{key}.n_sectors", default=len(dofs),
-                      integer=True, minimum=1)
-            h = _num(ctx, eo, "harmonic", f"{key}.harmonic", default=1, integer=True,
-                     minimum=1)
-            if h > H:
-                raise ctx.error(f"{key}.harmonic", f"a harmonic in 1..solver.harmonics={H}", h)
-            amp = _num(ctx, eo, "amplitude", f"{key}.amplitude", required=True)
-            ph = _num(ctx, eo, "phase", f"{key}.phase", default=0.0)
-            F += engine_order_loads(n, sect, order, ns, amp * np.exp(1j * np.deg2rad(ph)),
-                                    harmonic=h, H=H)
-        if not np.any(F[:, 1:]):
-            raise ctx.error("excitation", "at least one load on a harmonic >= 1 "
-                            "([[excitation.load]] or [[excitation.engine_order]])")
+        damping = self.damping(_table(ctx, raw, "damping"), M)
+        loads = self.excitation(_table(ctx, raw, "excitation"), H)
 
         # ---- contacts ----
         cons = raw.get("contacts", [])
         if not isinstance(cons, list):
             raise ctx.error("contacts", "an array of tables [[contacts]]", cons)
-        contacts = [self.contact(c, f"contacts[{i}]", n, labels) for i, c in enumerate(cons)]
+        contacts = [self.contact(c, f"contacts[{i}]") for i, c in enumerate(cons)]
         names = [c.name for c in contacts]
         for i, nm in enumerate(names):
             if nm in names[:i]:
@@ -480,16 +389,351 @@ class _Parser:
         _unknown(ctx, out, {"dofs", "plot", "csv"}, "outputs")
         od = out.get("dofs")
         if not isinstance(od, list) or not od:
-            raise ctx.error("outputs.dofs", "a non-empty list of DoF indices or labels", od)
-        outputs = [self.dof(v, f"outputs.dofs[{i}]", n, labels) for i, v in enumerate(od)]
-        onames = [labels[i] if labels else f"dof{i}" for i in outputs]
+            raise ctx.error("outputs.dofs", "a non-empty list of DoFs", od)
+        out_refs = [(self.dof(v, f"outputs.dofs[{i}]"), f"outputs.dofs[{i}]")
+                    for i, v in enumerate(od)]
+
+        # ---- everything checked: build (or reuse) the reduced model, resolve the nodes ----
+        rom, log = None, []
+        if self.fe:
+            from .reduction.rom import PairSpec, build_reduced_model
+            pairs = [PairSpec(name=c.name, a=c.a, b=c.b, normal=c.normal, tangent=c.tangent,
+                              n_dir=len(LAW_PARAMS[c.law][0]), kt=c.stick[0], kn=c.stick[1],
+                              tol=c.tol, key=c.key) for c in contacts]
+            rom = build_reduced_model(source, spec, pairs, self.path, log=log.append)
+            M, K, n = rom.M, rom.K, rom.K.shape[0]
+            self.n, self.rom = n, rom
+            contacts = [self.reduced_contact(c, rom) for c in contacts]
+            if damping["type"] == "modal" and damping["zeta"].size > n:
+                raise ctx.error("damping.zeta", f"at most {n} modal ratios (the reduced "
+                                "model's size)", damping["zeta"].size)
+        if damping["type"] == "modal" and damping["zeta"].size == 1 and damping["all"]:
+            damping["zeta"] = np.full(n, damping["zeta"][0])
+        del damping["all"]
+        F = np.zeros((n, H + 1), complex)
+        for ref, h, amp, key in loads:
+            self.add_load(F, ref, h, amp, key)
+        if not np.any(F[:, 1:]):
+            raise ctx.error("excitation", "at least one load on a harmonic >= 1 "
+                            "([[excitation.load]] or [[excitation.engine_order]])")
+        outputs = [self.coordinate(ref, key) for ref, key in out_refs]
+        onames = [od[i] if self.fe else (labels[j] if labels else f"dof{j}")
+                  for i, j in enumerate(outputs)]
 
         return Deck(path=self.path, title=title, M=M, K=K, damping=damping, F=F,
                     contacts=contacts, harmonics=H, samples=N, formulation=form,
                     omega_start=f0 * scale, omega_end=f1 * scale, frequency_unit=unit,
                     continuation=cont, solver=solver, outputs=outputs, output_names=onames,
-                    dof_labels=labels, plot=_bool(ctx, out, "plot", "outputs.plot", True),
-                    csv=_bool(ctx, out, "csv", "outputs.csv", True), raw=raw)
+                    dof_labels=labels if not self.fe else list(rom.labels),
+                    plot=_bool(ctx, out, "plot", "outputs.plot", True),
+                    csv=_bool(ctx, out, "csv", "outputs.csv", True), raw=raw,
+                    reduced=rom, log=log)
+
+    # ---- [model]: matrices used as they are ----
+    def matrices(self, mdl):
+        ctx = self.ctx
+        _unknown(ctx, mdl, {"format", "mass", "stiffness", "dof_labels"}, "model")
+        fmt = _str(ctx, mdl, "format", "model.format", default="mtx", choices=MATRIX_FORMATS)
+        M = read_matrix(self.file(mdl, "mass", "model.mass"), fmt, "model.mass", self.path)
+        K = read_matrix(self.file(mdl, "stiffness", "model.stiffness"), fmt,
+                        "model.stiffness", self.path)
+        if M.shape != K.shape:
+            raise ctx.error("model.stiffness", f"a matrix of the mass matrix's shape "
+                            f"{M.shape}", K.shape)
+        n = M.shape[0]
+        if np.any(M.diagonal() <= 0):
+            i = int(np.argmax(M.diagonal() <= 0))
+            raise ctx.error("model.mass", f"a mass matrix with a positive diagonal "
+                            f"(DoF {i} has {M.diagonal()[i]})")
+        for A, key in ((M, "model.mass"), (K, "model.stiffness")):
+            asym = abs(A - A.T).max() if A.nnz else 0.0
+            if asym > 1e-8 * max(abs(A).max(), 1e-300):
+                raise ctx.error(key, "a symmetric matrix", f"max |A - A^T| = {asym:.3g}")
+        labels = None
+        if "dof_labels" in mdl:
+            lp = self.file(mdl, "dof_labels", "model.dof_labels")
+            labels = [s.strip() for s in lp.read_text().splitlines() if s.strip()]
+            if len(labels) != n:
+                raise ctx.error("model.dof_labels", f"{n} labels (one per line, matrix "
+                                f"order) in {lp}", f"{len(labels)} labels")
+            if len(set(labels)) != n:
+                raise ctx.error("model.dof_labels", f"unique labels in {lp}")
+        return M, K, labels
+
+    # ---- [fe_model] and [reduction]: FE matrices to reduce ----
+    def fe_model(self, fe):
+        from .reduction.rom import FORMATS, FESource
+        ctx = self.ctx
+        fmt = _str(ctx, fe, "format", "fe_model.format", required=True,
+                   choices=tuple(FORMATS))
+        roles, required = FORMATS[fmt]
+        opts = {"abaqus": ("layout",), "op4": ("stiffness_name", "mass_name")}.get(fmt, ())
+        _unknown(ctx, fe, {"format", *roles, *opts}, "fe_model")
+        files = {}
+        for r in roles:
+            if r in fe or r in required:
+                files[r] = self.file(fe, r, f"fe_model.{r}")
+        options = {}
+        for o in opts:
+            v = _str(ctx, fe, o, f"fe_model.{o}",
+                     choices=("auto", "matrix", "coordinate") if o == "layout" else None)
+            if v is not None:
+                options[o] = v
+        src = FESource(fmt, files, options)
+        for r, f in files.items():
+            if fmt == "calculix" and r == "job":
+                for sfx in (".sti", ".mas", ".dof") + ((".inp",) if "inp" not in files else ()):
+                    if not f.with_suffix(sfx).is_file():
+                        raise ctx.error("fe_model.job", f"a job name whose {sfx} file exists "
+                                        "(run ccx with *FREQUENCY, SOLVER=MATRIXSTORAGE)",
+                                        str(f.with_suffix(sfx)))
+            elif not f.is_file():
+                raise ctx.error(f"fe_model.{r}", "an existing file", str(f))
+        return src
+
+    def reduction(self, red):
+        from .reduction.rom import ReductionSpec
+        ctx = self.ctx
+        if "pairs" in red:
+            raise ctx.error("reduction.pairs", "no [[reduction.pairs]]: contact pairs are "
+                            "[[contacts]] tables with node sets a, b and a normal")
+        _unknown(ctx, red, {"interface", "active", "fixed_interface_modes", "cache",
+                            "interface_modes"}, "reduction")
+        iface = self.names(red, "interface", "reduction.interface", required=True)
+        active = self.names(red, "active", "reduction.active", required=False)
+        n_cb = _num(ctx, red, "fixed_interface_modes", "reduction.fixed_interface_modes",
+                    integer=True, minimum=0)
+        cache = self.file(red, "cache", "reduction.cache") if "cache" in red else \
+            self.path.with_suffix(".rom.h5")
+        im = _table(ctx, red, "reduction.interface_modes", required=False)
+        pre = "reduction.interface_modes"
+        method = _str(ctx, im, "method", f"{pre}.method", default="none",
+                      choices=("none", "gsi", "ms"))
+        allowed = {"none": {"method"}, "gsi": {"method", "free", "stick", "per_side"},
+                   "ms": {"method", "sectors", "engine_orders", "time_harmonics", "axis",
+                          "origin"}}[method]
+        _unknown(ctx, im, allowed, pre)
+        kw = {}
+        if method == "gsi":
+            kw["free"] = _num(ctx, im, "free", f"{pre}.free", default=0, integer=True,
+                              minimum=0)
+            kw["stick"] = _num(ctx, im, "stick", f"{pre}.stick", default=0, integer=True,
+                               minimum=0)
+            if kw["free"] + kw["stick"] == 0:
+                raise ctx.error(f"{pre}.free", "free + stick >= 1 GSI modes")
+            kw["per_side"] = _bool(ctx, im, "per_side", f"{pre}.per_side", False)
+        elif method == "ms":
+            kw["sectors"] = _num(ctx, im, "sectors", f"{pre}.sectors", required=True,
+                                 integer=True, minimum=1)
+            kw["engine_orders"] = self.ints(im, "engine_orders", f"{pre}.engine_orders",
+                                            required=True)
+            th = self.ints(im, "time_harmonics", f"{pre}.time_harmonics", minimum=0)
+            kw["time_harmonics"] = th or (1,)
+            kw["axis"] = self.vector(im, "axis", f"{pre}.axis", (0.0, 0.0, 1.0))
+            kw["origin"] = self.vector(im, "origin", f"{pre}.origin", (0.0, 0.0, 0.0),
+                                       nonzero=False)
+        return ReductionSpec(interface=tuple(iface), active=tuple(active),
+                             fixed_interface_modes=n_cb, method=method, cache=cache, **kw)
+
+    def names(self, d, name, key, required):
+        v = d.get(name)
+        if v is None and not required:
+            return []
+        if isinstance(v, str):
+            v = [v]
+        if not isinstance(v, list) or not v or not all(isinstance(s, str) and s for s in v):
+            raise self.ctx.error(key, "a node-set name or a non-empty list of names", v)
+        return v
+
+    def ints(self, d, name, key, required=False, minimum=None):
+        v = d.get(name)
+        if v is None and not required:
+            return ()
+        if (not isinstance(v, list) or not v
+                or any(isinstance(x, bool) or not isinstance(x, int) for x in v)
+                or (minimum is not None and min(v) < minimum)):
+            what = "integers" if minimum is None else f"integers >= {minimum}"
+            raise self.ctx.error(key, f"a non-empty list of {what}", v)
+        return tuple(v)
+
+    def vector(self, d, name, key, default=None, nonzero=True):
+        v = d.get(name, default)
+        if (not isinstance(v, (list, tuple)) or len(v) != 3
+                or any(isinstance(x, bool) or not isinstance(x, (int, float))
+                       or not math.isfinite(x) for x in v)
+                or (nonzero and not any(v))):
+            raise self.ctx.error(key, "a list of 3 finite numbers"
+                                 + (", not all zero" if nonzero else ""), v)
+        return tuple(float(x) for x in v)
+
+    # ---- damping, excitation ----
+    def damping(self, damp, M):
+        ctx, n = self.ctx, self.n
+        dtype = _str(ctx, damp, "type", "damping.type", required=True,
+                     choices=("rayleigh", "modal", "matrix"))
+        if dtype == "rayleigh":
+            _unknown(ctx, damp, {"type", "alpha", "beta"}, "damping")
+            return {"type": "rayleigh",
+                    "alpha": float(_num(ctx, damp, "alpha", "damping.alpha", default=0.0,
+                                        nonneg=True)),
+                    "beta": float(_num(ctx, damp, "beta", "damping.beta", default=0.0,
+                                       nonneg=True)), "all": False}
+        if dtype == "modal":
+            _unknown(ctx, damp, {"type", "zeta"}, "damping")
+            z = damp.get("zeta")
+            if isinstance(z, (int, float)) and not isinstance(z, bool):
+                zeta = _num(ctx, damp, "zeta", "damping.zeta", nonneg=True)
+                if zeta >= 1:
+                    raise ctx.error("damping.zeta", "a damping ratio in [0, 1)", zeta)
+                return {"type": "modal", "zeta": np.array([float(zeta)]), "all": True}
+            if isinstance(z, list) and z:
+                zeta = np.array([_num(ctx, {"z": zi}, "z", f"damping.zeta[{i}]", nonneg=True)
+                                 for i, zi in enumerate(z)], float)
+                if np.any(zeta >= 1):
+                    i = int(np.argmax(zeta >= 1))
+                    raise ctx.error(f"damping.zeta[{i}]", "a damping ratio in [0, 1)", z[i])
+                if n is not None and zeta.size > n:
+                    raise ctx.error("damping.zeta", f"at most {n} modal ratios", zeta.size)
+                return {"type": "modal", "zeta": zeta, "all": False}
+            raise ctx.error("damping.zeta", "a damping ratio or a list of ratios "
+                            "(one per mode, lowest first)", z)
+        _unknown(ctx, damp, {"type", "file"}, "damping")
+        if self.fe:
+            raise ctx.error("damping.type", "'rayleigh' or 'modal' with [fe_model] (a damping "
+                            "matrix file needs [model])", dtype)
+        C = read_matrix(self.file(damp, "file", "damping.file"), "mtx", "damping.file",
+                        self.path)
+        if C.shape != M.shape:
+            raise ctx.error("damping.file", f"a matrix of shape {M.shape}", C.shape)
+        return {"type": "matrix", "C": C, "all": False}
+
+    def excitation(self, exc, H):
+        """[(DoF reference, harmonic, complex amplitude, key)] of every load."""
+        ctx = self.ctx
+        _unknown(ctx, exc, {"load", "engine_order"}, "excitation")
+        out = []
+        loads = exc.get("load", [])
+        if not isinstance(loads, list):
+            raise ctx.error("excitation.load", "an array of tables [[excitation.load]]", loads)
+        for i, ld in enumerate(loads):
+            key = f"excitation.load[{i}]"
+            if not isinstance(ld, dict):
+                raise ctx.error(key, "a table", ld)
+            _unknown(ctx, ld, {"dof", "harmonic", "amplitude", "phase"}, key)
+            if "dof" not in ld:
+                raise ctx.error(f"{key}.dof", "a DoF (missing)")
+            d = self.dof(ld["dof"], f"{key}.dof")
+            h = _num(ctx, ld, "harmonic", f"{key}.harmonic", default=1, integer=True,
+                     minimum=0)
+            if h > H:
+                raise ctx.error(f"{key}.harmonic", f"a harmonic in 0..solver.harmonics={H}", h)
+            amp = _num(ctx, ld, "amplitude", f"{key}.amplitude", required=True)
+            ph = _num(ctx, ld, "phase", f"{key}.phase", default=0.0)
+            if h == 0 and ph not in (0, 0.0):
+                raise ctx.error(f"{key}.phase", "0 for a static load (harmonic 0)", ph)
+            out.append((d, h, amp * np.exp(1j * np.deg2rad(ph)), f"{key}.dof"))
+        eos = exc.get("engine_order", [])
+        if isinstance(eos, dict):
+            eos = [eos]
+        if not isinstance(eos, list):
+            raise ctx.error("excitation.engine_order", "an array of tables", eos)
+        for i, eo in enumerate(eos):
+            key = f"excitation.engine_order[{i}]"
+            if not isinstance(eo, dict):
+                raise ctx.error(key, "a table", eo)
+            _unknown(ctx, eo, {"eo", "dofs", "n_sectors", "amplitude", "phase", "harmonic"},
+                     key)
+            order = _num(ctx, eo, "eo", f"{key}.eo", required=True, integer=True)
+            dofs = eo.get("dofs")
+            if not isinstance(dofs, list) or not dofs:
+                raise ctx.error(f"{key}.dofs", "a non-empty list: one DoF (or list of DoFs) "
+                                "per sector", dofs)
+            ns = _num(ctx, eo, "n_sectors", f"{key}.n_sectors", default=len(dofs),
+                      integer=True, minimum=1)
+            h = _num(ctx, eo, "harmonic", f"{key}.harmonic", default=1, integer=True,
+                     minimum=1)
+            if h > H:
+                raise ctx.error(f"{key}.harmonic", f"a harmonic in 1..solver.harmonics={H}", h)
+            amp = _num(ctx, eo, "amplitude", f"{key}.amplitude", required=True)
+            ph = _num(ctx, eo, "phase", f"{key}.phase", default=0.0)
+            a0 = amp * np.exp(1j * np.deg2rad(ph))
+            for s, ds in enumerate(dofs):
+                phase = np.exp(-2j * np.pi * order * s / ns)     # as engine_order_loads
+                items = ds if isinstance(ds, list) else [ds]
+                for j, v in enumerate(items):
+                    k = f"{key}.dofs[{s}]" + (f"[{j}]" if isinstance(ds, list) else "")
+                    out.append((self.dof(v, k), h, a0 * phase, k))
+        return out
+
+    def add_load(self, F, ref, h, amp, key):
+        """Add a load to F (n, H+1); with [fe_model] a node set loads each of its nodes."""
+        if not self.fe:
+            F[ref, h] += amp
+            return
+        try:
+            for node in self.fe_nodes(ref, key):
+                F[:, h] += amp * self.rom.load_row(node, ref[1])
+        except InputError as exc:
+            raise InputError(f"{self.path}: {key}: {exc}") from None
+
+    def coordinate(self, ref, key):
+        """Model coordinate of an output DoF (a kept physical DoF of a reduced model)."""
+        if not self.fe:
+            return ref
+        node, d = self.fe_node(ref, key)
+        lab = f"N{node}:{('UX', 'UY', 'UZ', 'ROTX', 'ROTY', 'ROTZ')[d - 1]}"
+        if lab not in self.rom.labels:
+            raise self.ctx.error(key, "a DoF kept by the reduction (a node of "
+                                 "reduction.active, or of reduction.interface without "
+                                 "interface modes)", ref[2])
+        return self.rom.labels.index(lab)
+
+    def fe_nodes(self, ref, key):
+        """Node ids of a parsed "NODE:DIR" reference (a node, or every node of a set)."""
+        node, _, text = ref
+        if not isinstance(node, str):
+            return [node]
+        ids = self.rom.node_sets.get(node.upper())
+        if ids is None:
+            raise self.ctx.error(key, "a node id or a node set name (known sets: "
+                                 + ", ".join(sorted(self.rom.node_sets)) + ")", text)
+        return [int(i) for i in ids]
+
+    def fe_node(self, ref, key):
+        """(node id, direction) of a reference that must name one node."""
+        nodes = self.fe_nodes(ref, key)
+        if len(nodes) != 1:
+            raise self.ctx.error(key, f"one node (set {ref[0]} has {len(nodes)})", ref[2])
+        return nodes[0], ref[1]
+
+    def dof(self, v, key):
+        """A DoF reference: with [model] the 0-based index (int) or the label; with
+        [fe_model] (node id or one-node set name, direction number, text) from "NODE:DIR"."""
+        if self.fe:
+            if isinstance(v, str) and v.count(":") == 1:
+                node, d = (s.strip() for s in v.split(":"))
+                dn = _DIR_NUMBERS.get(d.lower())
+                if node.upper().startswith("N") and node[1:].isdigit():
+                    node = node[1:]
+                if dn is not None and node:
+                    return (int(node) if node.isdigit() else node, dn, v)
+            raise self.ctx.error(key, "a DoF \"NODE:DIR\": a node id or node set name, "
+                                 "and x, y, z (or UX..ROTZ, 1..6)", v)
+        n_dof, labels = self.n, self.labels
+        if isinstance(v, bool):
+            raise self.ctx.error(key, "a DoF index (integer) or label (string)", v)
+        if isinstance(v, int):
+            if not 0 <= v < n_dof:
+                raise self.ctx.error(key, f"a DoF index in 0..{n_dof - 1}", v)
+            return v
+        if isinstance(v, str):
+            if labels is None:
+                raise self.ctx.error(key, "a DoF index (labels need model.dof_labels)", v)
+            try:
+                return labels.index(v)
+            except ValueError:
+                raise self.ctx.error(key, "a DoF label listed in model.dof_labels", v) from None
+        raise self.ctx.error(key, "a DoF index (integer) or label (string)", v)
 
     def file(self, d, name, key) -> Path:
         v = d.get(name)
@@ -498,12 +742,15 @@ class _Parser:
         p = Path(v)
         return p if p.is_absolute() else self.base / p
 
-    def contact(self, c, key, n, labels) -> ContactSpec:
+    def contact(self, c, key):
         ctx = self.ctx
         if not isinstance(c, dict):
             raise ctx.error(key, "a table [[contacts]]", c)
         law = _str(ctx, c, "law", f"{key}.law", required=True, choices=tuple(LAW_PARAMS))
+        if self.fe:
+            return self.node_set_contact(c, key, law)
         dirs, pnames, nsl = LAW_PARAMS[law]
+        n, labels = self.n, self.labels
         ndir = len(dirs)
         _unknown(ctx, c, {"name", "law", "elements", "directions", "w0"} | set(pnames), key)
         name = _str(ctx, c, "name", f"{key}.name", default=key)
@@ -546,19 +793,62 @@ class _Parser:
                             cols.append(b[j])
                             vals.append(-D[d, j])
         G = sp.csr_matrix((vals, (rows, cols)), shape=(ne * ndir, n))
+        params, w0 = self.law_parameters(c, key, law, ne)
+        return ContactSpec(name=name, law=law, G=G, params=params, w0=w0)
+
+    def law_parameters(self, c, key, law, ne):
+        """(params (ne, n_par), w0 (ne, n_slider) or None) of a contact table."""
+        _, pnames, nsl = LAW_PARAMS[law]
         params = np.empty((ne, len(pnames)))
         for j, p in enumerate(pnames):
             params[:, j] = self.per_element(c, p, f"{key}.{p}", ne, required=True,
                                             nonneg=p in _NONNEGATIVE)
         if law in ("jenkins", "normal1d", "normal2d") and np.any(params[:, 0] <= 0):
-            raise ctx.error(f"{key}.kt", "a positive tangential stiffness (N/m)")
+            raise self.ctx.error(f"{key}.kt", "a positive tangential stiffness (N/m)")
+        if law in ("normal1d", "normal2d") and np.any(params[:, 1] <= 0):
+            raise self.ctx.error(f"{key}.kn", "a positive normal stiffness (N/m)")
         w0 = None
         if "w0" in c:
             if nsl == 0:
-                raise ctx.error(f"{key}.w0", f"no initial slider for law {law!r} "
-                                "(it has none)")
+                raise self.ctx.error(f"{key}.w0", f"no initial slider for law {law!r} "
+                                     "(it has none)")
             w0 = np.repeat(self.per_element(c, "w0", f"{key}.w0", ne)[:, None], nsl, axis=1)
-        return ContactSpec(name=name, law=law, G=G, params=params, w0=w0)
+        return params, w0
+
+    def node_set_contact(self, c, key, law):
+        """A [[contacts]] table of a reduced model: node sets a, b, a normal."""
+        ctx = self.ctx
+        _, pnames, _ = LAW_PARAMS[law]
+        _unknown(ctx, c, {"name", "law", "a", "b", "normal", "tangent", "tol", "w0"}
+                 | set(pnames), key)
+        name = _str(ctx, c, "name", f"{key}.name", default=f"contacts{key[9:-1]}")
+        a = _str(ctx, c, "a", f"{key}.a", required=True)
+        b = _str(ctx, c, "b", f"{key}.b", default="ground")
+        b = None if b.lower() == "ground" else b
+        normal = c.get("normal")
+        if isinstance(normal, str):
+            normal = _str(ctx, c, "normal", f"{key}.normal",
+                          choices=("axial", "radial", "tangential"))
+        else:
+            normal = self.vector(c, "normal", f"{key}.normal")
+        tangent = self.vector(c, "tangent", f"{key}.tangent") if "tangent" in c else None
+        tol = _num(ctx, c, "tol", f"{key}.tol", positive=True)
+        for p in [*pnames, "w0"]:
+            if isinstance(c.get(p), list):
+                raise ctx.error(f"{key}.{p}", "a number (the same for every pair of the "
+                                "node sets)", c[p])
+        params, w0 = self.law_parameters(c, key, law, 1)
+        stick = (params[0, 0], params[0, 1] if law in ("normal1d", "normal2d") else 0.0)
+        return _NodeSetContact(name=name, law=law, a=a, b=b, normal=normal, tangent=tangent,
+                               tol=tol, params=params[0], w0=None if w0 is None else w0[0],
+                               stick=tuple(float(x) for x in stick), key=key)
+
+    def reduced_contact(self, c, rom) -> ContactSpec:
+        """ContactSpec of a node-set contact: its physical pairs mapped by the reduction."""
+        G = rom.contact_matrix(c.name)
+        ne = rom.pairs[c.name].n_elem
+        return ContactSpec(name=c.name, law=c.law, G=G, params=np.tile(c.params, (ne, 1)),
+                           w0=None if c.w0 is None else np.tile(c.w0, (ne, 1)))
 
     def node(self, v, key, n, labels, allow_ground):
         if v is None:
@@ -570,7 +860,7 @@ class _Parser:
         items = v if isinstance(v, list) else [v]
         if not items:
             raise self.ctx.error(key, "a non-empty list of DoFs", v)
-        return [self.dof(x, f"{key}[{i}]" if isinstance(v, list) else key, n, labels)
+        return [self.dof(x, f"{key}[{i}]" if isinstance(v, list) else key)
                 for i, x in enumerate(items)]
 
     def frame(self, frame, key, ndir, nd, dirs):

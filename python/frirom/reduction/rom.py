@@ -1,0 +1,483 @@
+"""Reduced models of FE matrices: Craig-Bampton + interface reduction, cached in HDF5.
+
+The deck (frirom.deck, docs/deck.md) parses ``[fe_model]``, ``[reduction]`` and the
+node-set contacts into a :class:`FESource`, a :class:`ReductionSpec` and
+:class:`PairSpec` s; :func:`build_reduced_model` turns them into a :class:`ReducedModel`
+(K, M, the map T back to the FE DoFs, the physical contact pairs). The model is saved to
+the cache file with a fingerprint of the matrix files' bytes and of the reduction
+settings, and read back (without even parsing the FE files) while neither changes:
+friction coefficients, preloads, excitation, damping, harmonics or frequencies can be
+edited without recomputing it. Contact stiffnesses enter the fingerprint only when
+full-stick interface modes are asked for.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse as sp
+
+from .._errors import InputError
+from .interface import ContactPairs, contact_matrix, gsi_basis, local_frames, reduce_interface
+
+__all__ = ["FESource", "PairSpec", "ReductionSpec", "ReducedModel", "build_reduced_model",
+           "read_fe_model", "pairs_from_node_sets", "FORMATS"]
+
+#: format -> (file roles, required roles); see docs/deck.md, [fe_model]
+FORMATS = {
+    "calculix": (("job", "inp"), ("job",)),
+    "mtx": (("stiffness", "mass", "dofs"), ("stiffness", "mass")),
+    "abaqus": (("stiffness", "mass", "dofs", "inp"), ("stiffness", "mass")),
+    "hbmat": (("stiffness", "mass", "mapping"), ("stiffness", "mass")),
+    "op4": (("file", "dofs"), ("file",)),
+}
+CACHE_VERSION = 2
+
+
+@dataclass(frozen=True)
+class FESource:
+    """Where the FE matrices come from: format, files by role (absolute paths), and the
+    format's options (abaqus ``layout``, op4 ``stiffness_name``/``mass_name``)."""
+
+    format: str
+    files: dict
+    options: dict = field(default_factory=dict)
+
+    def paths(self) -> list:
+        """Every file the model is read from (those that exist), for the fingerprint."""
+        f = dict(self.files)
+        if self.format == "calculix":
+            job = f.pop("job")
+            f.update({s: job.with_suffix(s) for s in (".sti", ".mas", ".dof")})
+            f.setdefault("inp", job.with_suffix(".inp"))
+        return [Path(p) for _, p in sorted(f.items()) if p is not None]
+
+
+@dataclass(frozen=True)
+class PairSpec:
+    """A set of contact pairs between two node sets (``b`` None: ground).
+
+    normal: a 3-vector or 'axial' / 'radial' / 'tangential'; tangent: optional 3-vector for
+    the first tangential direction; n_dir: local directions kept (3: t1, t2, n; 2: t1, n;
+    1: t1); kt, kn: stick stiffness [N/m] (full-stick modes); tol: matching distance [m]
+    (default 1e-6 of the model size); key: the deck key path used in error messages.
+    """
+
+    name: str
+    a: str
+    b: str | None
+    normal: object
+    n_dir: int
+    kt: float
+    kn: float
+    tangent: object = None
+    tol: float | None = None
+    key: str = ""
+
+
+@dataclass(frozen=True)
+class ReductionSpec:
+    """The ``[reduction]`` table, checked (docs/deck.md)."""
+
+    interface: tuple
+    active: tuple = ()
+    fixed_interface_modes: int | None = None
+    method: str = "none"                 # none | gsi | ms
+    free: int = 0
+    stick: int = 0
+    per_side: bool = False
+    sectors: int | None = None
+    engine_orders: tuple = ()
+    time_harmonics: tuple = (1,)
+    axis: tuple = (0.0, 0.0, 1.0)
+    origin: tuple = (0.0, 0.0, 0.0)
+    cache: Path | None = None
+
+
+def read_fe_model(src: FESource):
+    """The FEModel of a :class:`FESource` (through the readers of frirom.io)."""
+    from .. import io as fio
+    f, o = src.files, src.options
+    if src.format == "calculix":
+        model = fio.read_calculix(f["job"], inp=f.get("inp"))
+    elif src.format == "mtx":
+        model = fio.read_matrix_market(f["stiffness"], f["mass"], f.get("dofs"))
+    elif src.format == "abaqus":
+        model = fio.read_abaqus(f["stiffness"], f["mass"], fmt=o.get("layout", "auto"),
+                                dofs=f.get("dofs"), inp=f.get("inp"))
+    elif src.format == "hbmat":
+        model = fio.read_hbmat(f["stiffness"], f["mass"], f.get("mapping"))
+    else:
+        model = fio.read_op4(f["file"], o.get("stiffness_name", "KAA"),
+                             o.get("mass_name", "MAA"), f.get("dofs"))
+    if model.M is None:
+        raise InputError(f"{src.paths()[0]}: no mass matrix (the reduction needs M)")
+    return model
+
+
+def _node_dofs(model, nodes):
+    """(n, 3) matrix indices of the x y z DoFs of node ids (-1 where constrained)."""
+    key = {(int(a), int(b)): i for i, (a, b) in enumerate(model.dofs)}
+    return np.array([[key.get((int(nd), c), -1) for c in (1, 2, 3)] for nd in nodes],
+                    dtype=np.int64)
+
+
+def pairs_from_node_sets(model, set_a: str, set_b: str | None, normal, kt: float, kn: float,
+                         n_dir: int = 3, tol: float | None = None,
+                         axis=(0.0, 0.0, 1.0), origin=(0.0, 0.0, 0.0),
+                         tangent=None) -> ContactPairs:
+    """Contact pairs between the nodes of two node sets at the same position (or ground).
+
+    normal: a 3-vector, or 'axial' / 'radial' / 'tangential' (about ``axis`` through
+    ``origin``); tangent: optional 3-vector for t1 (projected on the contact plane); the
+    local frame is (t1, t2, n) from :func:`local_frames`, of which n_dir = 3 keeps
+    (t1, t2, n), 2 keeps (t1, n) and 1 keeps t1. Stick stiffness (kt[, kt], kn).
+    """
+    na = model.node_sets.get(set_a.upper())
+    if na is None:
+        raise InputError(f"unknown node set {set_a!r}; the model has {sorted(model.node_sets)}")
+    xa = model.coordinates(na)
+    da = _node_dofs(model, na)
+    if np.any(da < 0):
+        bad = na[np.any(da < 0, axis=1)]
+        raise InputError(f"node set {set_a}: node(s) {bad[:5].tolist()} are constrained; "
+                         "contact nodes need their x y z DoFs")
+    if set_b is None:
+        db = -np.ones_like(da)
+    else:
+        nb = model.node_sets.get(set_b.upper())
+        if nb is None:
+            raise InputError(f"unknown node set {set_b!r}; the model has "
+                             f"{sorted(model.node_sets)}")
+        xb = model.coordinates(nb)
+        scale = max(np.abs(xa).max(), np.abs(xb).max(), 1e-300)
+        tol = 1e-6 * scale if tol is None else tol
+        from scipy.spatial import cKDTree
+        dist, j = cKDTree(xb).query(xa)
+        far = np.nonzero(dist > tol)[0]
+        if far.size:
+            raise InputError(f"node {na[far[0]]} of set {set_a} has no node of set {set_b} "
+                             f"within {tol:.3g} (nearest {dist[far[0]]:.3g})")
+        if np.unique(j).size != j.size:
+            raise InputError(f"nodes of set {set_a} share a node of set {set_b}: the sets "
+                             "must face each other node to node")
+        db = _node_dofs(model, nb[j])
+        if np.any(db < 0):
+            raise InputError(f"node set {set_b}: some nodes are constrained; contact nodes "
+                             "need their x y z DoFs")
+    tang = None if tangent is None else np.tile(np.asarray(tangent, float), (len(na), 1))
+    if isinstance(normal, str):
+        a = np.asarray(axis, float) / np.linalg.norm(axis)
+        rel = xa - np.asarray(origin, float)
+        radial = rel - np.outer(rel @ a, a)
+        nvec = {"axial": np.tile(a, (len(na), 1)), "radial": radial,
+                "tangential": np.cross(a, radial)}.get(normal)
+        if nvec is None:
+            raise InputError(f"normal {normal!r}: expected a 3-vector, 'axial', 'radial' "
+                             "or 'tangential'")
+        if tang is None:
+            tang = np.tile(a, (len(na), 1)) if normal != "axial" else np.cross(a, radial)
+    else:
+        nvec = np.tile(np.asarray(normal, float), (len(na), 1))
+    fr = local_frames(nvec, tang)
+    keep = {3: [0, 1, 2], 2: [0, 2], 1: [0]}.get(n_dir)
+    if keep is None:
+        raise InputError(f"n_dir must be 1, 2 or 3, got {n_dir}")
+    k = np.array([kt, kt, kn])[keep]
+    return ContactPairs(da, db, fr[:, keep, :], np.tile(k, (len(na), 1)))
+
+
+# --------------------------------------------------------------------------------------------
+# the reduced model
+# --------------------------------------------------------------------------------------------
+
+_DIRECTIONS = {1: "UX", 2: "UY", 3: "UZ", 4: "ROTX", 5: "ROTY", 6: "ROTZ"}
+
+
+@dataclass
+class ReducedModel:
+    """Reduced matrices with their way back to the FE model.
+
+    K, M: (n_r, n_r), dense, or CSR for large models without CB; labels: one per reduced
+    coordinate ('N12:UX' for a kept physical DoF, 'gsi 3', 'ms h=2 c ...', 'cb mode 5');
+    T: (n_fe, n_r) map x_fe = T q (CB and interface reduction composed; dense with CB,
+    sparse without); pairs: {name: ContactPairs on the FE DoFs}; fe_dofs: (n_fe, 2) (node,
+    direction) of the FE DoFs; node_sets: {NAME: node ids}; from_cache: True when read back
+    from the cache file; build_seconds: time the reduction took when it was built.
+    """
+
+    K: np.ndarray
+    M: np.ndarray
+    T: np.ndarray
+    labels: list
+    pairs: dict = field(default_factory=dict)
+    fe_dofs: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
+    node_sets: dict = field(default_factory=dict)
+    from_cache: bool = False
+    build_seconds: float = 0.0
+
+    @property
+    def n_fe(self) -> int:
+        return self.T.shape[0]
+
+    def contact_matrix(self, name: str) -> sp.csr_matrix:
+        """G of a pair set on the reduced coordinates, (n_elem*n_dir, n_r)."""
+        if name not in self.pairs:
+            raise InputError(f"no contact pair set {name!r}; known: {sorted(self.pairs)}")
+        g = sp.csr_matrix(contact_matrix(self.pairs[name], self.n_fe) @ self.T)
+        g.eliminate_zeros()
+        return g
+
+    def fe_index(self, node: int, direction: int) -> int:
+        """Row of the FE DoF (node, direction) in T; InputError if absent/constrained."""
+        hit = np.nonzero((self.fe_dofs[:, 0] == node) & (self.fe_dofs[:, 1] == direction))[0]
+        if hit.size == 0:
+            raise InputError(f"node {node} has no DoF {_DIRECTIONS.get(direction, direction)} "
+                             "in the FE matrices (unknown node or constrained DoF)")
+        return int(hit[0])
+
+    def dof_index(self, label: str) -> int:
+        """Reduced coordinate of a kept physical DoF label ('N12:UX')."""
+        try:
+            return self.labels.index(label)
+        except ValueError:
+            raise InputError(f"DoF {label!r} is not a reduced coordinate (only active and "
+                             "non-reduced master DoFs are)") from None
+
+    def load_row(self, node: int, direction: int) -> np.ndarray:
+        """Reduced load (n_r,) of a unit force on FE DoF (node, direction): row of T."""
+        row = self.T[self.fe_index(node, direction)]
+        return np.asarray(row.toarray()).ravel() if sp.issparse(row) else np.asarray(row)
+
+    def expand(self, q) -> np.ndarray:
+        return self.T @ np.asarray(q)
+
+    def save(self, path, fingerprint: str) -> None:
+        import h5py
+        with h5py.File(path, "w") as h:
+            h.attrs["fingerprint"] = fingerprint
+            h.attrs["version"] = CACHE_VERSION
+            h.attrs["build_seconds"] = self.build_seconds
+            for k in ("K", "M", "T"):
+                a = getattr(self, k)
+                if sp.issparse(a):
+                    a = sp.csr_matrix(a)
+                    g = h.create_group(k)
+                    g.attrs["shape"] = a.shape
+                    for part in ("data", "indices", "indptr"):
+                        g.create_dataset(part, data=getattr(a, part))
+                else:
+                    h.create_dataset(k, data=a)
+            h.create_dataset("labels", data=np.array(self.labels, dtype="S"))
+            h.create_dataset("fe_dofs", data=self.fe_dofs)
+            for name, nodes in self.node_sets.items():
+                h.create_dataset(f"node_sets/{name}", data=nodes)
+            for name, p in self.pairs.items():
+                g = h.create_group(f"pairs/{name}")
+                for k in ("dofs_a", "dofs_b", "frames", "stiffness"):
+                    g.create_dataset(k, data=getattr(p, k))
+
+    @classmethod
+    def load(cls, path, fingerprint: str):
+        """The cached model, or None if absent, unreadable or built from other inputs."""
+        import h5py
+        try:
+            with h5py.File(path, "r") as h:
+                if (h.attrs.get("fingerprint") != fingerprint
+                        or h.attrs.get("version") != CACHE_VERSION):
+                    return None
+                pairs = {}
+                for name in h.get("pairs", {}):
+                    g = h[f"pairs/{name}"]
+                    pairs[name] = ContactPairs(g["dofs_a"][()], g["dofs_b"][()],
+                                               g["frames"][()], g["stiffness"][()])
+                sets = {k: v[()] for k, v in h.get("node_sets", {}).items()}
+                K, M, T = (_read_matrix(h[k]) for k in ("K", "M", "T"))
+                return cls(K=K, M=M, T=T,
+                           labels=[s.decode() for s in h["labels"][()]], pairs=pairs,
+                           fe_dofs=h["fe_dofs"][()], node_sets=sets, from_cache=True,
+                           build_seconds=float(h.attrs.get("build_seconds", 0.0)))
+        except (OSError, KeyError):
+            return None
+
+
+def _label(model, i):
+    nd, d = model.dofs[i]
+    return f"N{nd}:{_DIRECTIONS.get(int(d), d)}"
+
+
+def _fingerprint(source: FESource, spec: ReductionSpec, pairs: list) -> str:
+    """sha256 of the FE files' bytes, the reduction settings and the pair geometry (plus
+    the stick stiffness when full-stick modes are asked for)."""
+    h = hashlib.sha256()
+    h.update(f"frirom-rom-{CACHE_VERSION}-{source.format}".encode())
+    for f in source.paths():
+        if not f.is_file():
+            continue
+        h.update(f.name.encode())
+        with open(f, "rb") as fh:
+            for chunk in iter(lambda: fh.read(1 << 22), b""):
+                h.update(chunk)
+    cfg = {k: v for k, v in asdict(spec).items() if k != "cache"}
+    stick = spec.method == "gsi" and spec.stick > 0
+    pc = [{k: v for k, v in asdict(p).items()
+           if k != "key" and (stick or k not in ("kt", "kn"))} for p in pairs]
+    h.update(json.dumps([source.options, cfg, pc], sort_keys=True, default=str).encode())
+    return h.hexdigest()
+
+
+def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_path="deck",
+                        log=None) -> ReducedModel:
+    """Build the reduced model, or read it back from ``spec.cache`` when its fingerprint
+    matches; a rebuilt model rewrites the cache. ``log(str)`` gets one line saying which.
+
+    Errors name ``deck_path`` and the deck key concerned (``reduction.interface``,
+    ``contacts[i]``, ...).
+    """
+    from .cb import craig_bampton
+    from .multistage import harmonic_indices, ms_basis, radial_line_segments
+
+    where = f"{deck_path}: "
+    cache = spec.cache or Path(deck_path).with_suffix(".rom.h5")
+    fp = _fingerprint(source, spec, list(pairs))
+    cached = ReducedModel.load(cache, fp)
+    if cached is not None:
+        if log:
+            log(f"reduced model reused from {cache} ({cached.K.shape[0]} coordinates; "
+                f"built in {cached.build_seconds:.1f} s, not recomputed)")
+        return cached
+
+    t0 = time.perf_counter()
+    model = read_fe_model(source)
+    prs = {}
+    for p in pairs:
+        try:
+            prs[p.name] = pairs_from_node_sets(model, p.a, p.b, p.normal, p.kt, p.kn, p.n_dir,
+                                               p.tol, axis=spec.axis, origin=spec.origin,
+                                               tangent=p.tangent)
+        except InputError as exc:
+            raise InputError(f"{where}{p.key}: {exc}") from None
+    try:
+        iface_fe = model.dof_indices(list(spec.interface))
+        act_fe = (model.dof_indices(list(spec.active)) if spec.active
+                  else np.zeros(0, np.int64))
+    except InputError as exc:
+        raise InputError(f"{where}reduction.interface/active: {exc}") from None
+    for name, p in prs.items():
+        off = np.setdiff1d(p.dofs, iface_fe)
+        if off.size:
+            nd = model.dofs[off[0], 0]
+            raise InputError(f"{where}{[q.key for q in pairs if q.name == name][0]}: node "
+                             f"{nd} is not in the node sets of reduction.interface (contact "
+                             "nodes must be interface nodes)")
+    n_fe = model.n_dof
+    # Craig-Bampton on the interface + active node sets
+    if spec.fixed_interface_modes is not None:
+        try:
+            cb = craig_bampton(model, spec.fixed_interface_modes, interface=list(spec.interface),
+                               active=list(spec.active) or None)
+        except InputError as exc:
+            raise InputError(f"{where}reduction.fixed_interface_modes: {exc}") from None
+        K0, M0 = cb.K, cb.M
+        pos = -np.ones(n_fe, dtype=np.int64)
+        pos[cb.master_index] = np.arange(cb.n_masters)
+        T0 = np.zeros((n_fe, K0.shape[0]))
+        T0[cb.master_index, np.arange(cb.n_masters)] = 1.0
+        T0[np.ix_(cb.slave_index, np.arange(cb.n_masters))] = cb.psi
+        T0[np.ix_(cb.slave_index, cb.n_masters + np.arange(cb.n_modes))] = cb.phi
+        labels0 = [_label(model, i) for i in cb.master_index] + \
+            [f"cb mode {j + 1}" for j in range(cb.n_modes)]
+    else:
+        K0, M0 = model.K, model.M
+        pos = np.arange(n_fe)
+        T0 = None
+        labels0 = [_label(model, i) for i in range(n_fe)]
+    iface0, act0 = pos[iface_fe], pos[act_fe]
+
+    def to0(p):
+        return ContactPairs(pos[p.dofs_a], np.where(p.dofs_b >= 0, pos[np.maximum(p.dofs_b, 0)],
+                                                    -1), p.frames, p.stiffness)
+
+    pairs0 = {k: to0(v) for k, v in prs.items()}
+    pre = f"{where}reduction.interface_modes"
+    if spec.method == "none":
+        basis = None
+    elif spec.method == "gsi":
+        if spec.stick and not pairs0:
+            raise InputError(f"{pre}.stick: full-stick modes need contacts on node sets "
+                             "([[contacts]] with a and b)")
+        allp = None
+        if spec.stick:
+            if len({p.n_dir for p in pairs0.values()}) > 1:
+                raise InputError(f"{pre}.stick: all contacts must have the same number of "
+                                 "local directions for the full-stick modes")
+            allp = ContactPairs(*(np.vstack([getattr(p, k) for p in pairs0.values()])
+                                  for k in ("dofs_a", "dofs_b", "frames", "stiffness")))
+        groups = None
+        if spec.per_side and pairs0:
+            side_a = np.isin(iface0, np.concatenate([p.dofs_a.ravel()
+                                                     for p in pairs0.values()]))
+            groups = [g for g in (np.nonzero(side_a)[0], np.nonzero(~side_a)[0]) if g.size]
+        try:
+            basis, _ = gsi_basis(K0, M0, iface0, act0, allp, spec.free, spec.stick,
+                                 groups=groups)
+        except InputError as exc:
+            raise InputError(f"{pre}: {exc}") from None
+        iface_r = iface0
+        mode_labels = [f"gsi {j + 1}" for j in range(basis.shape[1])]
+    else:
+        nodes = np.unique(np.concatenate([model.node_sets[s.upper()] for s in spec.interface]))
+        nd = _node_dofs(model, nodes)
+        if np.any(nd < 0):
+            bad = nodes[np.any(nd < 0, axis=1)]
+            raise InputError(f"{where}reduction.interface: expected nodes with free x y z "
+                             f"DoFs for the MS reduction, got constrained node(s) "
+                             f"{bad[:5].tolist()}")
+        try:
+            xyz = model.coordinates(nodes)
+            nz = radial_line_segments(xyz, spec.sectors, spec.origin, spec.axis).n_segments
+            ms = ms_basis(xyz, pos[nd], spec.sectors,
+                          harmonic_indices(list(spec.engine_orders), spec.sectors, nz,
+                                           list(spec.time_harmonics)),
+                          spec.origin, spec.axis)
+        except InputError as exc:
+            raise InputError(f"{pre}: {exc}") from None
+        if ms.interface.size != iface0.size:
+            raise InputError(f"{where}reduction.interface: expected node sets whose nodes "
+                             "all keep x y z DoFs for the MS reduction")
+        basis, iface_r, mode_labels = ms.basis, ms.interface, ms.labels()
+    if basis is None:
+        K, M, T1, labels = K0, M0, None, labels0
+    else:
+        r = reduce_interface(K0, M0, iface_r, basis, labels=labels0, mode_labels=mode_labels)
+        K, M, T1, labels = r.K, r.M, r.R, r.labels
+    if T0 is None:      # no CB: T stays sparse (identity, or the interface basis)
+        T = sp.identity(n_fe, format="csr") if T1 is None else T1.tocsr()
+    else:
+        T = T0 if T1 is None else np.asarray(T1.T @ T0.T).T
+    out = ReducedModel(K=K, M=M, T=T, labels=labels, pairs=prs,
+                       fe_dofs=np.asarray(model.dofs, np.int64),
+                       node_sets={k: np.asarray(v, np.int64)
+                                  for k, v in model.node_sets.items()},
+                       build_seconds=time.perf_counter() - t0)
+    try:
+        out.save(cache, fp)
+    except OSError as exc:
+        raise InputError(f"{where}reduction.cache: cannot write {cache} ({exc})") from None
+    if log:
+        log(f"reduced model built in {out.build_seconds:.1f} s: {n_fe} FE DoFs -> "
+            f"{K.shape[0]} coordinates; saved to {cache}")
+    return out
+
+
+def _read_matrix(node):
+    import h5py
+    if isinstance(node, h5py.Group):
+        return sp.csr_matrix((node["data"][()], node["indices"][()], node["indptr"][()]),
+                             shape=tuple(node.attrs["shape"]))
+    return node[()]
