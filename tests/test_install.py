@@ -1,9 +1,10 @@
 """The plain meson install serves legacy Fortran codes: library, .mod files, frirom.pc.
 
 Builds the library alone (-Dpython=false) into a temporary prefix, then compiles and runs
-a Fortran program that `use`s frirom_aft and links with `pkg-config --cflags --libs
-frirom`, as a legacy code's makefile would. The program checks a stuck Jenkins element
-against the linear spring (exact) and prints the force.
+Fortran programs that `use` frirom_aft and frirom_eigen and link with `pkg-config
+--cflags --libs frirom`, as a legacy code's makefile would. They check a stuck Jenkins
+element against the linear spring (exact) and the first eigenvalue of a spring chain
+against its closed form (1e-10; ARPACK + MUMPS through the static library).
 """
 
 import os
@@ -39,6 +40,44 @@ end program legacy
 """
 
 
+LEGACY_EIGEN = """\
+program legacy_eigen
+    use frirom_kinds, only: wp, ip
+    use frirom_eigen, only: eigen_work, eigen_factor, eigen_modes, eigen_destroy
+    implicit none
+    integer(ip), parameter :: n = 40
+    type(eigen_work) :: work
+    integer(ip) :: info, i, krow(2*n - 1), kcol(2*n - 1), mrow(n), mptr(n + 1), mind(n)
+    real(wp) :: kval(2*n - 1), mval(n), lam(3), phi(n, 3), exact
+    character(len=200) :: msg
+    ! fixed-fixed spring chain, k = m = 1: lambda_j = 2 - 2 cos(j pi / (n + 1))
+    do i = 1, n
+        krow(i) = i
+        kcol(i) = i
+        kval(i) = 2.0_wp
+        mrow(i) = i
+        mval(i) = 1.0_wp
+        mptr(i) = i
+        mind(i) = i
+    end do
+    mptr(n + 1) = n + 1
+    do i = 1, n - 1
+        krow(n + i) = i
+        kcol(n + i) = i + 1
+        kval(n + i) = -1.0_wp
+    end do
+    call eigen_factor(work, n, krow, kcol, kval, mrow, mrow, mval, 0.0_wp, info, msg)
+    if (info /= 0) error stop 'eigen_factor failed'
+    call eigen_modes(work, mptr, mind, mval, 3_ip, lam, phi, info, msg)
+    if (info /= 0) error stop 'eigen_modes failed'
+    exact = 2.0_wp - 2.0_wp*cos(acos(-1.0_wp)/(n + 1))
+    if (abs(lam(1) - exact) > 1.0e-10_wp*exact) error stop 'first eigenvalue wrong'
+    print '(a,es12.5)', 'legacy eigen ok ', lam(1)
+    call eigen_destroy(work)
+end program legacy_eigen
+"""
+
+
 def _tool(name):
     here = Path(sys.executable).parent / name
     return str(here) if here.exists() else shutil.which(name)
@@ -61,9 +100,11 @@ def test_legacy_fortran_program_links_installed_library(tmp_path):
     env["PKG_CONFIG_PATH"] = str(pcs[0].parent)
     flags = subprocess.run(["pkg-config", "--cflags", "--libs", "frirom"], check=True,
                            env=env, capture_output=True, text=True).stdout.split()
-    src = tmp_path / "legacy.f90"
-    src.write_text(LEGACY)
-    exe = tmp_path / "legacy"
-    subprocess.run(["gfortran", str(src), "-o", str(exe)] + flags, check=True, env=env)
-    out = subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout
-    assert "legacy ok" in out
+    for name, text, expect in (("legacy", LEGACY, "legacy ok"),
+                               ("legacy_eigen", LEGACY_EIGEN, "legacy eigen ok")):
+        src = tmp_path / f"{name}.f90"
+        src.write_text(text)
+        exe = tmp_path / name
+        subprocess.run(["gfortran", str(src), "-o", str(exe)] + flags, check=True, env=env)
+        out = subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout
+        assert expect in out
