@@ -18,7 +18,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "models"))
-from block import run_ccx  # noqa: E402
+from ccx import run_ccx  # noqa: E402
 from lap_joint import write_lap_joint_deck  # noqa: E402
 
 

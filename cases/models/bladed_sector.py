@@ -21,14 +21,13 @@ Two decks:
 from __future__ import annotations
 
 import argparse
-import os
-import shutil
-import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 
-STEEL = dict(E=2.1e11, nu=0.3, rho=7850.0)
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from ccx import STEEL, nset, run_ccx, solid_material  # noqa: E402,F401  (run_ccx re-exported)
 
 
 def sector_mesh(n_sectors=12, r=(0.10, 0.115, 0.14, 0.17, 0.20, 0.23, 0.26, 0.30),
@@ -97,12 +96,6 @@ def sector_mesh(n_sectors=12, r=(0.10, 0.115, 0.14, 0.17, 0.20, 0.23, 0.26, 0.30
 # (sign, exponent included) within that.
 
 
-def _nset(fh, name, nodes):
-    fh.write(f"*NSET, NSET={name}\n")
-    for k in range(0, len(nodes), 10):
-        fh.write(", ".join(str(v) for v in nodes[k:k + 10]) + "\n")
-
-
 def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, **mesh):
     """Write ``cyclic.inp`` and ``sector.inp`` in ``out``; returns their paths."""
     out = Path(out)
@@ -121,9 +114,7 @@ def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, **mesh):
     common += [f"{e}, " + ", ".join(str(c) for c in conn) + "\n"
                for e, conn in enumerate(elems, start=1)]
     head = "".join(common)
-    mat = ("*MATERIAL, NAME=STEEL\n*ELASTIC\n"
-           f"{material['E']:.6g}, {material['nu']:.6g}\n*DENSITY\n{material['rho']:.6g}\n"
-           "*SOLID SECTION, ELSET=EALL, MATERIAL=STEEL\n")
+    mat = solid_material(material)
     paths = []
     for name in ("cyclic", "sector"):
         p = out / f"{name}.inp"
@@ -131,7 +122,7 @@ def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, **mesh):
             fh.write(head)
             for sname, nodes in (("LEFT", left), ("RIGHT", right), ("FLANGE", flange),
                                  ("FIX", fix), ("TIP", tip)):
-                _nset(fh, sname, nodes)
+                fh.write(nset(sname, nodes))
             fh.write(mat)
             if name == "cyclic":
                 fh.write("*SURFACE, NAME=SLEFT, TYPE=NODE\nLEFT\n"
@@ -171,30 +162,11 @@ def write_stage_deck(out, n_sectors=12, material=STEEL, **mesh):
         fh.write("*ELEMENT, TYPE=C3D8, ELSET=EALL\n")
         fh.writelines(f"{e}, " + ", ".join(str(c) for c in conn) + "\n"
                       for e, conn in enumerate(elems, start=1))
-        _nset(fh, "FLANGE", flange)
-        _nset(fh, "TIPS", np.array(tips))
-        fh.write("*MATERIAL, NAME=STEEL\n*ELASTIC\n"
-                 f"{material['E']:.6g}, {material['nu']:.6g}\n*DENSITY\n"
-                 f"{material['rho']:.6g}\n*SOLID SECTION, ELSET=EALL, MATERIAL=STEEL\n"
-                 "*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n1\n*END STEP\n")
+        fh.write(nset("FLANGE", flange))
+        fh.write(nset("TIPS", np.array(tips)))
+        fh.write(solid_material(material))
+        fh.write("*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n1\n*END STEP\n")
     return p
-
-
-def run_ccx(inp, timeout=1800, expect=(".dat",)):
-    """Run ccx on a deck in its own directory; RuntimeError with the log tail on failure."""
-    inp = Path(inp)
-    ccx = shutil.which("ccx")
-    if ccx is None:
-        raise RuntimeError("ccx (Debian package calculix-ccx) is not on PATH")
-    env = dict(os.environ, OMP_NUM_THREADS=os.environ.get("OMP_NUM_THREADS", "1"))
-    res = subprocess.run([ccx, "-i", inp.stem], cwd=inp.parent, capture_output=True,
-                         text=True, timeout=timeout, env=env)
-    job = inp.with_suffix("")
-    missing = [e for e in expect if not job.with_suffix(e).exists()]
-    if res.returncode != 0 or missing or "*ERROR" in res.stdout:
-        tail = "\n".join((res.stdout + res.stderr).splitlines()[-20:])
-        raise RuntimeError(f"ccx failed on {inp} (exit {res.returncode}):\n{tail}")
-    return job
 
 
 def read_cyclic_eigenvalues(dat) -> dict:
@@ -230,7 +202,7 @@ def main(argv=None):
     ap.add_argument("--out", default="sector")
     a = ap.parse_args(argv)
     cyc, sec = write_sector_decks(a.out, a.sectors, a.modes)
-    run_ccx(cyc)
+    run_ccx(cyc, expect=(".dat",))
     run_ccx(sec, expect=(".sti", ".mas", ".dof"))
     for nd, lam in sorted(read_cyclic_eigenvalues(Path(a.out) / "cyclic.dat").items()):
         print(nd, np.sqrt(np.maximum(lam, 0)) / (2 * np.pi))

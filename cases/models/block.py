@@ -13,14 +13,14 @@ then ``*FREQUENCY, SOLVER=MATRIXSTORAGE``, which writes job.sti/.mas/.dof and en
 from __future__ import annotations
 
 import argparse
-import os
-import shutil
-import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 
-STEEL = dict(E=2.1e11, nu=0.3, rho=7850.0)
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from ccx import STEEL, nset, run_ccx, solid_material  # noqa: E402,F401  (re-exported)
+
 
 
 def block_mesh(nx, ny, nz, size=(0.2, 0.05, 0.05), order=1):
@@ -97,34 +97,13 @@ def write_block_deck(path, nx=12, ny=4, nz=4, size=(0.2, 0.05, 0.05), order=1,
             if len(items) > 16:
                 fh.write(", ".join(items[16:]) + "\n")
         for name, nodes in (("FIX", fix), ("IFACE", iface), ("ACTIVE", active)):
-            fh.write(f"*NSET, NSET={name}\n")
-            for k in range(0, len(nodes), 10):
-                fh.write(", ".join(str(v) for v in nodes[k:k + 10]) + "\n")
-        fh.write("*MATERIAL, NAME=STEEL\n*ELASTIC\n"
-                 f"{material['E']:.6g}, {material['nu']:.6g}\n"
-                 f"*DENSITY\n{material['rho']:.6g}\n"
-                 "*SOLID SECTION, ELSET=EALL, MATERIAL=STEEL\n")
+            fh.write(nset(name, nodes))
+        fh.write(solid_material(material))
         fh.write("*BOUNDARY\nFIX, 1, 3\n")
         if n_ref_modes > 0:
             fh.write(f"*STEP\n*FREQUENCY\n{n_ref_modes}\n*END STEP\n")
         fh.write("*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n1\n*END STEP\n")
     return path
-
-
-def run_ccx(inp, timeout=1800):
-    """Run ccx on a deck in its own directory; RuntimeError with the log tail on failure."""
-    inp = Path(inp)
-    ccx = shutil.which("ccx")
-    if ccx is None:
-        raise RuntimeError("ccx (Debian package calculix-ccx) is not on PATH")
-    env = dict(os.environ, OMP_NUM_THREADS=os.environ.get("OMP_NUM_THREADS", "1"))
-    res = subprocess.run([ccx, "-i", inp.stem], cwd=inp.parent, capture_output=True,
-                         text=True, timeout=timeout, env=env)
-    job = inp.with_suffix("")
-    if res.returncode != 0 or not job.with_suffix(".sti").exists() or "*ERROR" in res.stdout:
-        tail = "\n".join((res.stdout + res.stderr).splitlines()[-20:])
-        raise RuntimeError(f"ccx failed on {inp} (exit {res.returncode}):\n{tail}")
-    return job
 
 
 def main(argv=None):

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from block import STEEL, run_ccx  # noqa: E402
+from ccx import STEEL, nset, run_ccx, solid_material  # noqa: E402
 
 # gmsh's 10-node tetrahedron numbers its last two edge nodes (2-3, 1-3) the other way
 # round from Abaqus/CalculiX C3D10 (1-3, 2-3 in 0-based vertices).
@@ -99,13 +99,8 @@ def write_lap_joint_deck(path, size=0.006, n_ref_modes=20, material=STEEL, **geo
         for e, conn in enumerate(elems, start=1):
             fh.write(f"{e}, " + ", ".join(str(c) for c in conn) + "\n")
         for name, nodes in sets.items():
-            fh.write(f"*NSET, NSET={name}\n")
-            for k in range(0, len(nodes), 10):
-                fh.write(", ".join(str(v) for v in nodes[k:k + 10]) + "\n")
-        fh.write("*MATERIAL, NAME=STEEL\n*ELASTIC\n"
-                 f"{material['E']:.6g}, {material['nu']:.6g}\n"
-                 f"*DENSITY\n{material['rho']:.6g}\n"
-                 "*SOLID SECTION, ELSET=EALL, MATERIAL=STEEL\n*BOUNDARY\nFIX, 1, 3\n")
+            fh.write(nset(name, nodes))
+        fh.write(solid_material(material) + "*BOUNDARY\nFIX, 1, 3\n")
         if n_ref_modes > 0:
             fh.write(f"*STEP\n*FREQUENCY\n{n_ref_modes}\n*END STEP\n")
         fh.write("*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n1\n*END STEP\n")

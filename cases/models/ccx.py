@@ -1,0 +1,48 @@
+"""What every CalculiX model generator here shares: the steel, deck snippets, running ccx.
+
+The generators (block.py, lap_joint.py, bladed_sector.py) import this module from the
+same folder.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+STEEL = dict(E=2.1e11, nu=0.3, rho=7850.0)   # Pa, -, kg/m^3
+
+
+def nset(name: str, nodes) -> str:
+    """A *NSET block, ten node ids a line."""
+    nodes = list(nodes)
+    lines = [f"*NSET, NSET={name}"]
+    lines += [", ".join(str(v) for v in nodes[k:k + 10]) for k in range(0, len(nodes), 10)]
+    return "\n".join(lines) + "\n"
+
+
+def solid_material(material=STEEL, elset: str = "EALL") -> str:
+    """An isotropic elastic material with density and the solid section of `elset`."""
+    return ("*MATERIAL, NAME=STEEL\n*ELASTIC\n"
+            f"{material['E']:.6g}, {material['nu']:.6g}\n*DENSITY\n{material['rho']:.6g}\n"
+            f"*SOLID SECTION, ELSET={elset}, MATERIAL=STEEL\n")
+
+
+def run_ccx(inp, timeout: float = 1800, expect=(".sti",)) -> Path:
+    """Run ccx on a deck in its own directory and return the job path (deck without
+    suffix). RuntimeError with the log tail when ccx fails, prints *ERROR, or leaves any
+    of the `expect`ed files unwritten (.sti for matrix storage, .dat for eigenvalues)."""
+    inp = Path(inp)
+    ccx = shutil.which("ccx")
+    if ccx is None:
+        raise RuntimeError("ccx (Debian package calculix-ccx) is not on PATH")
+    env = dict(os.environ, OMP_NUM_THREADS=os.environ.get("OMP_NUM_THREADS", "1"))
+    res = subprocess.run([ccx, "-i", inp.stem], cwd=inp.parent, capture_output=True,
+                         text=True, timeout=timeout, env=env)
+    job = inp.with_suffix("")
+    missing = [e for e in expect if not job.with_suffix(e).exists()]
+    if res.returncode != 0 or missing or "*ERROR" in res.stdout:
+        tail = "\n".join((res.stdout + res.stderr).splitlines()[-20:])
+        raise RuntimeError(f"ccx failed on {inp} (exit {res.returncode}):\n{tail}")
+    return job
