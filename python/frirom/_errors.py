@@ -49,8 +49,15 @@ class SingularMatrixError(NumericalError):
     code = 10
 
 
+class FactorizationError(NumericalError):
+    """The sparse factorisation (MUMPS) of K - sigma M failed: out of memory, or a
+    structurally singular matrix (a free body without masters, a zero-stiffness DoF)."""
+    code = 40
+
+
 _BY_CODE = {cls.code: cls for cls in (SizeError, ParameterError, NonFiniteError,
-                                      SamplesError, ConvergenceError, SingularMatrixError)}
+                                      SamplesError, ConvergenceError, SingularMatrixError,
+                                      FactorizationError)}
 _BY_CODE[11] = ParameterError      # unknown contact law
 _BY_CODE[12] = ConvergenceError    # hysteresis cycle did not close
 _BY_CODE[20] = ConvergenceError    # continuation stopped at the minimum step
