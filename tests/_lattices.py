@@ -190,3 +190,15 @@ def tuned_rotor(n_sectors=7, per_sector=3, radii=(1.0, 1.15, 1.3), n_axial=3, bl
             "frames": frames, "rot": rot,
             "k_ground": np.tile(np.asarray(k_ground, float), (len(iface_nodes), 1)),
             "n_sectors": n, "nz": nz}
+
+
+def stuck_rotor(axis, origin, **kw):
+    """tuned_rotor with its interface nodes tied to ground by their contact stiffnesses:
+    adds "pairs" (the ContactPairs) and "Kt" (dense stuck stiffness) to the dict."""
+    from frirom.reduction.interface import ContactPairs, stick_stiffness
+    r = tuned_rotor(axis=axis, origin=origin, **kw)
+    nodes = r["iface_nodes"]
+    r["pairs"] = ContactPairs(r["dofs"][nodes], -np.ones((len(nodes), 3), int), r["frames"],
+                              r["k_ground"])
+    r["Kt"] = (r["K"] + stick_stiffness(r["pairs"], r["K"].shape[0])).toarray()
+    return r

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from _lattices import tuned_rotor
+from _lattices import stuck_rotor
 from frirom._errors import InputError
 from frirom.io import read_calculix
 from frirom.reduction.cyclic import cyclic_sector, tran_reduce
@@ -29,12 +29,7 @@ ETA = 0.01
 
 @pytest.fixture(scope="module")
 def rotor():
-    r = tuned_rotor(axis=AXIS, origin=ORIGIN)
-    nodes = r["iface_nodes"]
-    n = r["K"].shape[0]
-    pairs = ContactPairs(r["dofs"][nodes], -np.ones((len(nodes), 3), int), r["frames"],
-                         r["k_ground"])
-    r["Kt"] = (r["K"] + stick_stiffness(pairs, n)).toarray()
+    r = stuck_rotor(AXIS, ORIGIN)
     s = r["sector"]
     ns = s["K"].shape[0]
     g = ContactPairs(s["node_dofs"][s["ground_nodes"]], -np.ones((len(s["ground_nodes"]), 3),

@@ -9,7 +9,7 @@ import pytest
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from _lattices import tuned_rotor
+from _lattices import stuck_rotor, tuned_rotor
 from frirom._errors import InputError
 from frirom.reduction.interface import (ContactPairs, contact_matrix, reduce_interface,
                                         stick_stiffness)
@@ -58,13 +58,7 @@ def test_harmonic_indices_match_spectrum_of_travelling_wave(n_sec, z, eo, j):
 
 @pytest.fixture(scope="module")
 def rotor():
-    r = tuned_rotor(axis=AXIS, origin=ORIGIN)
-    nodes = r["iface_nodes"]
-    n = r["K"].shape[0]
-    pairs = ContactPairs(r["dofs"][nodes], -np.ones((len(nodes), 3), int), r["frames"],
-                         r["k_ground"])
-    r["pairs"] = pairs
-    r["Kt"] = (r["K"] + stick_stiffness(pairs, n)).toarray()
+    r = stuck_rotor(AXIS, ORIGIN)
     r["Md"] = r["M"].toarray()
     r["lam"] = sla.eigh(r["Kt"], r["Md"], eigvals_only=True)
     return r
