@@ -266,3 +266,122 @@ class Excitation:
             out[:, 2 * h - 1] = self.F[:, h].real
             out[:, 2 * h] = -self.F[:, h].imag
         return out
+
+
+@dataclass
+class SectorModes:
+    """Modes of one harmonic index (nodal diameter) k of a tuned cyclic sector.
+
+    psi: (n_dof, n_modes) complex, the mode shapes on every DoF of the sector (dependent
+    cyclic boundary included), normalised so that psi^H M_k psi = I over the sector;
+    omega: (n_modes,) natural frequencies [rad/s], > 0; zeta: (n_modes,) damping ratios.
+    For k = 0 and k = N/2 the shapes are real (stored complex).
+    """
+
+    k: int
+    psi: np.ndarray
+    omega: np.ndarray
+    zeta: np.ndarray
+
+    def __post_init__(self):
+        self.psi = np.asarray(self.psi, dtype=complex)
+        self.omega = np.asarray(self.omega, dtype=float).ravel()
+        self.zeta = np.asarray(self.zeta, dtype=float).ravel()
+        nm = self.omega.size
+        if self.psi.ndim != 2 or self.psi.shape[1] != nm or self.zeta.size != nm or nm == 0:
+            raise SizeError(f"modes of harmonic index {self.k}: psi (n_dof, n_modes), omega "
+                            f"and zeta (n_modes,) expected, got {self.psi.shape}, {nm}, "
+                            f"{self.zeta.size}")
+        if not (np.all(np.isfinite(self.psi)) and np.all(np.isfinite(self.omega))
+                and np.all(np.isfinite(self.zeta))):
+            raise NonFiniteError(f"modes of harmonic index {self.k}: NaN or Inf")
+        if np.any(self.omega <= 0):
+            raise ParameterError(f"modes of harmonic index {self.k}: a natural frequency is "
+                                 f"{self.omega.min():.3g} rad/s; the sector needs supports "
+                                 "that remove rigid-body motion at every nodal diameter")
+        if np.any(self.zeta < 0):
+            raise ParameterError(f"modes of harmonic index {self.k}: damping ratios must be "
+                                 ">= 0")
+
+
+@dataclass
+class CyclicModel:
+    """A tuned rotor of N identical sectors under an engine-order travelling wave, solved on
+    sector 0 (the harmonic balance is exact for the rotor's travelling-wave response).
+
+    Time harmonic h of the response lives on harmonic index (nodal diameter)
+    k_h = sign h EO mod N: sector s moves as x_s^h = Q^s x_0^h exp(i k_h s 2 pi / N). The
+    linear part of every harmonic comes from the modes of its own k_h (``modes``, one
+    :class:`SectorModes` per k in 0..N-1 needed; k and N - k are complex conjugates, so
+    only one of them need be given). ``single_index`` = k* instead uses k* for every
+    harmonic, static one included: the shortcut of a ROM built for one harmonic index, an
+    approximation that is exact only when the solution has one harmonic on that index.
+
+    n_dof: sector DoFs (the rows of every psi); n_sectors: N; engine_order: EO;
+    sign: -1 (the deck's convention: sector s lags sector 0 by 2 pi EO s / N, so
+    k_h = -h EO mod N) or +1; contacts: ContactGroup whose G has n_dof columns (DoFs of
+    sector 0) or 2 n_dof (sector 0, then the next sector s = 1 in its own frame, i.e. the
+    same DoF numbering rotated with the sector: a contact between neighbouring sectors
+    such as a shroud or an underplatform damper; its rotation into sector 0's frame is
+    part of G). Excitation and outputs are sector 0's DoFs.
+    """
+
+    n_dof: int
+    n_sectors: int
+    engine_order: int
+    modes: dict
+    contacts: list = field(default_factory=list)
+    sign: int = -1
+    single_index: int | None = None
+    dof_labels: list | None = None
+
+    def __post_init__(self):
+        n, N = int(self.n_dof), int(self.n_sectors)
+        if N < 2:
+            raise ParameterError(f"cyclic model: n_sectors must be >= 2, got {N}")
+        if self.sign not in (-1, 1):
+            raise ParameterError(f"cyclic model: sign must be -1 or +1, got {self.sign}")
+        if self.single_index is not None and not 0 <= int(self.single_index) < N:
+            raise ParameterError(f"cyclic model: single_index must lie in 0..{N - 1}, got "
+                                 f"{self.single_index}")
+        for k, m in self.modes.items():
+            if not isinstance(m, SectorModes):
+                raise ParameterError("cyclic model: modes must map k to SectorModes")
+            if m.psi.shape[0] != n:
+                raise SizeError(f"cyclic model: modes of harmonic index {k} have "
+                                f"{m.psi.shape[0]} rows, the sector has {n} DoFs")
+        if not isinstance(self.contacts, (list, tuple)) or not self.contacts:
+            raise ParameterError("cyclic model: at least one ContactGroup is needed")
+        for g in self.contacts:
+            if not isinstance(g, ContactGroup):
+                raise ParameterError("contacts: every entry must be a ContactGroup")
+            if g.G.shape[1] not in (n, 2 * n):
+                raise SizeError(f"contact {g.name!r}: G has {g.G.shape[1]} columns; a cyclic "
+                                f"sector of {n} DoFs needs {n} (sector 0) or {2 * n} (sector "
+                                "0, then the next sector)")
+        if self.dof_labels is not None and len(self.dof_labels) != n:
+            raise SizeError(f"dof_labels: {len(self.dof_labels)} labels for {n} DoFs")
+        self.n_dof, self.n_sectors = n, N
+
+    def harmonic_index(self, h: int) -> int:
+        """The nodal diameter k_h (0..N-1) time harmonic h lives on."""
+        if self.single_index is not None:
+            return int(self.single_index)
+        return (self.sign * int(h) * int(self.engine_order)) % self.n_sectors
+
+    def modes_of(self, k: int) -> SectorModes:
+        """SectorModes of index k, from those of N - k (complex conjugate) if needed."""
+        k %= self.n_sectors
+        if k in self.modes:
+            return self.modes[k]
+        kc = (-k) % self.n_sectors
+        if kc in self.modes:
+            m = self.modes[kc]
+            return SectorModes(k, m.psi.conj(), m.omega, m.zeta)
+        raise ParameterError(f"cyclic model: no modes of harmonic index {k} (nor "
+                             f"{kc}); they are needed for time harmonics h with "
+                             f"k_h = {k}")
+
+    def indices(self, H: int) -> list:
+        """k_h for h = 0..H."""
+        return [self.harmonic_index(h) for h in range(H + 1)]

@@ -15,6 +15,11 @@ matrices (removed by boundary conditions) are zero.
 modes (Tran 2001): the lowest eigenvectors of the boundary-condensed pair. Engine-order
 travelling-wave excitation: :meth:`CyclicSector.travelling_wave_load` and
 :meth:`CyclicSector.expand`.
+
+Nonlinear forced response of a sector: :func:`sector_modes` gives the modes of one harmonic
+index on every sector DoF, :func:`cyclic_model` the :class:`frirom.model.CyclicModel` the
+solver takes, with the modes of every index k_h = sign h EO mod N that time harmonic h of
+an engine-order EO travelling wave lives on.
 """
 
 from __future__ import annotations
@@ -27,10 +32,12 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.spatial import cKDTree
 
-from .._errors import InputError, NumericalError, SingularMatrixError, SizeError
+from .._errors import InputError, NumericalError, ParameterError, SingularMatrixError, SizeError
+from ..model import CyclicModel, Damping, SectorModes
 from .multistage import cylindrical_frame
 
-__all__ = ["CyclicSector", "cyclic_sector", "axis_rotation", "tran_reduce"]
+__all__ = ["CyclicSector", "cyclic_sector", "axis_rotation", "tran_reduce", "sector_modes",
+           "cyclic_model"]
 
 
 def axis_rotation(angle: float, axis=(0.0, 0.0, 1.0)) -> np.ndarray:
@@ -310,3 +317,97 @@ def tran_reduce(Kk, Mk, boundary, n_modes: int):
     Kr = (R.conj().T @ Ks @ R).toarray()
     Mr = (R.conj().T @ Ms @ R).toarray()
     return 0.5 * (Kr + Kr.conj().T), 0.5 * (Mr + Mr.conj().T), R, lam
+
+
+def _ratios(damping, omega):
+    """Damping ratios of modes of natural frequencies omega [rad/s]."""
+    if damping is None:
+        return np.zeros_like(omega)
+    if not isinstance(damping, Damping):
+        raise ParameterError("damping: expected a frirom.model.Damping or None")
+    if damping.kind == "rayleigh":
+        return damping.alpha / (2.0 * omega) + damping.beta * omega / 2.0
+    if damping.kind == "modal":
+        return damping.zeta[np.minimum(np.arange(omega.size), damping.zeta.size - 1)]
+    raise ParameterError("damping: a cyclic sector takes modal ratios or Rayleigh damping "
+                         "(both diagonal in the modes of every harmonic index), not a "
+                         "damping matrix")
+
+
+def sector_modes(sector: CyclicSector, K, M, k: int, damping=None, n_modes=None,
+                 boundary_modes=None, method: str = "auto") -> SectorModes:
+    """Modes of harmonic index k on every DoF of the sector, with their damping ratios.
+
+    K, M: the sector's (n_dof, n_dof) real matrices; damping: Damping.rayleigh (ratios
+    alpha / 2w + beta w / 2) or Damping.modal (zeta[r] for the r-th mode of every index,
+    the last ratio for the modes above) or None; n_modes: modes kept (default all of the
+    projected pair: the receptances are then exact; fewer truncate them with no residual
+    flexibility); boundary_modes: Tran's interface modes for the cyclic boundary (default
+    none: the boundary is kept whole); method: 'dense', 'arpack' or 'auto' (dense up to
+    4000 coordinates; ARPACK needs n_modes).
+    """
+    Kk, Mk = sector.matrices(K, M, k)
+    n = Kk.shape[0]
+    R = None
+    if boundary_modes is not None:
+        Kr, Mr, R, _ = tran_reduce(Kk, Mk, sector.boundary, int(boundary_modes))
+        Kk, Mk = sp.csr_matrix(Kr), sp.csr_matrix(Mr)
+        n = Kk.shape[0]
+    nm = n if n_modes is None else int(n_modes)
+    if not 1 <= nm <= n:
+        raise InputError(f"sector_modes: n_modes must lie in 1..{n}, got {nm}")
+    if method not in ("auto", "dense", "arpack"):
+        raise InputError(f"method must be 'auto', 'dense' or 'arpack', got {method!r}")
+    dense = method == "dense" or (method == "auto" and (n <= 4000 or nm > n // 4))
+    try:
+        if dense:
+            Kd, Md = Kk.toarray(), Mk.toarray()
+            lam, phi = sla.eigh(0.5 * (Kd + Kd.conj().T), 0.5 * (Md + Md.conj().T),
+                                subset_by_index=[0, nm - 1])
+        else:
+            lam, phi = spla.eigsh(Kk.tocsc(), k=nm, M=Mk.tocsc(), sigma=0.0, which="LM")
+            order = np.argsort(lam)
+            lam, phi = lam[order].real, phi[:, order]
+            phi = phi / np.sqrt(np.einsum("ir,ir->r", phi.conj(), Mk @ phi).real)
+    except (np.linalg.LinAlgError, ValueError, RuntimeError, spla.ArpackError) as exc:
+        raise NumericalError(f"sector_modes: eigen-solve of harmonic index {k} failed "
+                             f"({exc}); is the sector's mass matrix positive definite?"
+                             ) from None
+    if np.any(lam <= 0):
+        raise ParameterError(f"sector_modes: harmonic index {k} has a rigid-body (zero "
+                             "frequency) mode; the sector needs supports at every nodal "
+                             "diameter")
+    if R is not None:
+        phi = R @ phi
+    psi = sector.projection(k) @ phi
+    omega = np.sqrt(lam)
+    return SectorModes(k=int(k) % sector.n_sectors, psi=psi, omega=omega,
+                       zeta=_ratios(damping, omega))
+
+
+def cyclic_model(sector: CyclicSector, K, M, contacts, engine_order: int, harmonics: int,
+                 damping=None, sign: int = -1, n_modes=None, boundary_modes=None,
+                 single_index=None, dof_labels=None) -> CyclicModel:
+    """The CyclicModel of a sector under an engine-order travelling wave, harmonics 0..H.
+
+    Computes the modes of every index k_h = sign h EO mod N (h = 0..H; one of k and N - k),
+    or of ``single_index`` only (the one-index approximation, see CyclicModel). contacts:
+    ContactGroup on the sector's DoFs (or on sector 0 and the next sector, 2 n_dof
+    columns); the other arguments as in :func:`sector_modes`.
+    """
+    if not (isinstance(harmonics, (int, np.integer)) and harmonics >= 0):
+        raise ParameterError(f"harmonics: expected an integer >= 0, got {harmonics!r}")
+    N = sector.n_sectors
+    if single_index is not None:
+        ks = {int(single_index) % N}
+    else:
+        ks = set()
+        for h in range(harmonics + 1):
+            k = (sign * h * int(engine_order)) % N
+            if k not in ks and (-k) % N not in ks:
+                ks.add(k)
+    modes = {k: sector_modes(sector, K, M, k, damping, n_modes, boundary_modes)
+             for k in sorted(ks)}
+    return CyclicModel(n_dof=sector.n_dof, n_sectors=N, engine_order=int(engine_order),
+                       modes=modes, contacts=list(contacts), sign=sign,
+                       single_index=single_index, dof_labels=dof_labels)
