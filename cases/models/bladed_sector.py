@@ -8,14 +8,20 @@ bore (r0..r0 + tf, -L <= z <= 0) whose end face z = -L is the flange contact fac
 FLANGE, clamped in the decks), and a twisted blade (r1..r2) in the middle of the sector.
 Node sets: LEFT (theta = 0), RIGHT (theta = 2 pi / N), FLANGE, TIP (a blade-tip node), FIX
 (FLANGE without the nodes of LEFT, the dependent cyclic surface: ccx refuses boundary
-conditions on it; the cyclic constraint makes them zero anyway).
+conditions on it; the cyclic constraint makes them zero anyway), FLANGE_IN and FLANGE_OUT
+(the inner (r = r0) and outer edges of the flange face), FLANGE_C (FLANGE_OUT without the
+nodes of LEFT: a contact set that holds each node of the rotor once), RIM_L and RIM_R (the
+nodes of LEFT and RIGHT at the disk rim, free: faces of a contact with the next sector).
 
 Two decks:
 * ``cyclic.inp``: ``*CYCLIC SYMMETRY MODEL`` (LEFT dependent, RIGHT independent) and a
   ``*FREQUENCY`` step with ``*SELECT CYCLIC SYMMETRY MODES`` for nodal diameters 0..N/2;
   ccx prints the eigenvalues of every nodal diameter in ``cyclic.dat`` (the reference).
 * ``sector.inp``: the same mesh and boundary conditions without cyclic symmetry and a
-  ``*FREQUENCY, SOLVER=MATRIXSTORAGE`` step: ``sector.sti/.mas/.dof``.
+  ``*FREQUENCY, SOLVER=MATRIXSTORAGE`` step: ``sector.sti/.mas/.dof``. With
+  ``sector_clamp="inner"`` only FLANGE_IN is clamped there (the bolted inner edge), so that
+  the outer edge FLANGE_OUT is free for contact elements; ``cyclic.inp`` keeps the whole
+  face clamped (the reference a stuck flange contact must reproduce).
 """
 
 from __future__ import annotations
@@ -96,8 +102,14 @@ def sector_mesh(n_sectors=12, r=(0.10, 0.115, 0.14, 0.17, 0.20, 0.23, 0.26, 0.30
 # (sign, exponent included) within that.
 
 
-def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, **mesh):
-    """Write ``cyclic.inp`` and ``sector.inp`` in ``out``; returns their paths."""
+def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, sector_clamp="flange",
+                       **mesh):
+    """Write ``cyclic.inp`` and ``sector.inp`` in ``out``; returns their paths.
+
+    sector_clamp: "flange" (sector.inp clamps FIX, as cyclic.inp) or "inner" (sector.inp
+    clamps FLANGE_IN only)."""
+    if sector_clamp not in ("flange", "inner"):
+        raise ValueError(f"sector_clamp: expected 'flange' or 'inner', got {sector_clamp!r}")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     ids, xyz, elems, grid, (nr, nth, zg) = sector_mesh(n_sectors, **mesh)
@@ -105,6 +117,12 @@ def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, **mesh):
     right = ids[grid[:, 1] == nth]
     flange = ids[grid[:, 2] == 0]
     fix = np.setdiff1d(flange, left)
+    flange_in = ids[(grid[:, 2] == 0) & (grid[:, 0] == 0)]
+    flange_out = np.setdiff1d(flange, flange_in)
+    flange_c = np.setdiff1d(flange_out, left)
+    i_rim = int(np.max(grid[np.isin(ids, left), 0]))     # outermost radial station of LEFT
+    rim_l = left[(grid[np.isin(ids, left), 0] == i_rim)]
+    rim_r = right[(grid[np.isin(ids, right), 0] == i_rim)]
     tip = ids[[int(np.argmax(np.hypot(xyz[:, 0], xyz[:, 1]) + 1e-3 * xyz[:, 2]))]]
     common = []
     common.append(f"** bladed-disk sector with flange, {n_sectors} sectors, C3D8\n")
@@ -121,7 +139,9 @@ def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, **mesh):
         with open(p, "w") as fh:
             fh.write(head)
             for sname, nodes in (("LEFT", left), ("RIGHT", right), ("FLANGE", flange),
-                                 ("FIX", fix), ("TIP", tip)):
+                                 ("FIX", fix), ("TIP", tip), ("FLANGE_IN", flange_in),
+                                 ("FLANGE_OUT", flange_out), ("FLANGE_C", flange_c),
+                                 ("RIM_L", rim_l), ("RIM_R", rim_r)):
                 fh.write(nset(sname, nodes))
             fh.write(mat)
             if name == "cyclic":
@@ -130,7 +150,8 @@ def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, **mesh):
                          "*TIE, NAME=CYC, CYCLIC SYMMETRY\nSLEFT, SRIGHT\n"
                          f"*CYCLIC SYMMETRY MODEL, N={n_sectors}, NGRAPH=1, TIE=CYC\n"
                          "0., 0., 0., 0., 0., 1.\n")
-            fh.write("*BOUNDARY\nFIX, 1, 3\n")
+            clamped = "FLANGE_IN" if name == "sector" and sector_clamp == "inner" else "FIX"
+            fh.write(f"*BOUNDARY\n{clamped}, 1, 3\n")
             if name == "cyclic":
                 fh.write(f"*STEP\n*FREQUENCY\n{n_modes}\n"
                          f"*SELECT CYCLIC SYMMETRY MODES, NMIN=0, NMAX={n_sectors // 2}\n"

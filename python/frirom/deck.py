@@ -7,6 +7,10 @@ damping, excitation, contacts, harmonics, frequency range, continuation options 
 outputs. With ``[fe_model]``, contacts join node sets (pairs matched by coordinates, local
 frame from a normal), and excitation and outputs name FE nodes and directions
 (``"ACTIVE:z"``, ``"1234:UX"``): the reduced coordinates never appear in a deck.
+``[reduction.cyclic]`` makes the reduced model one sector of a tuned rotor under an
+engine-order travelling wave: ``Deck.model()`` is then a :class:`frirom.model.CyclicModel`
+whose modes (one Hermitian eigen-solve per nodal diameter the harmonics live on) are
+computed by ``load_deck`` after the cached reduction.
 
 ``load_deck(path)`` checks every field before any computation, then loads the matrices
 (and builds or reuses the reduced model) and returns a :class:`Deck` holding plain
@@ -197,6 +201,9 @@ class Deck:
     raw: dict = field(default_factory=dict, repr=False)
     reduced: object = None    # frirom.reduction.rom.ReducedModel with [fe_model]
     log: list = field(default_factory=list)   # what the reduction did (built / reused)
+    #: with [reduction.cyclic]: {'sector': CyclicSector, 'modes': {k: SectorModes},
+    #: 'engine_order', 'single_index' (None or k*), 'sign', 'seconds'}
+    cyclic: dict | None = None
 
     @property
     def n_dof(self) -> int:
@@ -208,7 +215,7 @@ class Deck:
         d = self.damping
         if d["type"] == "rayleigh":
             return Damping.rayleigh(d["alpha"], d["beta"])
-        if d["type"] == "modal" and self.reduced is not None:
+        if d["type"] == "modal" and self.reduced is not None and self.cyclic is None:
             # the ratios of the reduced model's own modes (python/frirom/reduction/damping.py)
             from .reduction.damping import modal_damping
             return Damping.matrix(modal_damping(self.K, self.M, d["zeta"])[0])
@@ -217,9 +224,16 @@ class Deck:
         return Damping.matrix(d["C"])
 
     def model(self):
-        from .model import ContactGroup, Model
+        """The solver's Model, or its CyclicModel with [reduction.cyclic]."""
+        from .model import ContactGroup, CyclicModel, Model
         groups = [ContactGroup(law=c.law, G=c.G, params=c.params, w0=c.w0, name=c.name)
                   for c in self.contacts]
+        if self.cyclic is not None:
+            c = self.cyclic
+            return CyclicModel(n_dof=self.n_dof, n_sectors=c["sector"].n_sectors,
+                               engine_order=c["engine_order"], modes=c["modes"],
+                               contacts=groups, sign=c["sign"],
+                               single_index=c["single_index"], dof_labels=self.dof_labels)
         return Model(self.M, self.K, self.damping_object(), groups,
                      dof_labels=self.dof_labels)
 
@@ -281,6 +295,7 @@ class _NodeSetContact:
     w0: np.ndarray | None     # (n_slider,)
     stick: tuple              # (kt, kn) of the full-stick interface modes
     key: str
+    b_sector: int = 0         # 1: side b in the next sector (cyclic)
 
 
 class _Parser:
@@ -290,6 +305,7 @@ class _Parser:
         self.base = path.parent
         self.fe = False
         self.n = self.labels = self.rom = None
+        self.cyc = None           # the checked [reduction.cyclic] table
 
     def run(self) -> Deck:
         ctx = self.ctx
@@ -345,6 +361,14 @@ class _Parser:
         if v is not None:
             solver["max_iterations"] = v
         solver["stability"] = _bool(ctx, sol, "stability", "solver.stability", True)
+        if self.cyc is not None:
+            if form != "condensed":
+                raise ctx.error("solver.formulation", "'condensed' with [reduction.cyclic] "
+                                "(a cyclic sector is solved on its modal receptances)", form)
+            if sol.get("stability") is True:
+                raise ctx.error("solver.stability", "false with [reduction.cyclic] (Hill "
+                                "stability is not implemented for cyclic sectors)", True)
+            solver["stability"] = False
 
         damping = self.damping(_table(ctx, raw, "damping"), M)
         loads = self.excitation(_table(ctx, raw, "excitation"), H)
@@ -353,6 +377,9 @@ class _Parser:
         cons = raw.get("contacts", [])
         if not isinstance(cons, list):
             raise ctx.error("contacts", "an array of tables [[contacts]]", cons)
+        if self.cyc is not None and not cons:
+            raise ctx.error("contacts", "at least one [[contacts]] table with "
+                            "[reduction.cyclic] (a cyclic sector is solved for its contacts)")
         contacts = [self.contact(c, f"contacts[{i}]") for i, c in enumerate(cons)]
         names = [c.name for c in contacts]
         for i, nm in enumerate(names):
@@ -399,15 +426,18 @@ class _Parser:
             from .reduction.rom import PairSpec, build_reduced_model
             pairs = [PairSpec(name=c.name, a=c.a, b=c.b, normal=c.normal, tangent=c.tangent,
                               n_dir=len(LAW_PARAMS[c.law][0]), kt=c.stick[0], kn=c.stick[1],
-                              tol=c.tol, key=c.key) for c in contacts]
+                              tol=c.tol, key=c.key, b_sector=c.b_sector) for c in contacts]
             rom = build_reduced_model(source, spec, pairs, self.path, log=log.append)
             M, K, n = rom.M, rom.K, rom.K.shape[0]
             self.n, self.rom = n, rom
+            if self.cyc is not None:
+                sector = self.cyclic_sector(rom, spec, contacts)
             contacts = [self.reduced_contact(c, rom) for c in contacts]
             if damping["type"] == "modal" and damping["zeta"].size > n:
                 raise ctx.error("damping.zeta", f"at most {n} modal ratios (the reduced "
                                 "model's size)", damping["zeta"].size)
-        if damping["type"] == "modal" and damping["zeta"].size == 1 and damping["all"]:
+        if (damping["type"] == "modal" and damping["zeta"].size == 1 and damping["all"]
+                and self.cyc is None):
             damping["zeta"] = np.full(n, damping["zeta"][0])
         del damping["all"]
         F = np.zeros((n, H + 1), complex)
@@ -419,6 +449,9 @@ class _Parser:
         outputs = [self.coordinate(ref, key) for ref, key in out_refs]
         onames = [od[i] if self.fe else (labels[j] if labels else f"dof{j}")
                   for i, j in enumerate(outputs)]
+        cyclic = None
+        if self.cyc is not None:
+            cyclic = self.cyclic_modes(sector, rom, damping, H, log.append)
 
         return Deck(path=self.path, title=title, M=M, K=K, damping=damping, F=F,
                     contacts=contacts, harmonics=H, samples=N, formulation=form,
@@ -427,7 +460,7 @@ class _Parser:
                     dof_labels=labels if not self.fe else list(rom.labels),
                     plot=_bool(ctx, out, "plot", "outputs.plot", True),
                     csv=_bool(ctx, out, "csv", "outputs.csv", True), raw=raw,
-                    reduced=rom, log=log)
+                    reduced=rom, log=log, cyclic=cyclic)
 
     # ---- [model]: matrices used as they are ----
     def matrices(self, mdl):
@@ -498,7 +531,7 @@ class _Parser:
             raise ctx.error("reduction.pairs", "no [[reduction.pairs]]: contact pairs are "
                             "[[contacts]] tables with node sets a, b and a normal")
         _unknown(ctx, red, {"interface", "active", "fixed_interface_modes", "cache",
-                            "interface_modes"}, "reduction")
+                            "interface_modes", "cyclic", "axis", "origin"}, "reduction")
         iface = self.names(red, "interface", "reduction.interface", required=True)
         active = self.names(red, "active", "reduction.active", required=False)
         n_cb = _num(ctx, red, "fixed_interface_modes", "reduction.fixed_interface_modes",
@@ -522,18 +555,144 @@ class _Parser:
             if kw["free"] + kw["stick"] == 0:
                 raise ctx.error(f"{pre}.free", "free + stick >= 1 GSI modes")
             kw["per_side"] = _bool(ctx, im, "per_side", f"{pre}.per_side", False)
-        elif method == "ms":
+        axis = self.vector(red, "axis", "reduction.axis", (0.0, 0.0, 1.0))
+        origin = self.vector(red, "origin", "reduction.origin", (0.0, 0.0, 0.0),
+                             nonzero=False)
+        kw["axis"], kw["origin"] = axis, origin
+        if "cyclic" in red:
+            if method == "ms":
+                raise ctx.error(f"{pre}.method", "'none' or 'gsi' with [reduction.cyclic] "
+                                "(multi-stage modes are for whole 360-degree stages)", method)
+            cyc = self.cyclic_table(_table(ctx, red, "reduction.cyclic"))
+            kw["sectors"] = cyc["sectors"]
+            kw["cyclic"] = (cyc["left"], cyc["right"])
+            self.cyc = cyc
+        if method == "ms":
             kw["sectors"] = _num(ctx, im, "sectors", f"{pre}.sectors", required=True,
                                  integer=True, minimum=1)
             kw["engine_orders"] = self.ints(im, "engine_orders", f"{pre}.engine_orders",
                                             required=True)
             th = self.ints(im, "time_harmonics", f"{pre}.time_harmonics", minimum=0)
             kw["time_harmonics"] = th or (1,)
-            kw["axis"] = self.vector(im, "axis", f"{pre}.axis", (0.0, 0.0, 1.0))
-            kw["origin"] = self.vector(im, "origin", f"{pre}.origin", (0.0, 0.0, 0.0),
-                                       nonzero=False)
+            kw["axis"] = self.vector(im, "axis", f"{pre}.axis", axis)
+            kw["origin"] = self.vector(im, "origin", f"{pre}.origin", origin, nonzero=False)
         return ReductionSpec(interface=tuple(iface), active=tuple(active),
                              fixed_interface_modes=n_cb, method=method, cache=cache, **kw)
+
+    def cyclic_table(self, cy):
+        """The checked [reduction.cyclic] table (a dict)."""
+        ctx, pre = self.ctx, "reduction.cyclic"
+        _unknown(ctx, cy, {"sectors", "left", "right", "dependent", "engine_order",
+                           "boundary_modes", "modes", "harmonic_index", "tol"}, pre)
+        n = _num(ctx, cy, "sectors", f"{pre}.sectors", required=True, integer=True, minimum=2)
+        out = {"sectors": n}
+        for side in ("left", "right"):
+            v = _str(ctx, cy, side, f"{pre}.{side}", required=True)
+            if not v:
+                raise ctx.error(f"{pre}.{side}", "a node-set name", v)
+            out[side] = v
+        if out["left"].upper() == out["right"].upper():
+            raise ctx.error(f"{pre}.right", "a node set other than reduction.cyclic.left",
+                            out["right"])
+        out["dependent"] = _str(ctx, cy, "dependent", f"{pre}.dependent", default="right",
+                                choices=("right", "left"))
+        out["engine_order"] = _num(ctx, cy, "engine_order", f"{pre}.engine_order",
+                                   required=True, integer=True)
+        out["boundary_modes"] = _num(ctx, cy, "boundary_modes", f"{pre}.boundary_modes",
+                                     integer=True, minimum=1)
+        out["modes"] = _num(ctx, cy, "modes", f"{pre}.modes", integer=True, minimum=1)
+        out["tol"] = _num(ctx, cy, "tol", f"{pre}.tol", positive=True)
+        hi = cy.get("harmonic_index", "per_harmonic")
+        expected = (f"\"per_harmonic\" or an integer nodal diameter k* in 0..{n - 1} (the "
+                    "one-index approximation)")
+        if isinstance(hi, str):
+            if hi.lower() != "per_harmonic":
+                raise ctx.error(f"{pre}.harmonic_index", expected, hi)
+            out["single_index"] = None
+        elif isinstance(hi, int) and not isinstance(hi, bool) and 0 <= hi < n:
+            out["single_index"] = hi
+        else:
+            raise ctx.error(f"{pre}.harmonic_index", expected, hi)
+        return out
+
+    def cyclic_sector(self, rom, spec, contacts):
+        """The CyclicSector on the reduced coordinates; checks the node-set contacts."""
+        from .reduction.cyclic import cyclic_sector
+        cy, pre = self.cyc, "reduction.cyclic"
+        L = rom.node_sets[cy["left"].upper()]
+        R = rom.node_sets[cy["right"].upper()]
+        try:
+            cs = cyclic_sector(rom.coordinates(L), rom.node_dofs(L), rom.coordinates(R),
+                               rom.node_dofs(R), cy["sectors"], rom.K.shape[0],
+                               origin=spec.origin, axis=spec.axis, tol=cy["tol"],
+                               nodes_left=L, nodes_right=R, dependent=cy["dependent"])
+        except InputError as exc:
+            raise InputError(f"{self.path}: {pre}.left/right: {exc} (axis {spec.axis} through "
+                             f"{spec.origin}: reduction.axis, reduction.origin)") from None
+        # a contact on both images of a boundary node would count it twice in the rotor
+        partner = {int(a): int(b) for a, b in cs.node_pairs}
+        for c in contacts:
+            p = rom.pairs[c.name]
+            sides = [("a", p.dofs_a)] + ([("b", p.dofs_b)] if c.b is not None
+                                         and not c.b_sector else [])
+            nodes = set()
+            for side, d in sides:
+                nodes |= {int(x) for x in rom.fe_dofs[d[:, 0], 0]}
+            both = sorted(a for a in nodes if partner.get(a) in nodes)
+            if both:
+                raise InputError(
+                    f"{self.path}: {c.key}: node {both[0]} (left boundary) and node "
+                    f"{partner[both[0]]} (its image on the right boundary) are the same "
+                    "node of the rotor: the contact would act on it twice; keep one of them "
+                    "in the contact's node sets")
+        return cs
+
+    def cyclic_modes(self, cs, rom, damping, H, log):
+        """Modes of every nodal diameter the harmonics 0..H live on (after the cache)."""
+        import time
+        from .model import Damping
+        from .reduction.cyclic import sector_modes
+        cy, pre = self.cyc, "reduction.cyclic"
+        N, eo, sign = cy["sectors"], cy["engine_order"], -1
+        if cy["single_index"] is not None:
+            ks = [cy["single_index"]]
+        else:
+            ks = []
+            for h in range(H + 1):
+                k = (sign * h * eo) % N
+                if k not in ks and (-k) % N not in ks:
+                    ks.append(k)
+        damp = (Damping.rayleigh(damping["alpha"], damping["beta"])
+                if damping["type"] == "rayleigh" else Damping.modal(damping["zeta"]))
+        t0 = time.perf_counter()
+        modes = {}
+        for k in ks:
+            try:
+                modes[k] = sector_modes(cs, rom.K, rom.M, k, damp, cy["modes"],
+                                        cy["boundary_modes"])
+            except InputError as exc:
+                msg = str(exc)
+                key = ("boundary_modes" if "tran_reduce" in msg else
+                       "modes" if "n_modes" in msg else "sectors")
+                if "rigid-body" in msg:
+                    msg = (f"nodal diameter {k} has a rigid-body (zero-frequency) mode: the "
+                           "sector's modes are those without contacts, so it needs supports "
+                           "(constrained DoFs in the FE model) at every nodal diameter")
+                raise InputError(f"{self.path}: {pre}.{key}: {msg}") from None
+        dt = time.perf_counter() - t0
+        n_i = cs.independent.size
+        nm = {k: m.omega.size for k, m in modes.items()}
+        how = ("one-index approximation, harmonic_index = " + str(ks[0])
+               if cy["single_index"] is not None else
+               f"k_h = -h EO mod N for h = 0..{H}, EO = {eo}")
+        nds = ", ".join(str(min(k, N - k)) for k in modes)
+        log(f"cyclic sector: N = {N}, harmonic indices k = {list(modes)} (nodal diameters "
+            f"{nds}; {how}); "
+            f"{len(modes)} Hermitian eigen-solve(s) of {n_i} coordinates"
+            + (f" (Tran: {cy['boundary_modes']} boundary modes)" if cy["boundary_modes"]
+               else "") + f", {max(nm.values())} modes each, in {dt:.2f} s")
+        return {"sector": cs, "modes": modes, "engine_order": eo,
+                "single_index": cy["single_index"], "sign": sign, "seconds": dt}
 
     def names(self, d, name, key, required):
         v = d.get(name)
@@ -635,6 +794,11 @@ class _Parser:
         eos = exc.get("engine_order", [])
         if isinstance(eos, dict):
             eos = [eos]
+        if eos and self.cyc is not None:
+            raise ctx.error("excitation.engine_order", "no [[excitation.engine_order]] with "
+                            "[reduction.cyclic]: give sector 0's loads in "
+                            "[[excitation.load]]; reduction.cyclic.engine_order makes them a "
+                            "travelling wave")
         if not isinstance(eos, list):
             raise ctx.error("excitation.engine_order", "an array of tables", eos)
         for i, eo in enumerate(eos):
@@ -819,12 +983,22 @@ class _Parser:
         """A [[contacts]] table of a reduced model: node sets a, b, a normal."""
         ctx = self.ctx
         _, pnames, _ = LAW_PARAMS[law]
-        _unknown(ctx, c, {"name", "law", "a", "b", "normal", "tangent", "tol", "w0"}
-                 | set(pnames), key)
+        _unknown(ctx, c, {"name", "law", "a", "b", "b_sector", "normal", "tangent", "tol",
+                          "w0"} | set(pnames), key)
         name = _str(ctx, c, "name", f"{key}.name", default=f"contacts{key[9:-1]}")
         a = _str(ctx, c, "a", f"{key}.a", required=True)
         b = _str(ctx, c, "b", f"{key}.b", default="ground")
         b = None if b.lower() == "ground" else b
+        bs = _num(ctx, c, "b_sector", f"{key}.b_sector", default=0, integer=True)
+        if bs not in (0, 1):
+            raise ctx.error(f"{key}.b_sector", "0 (side b in sector 0) or 1 (side b in the "
+                            "next sector)", bs)
+        if bs == 1 and self.cyc is None:
+            raise ctx.error(f"{key}.b_sector", "0 without [reduction.cyclic] (a contact with "
+                            "the next sector needs a cyclic sector)", bs)
+        if bs == 1 and b is None:
+            raise ctx.error(f"{key}.b", "a node set of the next sector with b_sector = 1, "
+                            "not the ground", "ground")
         normal = c.get("normal")
         if isinstance(normal, str):
             normal = _str(ctx, c, "normal", f"{key}.normal",
@@ -841,7 +1015,8 @@ class _Parser:
         stick = (params[0, 0], params[0, 1] if law in ("normal1d", "normal2d") else 0.0)
         return _NodeSetContact(name=name, law=law, a=a, b=b, normal=normal, tangent=tangent,
                                tol=tol, params=params[0], w0=None if w0 is None else w0[0],
-                               stick=tuple(float(x) for x in stick), key=key)
+                               stick=tuple(float(x) for x in stick), key=key,
+                               b_sector=bs)
 
     def reduced_contact(self, c, rom) -> ContactSpec:
         """ContactSpec of a node-set contact: its physical pairs mapped by the reduction."""

@@ -9,6 +9,14 @@ settings, and read back (without even parsing the FE files) while neither change
 friction coefficients, preloads, excitation, damping, harmonics or frequencies can be
 edited without recomputing it. Contact stiffnesses enter the fingerprint only when
 full-stick interface modes are asked for.
+
+A cyclic sector (``ReductionSpec.cyclic``: the left and right boundary node sets) keeps
+its boundary DoFs as Craig-Bampton masters (physical coordinates of the reduced model,
+never reduced by interface modes) and stores their nodes' coordinates, so that the deck
+can match the boundaries (:func:`frirom.reduction.cyclic.cyclic_sector`) and compute the
+modes of every nodal diameter after the cache. A contact with ``PairSpec.b_sector = 1``
+joins sector 0's set ``a`` to set ``b`` of the next sector (matched after rotating ``b`` by
++2 pi / N about the axis); its G has the two blocks of :class:`frirom.model.CyclicModel`.
 """
 
 from __future__ import annotations
@@ -36,7 +44,7 @@ FORMATS = {
     "hbmat": (("stiffness", "mass", "mapping"), ("stiffness", "mass")),
     "op4": (("file", "dofs"), ("file",)),
 }
-CACHE_VERSION = 2
+CACHE_VERSION = 3
 
 
 @dataclass(frozen=True)
@@ -65,7 +73,9 @@ class PairSpec:
     normal: a 3-vector or 'axial' / 'radial' / 'tangential'; tangent: optional 3-vector for
     the first tangential direction; n_dir: local directions kept (3: t1, t2, n; 2: t1, n;
     1: t1); kt, kn: stick stiffness [N/m] (full-stick modes); tol: matching distance [m]
-    (default 1e-6 of the model size); key: the deck key path used in error messages.
+    (default 1e-6 of the model size); key: the deck key path used in error messages;
+    b_sector: 0 (side b in sector 0) or 1 (side b in the next sector of a cyclic sector,
+    ``ReductionSpec.sectors`` and ``axis``/``origin`` give the rotation).
     """
 
     name: str
@@ -78,11 +88,16 @@ class PairSpec:
     tangent: object = None
     tol: float | None = None
     key: str = ""
+    b_sector: int = 0
 
 
 @dataclass(frozen=True)
 class ReductionSpec:
-    """The ``[reduction]`` table, checked (docs/deck.md)."""
+    """The ``[reduction]`` table, checked (docs/deck.md).
+
+    cyclic: () or (left, right) node-set names of the cyclic boundaries of a sector (extra
+    Craig-Bampton masters kept physical); ``sectors`` is then N (also for ``ms``).
+    """
 
     interface: tuple
     active: tuple = ()
@@ -97,6 +112,7 @@ class ReductionSpec:
     axis: tuple = (0.0, 0.0, 1.0)
     origin: tuple = (0.0, 0.0, 0.0)
     cache: Path | None = None
+    cyclic: tuple = ()
 
 
 def read_fe_model(src: FESource):
@@ -130,13 +146,15 @@ def _node_dofs(model, nodes):
 def pairs_from_node_sets(model, set_a: str, set_b: str | None, normal, kt: float, kn: float,
                          n_dir: int = 3, tol: float | None = None,
                          axis=(0.0, 0.0, 1.0), origin=(0.0, 0.0, 0.0),
-                         tangent=None) -> ContactPairs:
+                         tangent=None, b_rotation=None) -> ContactPairs:
     """Contact pairs between the nodes of two node sets at the same position (or ground).
 
     normal: a 3-vector, or 'axial' / 'radial' / 'tangential' (about ``axis`` through
     ``origin``); tangent: optional 3-vector for t1 (projected on the contact plane); the
     local frame is (t1, t2, n) from :func:`local_frames`, of which n_dir = 3 keeps
     (t1, t2, n), 2 keeps (t1, n) and 1 keeps t1. Stick stiffness (kt[, kt], kn).
+    b_rotation: (3, 3) rotation about ``origin`` applied to set b's coordinates before the
+    matching (side b in the next sector of a cyclic rotor); dofs_b stay those of set b.
     """
     na = model.node_sets.get(set_a.upper())
     if na is None:
@@ -155,14 +173,18 @@ def pairs_from_node_sets(model, set_a: str, set_b: str | None, normal, kt: float
             raise InputError(f"unknown node set {set_b!r}; the model has "
                              f"{sorted(model.node_sets)}")
         xb = model.coordinates(nb)
+        if b_rotation is not None:
+            o = np.asarray(origin, float)
+            xb = (xb - o) @ np.asarray(b_rotation, float).T + o
         scale = max(np.abs(xa).max(), np.abs(xb).max(), 1e-300)
         tol = 1e-6 * scale if tol is None else tol
         from scipy.spatial import cKDTree
         dist, j = cKDTree(xb).query(xa)
         far = np.nonzero(dist > tol)[0]
         if far.size:
-            raise InputError(f"node {na[far[0]]} of set {set_a} has no node of set {set_b} "
-                             f"within {tol:.3g} (nearest {dist[far[0]]:.3g})")
+            nxt = " (in the next sector)" if b_rotation is not None else ""
+            raise InputError(f"node {na[far[0]]} of set {set_a} has no node of set {set_b}"
+                             f"{nxt} within {tol:.3g} (nearest {dist[far[0]]:.3g})")
         if np.unique(j).size != j.size:
             raise InputError(f"nodes of set {set_a} share a node of set {set_b}: the sets "
                              "must face each other node to node")
@@ -208,7 +230,10 @@ class ReducedModel:
     T: (n_fe, n_r) map x_fe = T q (CB and interface reduction composed; dense with CB,
     sparse without); pairs: {name: ContactPairs on the FE DoFs}; fe_dofs: (n_fe, 2) (node,
     direction) of the FE DoFs; node_sets: {NAME: node ids}; from_cache: True when read back
-    from the cache file; build_seconds: time the reduction took when it was built.
+    from the cache file; build_seconds: time the reduction took when it was built;
+    node_ids, node_xyz: (n,) ids and (n, 3) coordinates of the nodes of the interface,
+    active and cyclic-boundary node sets; b_rotation: {pair-set name: (3, 3) rotation Q} of
+    the pair sets whose side b is in the next sector.
     """
 
     K: np.ndarray
@@ -220,18 +245,54 @@ class ReducedModel:
     node_sets: dict = field(default_factory=dict)
     from_cache: bool = False
     build_seconds: float = 0.0
+    node_ids: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    node_xyz: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    b_rotation: dict = field(default_factory=dict)
 
     @property
     def n_fe(self) -> int:
         return self.T.shape[0]
 
     def contact_matrix(self, name: str) -> sp.csr_matrix:
-        """G of a pair set on the reduced coordinates, (n_elem*n_dir, n_r)."""
+        """G of a pair set on the reduced coordinates, (n_elem*n_dir, n_r).
+
+        For a pair set whose side b is in the next sector (``b_rotation``), G is
+        (n_elem*n_dir, 2 n_r): [frame A T, -frame Q B T], the second block acting on the
+        next sector's coordinates in its own frame (Q rotates them into sector 0's).
+        """
         if name not in self.pairs:
             raise InputError(f"no contact pair set {name!r}; known: {sorted(self.pairs)}")
-        g = sp.csr_matrix(contact_matrix(self.pairs[name], self.n_fe) @ self.T)
+        p = self.pairs[name]
+        if name not in self.b_rotation:
+            g = sp.csr_matrix(contact_matrix(p, self.n_fe) @ self.T)
+            g.eliminate_zeros()
+            return g
+        Q = np.asarray(self.b_rotation[name], float)
+        ground = -np.ones_like(p.dofs_a)
+        ga = contact_matrix(ContactPairs(p.dofs_a, ground, p.frames, p.stiffness), self.n_fe)
+        gb = contact_matrix(ContactPairs(p.dofs_b, ground, p.frames @ Q, p.stiffness),
+                            self.n_fe)
+        g = sp.hstack([sp.csr_matrix(ga @ self.T), -sp.csr_matrix(gb @ self.T)]).tocsr()
         g.eliminate_zeros()
         return g
+
+    def coordinates(self, nodes) -> np.ndarray:
+        """(n, 3) coordinates of stored nodes (those of the reduction's node sets)."""
+        nodes = np.asarray(nodes, np.int64).ravel()
+        order = np.argsort(self.node_ids)
+        pos = np.searchsorted(self.node_ids, nodes, sorter=order)
+        pos = np.minimum(pos, max(len(order) - 1, 0))
+        if len(order) == 0 or np.any(self.node_ids[order[pos]] != nodes):
+            raise InputError("no stored coordinates for some nodes (only the nodes of the "
+                             "interface, active and cyclic-boundary sets are kept)")
+        return self.node_xyz[order[pos]]
+
+    def node_dofs(self, nodes) -> np.ndarray:
+        """(n, 3) reduced coordinates of the x y z DoFs of nodes kept physical ('N12:UX'),
+        -1 where the DoF is absent (constrained in the FE model)."""
+        pos = {lab: i for i, lab in enumerate(self.labels)}
+        return np.array([[pos.get(f"N{int(nd)}:{d}", -1) for d in ("UX", "UY", "UZ")]
+                         for nd in np.asarray(nodes).ravel()], dtype=np.int64).reshape(-1, 3)
 
     def fe_index(self, node: int, direction: int) -> int:
         """Row of the FE DoF (node, direction) in T; InputError if absent/constrained."""
@@ -275,12 +336,16 @@ class ReducedModel:
                     h.create_dataset(k, data=a)
             h.create_dataset("labels", data=np.array(self.labels, dtype="S"))
             h.create_dataset("fe_dofs", data=self.fe_dofs)
+            h.create_dataset("node_ids", data=self.node_ids)
+            h.create_dataset("node_xyz", data=self.node_xyz)
             for name, nodes in self.node_sets.items():
                 h.create_dataset(f"node_sets/{name}", data=nodes)
             for name, p in self.pairs.items():
                 g = h.create_group(f"pairs/{name}")
                 for k in ("dofs_a", "dofs_b", "frames", "stiffness"):
                     g.create_dataset(k, data=getattr(p, k))
+                if name in self.b_rotation:
+                    g.create_dataset("b_rotation", data=self.b_rotation[name])
 
     @classmethod
     def load(cls, path, fingerprint: str):
@@ -291,17 +356,21 @@ class ReducedModel:
                 if (h.attrs.get("fingerprint") != fingerprint
                         or h.attrs.get("version") != CACHE_VERSION):
                     return None
-                pairs = {}
+                pairs, rot = {}, {}
                 for name in h.get("pairs", {}):
                     g = h[f"pairs/{name}"]
                     pairs[name] = ContactPairs(g["dofs_a"][()], g["dofs_b"][()],
                                                g["frames"][()], g["stiffness"][()])
+                    if "b_rotation" in g:
+                        rot[name] = g["b_rotation"][()]
                 sets = {k: v[()] for k, v in h.get("node_sets", {}).items()}
                 K, M, T = (_read_matrix(h[k]) for k in ("K", "M", "T"))
                 return cls(K=K, M=M, T=T,
                            labels=[s.decode() for s in h["labels"][()]], pairs=pairs,
                            fe_dofs=h["fe_dofs"][()], node_sets=sets, from_cache=True,
-                           build_seconds=float(h.attrs.get("build_seconds", 0.0)))
+                           build_seconds=float(h.attrs.get("build_seconds", 0.0)),
+                           node_ids=h["node_ids"][()], node_xyz=h["node_xyz"][()],
+                           b_rotation=rot)
         except (OSError, KeyError):
             return None
 
@@ -354,12 +423,18 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
 
     t0 = time.perf_counter()
     model = read_fe_model(source)
-    prs = {}
+    prs, rot = {}, {}
     for p in pairs:
+        if p.b_sector:
+            if not spec.cyclic or not spec.sectors:
+                raise InputError(f"{where}{p.key}.b_sector: a contact with the next sector "
+                                 "needs [reduction.cyclic]")
+            from .cyclic import axis_rotation
+            rot[p.name] = axis_rotation(2 * np.pi / spec.sectors, spec.axis)
         try:
             prs[p.name] = pairs_from_node_sets(model, p.a, p.b, p.normal, p.kt, p.kn, p.n_dir,
                                                p.tol, axis=spec.axis, origin=spec.origin,
-                                               tangent=p.tangent)
+                                               tangent=p.tangent, b_rotation=rot.get(p.name))
         except InputError as exc:
             raise InputError(f"{where}{p.key}: {exc}") from None
     try:
@@ -368,6 +443,24 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
                   else np.zeros(0, np.int64))
     except InputError as exc:
         raise InputError(f"{where}reduction.interface/active: {exc}") from None
+    cyc_fe = np.zeros(0, np.int64)
+    for side, name in zip(("left", "right"), spec.cyclic):
+        if name.upper() not in model.node_sets:
+            raise InputError(f"{where}reduction.cyclic.{side}: expected a node set of the "
+                             f"model, got {name!r} (known: {sorted(model.node_sets)})")
+        # constrained boundary nodes (no DoF in the matrices) are allowed: zero on both sides
+        cyc_fe = np.union1d(cyc_fe, model.dof_indices(name, missing="ignore"))
+    if spec.cyclic and spec.method == "gsi":
+        bnodes = np.union1d(*(model.node_sets[s.upper()] for s in spec.cyclic))
+        for s in spec.interface:
+            shared = np.intersect1d(model.node_sets[s.upper()], bnodes)
+            if shared.size:
+                raise InputError(f"{where}reduction.interface: node set {s} shares node(s) "
+                                 f"{shared[:5].tolist()} with the cyclic boundaries "
+                                 "(reduction.cyclic.left/right), whose DoFs must stay "
+                                 "physical: with GSI interface modes, take the boundary "
+                                 "nodes out of the interface sets (or use method = 'none')")
+    keep_fe = np.setdiff1d(cyc_fe, iface_fe)       # boundary DoFs kept physical
     for name, p in prs.items():
         off = np.setdiff1d(p.dofs, iface_fe)
         if off.size:
@@ -380,7 +473,8 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
     if spec.fixed_interface_modes is not None:
         try:
             cb = craig_bampton(model, spec.fixed_interface_modes, interface=list(spec.interface),
-                               active=list(spec.active) or None)
+                               active=list(spec.active) or None,
+                               masters=cyc_fe if cyc_fe.size else None)
         except InputError as exc:
             raise InputError(f"{where}reduction.fixed_interface_modes: {exc}") from None
         K0, M0 = cb.K, cb.M
@@ -397,7 +491,7 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
         pos = np.arange(n_fe)
         T0 = None
         labels0 = [_label(model, i) for i in range(n_fe)]
-    iface0, act0 = pos[iface_fe], pos[act_fe]
+    iface0, act0 = pos[iface_fe], np.union1d(pos[act_fe], pos[keep_fe])
 
     def to0(p):
         return ContactPairs(pos[p.dofs_a], np.where(p.dofs_b >= 0, pos[np.maximum(p.dofs_b, 0)],
@@ -412,6 +506,9 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
             raise InputError(f"{pre}.stick: full-stick modes need contacts on node sets "
                              "([[contacts]] with a and b)")
         allp = None
+        if spec.stick and rot:
+            raise InputError(f"{pre}.stick: full-stick modes with contacts to the next "
+                             "sector (b_sector = 1) are not implemented; use free modes")
         if spec.stick:
             if len({p.n_dir for p in pairs0.values()}) > 1:
                 raise InputError(f"{pre}.stick: all contacts must have the same number of "
@@ -460,11 +557,22 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
         T = sp.identity(n_fe, format="csr") if T1 is None else T1.tocsr()
     else:
         T = T0 if T1 is None else np.asarray(T1.T @ T0.T).T
+    kept_sets = [*spec.interface, *spec.active, *spec.cyclic]
+    kept_nodes = np.unique(np.concatenate([np.asarray(model.node_sets[s.upper()], np.int64)
+                                           for s in kept_sets]))
+    try:
+        kept_xyz = np.asarray(model.coordinates(kept_nodes), float).reshape(-1, 3)
+    except InputError:
+        if spec.cyclic:
+            raise InputError(f"{where}reduction.cyclic: the cyclic boundaries need node "
+                             "coordinates (fe_model with an .inp)") from None
+        kept_nodes, kept_xyz = np.zeros(0, np.int64), np.zeros((0, 3))
     out = ReducedModel(K=K, M=M, T=T, labels=labels, pairs=prs,
                        fe_dofs=np.asarray(model.dofs, np.int64),
                        node_sets={k: np.asarray(v, np.int64)
                                   for k, v in model.node_sets.items()},
-                       build_seconds=time.perf_counter() - t0)
+                       build_seconds=time.perf_counter() - t0,
+                       node_ids=kept_nodes, node_xyz=kept_xyz, b_rotation=rot)
     try:
         out.save(cache, fp)
     except OSError as exc:
