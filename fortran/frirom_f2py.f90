@@ -114,13 +114,14 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
                         nnzg, gp, gi, gx, npart, params, nw0, w0, nout, outdofs, ny, y0, lam0, &
                         tan0, start_mode, ds, ds_min, ds_max, lam_end, lam_lo, tol_r, tol_x, &
                         tol_stall, max_iter, reuse, yscale, lscale, maxpts, netot, stability, &
-                        nmodes, phi, wmodes, zmodes, history, ys, lams, tans, iters, xo, states, hill_re, &
-                        sliders, npts, finished, ds_out, timings, info, msg)
+                        nmodes, phi, wmodes, zmodes, hmodes, psi, wharm, zharm, history, ys, &
+                        lams, tans, iters, xo, states, hill_re, sliders, npts, finished, &
+                        ds_out, timings, info, msg)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options
     use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
-                          hbm_run, N_TIMERS
+                          hbm_set_modes_harmonic, hbm_run, N_TIMERS
     implicit none
     integer(4), intent(in) :: form, nh, nsamp, ndof, nnzk, nnzm, nnzc
     integer(4), intent(in) :: kp(ndof + 1), ki(nnzk), mp(ndof + 1), mi(nnzm), cp(ndof + 1), &
@@ -146,6 +147,11 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     integer(4), intent(in) :: history      !! 1: carry contact sliders from point to point
     real(8), intent(in) :: phi(ndof, max(nmodes, 1)), wmodes(max(nmodes, 1)), &
                            zmodes(max(nmodes, 1))
+    !> > 0: modes of their own for every harmonic h (cyclic sectors: nodal diameter h EO
+    !> mod N), psi(:, :, h + 1) complex shapes on all DoFs, omega and zeta per harmonic
+    integer(4), intent(in) :: hmodes
+    complex(8), intent(in) :: psi(ndof, max(hmodes, 1), nh + 1)
+    real(8), intent(in) :: wharm(max(hmodes, 1), nh + 1), zharm(max(hmodes, 1), nh + 1)
     real(8), intent(out) :: ys(ny, maxpts), lams(maxpts), tans(ny + 1, maxpts)
     integer(4), intent(out) :: iters(maxpts)
     real(8), intent(out) :: xo(nout, 2*nh + 1, maxpts), states(3, netot, maxpts)
@@ -194,6 +200,8 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
         call set_status(linfo, FRIROM_ERR_SIZE, msg, 'hbm_continue: ny or netot does not '// &
                         'match the model')
     if (linfo == 0 .and. nmodes > 0) call hbm_set_modes(sys, phi, wmodes, zmodes, linfo, msg)
+    if (linfo == 0 .and. hmodes > 0) call hbm_set_modes_harmonic(sys, psi, wharm, zharm, &
+                                                                 linfo, msg)
     if (linfo /= 0) then
         info = linfo
         return

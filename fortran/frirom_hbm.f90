@@ -12,12 +12,16 @@
 !> The parameter lam is the frequency w (mode 1, excitation fe0) or a load factor (mode 2,
 !> excitation fe0 + lam fe1 at the fixed frequency omega_fix). Contact groups go through
 !> the AFT kernel (frirom_aft) with one plan made when the system is built.
-!> K, M and C must be symmetric (the condensed dR/dw uses D_h^T = D_h).
+!> K, M and C must be symmetric (the condensed dR/dw uses D_h^T = D_h). The condensed
+!> receptances may instead come from modes: the same real modes for every harmonic
+!> (hbm_set_modes) or complex modes of their own per harmonic (hbm_set_modes_harmonic, a
+!> cyclic sector whose harmonic h lives on nodal diameter h EO mod N); K, M, C are then
+!> not used and may be empty.
 module frirom_hbm
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, &
                              FRIROM_ERR_ALLOC, FRIROM_ERR_LAPACK, FRIROM_ERR_SINGULAR, &
-                             FRIROM_ERR_MODEL, FRIROM_ERR_LAW, set_status
+                             FRIROM_ERR_MODEL, FRIROM_ERR_LAW, FRIROM_ERR_NONFINITE, set_status
     use frirom_banded, only: band_matrix, zband_matrix, band_init, band_zero, band_add, &
                              band_factor, band_solve, zband_init, zband_zero, zband_add, &
                              zband_factor, zband_solve
@@ -27,8 +31,8 @@ module frirom_hbm
     implicit none
     private
     public :: csr_matrix, contact_group, contact_set, hbm_system, hbm_condensed, hbm_full, &
-              hbm_setup, hbm_set_modes, hbm_run, hbm_hill, hbm_sliders, contact_eval, &
-              contact_assemble, &
+              hbm_setup, hbm_set_modes, hbm_set_modes_harmonic, hbm_run, hbm_hill, &
+              hbm_sliders, contact_eval, contact_assemble, &
               HBM_FREQUENCY, HBM_LOAD, &
               T_AFT, T_ASM, T_FACT, T_SOLVE, T_REC, N_EVAL, N_FACT, N_TIMERS
 
@@ -110,12 +114,15 @@ module frirom_hbm
         real(wp), allocatable :: kc(:, :), jm(:, :)      !! (n, n) contact Jacobian, J
         integer(ip), allocatable :: ipiv(:)
         real(wp), allocatable :: xd(:, :), fd(:, :)      !! (nnl, nc)
-        !> modal superposition instead of factorising D_h (hbm_set_modes)
+        !> modal superposition instead of factorising D_h (hbm_set_modes, or
+        !> hbm_set_modes_harmonic: modes of their own for every harmonic)
         logical :: modal = .false.
-        real(wp), allocatable :: phi(:, :)               !! (ndof, nm) mass-normalised modes
-        real(wp), allocatable :: wm(:), zm(:)            !! (nm) rad/s, damping ratios
+        integer(ip), allocatable :: mrow(:)              !! (nr) DoFs where psi is kept
+        integer(ip), allocatable :: nlr(:)               !! (nnl) rows of the nl DoFs in psi
+        complex(wp), allocatable :: psi(:, :, :)         !! (nr, nm, 0:nh) mode shapes
+        real(wp), allocatable :: wm(:, :), zm(:, :)      !! (nm, 0:nh) rad/s, damping ratios
         complex(wp), allocatable :: dg(:, :)             !! (nm, 0:nh) d g_r / d w
-        complex(wp), allocatable :: qf(:, :)             !! (nm, 0:nh) Phi^T fe0_h
+        complex(wp), allocatable :: qf(:, :), qf1(:, :)  !! (nm, 0:nh) Psi_h^H fe0_h, fe1_h
     contains
         procedure :: eval => cond_eval
         procedure :: solve => cond_solve
@@ -633,66 +640,146 @@ contains
         real(wp), intent(in) :: wm(:), zm(:) !! (nm) natural frequencies rad/s, ratios
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
-        integer(ip) :: nm, h, r
+        integer(ip) :: nm, h
+        info = FRIROM_OK
+        nm = size(phi, 2)
+        if (size(phi, 1) /= sysc%ndof .or. size(wm) /= nm .or. size(zm) /= nm .or. nm < 1) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'modes: phi (ndof, nm), '// &
+                            'omega and zeta (nm)')
+            return
+        end if
+        if (.not. all(abs(phi) <= huge(1.0_wp))) then
+            call set_status(info, FRIROM_ERR_NONFINITE, errmsg, 'modes: phi has NaN or Inf')
+            return
+        end if
+        call modal_store(sysc, nm, spread(wm, 2, sysc%nh + 1), spread(zm, 2, sysc%nh + 1), &
+                         info, errmsg, phi=phi)
+    end subroutine hbm_set_modes
+
+    !> Modal superposition with modes of their own for every harmonic h:
+    !> H_h = Psi_h diag(1 / (w_hr^2 - (h w)^2 + 2 i zeta_hr w_hr h w)) Psi_h^H. A cyclic
+    !> sector under an engine-order excitation is such a system: harmonic h lives on
+    !> the nodal diameter h EO mod N, with complex mode shapes of that diameter. Modes
+    !> with psi = 0 pad harmonics that have fewer modes.
+    subroutine hbm_set_modes_harmonic(sysc, psi, wm, zm, info, errmsg)
+        class(hbm_system), intent(inout), target :: sysc  !! must be an hbm_condensed
+        complex(wp), intent(in) :: psi(:, :, 0:)  !! (ndof, nm, 0:nh) mode shapes
+        real(wp), intent(in) :: wm(:, 0:), zm(:, 0:) !! (nm, 0:nh) rad/s, damping ratios
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        integer(ip) :: nm
+        info = FRIROM_OK
+        nm = size(psi, 2)
+        if (size(psi, 1) /= sysc%ndof .or. size(psi, 3) /= sysc%nh + 1 .or. nm < 1 .or. &
+            any(shape(wm) /= [nm, sysc%nh + 1]) .or. any(shape(zm) /= shape(wm))) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'harmonic modes: psi (ndof, nm, '// &
+                            'H+1), omega and zeta (nm, H+1)')
+            return
+        end if
+        if (.not. all(abs(psi) <= huge(1.0_wp))) then
+            call set_status(info, FRIROM_ERR_NONFINITE, errmsg, 'harmonic modes: psi has '// &
+                            'NaN or Inf')
+            return
+        end if
+        call modal_store(sysc, nm, wm, zm, info, errmsg, psi=psi)
+    end subroutine hbm_set_modes_harmonic
+
+    !> Keep the modes on the rows the solver reads (contact and output DoFs) and project
+    !> both load parts on them; the modes are phi (real, the same for every harmonic) or
+    !> psi (complex, per harmonic), on all DoFs.
+    subroutine modal_store(sysc, nm, wm, zm, info, errmsg, phi, psi)
+        class(hbm_system), intent(inout), target :: sysc
+        integer(ip), intent(in) :: nm
+        real(wp), intent(in) :: wm(:, 0:), zm(:, 0:)   !! (nm, 0:nh)
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        real(wp), intent(in), optional :: phi(:, :)         !! (ndof, nm)
+        complex(wp), intent(in), optional :: psi(:, :, 0:)  !! (ndof, nm, 0:nh)
+        integer(ip) :: h, r, i, nr
+        logical, allocatable :: keep(:)
+        integer(ip), allocatable :: at(:)
+        complex(wp), allocatable :: v(:)
         info = FRIROM_OK
         select type (sys => sysc)
         type is (hbm_condensed)
-            nm = size(phi, 2)
-            if (size(phi, 1) /= sys%ndof .or. size(wm) /= nm .or. size(zm) /= nm .or. nm < 1) then
-                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'modes: phi (ndof, nm), '// &
-                                'omega and zeta (nm)')
-                return
-            end if
-            if (any(wm <= 0.0_wp) .or. any(zm < 0.0_wp) .or. .not. all(abs(phi) <= huge(1.0_wp))) &
-                then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'modes: need omega > 0, '// &
-                                'zeta >= 0 and finite shapes')
+            allocate (keep(sys%ndof), at(sys%ndof))
+            keep = .false.
+            keep(sys%nl) = .true.
+            keep(sys%outdofs) = .true.
+            nr = count(keep)
+            at = 0
+            sys%mrow = pack([(i, i=1, sys%ndof)], keep)
+            at(sys%mrow) = [(i, i=1, nr)]
+            sys%nlr = at(sys%nl)
+            if (allocated(sys%psi)) deallocate (sys%psi, sys%wm, sys%zm, sys%dg, sys%qf, &
+                                                sys%qf1)
+            allocate (sys%psi(nr, nm, 0:sys%nh), sys%wm(nm, 0:sys%nh), sys%zm(nm, 0:sys%nh), &
+                      sys%dg(nm, 0:sys%nh), sys%qf(nm, 0:sys%nh), sys%qf1(nm, 0:sys%nh))
+            do h = 0, sys%nh
+                sys%wm(:, h) = wm(:, h)
+                sys%zm(:, h) = zm(:, h)
+                do r = 1, nm
+                    if (present(phi)) then
+                        v = cmplx(phi(:, r), 0.0_wp, wp)
+                    else
+                        v = psi(:, r, h)
+                    end if
+                    sys%psi(:, r, h) = v(sys%mrow)
+                    sys%qf(r, h) = sum(conjg(v)*harm_col(sys%fe0, h))
+                    sys%qf1(r, h) = sum(conjg(v)*harm_col(sys%fe1, h))
+                end do
+            end do
+            if (any(sys%wm <= 0.0_wp) .or. any(sys%zm < 0.0_wp) .or. &
+                .not. all(abs(sys%wm) + abs(sys%zm) <= huge(1.0_wp))) then
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'modes: need omega > 0 and '// &
+                                'zeta >= 0, finite')
                 return
             end if
             sys%modal = .true.
-            sys%phi = phi
-            sys%wm = wm
-            sys%zm = zm
-            allocate (sys%dg(nm, 0:sys%nh), sys%qf(nm, 0:sys%nh))
-            do h = 0, sys%nh
-                do r = 1, nm
-                    sys%qf(r, h) = sum(phi(:, r)*sys%fe0(:, 1))
-                    if (h > 0) sys%qf(r, h) = cmplx(sum(phi(:, r)*sys%fe0(:, 2*h)), &
-                                                    -sum(phi(:, r)*sys%fe0(:, 2*h + 1)), wp)
-                end do
-            end do
             sys%w_cache = -1.0_wp
         class default
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'modal superposition needs the '// &
                             'condensed formulation')
         end select
-    end subroutine hbm_set_modes
+    end subroutine modal_store
 
-    !> Receptance columns at w from the modes (see hbm_set_modes).
+    !> Complex amplitudes of harmonic h of every row of a real-harmonic array a(:, 2H+1).
+    pure function harm_col(a, h) result(z)
+        real(wp), intent(in) :: a(:, :)
+        integer(ip), intent(in) :: h
+        complex(wp) :: z(size(a, 1))
+        if (h == 0) then
+            z = cmplx(a(:, 1), 0.0_wp, wp)
+        else
+            z = cmplx(a(:, 2*h), -a(:, 2*h + 1), wp)
+        end if
+    end function harm_col
+
+    !> Receptance columns at w from the modes (see hbm_set_modes), on the kept rows.
     subroutine cond_receptance_modal(sys, w)
         type(hbm_condensed), intent(inout) :: sys
         real(wp), intent(in) :: w
-        integer(ip) :: h, j, nm
+        integer(ip) :: h, j, nm, nr
         real(wp) :: hw, t0
-        complex(wp), allocatable :: g(:), tmp(:, :), q(:)
+        complex(wp), allocatable :: g(:), tmp(:, :), rows(:, :)
         t0 = wtime()
-        nm = size(sys%wm)
-        allocate (g(nm), tmp(nm, sys%nnl), q(nm))
+        nm = size(sys%wm, 1)
+        nr = size(sys%mrow)
+        allocate (g(nm), tmp(nm, sys%nnl), rows(nr, sys%nnl))
         do h = 0, sys%nh
             hw = h*w
-            g = 1.0_wp/cmplx(sys%wm**2 - hw**2, 2.0_wp*sys%zm*sys%wm*hw, wp)
-            sys%dg(:, h) = -g**2*cmplx(-2.0_wp*h*hw, 2.0_wp*sys%zm*sys%wm*h, wp)
-            do j = 1, sys%nnl
-                tmp(:, j) = g*sys%phi(sys%nl(j), :)
-            end do
-            sys%ymat(:, :, h) = matmul(sys%phi, tmp)
-            sys%ye0(:, h) = matmul(sys%phi, g*sys%qf(:, h))
-            do j = 1, nm
-                q(j) = sum(sys%phi(:, j)*sys%fe1(:, 1))
-                if (h > 0) q(j) = cmplx(sum(sys%phi(:, j)*sys%fe1(:, 2*h)), &
-                                        -sum(sys%phi(:, j)*sys%fe1(:, 2*h + 1)), wp)
-            end do
-            sys%ye1(:, h) = matmul(sys%phi, g*q)
+            associate (wr => sys%wm(:, h), zr => sys%zm(:, h), ps => sys%psi(:, :, h))
+                g = 1.0_wp/cmplx(wr**2 - hw**2, 2.0_wp*zr*wr*hw, wp)
+                sys%dg(:, h) = -g**2*cmplx(-2.0_wp*h*hw, 2.0_wp*zr*wr*h, wp)
+                do j = 1, sys%nnl
+                    tmp(:, j) = g*conjg(ps(sys%nlr(j), :))
+                end do
+                call zgemm('N', 'N', nr, sys%nnl, nm, (1.0_wp, 0.0_wp), ps, nr, tmp, nm, &
+                           (0.0_wp, 0.0_wp), rows, nr)
+                sys%ymat(sys%mrow, :, h) = rows
+                sys%ye0(sys%mrow, h) = matmul(ps, g*sys%qf(:, h))
+                sys%ye1(sys%mrow, h) = matmul(ps, g*sys%qf1(:, h))
+            end associate
             do j = 1, sys%nnl
                 sys%ar(j, :, h) = real(sys%ymat(sys%nl(j), :, h), wp)
                 sys%ai(j, :, h) = aimag(sys%ymat(sys%nl(j), :, h))
@@ -844,8 +931,10 @@ contains
                 end if
                 if (this%modal) then
                     ! R = X - Phi_n diag(g) (Phi^T fe - Phi_n^T fc): dR/dw = -Phi_n dg q
-                    xe = -matmul(this%phi(this%nl, :), this%dg(:, h)*(this%qf(:, h) - &
-                                 matmul(transpose(this%phi(this%nl, :)), fc)))
+                    associate (pn => this%psi(this%nlr, :, h))
+                        xe = -matmul(pn, this%dg(:, h)*(this%qf(:, h) - &
+                                                        matmul(conjg(transpose(pn)), fc)))
+                    end associate
                     ca = 2*h
                     cb = 2*h + 1
                     rh = rh + cmplx(this%xd(:, ca), -this%xd(:, cb), wp)

@@ -5,12 +5,16 @@
 program test_hbm
     use frirom_kinds, only: wp, ip
     use frirom_newton, only: cont_options, newton_correct
-    use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes
+    use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
+                          hbm_set_modes_harmonic
     implicit none
     integer(ip), parameter :: ndof = 4, nh = 3, nc = 2*nh + 1
     type(hbm_condensed) :: sc, scl
     type(hbm_full) :: sf, sfl, sbad, sfn
-    type(hbm_condensed) :: scn, scm
+    type(hbm_condensed) :: scn, scm, sch
+    complex(wp) :: psi(ndof, ndof, 0:nh)
+    real(wp) :: yr(3*nc), r1(3*nc), r2(3*nc), rl1(3*nc), rl2(3*nc), rr1, rr2
+    integer(ip) :: h
     real(wp) :: kd(ndof, ndof), md(ndof, ndof), wev(ndof), work(64)
     integer(ip) :: k
     integer(ip) :: kp(ndof + 1), ki(10), mp(ndof + 1), mi(ndof), cp(ndof + 1), ci(10)
@@ -93,6 +97,31 @@ program test_hbm
     call hbm_set_modes(scm, kd, sqrt(wev), [(0.02_wp, i = 1, ndof)], info, msg)
     call check(info == 0, 'set modes: '//trim(msg))
     call fd_check(scm, 'condensed modal')
+    ! modes per harmonic (hbm_set_modes_harmonic, the cyclic-sector path): the real shapes
+    ! times a phase of their own for every mode and harmonic give the same receptances
+    ! Psi g Psi^H, hence the same residual and dR/dw as the real modes to rounding
+    do h = 0, nh
+        do i = 1, ndof
+            psi(:, i, h) = kd(:, i)*exp(cmplx(0.0_wp, 0.7_wp*i + 1.3_wp*h, wp))
+        end do
+    end do
+    call hbm_setup(sch, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
+                   fe1, 1, 0.0_wp, ginfo, gp, gi, gx, params, w0, outd, info, msg)
+    call hbm_set_modes_harmonic(sch, psi, spread(sqrt(wev), 2, nh + 1), &
+                                spread([(0.02_wp, i = 1, ndof)], 2, nh + 1), info, msg)
+    call check(info == 0, 'set harmonic modes: '//trim(msg))
+    call random_number(yr)
+    yr = 0.2_wp*(yr - 0.5_wp)
+    call scm%eval(yr, 0.9_wp, r1, rr1, .false., rl1, info, msg)
+    call sch%eval(yr, 0.9_wp, r2, rr2, .false., rl2, info, msg)
+    err = max(maxval(abs(r1 - r2))/rr1, maxval(abs(rl1 - rl2))/maxval(abs(rl1)))
+    print '(a, es9.2)', 'harmonic modes vs real modes: residual and dR/dw differ by ', err
+    call check(err < 1.0e-13_wp, 'harmonic modes reproduce the real modal receptances')
+    call fd_check(sch, 'condensed harmonic modes')
+    ! a mode of zero frequency is refused with a message
+    call hbm_set_modes_harmonic(sch, psi, 0.0_wp*spread(sqrt(wev), 2, nh + 1), &
+                                spread([(0.02_wp, i = 1, ndof)], 2, nh + 1), info, msg)
+    call check(info /= 0 .and. index(msg, 'omega > 0') > 0, 'zero frequency reported')
     ! bad input is reported, not crashed on
     perm = [1, 1, 2, 3]
     call hbm_setup(sbad, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &

@@ -8,6 +8,11 @@ Formulations (same answer, different cost):
   models with few contact DoFs (reduced models).
 * ``'banded'``: all DoFs x harmonics in reverse Cuthill-McKee order, banded LU; for
   unreduced FE and lumped models with many contact DoFs.
+
+A :class:`frirom.model.CyclicModel` (one sector of a tuned rotor under an engine-order
+travelling wave) is solved in the condensed formulation with receptances from the modes of
+each harmonic's own nodal diameter (time harmonic h on h EO mod N): exact for the
+travelling-wave response of the whole rotor, at the cost of one sector.
 """
 
 from __future__ import annotations
@@ -22,7 +27,7 @@ import scipy.sparse as sp
 
 from . import _kernels
 from ._errors import ParameterError, SizeError, raise_for_status
-from .model import LAW_CODES, Excitation, Model
+from .model import LAW_CODES, CyclicModel, Excitation, Model
 from .results import FRF, FRFPoint, amplitude_max
 
 FORMULATIONS = {"condensed": 1, "banded": 2}
@@ -148,10 +153,10 @@ def _modes(model: Model, nm: int):
 class _Packed:
     """The model as the Fortran arrays of hbm_continue (built once per run)."""
 
-    def __init__(self, model: Model, excitation: Excitation, opts: SolverOptions,
+    def __init__(self, model, excitation: Excitation, opts: SolverOptions,
                  outputs, load_part: str = "dynamic"):
-        if not isinstance(model, Model):
-            raise ParameterError("model: expected a frirom.model.Model")
+        if not isinstance(model, (Model, CyclicModel)):
+            raise ParameterError("model: expected a frirom.model.Model or CyclicModel")
         if not isinstance(excitation, Excitation):
             raise ParameterError("excitation: expected a frirom.model.Excitation")
         opts.check()
@@ -160,41 +165,31 @@ class _Packed:
         n = model.n_dof
         self.H, self.nc, self.n_dof = H, 2 * H + 1, n
         self.form = FORMULATIONS[opts.formulation]
-        self.K, self.M, self.C = (_csr(model.K), _csr(model.M), _csr(model.C))
         fe = excitation.real_harmonic(n, H)
+        if load_part not in ("static", "dynamic"):
+            raise ParameterError("load_part: expected 'static' or 'dynamic'")
         if opts.parameter == "frequency":
             self.fe0, self.fe1, self.mode = fe, np.zeros_like(fe), 1
         else:
             self.mode = 2
             mask = np.zeros(self.nc, bool)
             mask[0 if load_part == "static" else slice(1, None)] = True
-            if load_part not in ("static", "dynamic"):
-                raise ParameterError("load_part: expected 'static' or 'dynamic'")
             self.fe1 = np.where(mask, fe, 0.0)
             self.fe0 = fe - self.fe1
+        self.nmodes = 0
+        self.phi, self.wmodes, self.zmodes = np.zeros((1, 1)), np.ones(1), np.zeros(1)
+        if isinstance(model, CyclicModel):
+            self._init_cyclic(model, outputs)
+            return
+        self.K, self.M, self.C = (_csr(model.K), _csr(model.M), _csr(model.C))
         self.nl = model.nonlinear_dofs()
         if self.form == 1 and self.nl.size == 0:
             raise ParameterError("formulation 'condensed' needs contact DoFs; the model has "
                                  "no contact group (use 'banded')")
         # contact groups
         groups = model.contacts
-        self.group_names = [g.name for g in groups]
-        if groups:
-            G = sp.vstack([g.G for g in groups]).tocsr()
-            self.ginfo = np.array([[LAW_CODES[g.law], g.n_elem, g.n_dir] for g in groups],
-                                  dtype=np.int32).T.copy(order="F")
-            self.params = np.concatenate([g.params.ravel() for g in groups])
-            w0 = [g.w0.ravel() for g in groups]
-            self.w0 = np.concatenate(w0) if sum(a.size for a in w0) else np.zeros(1)
-            self.nw = int(sum(a.size for a in w0))
-        else:
-            self.nw = 0
-            G = sp.csr_matrix((0, n))
-            self.ginfo = np.zeros((3, 0), np.int32, order="F")
-            self.params, self.w0 = np.zeros(1), np.zeros(1)
+        G = self._groups(groups, n)
         self.G = _csr(G)
-        self.ne_tot = int(sum(g.n_elem for g in groups))
-        self.group_sizes = [g.n_elem for g in groups]
         # RCM over K, M, C and the contact couplings
         pat = (abs(model.K) + abs(model.M) + abs(model.C)).tocsr()
         if groups:
@@ -208,11 +203,8 @@ class _Packed:
         # outputs (0-based in Python)
         if outputs is None:
             outputs = np.arange(n) if n <= 100 else self.nl
-        self.outputs = np.asarray(outputs, dtype=int).ravel()
-        if self.outputs.size == 0:
-            self.outputs = np.zeros(1, dtype=int)
-        if np.any(self.outputs < 0) or np.any(self.outputs >= n):
-            raise SizeError(f"outputs: DoF indices must be in 0..{n - 1}")
+        self._set_outputs(outputs)
+        self.out_f = self.outputs
         self.ny = (self.nl.size if self.form == 1 else n) * self.nc
         self.stability = bool(opts.stability)
         if self.stability and 2 * n * self.nc > HILL_MAX:
@@ -220,11 +212,96 @@ class _Packed:
                           f"size 2 n_dof (2H+1) = {2 * n * self.nc} > {HILL_MAX}",
                           RuntimeWarning, stacklevel=3)
             self.stability = False
-        self.nmodes = 0
-        self.phi, self.wmodes, self.zmodes = np.zeros((n, 1)), np.ones(1), np.zeros(1)
+        self.phi = np.zeros((n, 1))
         if opts.modes:
             self.phi, self.wmodes, self.zmodes = _modes(model, int(opts.modes))
             self.nmodes = self.wmodes.size
+        self.hmodes = 0
+        self.psi = np.zeros((n, 1, H + 1), complex)
+        self.wharm, self.zharm = np.ones((1, H + 1)), np.zeros((1, H + 1))
+
+    def _groups(self, groups, ncol: int):
+        """Pack the contact groups; returns their stacked G (rows, ncol)."""
+        self.group_names = [g.name for g in groups]
+        self.ne_tot = int(sum(g.n_elem for g in groups))
+        self.group_sizes = [g.n_elem for g in groups]
+        if not groups:
+            self.nw = 0
+            self.ginfo = np.zeros((3, 0), np.int32, order="F")
+            self.params, self.w0 = np.zeros(1), np.zeros(1)
+            return sp.csr_matrix((0, ncol))
+        self.ginfo = np.array([[LAW_CODES[g.law], g.n_elem, g.n_dir] for g in groups],
+                              dtype=np.int32).T.copy(order="F")
+        self.params = np.concatenate([g.params.ravel() for g in groups])
+        w0 = [g.w0.ravel() for g in groups]
+        self.nw = int(sum(a.size for a in w0))
+        self.w0 = np.concatenate(w0) if self.nw else np.zeros(1)
+        return sp.vstack([sp.csr_matrix(g.G, shape=(g.G.shape[0], ncol)) if
+                          g.G.shape[1] == ncol else
+                          sp.hstack([g.G, sp.csr_matrix((g.G.shape[0], ncol - g.G.shape[1]))])
+                          for g in groups]).tocsr()
+
+    def _set_outputs(self, outputs) -> None:
+        n = self.n_dof
+        self.outputs = np.asarray(outputs, dtype=int).ravel()
+        if self.outputs.size == 0:
+            self.outputs = np.zeros(1, dtype=int)
+        if np.any(self.outputs < 0) or np.any(self.outputs >= n):
+            raise SizeError(f"outputs: DoF indices must be in 0..{n - 1}")
+
+    def _init_cyclic(self, model: CyclicModel, outputs) -> None:
+        """A cyclic sector as a condensed system on the DoFs the solver reads: contact DoFs
+        of sector 0 and of the next sector (columns n.. of G, shapes times exp(i k_h alpha)),
+        outputs and loaded DoFs; receptances from the modes of each harmonic's nodal
+        diameter (hbm_set_modes_harmonic); K, M, C are not used (empty)."""
+        o, n, H = self.opts, self.n_dof, self.H
+        if self.form != 1:
+            raise ParameterError("options.formulation: a cyclic sector is solved in the "
+                                 "'condensed' formulation (receptances per nodal diameter)")
+        if o.modes:
+            raise ParameterError("options.modes: a cyclic model brings its own modes per "
+                                 "nodal diameter (frirom.reduction.cyclic.cyclic_model)")
+        if o.stability:
+            raise ParameterError("options.stability: Hill's method is not implemented for "
+                                 "cyclic sectors (perturbations of every nodal diameter)")
+        G = self._groups(model.contacts, 2 * n)
+        cols = np.unique(G.indices)
+        if outputs is None:
+            outputs = np.arange(n) if n <= 100 else cols[cols < n]
+        self._set_outputs(outputs)
+        loaded = np.nonzero(np.any(self.fe0 != 0, axis=1) | np.any(self.fe1 != 0, axis=1))[0]
+        rows = np.unique(np.concatenate([cols, self.outputs, loaded]))
+        nr = rows.size
+        at = -np.ones(2 * n, dtype=np.int64)
+        at[rows] = np.arange(nr)
+        self.nl = at[cols]
+        self.out_f = at[self.outputs]
+        G = sp.csr_matrix((G.data, at[G.indices], G.indptr), shape=(G.shape[0], nr))
+        self.G = _csr(G)
+        real = rows[rows < n]
+        fe0, fe1 = np.zeros((nr, self.nc)), np.zeros((nr, self.nc))
+        fe0[at[real]], fe1[at[real]] = self.fe0[real], self.fe1[real]
+        self.fe0, self.fe1, self.n_dof = fe0, fe1, nr
+        self.phi = np.zeros((nr, 1))
+        alpha = 2 * np.pi / model.n_sectors
+        per = [model.modes_of(model.harmonic_index(h)) for h in range(H + 1)]
+        nm = max(m.omega.size for m in per)
+        self.hmodes = nm
+        self.psi = np.zeros((nr, nm, H + 1), complex, order="F")
+        self.wharm = np.ones((nm, H + 1), order="F")
+        self.zharm = np.zeros((nm, H + 1), order="F")
+        nb = rows >= n
+        for h, m in enumerate(per):
+            r = m.omega.size
+            self.psi[~nb, :r, h] = m.psi[rows[~nb]]
+            self.psi[nb, :r, h] = m.psi[rows[nb] - n] * np.exp(1j * m.k * alpha)
+            self.wharm[:r, h], self.zharm[:r, h] = m.omega, m.zeta
+        self.indices = [m.k for m in per]
+        empty = _csr(sp.csr_matrix((nr, nr)))
+        self.K = self.M = self.C = empty
+        self.perm = np.arange(1, nr + 1, dtype=np.int32)
+        self.ny = self.nl.size * self.nc
+        self.stability = False
 
     def set_history(self, slider) -> None:
         """Initial sliders of all contact elements (the history of the point a run starts
@@ -249,11 +326,13 @@ class _Packed:
         res = _kernels.hbm_continue(
             self.form, o.n_samples, *self.K, *self.M, *self.C, self.perm, nl,
             np.asfortranarray(self.fe0), np.asfortranarray(self.fe1), self.mode, omega_fix,
-            self.ginfo, *self.G, self.params, self.w0, (self.outputs + 1).astype(np.int32),
+            self.ginfo, *self.G, self.params, self.w0, (self.out_f + 1).astype(np.int32),
             y0, lam0, tan0, start_mode, ds, o.ds_min, o.ds_max, lam_end, lam_lo,
             o.tol_residual, o.tol_update, o.tol_stall, o.max_iter, int(o.reuse_jacobian),
             yscale, lscale, maxpts, max(self.ne_tot, 1), int(self.stability), self.nmodes,
-            np.asfortranarray(self.phi), self.wmodes, self.zmodes, int(o.history), nh=self.H,
+            np.asfortranarray(self.phi), self.wmodes, self.zmodes, self.hmodes,
+            np.asfortranarray(self.psi), np.asfortranarray(self.wharm),
+            np.asfortranarray(self.zharm), int(o.history), nh=self.H,
             ndof=self.n_dof, nnl=self.nl.size or 1)
         r = SimpleNamespace(**dict(zip(
             ("ys", "lams", "tans", "iters", "xo", "states", "hill_re", "sliders", "npts",
@@ -459,9 +538,9 @@ def _homotopy_start(packed: _Packed, omega: float):
     return r._last_unknowns
 
 
-def frf(model: Model, excitation: Excitation, omega_start: float, omega_end: float,
-        options: SolverOptions | None = None, outputs=None, sink=None, start=None,
-        start_harmonics: int | None = None) -> FRF:
+def frf(model: Model | CyclicModel, excitation: Excitation, omega_start: float,
+        omega_end: float, options: SolverOptions | None = None, outputs=None, sink=None,
+        start=None, start_harmonics: int | None = None) -> FRF:
     """Forced response from omega_start to omega_end (rad/s) by pseudo-arc-length
     continuation in frequency, through turning points.
 
@@ -486,9 +565,9 @@ def frf(model: Model, excitation: Excitation, omega_start: float, omega_end: flo
                 start_harmonics)
 
 
-def load_curve(model: Model, excitation: Excitation, omega: float, scale_start: float,
-               scale_end: float, options: SolverOptions | None = None, outputs=None,
-               sink=None, start=None, part: str = "dynamic") -> FRF:
+def load_curve(model: Model | CyclicModel, excitation: Excitation, omega: float,
+               scale_start: float, scale_end: float, options: SolverOptions | None = None,
+               outputs=None, sink=None, start=None, part: str = "dynamic") -> FRF:
     """Continuation in a load factor s at fixed frequency omega: the excitation is
     F_other + s F_part, where part is 'dynamic' (harmonics >= 1: excitation level) or
     'static' (harmonic 0: preload)."""
@@ -502,7 +581,7 @@ def load_curve(model: Model, excitation: Excitation, omega: float, scale_start: 
     return _run(packed, float(scale_start), float(scale_end), float(omega), sink, start, None)
 
 
-def solve_point(model: Model, excitation: Excitation, omega: float,
+def solve_point(model: Model | CyclicModel, excitation: Excitation, omega: float,
                 options: SolverOptions | None = None, outputs=None, start=None,
                 start_harmonics: int | None = None) -> FRFPoint:
     """The periodic response at one frequency omega (rad/s), Newton from the linear
