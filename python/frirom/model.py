@@ -385,3 +385,9 @@ class CyclicModel:
     def indices(self, H: int) -> list:
         """k_h for h = 0..H."""
         return [self.harmonic_index(h) for h in range(H + 1)]
+
+    def nonlinear_dofs(self) -> np.ndarray:
+        """Sorted sector DoFs in the column support of all contact G (0-based; a column of
+        the next sector's block counts as the same DoF of sector 0)."""
+        cols = [np.unique(g.G.indices) % self.n_dof for g in self.contacts]
+        return np.unique(np.concatenate(cols)) if cols else np.zeros(0, dtype=int)

@@ -462,12 +462,20 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
                                  "nodes out of the interface sets (or use method = 'none')")
     keep_fe = np.setdiff1d(cyc_fe, iface_fe)       # boundary DoFs kept physical
     for name, p in prs.items():
-        off = np.setdiff1d(p.dofs, iface_fe)
+        # contact nodes: interface nodes, or cyclic-boundary nodes (physical coordinates)
+        off = np.setdiff1d(p.dofs, np.union1d(iface_fe, cyc_fe))
+        key = [q.key for q in pairs if q.name == name][0]
         if off.size:
             nd = model.dofs[off[0], 0]
-            raise InputError(f"{where}{[q.key for q in pairs if q.name == name][0]}: node "
-                             f"{nd} is not in the node sets of reduction.interface (contact "
-                             "nodes must be interface nodes)")
+            raise InputError(f"{where}{key}: node {nd} is not in the node sets of "
+                             "reduction.interface (contact nodes must be interface nodes"
+                             + (" or nodes of the cyclic boundaries)" if spec.cyclic else ")"))
+        on_b = np.intersect1d(p.dofs, keep_fe)
+        if on_b.size and spec.method == "gsi" and spec.stick:
+            raise InputError(f"{where}{key}: node {model.dofs[on_b[0], 0]} is a cyclic-"
+                             "boundary node outside the interface sets: full-stick GSI modes "
+                             "need every contact node in reduction.interface (use free modes, "
+                             "or leave the boundary nodes out of the contact)")
     n_fe = model.n_dof
     # Craig-Bampton on the interface + active node sets
     if spec.fixed_interface_modes is not None:
