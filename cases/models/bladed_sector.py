@@ -11,7 +11,9 @@ Node sets: LEFT (theta = 0), RIGHT (theta = 2 pi / N), FLANGE, TIP (a blade-tip 
 conditions on it; the cyclic constraint makes them zero anyway), FLANGE_IN and FLANGE_OUT
 (the inner (r = r0) and outer edges of the flange face), FLANGE_C (FLANGE_OUT without the
 nodes of LEFT: a contact set that holds each node of the rotor once), RIM_L and RIM_R (the
-nodes of LEFT and RIGHT at the disk rim, free: faces of a contact with the next sector).
+nodes of LEFT and RIGHT at the disk rim, free: faces of a contact with the next sector),
+BOLT (the node of FLANGE_IN in the middle of the sector) and FLANGE_B (FLANGE without BOLT
+and without the nodes of LEFT).
 
 Two decks:
 * ``cyclic.inp``: ``*CYCLIC SYMMETRY MODEL`` (LEFT dependent, RIGHT independent) and a
@@ -20,8 +22,10 @@ Two decks:
 * ``sector.inp``: the same mesh and boundary conditions without cyclic symmetry and a
   ``*FREQUENCY, SOLVER=MATRIXSTORAGE`` step: ``sector.sti/.mas/.dof``. With
   ``sector_clamp="inner"`` only FLANGE_IN is clamped there (the bolted inner edge), so that
-  the outer edge FLANGE_OUT is free for contact elements; ``cyclic.inp`` keeps the whole
-  face clamped (the reference a stuck flange contact must reproduce).
+  the outer edge FLANGE_OUT is free for contact elements; with ``sector_clamp="bolt"`` only
+  the node BOLT is (one bolt per sector), the rest of the face being free for contacts.
+  ``cyclic.inp`` keeps the whole face clamped (the reference a stuck flange contact must
+  reproduce).
 """
 
 from __future__ import annotations
@@ -106,10 +110,12 @@ def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, sector_clam
                        **mesh):
     """Write ``cyclic.inp`` and ``sector.inp`` in ``out``; returns their paths.
 
-    sector_clamp: "flange" (sector.inp clamps FIX, as cyclic.inp) or "inner" (sector.inp
-    clamps FLANGE_IN only)."""
-    if sector_clamp not in ("flange", "inner"):
-        raise ValueError(f"sector_clamp: expected 'flange' or 'inner', got {sector_clamp!r}")
+    sector_clamp: "flange" (sector.inp clamps FIX, as cyclic.inp), "inner" (sector.inp
+    clamps FLANGE_IN only) or "bolt" (BOLT only)."""
+    clamps = {"flange": "FIX", "inner": "FLANGE_IN", "bolt": "BOLT"}
+    if sector_clamp not in clamps:
+        raise ValueError(f"sector_clamp: expected one of {sorted(clamps)}, got "
+                         f"{sector_clamp!r}")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     ids, xyz, elems, grid, (nr, nth, zg) = sector_mesh(n_sectors, **mesh)
@@ -123,6 +129,8 @@ def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, sector_clam
     i_rim = int(np.max(grid[np.isin(ids, left), 0]))     # outermost radial station of LEFT
     rim_l = left[(grid[np.isin(ids, left), 0] == i_rim)]
     rim_r = right[(grid[np.isin(ids, right), 0] == i_rim)]
+    bolt = ids[(grid[:, 2] == 0) & (grid[:, 0] == 0) & (grid[:, 1] == nth // 2)]
+    flange_b = np.setdiff1d(fix, bolt)
     tip = ids[[int(np.argmax(np.hypot(xyz[:, 0], xyz[:, 1]) + 1e-3 * xyz[:, 2]))]]
     common = []
     common.append(f"** bladed-disk sector with flange, {n_sectors} sectors, C3D8\n")
@@ -141,7 +149,8 @@ def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, sector_clam
             for sname, nodes in (("LEFT", left), ("RIGHT", right), ("FLANGE", flange),
                                  ("FIX", fix), ("TIP", tip), ("FLANGE_IN", flange_in),
                                  ("FLANGE_OUT", flange_out), ("FLANGE_C", flange_c),
-                                 ("RIM_L", rim_l), ("RIM_R", rim_r)):
+                                 ("RIM_L", rim_l), ("RIM_R", rim_r), ("BOLT", bolt),
+                                 ("FLANGE_B", flange_b)):
                 fh.write(nset(sname, nodes))
             fh.write(mat)
             if name == "cyclic":
@@ -150,7 +159,7 @@ def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, sector_clam
                          "*TIE, NAME=CYC, CYCLIC SYMMETRY\nSLEFT, SRIGHT\n"
                          f"*CYCLIC SYMMETRY MODEL, N={n_sectors}, NGRAPH=1, TIE=CYC\n"
                          "0., 0., 0., 0., 0., 1.\n")
-            clamped = "FLANGE_IN" if name == "sector" and sector_clamp == "inner" else "FIX"
+            clamped = clamps[sector_clamp] if name == "sector" else "FIX"
             fh.write(f"*BOUNDARY\n{clamped}, 1, 3\n")
             if name == "cyclic":
                 fh.write(f"*STEP\n*FREQUENCY\n{n_modes}\n"
