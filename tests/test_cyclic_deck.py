@@ -370,3 +370,39 @@ def test_stuck_flange_frf_resonance_at_ccx_frequency(tmp_path, capsys):
     # CB + penalty: ~6e-7 (test above, and here); peak fit and the stuck mode's damping
     # differing from zeta (the free modes') by some %: ~1e-6; ccx's 7 digits
     assert abs(err) < 1e-5
+
+
+def test_gsi_interface_with_contacts_on_the_boundary(sector_dir, capsys):
+    """GSI modes on an interface set without cyclic-boundary nodes (FLANGE_CI); the contact
+    set FLANGE_C also holds a node of RIGHT, a physical coordinate of the reduced model. The
+    stuck sector's ND-2 frequency approaches ccx's clamped one as GSI modes are added."""
+    out, ref = sector_dir
+    f_ccx = np.sqrt(ref[2][0]) / (2 * np.pi)
+    errs = []
+    for n_free in (3, 6, 15):
+        d = load_deck(write(out, "gsi.toml", interface='"FLANGE_CI"', cache="gsi.rom.h5",
+                            reduction_extra=("[reduction.interface_modes]\nmethod = \"gsi\"\n"
+                                             f"free = {n_free}")))
+        labels = d.reduced.labels
+        assert sum(lab.startswith("gsi") for lab in labels) == n_free
+        assert not any(f"N{nd}:" in lab for nd in d.reduced.node_sets["FLANGE_CI"]
+                       for lab in labels)                        # reduced by GSI
+        cs, g = d.cyclic["sector"], d.contacts[0].G
+        kk, mk = cs.matrices(sp.csr_matrix(d.K) + g.T @ (1e13 * g), sp.csr_matrix(d.M), 2)
+        lam = sla.eigh(kk.toarray(), mk.toarray(), eigvals_only=True, subset_by_index=[0, 0])
+        errs.append(np.sqrt(lam[0]) / (2 * np.pi) / f_ccx - 1)
+    with capsys.disabled():
+        print("\nGSI (free modes 3, 6, 15) + cyclic, stuck ND 2 vs ccx: "
+              + ", ".join(f"{e:+.1e}" for e in errs))
+    # Rayleigh-Ritz from above (up to the 6e-7 of CB + penalty), converging; 15 modes span
+    # the 15 interface DoFs: the CB value
+    assert all(e > -2e-6 for e in errs) and errs[0] >= errs[1] >= errs[2]
+    assert abs(errs[2]) < 2e-6
+    # full-stick GSI modes need every contact node in the interface sets
+    _error(out, r"contacts\[0\]: node \d+ is a cyclic-boundary node outside the interface "
+           "sets", interface='"FLANGE_CI"', cache="gsi.rom.h5",
+           reduction_extra='[reduction.interface_modes]\nmethod = "gsi"\nstick = 3')
+    # a load on both images of a boundary node
+    _error(out, r"excitation\.load\[1\]\.dof: expected a node set holding each node of the "
+           r"rotor once; node \d+ \(left", excitation_extra=(
+               '\n[[excitation.load]]\ndof = "FLANGE_OUT:z"\nharmonic = 0\namplitude = 1.0\n'))

@@ -12,8 +12,9 @@ conditions on it; the cyclic constraint makes them zero anyway), FLANGE_IN and F
 (the inner (r = r0) and outer edges of the flange face), FLANGE_C (FLANGE_OUT without the
 nodes of LEFT: a contact set that holds each node of the rotor once), RIM_L and RIM_R (the
 nodes of LEFT and RIGHT at the disk rim, free: faces of a contact with the next sector),
-BOLT (the node of FLANGE_IN in the middle of the sector) and FLANGE_B (FLANGE without BOLT
-and without the nodes of LEFT).
+BOLT (the node of FLANGE_IN in the middle of the sector), FLANGE_B (FLANGE without BOLT
+and without the nodes of LEFT), FLANGE_CI (FLANGE_C without the nodes of RIGHT: no node of
+the cyclic boundaries).
 
 Two decks:
 * ``cyclic.inp``: ``*CYCLIC SYMMETRY MODEL`` (LEFT dependent, RIGHT independent) and a
@@ -131,6 +132,7 @@ def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, sector_clam
     rim_r = right[(grid[np.isin(ids, right), 0] == i_rim)]
     bolt = ids[(grid[:, 2] == 0) & (grid[:, 0] == 0) & (grid[:, 1] == nth // 2)]
     flange_b = np.setdiff1d(fix, bolt)
+    flange_ci = np.setdiff1d(flange_c, right)
     tip = ids[[int(np.argmax(np.hypot(xyz[:, 0], xyz[:, 1]) + 1e-3 * xyz[:, 2]))]]
     common = []
     common.append(f"** bladed-disk sector with flange, {n_sectors} sectors, C3D8\n")
@@ -150,7 +152,7 @@ def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, sector_clam
                                  ("FIX", fix), ("TIP", tip), ("FLANGE_IN", flange_in),
                                  ("FLANGE_OUT", flange_out), ("FLANGE_C", flange_c),
                                  ("RIM_L", rim_l), ("RIM_R", rim_r), ("BOLT", bolt),
-                                 ("FLANGE_B", flange_b)):
+                                 ("FLANGE_B", flange_b), ("FLANGE_CI", flange_ci)):
                 fh.write(nset(sname, nodes))
             fh.write(mat)
             if name == "cyclic":

@@ -306,6 +306,7 @@ class _Parser:
         self.fe = False
         self.n = self.labels = self.rom = None
         self.cyc = None           # the checked [reduction.cyclic] table
+        self.partner = {}         # cyclic: left-boundary node -> its right-boundary image
 
     def run(self) -> Deck:
         ctx = self.ctx
@@ -631,6 +632,7 @@ class _Parser:
                              f"{spec.origin}: reduction.axis, reduction.origin)") from None
         # a contact on both images of a boundary node would count it twice in the rotor
         partner = {int(a): int(b) for a, b in cs.node_pairs}
+        self.partner = partner
         for c in contacts:
             p = rom.pairs[c.name]
             sides = [("a", p.dofs_a)] + ([("b", p.dofs_b)] if c.b is not None
@@ -834,8 +836,16 @@ class _Parser:
         if not self.fe:
             F[ref, h] += amp
             return
+        nodes = self.fe_nodes(ref, key)
+        if self.partner:
+            both = sorted(a for a in nodes if self.partner.get(a) in nodes)
+            if both:
+                raise self.ctx.error(key, "a node set holding each node of the rotor once; "
+                                     f"node {both[0]} (left cyclic boundary) and node "
+                                     f"{self.partner[both[0]]} (its image on the right one) "
+                                     "would both be loaded", ref[2])
         try:
-            for node in self.fe_nodes(ref, key):
+            for node in nodes:
                 F[:, h] += amp * self.rom.load_row(node, ref[1])
         except InputError as exc:
             raise InputError(f"{self.path}: {key}: {exc}") from None
