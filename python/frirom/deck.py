@@ -22,6 +22,7 @@ the deck file, the TOML key path (``contacts[2].mu``) and what was expected.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -651,7 +652,6 @@ class _Parser:
 
     def cyclic_modes(self, cs, rom, damping, H, log):
         """Modes of every nodal diameter the harmonics 0..H live on (after the cache)."""
-        import time
         from .model import Damping
         from .reduction.cyclic import sector_modes
         cy, pre = self.cyc, "reduction.cyclic"
