@@ -370,6 +370,15 @@ def test_stuck_flange_frf_resonance_at_ccx_frequency(tmp_path, capsys):
     # CB + penalty: ~6e-7 (test above, and here); peak fit and the stuck mode's damping
     # differing from zeta (the free modes') by some %: ~1e-6; ccx's 7 digits
     assert abs(err) < 1e-5
+    # the same deck through `frirom run`: the cyclic log lines, the same points in frf.h5
+    from frirom.cli import main
+    from frirom.results import FRF
+    assert main(["run", str(p), "--out", str(tmp_path / "run")]) == 0
+    printed = capsys.readouterr().out
+    assert "cyclic sector: N = 12, harmonic indices k = [0, 10, 8, 6]" in printed
+    saved = FRF.load(tmp_path / "run" / "frf.h5")
+    assert saved.omega.size == r.omega.size
+    assert np.abs(saved.X - r.X).max() < 1e-12 * np.abs(r.X).max()
 
 
 def test_gsi_interface_with_contacts_on_the_boundary(sector_dir, capsys):
