@@ -207,7 +207,8 @@ contains
                     case (LAW_NORMAL1D)
                         call jac_friction1d(plan, j, params(1, e), .true., jac(:, :, e))
                     case (LAW_NORMAL2D)
-                        call jac_friction2d(plan, j, params(1, e), tl, mp, jac(:, :, e))
+                        call jac_friction2d(plan, j, params(1, e), w0(:, e), tl, mp, &
+                                            jac(:, :, e))
                     case (LAW_CUBIC)
                         call jac_diagonal(plan, j, 2_ip, jac(:, :, e), 0_ip, 0_ip)
                     end select
@@ -651,20 +652,28 @@ contains
     !> Jacobian of the 2-D element. The slip direction depends on the whole history, so
     !> the slider tangent dw (2 x 3(2H+1)) is propagated through the period, repeated until
     !> it closes (slip contracts it; lift-off resets it), then once more accumulating.
-    !> A contact that slips while the march settles and then sticks all cycle is treated
-    !> as a fixed slider (its mean-force row ignores the settling slip, unlike the 1-D laws).
-    subroutine jac_friction2d(plan, j, kt, tol, max_periods, jac)
+    !> The propagation starts from the tangent the settling periods leave (marched again
+    !> from w0): a contact that slipped while the march settled and then sticks all cycle,
+    !> or only touches the friction limit, keeps a slider that depends on that history
+    !> (along the limit circle the recursion does not contract).
+    subroutine jac_friction2d(plan, j, kt, w0j, tol, max_periods, jac)
         type(aft_plan), intent(inout) :: plan
         integer(ip), intent(in) :: j, max_periods
         real(wp), intent(in) :: kt, tol
+        real(wp), intent(in) :: w0j(:)        !! (2) the element's initial slider
         real(wp), intent(inout) :: jac(:, :)  !! (3 nc, 3 nc)
         integer(ip) :: nc, pass
         nc = plan%fp%ncoef
         call jac_diagonal(plan, j, 4_ip, jac, 0_ip, 0_ip)       ! d f1/du1, stick
         call jac_diagonal(plan, j, 4_ip, jac, nc, nc)           ! d f2/du2, stick
         call jac_diagonal(plan, j, 5_ip, jac, 2*nc, 2*nc)       ! d fn/dv, contact
-        if (all(plan%state(j, :) == STATE_STICK)) return
         plan%dw = 0.0_wp
+        if (plan%closed_at(j) > 1 .and. any(plan%w(j, 1:2) /= w0j(1:2))) &
+            call settle2d(plan, j, kt, w0j, jac)
+        if (all(plan%state(j, :) == STATE_STICK)) then
+            if (any(plan%dw /= 0.0_wp)) call propagate2d(plan, j, kt, .true., jac)
+            return
+        end if
         do pass = 1, max_periods
             plan%dw0 = plan%dw
             call propagate2d(plan, j, kt, .false., jac)
@@ -672,6 +681,36 @@ contains
         end do
         call propagate2d(plan, j, kt, .true., jac)
     end subroutine jac_friction2d
+
+    !> Slider tangent dw that the settling periods of element j leave: march them again
+    !> from w0j (dw = 0 there), propagating the tangent through each.
+    subroutine settle2d(plan, j, kt, w0j, jac)
+        type(aft_plan), intent(inout) :: plan
+        integer(ip), intent(in) :: j
+        real(wp), intent(in) :: kt, w0j(:)
+        real(wp), intent(inout) :: jac(:, :)
+        integer(ip) :: n, per
+        integer(ip), allocatable :: st(:, :), st_keep(:)
+        real(wp), allocatable :: w(:, :), f(:, :, :), tg(:, :, :), tg_keep(:, :)
+        n = plan%fp%nsamp
+        allocate (st(1, n), w(1, 2), f(1, n, 3), tg(1, 6, n))
+        st_keep = plan%state(j, :)
+        tg_keep = plan%tangent(j, :, :)
+        w(1, :) = w0j(1:2)
+        plan%dw = 0.0_wp
+        associate (rin => plan%fp%rin, par => plan%par)
+            do per = 1, plan%closed_at(j) - 1
+                call friction2d_march(rin(j:j, :, 1), rin(j:j, :, 2), rin(j:j, :, 3), &
+                                      par(j:j, 1), par(j:j, 2), par(j:j, 3), par(j:j, 4), w, &
+                                      f(:, :, 1), f(:, :, 2), f(:, :, 3), st, tg)
+                plan%state(j, :) = st(1, :)
+                plan%tangent(j, :, :) = tg(1, :, :)
+                call propagate2d(plan, j, kt, .false., jac)
+            end do
+        end associate
+        plan%state(j, :) = st_keep
+        plan%tangent(j, :, :) = tg_keep
+    end subroutine settle2d
 
     !> One period of the 2-D slider tangent recursion (see friction2d_march):
     !> stick: d f = kt (dU_k - dw), dw kept; slip: d f = A_k (dU_k - dw) + b_k dV_k,
