@@ -6,8 +6,8 @@ committed), and ccx's own cyclic-symmetry frequencies (the clamped-flange refere
     frirom run cases/bladed_sector/bladed_sector.toml
 
 One 30-degree sector of a 12-sector steel bladed disk with a flange arm
-(cases/models/bladed_sector.py): ``sector.inp`` clamps only the inner edge of the flange
-face (FLANGE_IN, the bolted edge), so that its outer edge (FLANGE_C) is free for the
+(cases/models/bladed_sector.py): ``sector.inp`` clamps only one node of the flange face per
+sector (node set BOLT, the bolt), so that the rest of the face (FLANGE_B) is free for the
 friction contacts of the deck; ccx writes the sector's stiffness and mass matrices
 (``*FREQUENCY, SOLVER=MATRIXSTORAGE``). ``cyclic.inp`` is the same sector with the whole
 flange face clamped under ``*CYCLIC SYMMETRY MODEL``: ccx's frequencies per nodal diameter,
