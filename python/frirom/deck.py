@@ -653,17 +653,10 @@ class _Parser:
     def cyclic_modes(self, cs, rom, damping, H, log):
         """Modes of every nodal diameter the harmonics 0..H live on (after the cache)."""
         from .model import Damping
-        from .reduction.cyclic import sector_modes
+        from .reduction.cyclic import needed_indices, sector_modes
         cy, pre = self.cyc, "reduction.cyclic"
         N, eo, sign = cy["sectors"], cy["engine_order"], -1
-        if cy["single_index"] is not None:
-            ks = [cy["single_index"]]
-        else:
-            ks = []
-            for h in range(H + 1):
-                k = (sign * h * eo) % N
-                if k not in ks and (-k) % N not in ks:
-                    ks.append(k)
+        ks = needed_indices(eo, N, H, sign, cy["single_index"])
         damp = (Damping.rayleigh(damping["alpha"], damping["beta"])
                 if damping["type"] == "rayleigh" else Damping.modal(damping["zeta"]))
         t0 = time.perf_counter()

@@ -37,7 +37,7 @@ from ..model import CyclicModel, Damping, SectorModes
 from .multistage import cylindrical_frame
 
 __all__ = ["CyclicSector", "cyclic_sector", "axis_rotation", "tran_reduce", "sector_modes",
-           "cyclic_model"]
+           "cyclic_model", "needed_indices"]
 
 
 def axis_rotation(angle: float, axis=(0.0, 0.0, 1.0)) -> np.ndarray:
@@ -385,6 +385,21 @@ def sector_modes(sector: CyclicSector, K, M, k: int, damping=None, n_modes=None,
                        zeta=_ratios(damping, omega))
 
 
+def needed_indices(engine_order: int, n_sectors: int, harmonics: int, sign: int = -1,
+                   single_index=None) -> list:
+    """Harmonic indices whose modes the harmonics 0..H need, k_h = sign h EO mod N, in the
+    order of h, one of each pair k, N - k (complex conjugates); [single_index] alone for the
+    one-index approximation."""
+    if single_index is not None:
+        return [int(single_index) % n_sectors]
+    ks = []
+    for h in range(harmonics + 1):
+        k = (sign * h * int(engine_order)) % n_sectors
+        if k not in ks and (-k) % n_sectors not in ks:
+            ks.append(k)
+    return ks
+
+
 def cyclic_model(sector: CyclicSector, K, M, contacts, engine_order: int, harmonics: int,
                  damping=None, sign: int = -1, n_modes=None, boundary_modes=None,
                  single_index=None, dof_labels=None) -> CyclicModel:
@@ -398,16 +413,8 @@ def cyclic_model(sector: CyclicSector, K, M, contacts, engine_order: int, harmon
     if not (isinstance(harmonics, (int, np.integer)) and harmonics >= 0):
         raise ParameterError(f"harmonics: expected an integer >= 0, got {harmonics!r}")
     N = sector.n_sectors
-    if single_index is not None:
-        ks = {int(single_index) % N}
-    else:
-        ks = set()
-        for h in range(harmonics + 1):
-            k = (sign * h * int(engine_order)) % N
-            if k not in ks and (-k) % N not in ks:
-                ks.add(k)
     modes = {k: sector_modes(sector, K, M, k, damping, n_modes, boundary_modes)
-             for k in sorted(ks)}
+             for k in needed_indices(engine_order, N, harmonics, sign, single_index)}
     return CyclicModel(n_dof=sector.n_dof, n_sectors=N, engine_order=int(engine_order),
                        modes=modes, contacts=list(contacts), sign=sign,
                        single_index=single_index, dof_labels=dof_labels)
