@@ -217,7 +217,7 @@ class _Packed:
             self.phi, self.wmodes, self.zmodes = _modes(model, int(opts.modes))
             self.nmodes = self.wmodes.size
         self.hmodes = 0
-        self.psi = np.zeros((n, 1, H + 1), complex)
+        self.psi = np.zeros((n, 1, H + 1), complex, order="F")
         self.wharm, self.zharm = np.ones((1, H + 1)), np.zeros((1, H + 1))
 
     def _groups(self, groups, ncol: int):
