@@ -24,7 +24,7 @@ from _lattices import tuned_rotor
 from frirom import ParameterError, SizeError
 from frirom.model import ContactGroup, CyclicModel, Damping, Excitation, Model
 from frirom.reduction.cyclic import CyclicSector, axis_rotation, cyclic_model
-from frirom.solver import SolverOptions, frf, solve_point
+from frirom.solver import SolverOptions, frf, load_curve, solve_point
 
 N, EO, H = 7, 2, 3
 ALPHA, BETA = 2.0, 2e-6           # Rayleigh damping (1/s, s)
@@ -182,6 +182,17 @@ def test_sector_frf_matches_full_rotor_through_resonance(models):
         pf = solve_point(full, ex_f, r.omega[i], SolverOptions(**OPTS), outputs=out_f)
         Xs = r.X[i]
         assert np.abs(Xs - pf.X).max() < 1e-6 * np.abs(pf.X).max()
+
+
+def test_sector_load_curve_matches_full_rotor(models):
+    """Continuation in the excitation level (the load part of the condensed system) at the
+    ND-5 resonance ends where the full rotor's solve at full load does (measured 7e-13)."""
+    cm, full, ex_s, ex_f, out_s, out_f = models
+    w1 = cm.modes_of(5).omega[0]
+    r = load_curve(cm, ex_s, w1, 0.1, 1.0, SolverOptions(**OPTS), outputs=out_s)
+    pf = solve_point(full, ex_f, w1, SolverOptions(**OPTS), outputs=out_f)
+    assert r.complete and r.parameter[-1] == 1.0
+    assert np.abs(r.X[-1] - pf.X).max() < 1e-9 * np.abs(pf.X).max()
 
 
 def test_one_index_shortcut_is_an_approximation(models):
