@@ -38,7 +38,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from ccx import STEEL, nset, run_ccx, solid_material  # noqa: E402,F401  (run_ccx re-exported)
+# run_ccx is re-exported for the callers of this module
+from ccx import (STEEL, matrix_storage_steps, nset, run_ccx,  # noqa: E402,F401
+                 solid_material)
 
 
 def sector_mesh(n_sectors=12, r=(0.10, 0.115, 0.14, 0.17, 0.20, 0.23, 0.26, 0.30),
@@ -168,7 +170,7 @@ def write_sector_decks(out, n_sectors=12, n_modes=8, material=STEEL, sector_clam
                          f"*SELECT CYCLIC SYMMETRY MODES, NMIN=0, NMAX={n_sectors // 2}\n"
                          "*END STEP\n")
             else:
-                fh.write("*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n1\n*END STEP\n")
+                fh.write(matrix_storage_steps())
         paths.append(p)
     return paths
 
@@ -196,8 +198,7 @@ def write_stage_deck(out, n_sectors=12, material=STEEL, **mesh):
                       for e, conn in enumerate(elems, start=1))
         fh.write(nset("FLANGE", flange))
         fh.write(nset("TIPS", np.array(tips)))
-        fh.write(solid_material(material))
-        fh.write("*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n1\n*END STEP\n")
+        fh.write(solid_material(material) + matrix_storage_steps())
     return p
 
 

@@ -19,7 +19,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from ccx import STEEL, nset, run_ccx, solid_material  # noqa: E402,F401  (re-exported)
+from ccx import (STEEL, matrix_storage_steps, nset, run_ccx,  # noqa: E402,F401  (re-exported)
+                 solid_material)
 
 
 
@@ -99,10 +100,7 @@ def write_block_deck(path, nx=12, ny=4, nz=4, size=(0.2, 0.05, 0.05), order=1,
         for name, nodes in (("FIX", fix), ("IFACE", iface), ("ACTIVE", active)):
             fh.write(nset(name, nodes))
         fh.write(solid_material(material))
-        fh.write("*BOUNDARY\nFIX, 1, 3\n")
-        if n_ref_modes > 0:
-            fh.write(f"*STEP\n*FREQUENCY\n{n_ref_modes}\n*END STEP\n")
-        fh.write("*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n1\n*END STEP\n")
+        fh.write("*BOUNDARY\nFIX, 1, 3\n" + matrix_storage_steps(n_ref_modes))
     return path
 
 

@@ -29,6 +29,14 @@ def solid_material(material=STEEL, elset: str = "EALL") -> str:
             f"*SOLID SECTION, ELSET={elset}, MATERIAL=STEEL\n")
 
 
+def matrix_storage_steps(n_ref_modes: int = 0) -> str:
+    """An optional ``*FREQUENCY`` step of n_ref_modes modes (ccx prints their eigenvalues
+    in job.dat: the reference), then ``*FREQUENCY, SOLVER=MATRIXSTORAGE``, which writes
+    job.sti/.mas/.dof and ends the run, so it comes last."""
+    ref = f"*STEP\n*FREQUENCY\n{n_ref_modes}\n*END STEP\n" if n_ref_modes > 0 else ""
+    return ref + "*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n1\n*END STEP\n"
+
+
 def run_ccx(inp, timeout: float = 1800, expect=(".sti",)) -> Path:
     """Run ccx on a deck in its own directory and return the job path (deck without
     suffix). RuntimeError with the log tail when ccx fails, prints *ERROR, or leaves any

@@ -20,7 +20,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from ccx import STEEL, nset, run_ccx, solid_material  # noqa: E402
+from ccx import (STEEL, matrix_storage_steps, nset, run_ccx,  # noqa: E402
+                 solid_material)
 
 # gmsh's 10-node tetrahedron numbers its last two edge nodes (2-3, 1-3) the other way
 # round from Abaqus/CalculiX C3D10 (1-3, 2-3 in 0-based vertices).
@@ -100,10 +101,8 @@ def write_lap_joint_deck(path, size=0.006, n_ref_modes=20, material=STEEL, **geo
             fh.write(f"{e}, " + ", ".join(str(c) for c in conn) + "\n")
         for name, nodes in sets.items():
             fh.write(nset(name, nodes))
-        fh.write(solid_material(material) + "*BOUNDARY\nFIX, 1, 3\n")
-        if n_ref_modes > 0:
-            fh.write(f"*STEP\n*FREQUENCY\n{n_ref_modes}\n*END STEP\n")
-        fh.write("*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n1\n*END STEP\n")
+        fh.write(solid_material(material) + "*BOUNDARY\nFIX, 1, 3\n"
+                 + matrix_storage_steps(n_ref_modes))
     return path
 
 
