@@ -117,8 +117,9 @@ module frirom_hbm
         !> modal superposition instead of factorising D_h (hbm_set_modes, or
         !> hbm_set_modes_harmonic: modes of their own for every harmonic)
         logical :: modal = .false.
-        integer(ip), allocatable :: mrow(:)              !! (nr) DoFs where psi is kept
-        integer(ip), allocatable :: nlr(:)               !! (nnl) rows of the nl DoFs in psi
+        !> (nr) DoFs where psi is kept: the nl DoFs first (rows 1..nnl), then the other
+        !> output DoFs
+        integer(ip), allocatable :: mrow(:)
         complex(wp), allocatable :: psi(:, :, :)         !! (nr, nm, 0:nh) mode shapes
         real(wp), allocatable :: wm(:, :), zm(:, :)      !! (nm, 0:nh) rad/s, damping ratios
         complex(wp), allocatable :: dg(:, :)             !! (nm, 0:nh) d g_r / d w
@@ -696,21 +697,17 @@ contains
         real(wp), intent(in), optional :: phi(:, :)         !! (ndof, nm)
         complex(wp), intent(in), optional :: psi(:, :, 0:)  !! (ndof, nm, 0:nh)
         integer(ip) :: h, r, i, nr
-        logical, allocatable :: keep(:)
-        integer(ip), allocatable :: at(:)
-        complex(wp), allocatable :: v(:)
+        logical, allocatable :: extra(:)
+        complex(wp), allocatable :: v(:), f0(:), f1(:)
         info = FRIROM_OK
         select type (sys => sysc)
         type is (hbm_condensed)
-            allocate (keep(sys%ndof), at(sys%ndof))
-            keep = .false.
-            keep(sys%nl) = .true.
-            keep(sys%outdofs) = .true.
-            nr = count(keep)
-            at = 0
-            sys%mrow = pack([(i, i=1, sys%ndof)], keep)
-            at(sys%mrow) = [(i, i=1, nr)]
-            sys%nlr = at(sys%nl)
+            allocate (extra(sys%ndof))
+            extra = .false.
+            extra(sys%outdofs) = .true.
+            extra(sys%nl) = .false.
+            sys%mrow = [sys%nl, pack([(i, i=1, sys%ndof)], extra)]
+            nr = size(sys%mrow)
             if (allocated(sys%psi)) deallocate (sys%psi, sys%wm, sys%zm, sys%dg, sys%qf, &
                                                 sys%qf1)
             allocate (sys%psi(nr, nm, 0:sys%nh), sys%wm(nm, 0:sys%nh), sys%zm(nm, 0:sys%nh), &
@@ -718,6 +715,8 @@ contains
             do h = 0, sys%nh
                 sys%wm(:, h) = wm(:, h)
                 sys%zm(:, h) = zm(:, h)
+                f0 = harm_col(sys%fe0, h)
+                f1 = harm_col(sys%fe1, h)
                 do r = 1, nm
                     if (present(phi)) then
                         v = cmplx(phi(:, r), 0.0_wp, wp)
@@ -725,8 +724,8 @@ contains
                         v = psi(:, r, h)
                     end if
                     sys%psi(:, r, h) = v(sys%mrow)
-                    sys%qf(r, h) = sum(conjg(v)*harm_col(sys%fe0, h))
-                    sys%qf1(r, h) = sum(conjg(v)*harm_col(sys%fe1, h))
+                    sys%qf(r, h) = sum(conjg(v)*f0)
+                    sys%qf1(r, h) = sum(conjg(v)*f1)
                 end do
             end do
             if (any(sys%wm <= 0.0_wp) .or. any(sys%zm < 0.0_wp) .or. &
@@ -772,7 +771,7 @@ contains
                 g = 1.0_wp/cmplx(wr**2 - hw**2, 2.0_wp*zr*wr*hw, wp)
                 sys%dg(:, h) = -g**2*cmplx(-2.0_wp*h*hw, 2.0_wp*zr*wr*h, wp)
                 do j = 1, sys%nnl
-                    tmp(:, j) = g*conjg(ps(sys%nlr(j), :))
+                    tmp(:, j) = g*conjg(ps(j, :))
                 end do
                 call zgemm('N', 'N', nr, sys%nnl, nm, (1.0_wp, 0.0_wp), ps, nr, tmp, nm, &
                            (0.0_wp, 0.0_wp), rows, nr)
@@ -842,10 +841,8 @@ contains
             do j = 1, nnl
                 rhs(sys%iperm(sys%nl(j)), j) = (1.0_wp, 0.0_wp)
             end do
-            do i = 1, ndof
-                rhs(sys%iperm(i), nnl + 1) = harm_c(sys%fe0, i, h)
-                rhs(sys%iperm(i), nnl + 2) = harm_c(sys%fe1, i, h)
-            end do
+            rhs(sys%iperm, nnl + 1) = harm_col(sys%fe0, h)
+            rhs(sys%iperm, nnl + 2) = harm_col(sys%fe1, h)
             call zband_solve(sys%d, rhs, info, errmsg)
             if (info /= 0) return
             do i = 1, ndof
@@ -861,18 +858,6 @@ contains
         sys%w_cache = w
         sys%timers(T_REC) = sys%timers(T_REC) + wtime() - t0
     end subroutine cond_receptance
-
-    !> Complex amplitude of harmonic h of row i of a real-harmonic array a(:, 2H+1).
-    pure function harm_c(a, i, h) result(z)
-        real(wp), intent(in) :: a(:, :)
-        integer(ip), intent(in) :: i, h
-        complex(wp) :: z
-        if (h == 0) then
-            z = cmplx(a(i, 1), 0.0_wp, wp)
-        else
-            z = cmplx(a(i, 2*h), -a(i, 2*h + 1), wp)
-        end if
-    end function harm_c
 
     subroutine cond_eval(this, y, lam, r, rref, jac, rlam, info, errmsg)
         class(hbm_condensed), intent(inout) :: this
@@ -907,11 +892,7 @@ contains
         nhf = 0.0_wp
         nx = norm2(y)
         do h = 0, this%nh
-            if (h == 0) then
-                fc = cmplx(this%fd(:, 1), 0.0_wp, wp)
-            else
-                fc = cmplx(this%fd(:, 2*h), -this%fd(:, 2*h + 1), wp)
-            end if
+            fc = harm_col(this%fd, h)
             xe = this%ye0(this%nl, h) + s*this%ye1(this%nl, h)
             rh = cmplx(matmul(this%ar(:, :, h), real(fc, wp)) - &
                        matmul(this%ai(:, :, h), aimag(fc)), &
@@ -931,7 +912,7 @@ contains
                 end if
                 if (this%modal) then
                     ! R = X - Phi_n diag(g) (Phi^T fe - Phi_n^T fc): dR/dw = -Phi_n dg q
-                    associate (pn => this%psi(this%nlr, :, h))
+                    associate (pn => this%psi(1:nnl, :, h))
                         xe = -matmul(pn, this%dg(:, h)*(this%qf(:, h) - &
                                                         matmul(conjg(transpose(pn)), fc)))
                     end associate
@@ -1062,11 +1043,7 @@ contains
         if (info /= 0) return
         allocate (fc(this%nnl))
         do h = 0, this%nh
-            if (h == 0) then
-                fc = cmplx(this%fd(:, 1), 0.0_wp, wp)
-            else
-                fc = cmplx(this%fd(:, 2*h), -this%fd(:, 2*h + 1), wp)
-            end if
+            fc = harm_col(this%fd, h)
             do j = 1, size(this%outdofs)
                 o = this%outdofs(j)
                 z = this%ye0(o, h) + s*this%ye1(o, h) - sum(this%ymat(o, :, h)*fc)
