@@ -384,9 +384,20 @@ def test_stuck_flange_frf_resonance_at_ccx_frequency(tmp_path, capsys):
 def test_gsi_interface_with_contacts_on_the_boundary(sector_dir, capsys):
     """GSI modes on an interface set without cyclic-boundary nodes (FLANGE_CI); the contact
     set FLANGE_C also holds a node of RIGHT, a physical coordinate of the reduced model. The
-    stuck sector's ND-2 frequency approaches ccx's clamped one as GSI modes are added."""
+    stuck sector's ND-2 frequency with GSI modes lies above the Craig-Bampton model's (a
+    Rayleigh-Ritz subspace of it), equals it once the 15 modes span the 15 interface DoFs,
+    and is ccx's clamped one to the CB + penalty error."""
     out, ref = sector_dir
     f_ccx = np.sqrt(ref[2][0]) / (2 * np.pi)
+
+    def stuck_nd2(d, kt):
+        cs, g = d.cyclic["sector"], d.contacts[0].G
+        kk, mk = cs.matrices(sp.csr_matrix(d.K) + g.T @ (kt * g), sp.csr_matrix(d.M), 2)
+        lam = sla.eigh(kk.toarray(), mk.toarray(), eigvals_only=True, subset_by_index=[0, 0])
+        return np.sqrt(lam[0]) / (2 * np.pi)
+
+    d_cb = load_deck(write(out, "cbonly.toml", interface='"FLANGE_CI"', cache="cbonly.rom.h5"))
+    f_cb, f_clamp = stuck_nd2(d_cb, 1e11), stuck_nd2(d_cb, 1e13)
     errs = []
     for n_free in (3, 6, 15):
         d = load_deck(write(out, "gsi.toml", interface='"FLANGE_CI"', cache="gsi.rom.h5",
@@ -396,17 +407,17 @@ def test_gsi_interface_with_contacts_on_the_boundary(sector_dir, capsys):
         assert sum(lab.startswith("gsi") for lab in labels) == n_free
         assert not any(f"N{nd}:" in lab for nd in d.reduced.node_sets["FLANGE_CI"]
                        for lab in labels)                        # reduced by GSI
-        cs, g = d.cyclic["sector"], d.contacts[0].G
-        kk, mk = cs.matrices(sp.csr_matrix(d.K) + g.T @ (1e13 * g), sp.csr_matrix(d.M), 2)
-        lam = sla.eigh(kk.toarray(), mk.toarray(), eigvals_only=True, subset_by_index=[0, 0])
-        errs.append(np.sqrt(lam[0]) / (2 * np.pi) / f_ccx - 1)
+        errs.append(stuck_nd2(d, 1e11) / f_cb - 1)
     with capsys.disabled():
-        print("\nGSI (free modes 3, 6, 15) + cyclic, stuck ND 2 vs ccx: "
-              + ", ".join(f"{e:+.1e}" for e in errs))
-    # Rayleigh-Ritz from above (up to the 6e-7 of CB + penalty), converging; 15 modes span
-    # the 15 interface DoFs: the CB value
-    assert all(e > -2e-6 for e in errs) and errs[0] >= errs[1] >= errs[2]
-    assert abs(errs[2]) < 2e-6
+        print(f"\nstuck ND 2 (1e13 N/m): CB {f_clamp / f_ccx - 1:+.1e} vs ccx; with 1e11 N/m "
+              "GSI (free modes 3, 6, 15) vs CB: " + ", ".join(f"{e:+.1e}" for e in errs))
+    # GSI vs CB with 1e11 N/m contacts: the eigen-solve is good to ~1e-10 there (1e13 N/m
+    # leaves ~6e-8 of round-off, more than the GSI error on this small interface); measured
+    # +1.7e-6 with 3 modes, 2.5e-10 with the 15 that span the interface
+    assert all(e > -1e-9 for e in errs) and errs[0] >= errs[1] >= errs[2]
+    assert errs[0] > 1e-7 and abs(errs[2]) < 1e-9
+    # stuck by 1e13 N/m, the flange is ccx's clamped one to the CB + penalty error (~6e-7)
+    assert abs(f_clamp / f_ccx - 1) < 2e-6
     # full-stick GSI modes need every contact node in the interface sets
     _error(out, r"contacts\[0\]: node \d+ is a cyclic-boundary node outside the interface "
            "sets", interface='"FLANGE_CI"', cache="gsi.rom.h5",
