@@ -176,8 +176,6 @@ class _Packed:
             mask[0 if load_part == "static" else slice(1, None)] = True
             self.fe1 = np.where(mask, fe, 0.0)
             self.fe0 = fe - self.fe1
-        self.nmodes = 0
-        self.phi, self.wmodes, self.zmodes = np.zeros((1, 1)), np.ones(1), np.zeros(1)
         if isinstance(model, CyclicModel):
             self._init_cyclic(model, outputs)
             return
@@ -212,13 +210,10 @@ class _Packed:
                           f"size 2 n_dof (2H+1) = {2 * n * self.nc} > {HILL_MAX}",
                           RuntimeWarning, stacklevel=3)
             self.stability = False
-        self.phi = np.zeros((n, 1))
+        self._no_modes(n)
         if opts.modes:
             self.phi, self.wmodes, self.zmodes = _modes(model, int(opts.modes))
             self.nmodes = self.wmodes.size
-        self.hmodes = 0
-        self.psi = np.zeros((n, 1, H + 1), complex, order="F")
-        self.wharm, self.zharm = np.ones((1, H + 1)), np.zeros((1, H + 1))
 
     def _groups(self, groups, ncol: int):
         """Pack the contact groups; returns their stacked G (rows, ncol)."""
@@ -240,6 +235,15 @@ class _Packed:
                           g.G.shape[1] == ncol else
                           sp.hstack([g.G, sp.csr_matrix((g.G.shape[0], ncol - g.G.shape[1]))])
                           for g in groups]).tocsr()
+
+    def _no_modes(self, nrows: int) -> None:
+        """The mode arrays of hbm_continue, unused (nmodes = hmodes = 0) but shaped as f2py
+        wants them: real modes (nrows, 1) and per-harmonic modes (nrows, 1, H+1)."""
+        H = self.H
+        self.nmodes = self.hmodes = 0
+        self.phi, self.wmodes, self.zmodes = np.zeros((nrows, 1)), np.ones(1), np.zeros(1)
+        self.psi = np.zeros((nrows, 1, H + 1), complex, order="F")
+        self.wharm, self.zharm = np.ones((1, H + 1)), np.zeros((1, H + 1))
 
     def _set_outputs(self, outputs) -> None:
         n = self.n_dof
@@ -282,7 +286,7 @@ class _Packed:
         fe0, fe1 = np.zeros((nr, self.nc)), np.zeros((nr, self.nc))
         fe0[at[real]], fe1[at[real]] = self.fe0[real], self.fe1[real]
         self.fe0, self.fe1, self.n_dof = fe0, fe1, nr
-        self.phi = np.zeros((nr, 1))
+        self._no_modes(nr)
         alpha = 2 * np.pi / model.n_sectors
         per = [model.modes_of(model.harmonic_index(h)) for h in range(H + 1)]
         nm = max(m.omega.size for m in per)
@@ -296,7 +300,6 @@ class _Packed:
             self.psi[~nb, :r, h] = m.psi[rows[~nb]]
             self.psi[nb, :r, h] = m.psi[rows[nb] - n] * np.exp(1j * m.k * alpha)
             self.wharm[:r, h], self.zharm[:r, h] = m.omega, m.zeta
-        self.indices = [m.k for m in per]
         empty = _csr(sp.csr_matrix((nr, nr)))
         self.K = self.M = self.C = empty
         self.perm = np.arange(1, nr + 1, dtype=np.int32)
