@@ -9,7 +9,7 @@ slips over about half of the period at the peak.
 Run small: a coarser mesh (element size 12 mm: 65 node pairs, 390 interface DoFs, the
 preload per pair raised so that the bolt load stays 2.1 kN), H = 1, a 12 N shaker, 825-880
 Hz. The paper (Sec. 3.2.1) finds the GSI-reduced nonlinear FRF on top of the unreduced one
-with 40 GSI modes; measured here: 4e-4 in peak frequency and 1e-3 in peak amplitude, so
+with 40 GSI modes; measured here: 6e-4 in peak frequency and 4e-4 in peak amplitude, so
 the bounds are 2e-3 and 2e-2 (GSI with 10 modes misses them by far: see the printed table).
 At the case's own size and H = 3, cases/lap_joint/convergence.py gives the same study.
 """
@@ -55,11 +55,15 @@ def case(tmp_path_factory):
     return out
 
 
-def run(case, name, text, capsys):
+def run(case, name, text, capsys, complete=True):
+    """Peak frequency [Hz], amplitude, state fractions there and the log of a deck's run;
+    complete=False accepts a curve that stopped early (the poor ROMs of the table: with
+    GSI 20 the joint opens over ~90 % of the period and the H = 1, N = 16 curve folds back
+    and forth until it leaves the range, depending on round-off in the reduction)."""
     (case / f"{name}.toml").write_text(text)
     assert main(["run", str(case / f"{name}.toml"), "--out", str(case / name), "--quiet"]) == 0
     r = FRF.load(case / name / "frf.h5")
-    assert r.complete, r.message
+    assert r.complete or not complete, r.message
     i = int(np.argmax(r.amp_max[:, 0]))
     assert 0 < i < len(r) - 1                     # a peak inside the range
     return r.omega[i] / (2 * np.pi), r.amp_max[i, 0], r.state_fractions[i, 0], \
@@ -79,7 +83,8 @@ def test_gsi_lap_joint_matches_cb_and_reuses_its_reduction(case, capsys):
 
     f_c, a_c, st_c, log_cb = run(case, "cb", small(None), capsys)
     m_g, m_c = built.model(), load_deck(case / "cb.toml").model()
-    rows = [(n, *run(case, f"gsi{n}", small(n), capsys)[:2]) for n in (10, 20, 60)]
+    rows = [(n, *run(case, f"gsi{n}", small(n), capsys, complete=n > 20)[:2])
+            for n in (10, 20, 60)]
     rows.insert(2, (40, f_g, a_g))
     with capsys.disabled():
         print(f"\nlap joint (65 pairs, H = 1): CB only {m_c.n_dof} coordinates, "
