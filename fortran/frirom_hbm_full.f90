@@ -1,0 +1,120 @@
+!> The full banded formulation of frirom_hbm: all DoFs x harmonics, R = D X + F_c(X) - F_e,
+!> unknowns DoF by DoF in reverse Cuthill-McKee order so that J is banded (LAPACK dgbtrf).
+submodule (frirom_hbm) frirom_hbm_full
+    use frirom_status, only: FRIROM_OK, FRIROM_ERR_MODEL, set_status
+    use frirom_banded, only: band_init, band_zero, band_add, band_factor, band_solve
+    implicit none
+
+contains
+
+
+    module procedure full_init
+        integer(ip) :: kl
+        sys%n = sys%ndof*sys%nc
+        kl = min(sys%nc*(sys%bw + 1) - 1, sys%n - 1)
+        allocate (sys%rd(sys%ndof, sys%nc))
+        call band_init(sys%jb, sys%n, kl, kl, info, errmsg)
+    end procedure full_init
+
+    module procedure full_eval
+        real(wp) :: w, s, t0, hw, nfe, ndx
+        integer(ip) :: nc, i, h, ca, cb, k, ii, jj
+        logical :: ok
+        real(wp), allocatable :: dl(:, :)
+        info = FRIROM_OK
+        nc = this%nc
+        call freq_load(this, lam, w, s)
+        call hbm_contact_forces(this, y, jac, info, errmsg, timed=.true.)
+        if (info /= 0) return
+        ! D X, harmonic by harmonic
+        allocate (dl(this%ndof, nc))
+        this%rd = 0.0_wp
+        dl = 0.0_wp
+        call csr_matvec_add(this%k, this%xd(:, 1), this%rd(:, 1), 1.0_wp)
+        do h = 1, this%nh
+            hw = h*w
+            ca = 2*h
+            cb = 2*h + 1
+            call csr_matvec_add(this%k, this%xd(:, ca), this%rd(:, ca), 1.0_wp)
+            call csr_matvec_add(this%k, this%xd(:, cb), this%rd(:, cb), 1.0_wp)
+            call csr_matvec_add(this%m, this%xd(:, ca), this%rd(:, ca), -hw*hw)
+            call csr_matvec_add(this%m, this%xd(:, cb), this%rd(:, cb), -hw*hw)
+            call csr_matvec_add(this%c, this%xd(:, cb), this%rd(:, ca), hw)
+            call csr_matvec_add(this%c, this%xd(:, ca), this%rd(:, cb), -hw)
+            if (this%mode == HBM_FREQUENCY) then
+                call csr_matvec_add(this%m, this%xd(:, ca), dl(:, ca), -2.0_wp*h*hw)
+                call csr_matvec_add(this%m, this%xd(:, cb), dl(:, cb), -2.0_wp*h*hw)
+                call csr_matvec_add(this%c, this%xd(:, cb), dl(:, ca), real(h, wp))
+                call csr_matvec_add(this%c, this%xd(:, ca), dl(:, cb), -real(h, wp))
+            end if
+        end do
+        ndx = norm2(this%rd)
+        nfe = norm2(this%fe0 + s*this%fe1)
+        rref = max(nfe, ndx, norm2(this%fd))
+        this%rd = this%rd + this%fd - this%fe0 - s*this%fe1
+        if (this%mode == HBM_LOAD) dl = -this%fe1
+        do i = 1, this%ndof
+            r(nc*(this%iperm(i) - 1) + 1:nc*this%iperm(i)) = this%rd(i, :)
+            rlam(nc*(this%iperm(i) - 1) + 1:nc*this%iperm(i)) = dl(i, :)
+        end do
+        if (.not. jac) return
+        t0 = wtime()
+        ok = .true.
+        call band_zero(this%jb)
+        do i = 1, this%ndof
+            ii = nc*(this%iperm(i) - 1)
+            do k = this%k%p(i), this%k%p(i + 1) - 1
+                jj = nc*(this%iperm(this%k%i(k)) - 1)
+                do h = 1, nc
+                    call band_add(this%jb, ii + h, jj + h, this%k%x(k), ok)
+                end do
+            end do
+            do k = this%m%p(i), this%m%p(i + 1) - 1
+                jj = nc*(this%iperm(this%m%i(k)) - 1)
+                do h = 1, this%nh
+                    hw = h*w
+                    call band_add(this%jb, ii + 2*h, jj + 2*h, -hw*hw*this%m%x(k), ok)
+                    call band_add(this%jb, ii + 2*h + 1, jj + 2*h + 1, -hw*hw*this%m%x(k), ok)
+                end do
+            end do
+            do k = this%c%p(i), this%c%p(i + 1) - 1
+                jj = nc*(this%iperm(this%c%i(k)) - 1)
+                do h = 1, this%nh
+                    hw = h*w
+                    call band_add(this%jb, ii + 2*h, jj + 2*h + 1, hw*this%c%x(k), ok)
+                    call band_add(this%jb, ii + 2*h + 1, jj + 2*h, -hw*this%c%x(k), ok)
+                end do
+            end do
+        end do
+        if (.not. ok) then
+            call set_status(info, FRIROM_ERR_MODEL, errmsg, 'full Jacobian: entry outside band')
+            return
+        end if
+        call contact_assemble(this%cs, kb=this%jb, iperm=this%iperm, info=info, errmsg=errmsg)
+        this%timers(T_ASM) = this%timers(T_ASM) + wtime() - t0
+        if (info /= 0) return
+        t0 = wtime()
+        call band_factor(this%jb, info, errmsg)
+        this%timers(T_FACT) = this%timers(T_FACT) + wtime() - t0
+        this%timers(N_FACT) = this%timers(N_FACT) + 1
+    end procedure full_eval
+
+    module procedure full_solve
+        real(wp) :: t0
+        t0 = wtime()
+        call band_solve(this%jb, b, info, errmsg)
+        this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
+    end procedure full_solve
+
+    module procedure full_outputs
+        integer(ip) :: j, nc, p
+        info = FRIROM_OK
+        nc = this%nc
+        do j = 1, size(this%outdofs)
+            p = this%iperm(this%outdofs(j))
+            xo(j, :) = y(nc*(p - 1) + 1:nc*p)
+        end do
+        if (.false.) xo(1, 1) = lam
+        if (.false.) errmsg = ''
+    end procedure full_outputs
+end submodule frirom_hbm_full

@@ -1,0 +1,131 @@
+!> Hill stability of frirom_hbm's periodic solutions: Floquet exponents from the
+!> linearised harmonic balance equations over all DoFs x harmonics.
+submodule (frirom_hbm) frirom_hbm_hill
+    use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_ALLOC, FRIROM_ERR_LAPACK, &
+                             FRIROM_ERR_SINGULAR, set_status
+    implicit none
+
+contains
+
+    module procedure hbm_hill
+        integer(ip), parameter :: NMAX = 4000
+        real(wp), allocatable :: jm(:, :), d1(:, :), md(:, :), a(:, :), wr(:), wi(:), &
+                                 work(:), key(:)
+        real(wp) :: w, s, hw, vl(1, 1), vr(1, 1), wq(1)
+        integer(ip), allocatable :: colmap(:), idx(:)
+        integer(ip) :: nd, nc, n, i, k, j, h, c, linfo, lwork, stat, m, t
+        info = FRIROM_OK
+        nd = sys%ndof
+        nc = sys%nc
+        n = nd*nc
+        if (size(expo) /= 2*nd) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'hbm_hill: expo needs 2 ndof')
+            return
+        end if
+        if (2*n > NMAX) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'Hill stability: 2 ndof (2H+1) '// &
+                            'exceeds 4000 (dense eigen-solve); reduce the model or H')
+            return
+        end if
+        call freq_load(sys, lam, w, s)
+        allocate (jm(n, n), d1(n, n), md(nd, nd), a(2*n, 2*n), wr(2*n), wi(2*n), key(2*n), &
+                  idx(2*n), stat=stat)
+        if (stat /= 0) then
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'Hill matrices')
+            return
+        end if
+        ! contact Jacobians at the solution (a condensed system's G has the nl DoFs as columns)
+        call hbm_contact_forces(sys, y, .true., info, errmsg)
+        if (info /= 0) return
+        select type (sys)
+        type is (hbm_condensed)
+            colmap = sys%nl
+        class default
+            colmap = [(i, i = 1, nd)]
+        end select
+        jm = 0.0_wp
+        d1 = 0.0_wp
+        md = 0.0_wp
+        call contact_assemble(sys%cs, kd=jm, info=info, errmsg=errmsg, colmap=colmap, ldc=nd)
+        if (info /= 0) return
+        do i = 1, nd
+            do k = sys%k%p(i), sys%k%p(i + 1) - 1
+                j = sys%k%i(k)
+                do c = 1, nc
+                    jm(i + nd*(c - 1), j + nd*(c - 1)) = jm(i + nd*(c - 1), j + nd*(c - 1)) + &
+                                                         sys%k%x(k)
+                end do
+            end do
+            do k = sys%m%p(i), sys%m%p(i + 1) - 1
+                j = sys%m%i(k)
+                md(i, j) = md(i, j) + sys%m%x(k)
+                do h = 1, sys%nh
+                    hw = h*w
+                    jm(i + nd*(2*h - 1), j + nd*(2*h - 1)) = &
+                        jm(i + nd*(2*h - 1), j + nd*(2*h - 1)) - hw*hw*sys%m%x(k)
+                    jm(i + nd*(2*h), j + nd*(2*h)) = jm(i + nd*(2*h), j + nd*(2*h)) - &
+                                                     hw*hw*sys%m%x(k)
+                    d1(i + nd*(2*h - 1), j + nd*(2*h)) = d1(i + nd*(2*h - 1), j + nd*(2*h)) + &
+                                                         2*hw*sys%m%x(k)
+                    d1(i + nd*(2*h), j + nd*(2*h - 1)) = d1(i + nd*(2*h), j + nd*(2*h - 1)) - &
+                                                         2*hw*sys%m%x(k)
+                end do
+            end do
+            do k = sys%c%p(i), sys%c%p(i + 1) - 1
+                j = sys%c%i(k)
+                do c = 1, nc
+                    d1(i + nd*(c - 1), j + nd*(c - 1)) = d1(i + nd*(c - 1), j + nd*(c - 1)) + &
+                                                         sys%c%x(k)
+                end do
+                do h = 1, sys%nh
+                    hw = h*w
+                    jm(i + nd*(2*h - 1), j + nd*(2*h)) = jm(i + nd*(2*h - 1), j + nd*(2*h)) + &
+                                                         hw*sys%c%x(k)
+                    jm(i + nd*(2*h), j + nd*(2*h - 1)) = jm(i + nd*(2*h), j + nd*(2*h - 1)) - &
+                                                         hw*sys%c%x(k)
+                end do
+            end do
+        end do
+        ! M^-1 applied to every harmonic row block of J and D1 (Cholesky of M)
+        call dpotrf('L', nd, md, nd, linfo)
+        if (linfo /= 0) then
+            call set_status(info, FRIROM_ERR_SINGULAR, errmsg, 'Hill: dpotrf, M not positive '// &
+                            'definite')
+            return
+        end if
+        do c = 1, nc
+            call dpotrs('L', nd, n, md, nd, jm(nd*(c - 1) + 1, 1), n, linfo)
+            call dpotrs('L', nd, n, md, nd, d1(nd*(c - 1) + 1, 1), n, linfo)
+        end do
+        a = 0.0_wp
+        do i = 1, n
+            a(i, n + i) = 1.0_wp
+        end do
+        a(n + 1:2*n, 1:n) = -jm
+        a(n + 1:2*n, n + 1:2*n) = -d1
+        deallocate (jm, d1)
+        call dgeev('N', 'N', 2*n, a, 2*n, wr, wi, vl, 1, vr, 1, wq, -1, linfo)
+        lwork = int(wq(1))
+        allocate (work(lwork))
+        call dgeev('N', 'N', 2*n, a, 2*n, wr, wi, vl, 1, vr, 1, work, lwork, linfo)
+        if (linfo /= 0) then
+            call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'Hill: dgeev did not converge')
+            return
+        end if
+        ! the 2 ndof exponents with the smallest |Im s| (selection sort, m is small)
+        key = abs(wi)
+        idx = [(i, i = 1, 2*n)]
+        m = 2*nd
+        do i = 1, m
+            k = i
+            do j = i + 1, 2*n
+                if (key(idx(j)) < key(idx(k))) k = j
+            end do
+            t = idx(i)
+            idx(i) = idx(k)
+            idx(k) = t
+            expo(i) = cmplx(wr(idx(i)), wi(idx(i)), wp)
+        end do
+        maxre = maxval(real(expo, wp))
+    end procedure hbm_hill
+end submodule frirom_hbm_hill
