@@ -146,14 +146,14 @@ contains
         end if
     end subroutine harm_set
 
-    !> Receptance columns at w from the modes (see hbm_set_modes), on the kept rows.
-    subroutine cond_receptance_modal(sys, w)
+    !> Receptance columns at w from the modes (see hbm_set_modes), on the kept rows, and
+    !> the derivatives dg of the modal factors.
+    subroutine receptance_modal(sys, w)
         type(hbm_condensed), intent(inout) :: sys
         real(wp), intent(in) :: w
         integer(ip) :: h, j, nm, nr
-        real(wp) :: hw, t0
+        real(wp) :: hw
         complex(wp), allocatable :: g(:), tmp(:, :), rows(:, :)
-        t0 = wtime()
         nm = size(sys%wm, 1)
         nr = size(sys%mrow)
         allocate (g(nm), tmp(nm, sys%nnl), rows(nr, sys%nnl))
@@ -171,6 +171,27 @@ contains
                 sys%ye0(sys%mrow, h) = matmul(ps, g*sys%qf(:, h))
                 sys%ye1(sys%mrow, h) = matmul(ps, g*sys%qf1(:, h))
             end associate
+        end do
+    end subroutine receptance_modal
+
+    !> Receptances at frequency w, h = 0..H: the columns D_h^-1 P^T and D_h^-1 fe (from
+    !> modes or from a banded factorisation of D_h) and H_nn = A + iB, cached for w.
+    subroutine cond_receptance(sys, w, info, errmsg)
+        type(hbm_condensed), intent(inout) :: sys
+        real(wp), intent(in) :: w
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        integer(ip) :: h, j
+        real(wp) :: t0
+        info = FRIROM_OK
+        t0 = wtime()
+        if (sys%modal) then
+            call receptance_modal(sys, w)
+        else
+            call receptance_banded(sys, w, info, errmsg)
+            if (info /= 0) return
+        end if
+        do h = 0, sys%nh
             do j = 1, sys%nnl
                 sys%ar(j, :, h) = real(sys%ymat(sys%nl(j), :, h), wp)
                 sys%ai(j, :, h) = aimag(sys%ymat(sys%nl(j), :, h))
@@ -178,28 +199,24 @@ contains
         end do
         sys%w_cache = w
         sys%timers(T_REC) = sys%timers(T_REC) + wtime() - t0
-    end subroutine cond_receptance_modal
+    end subroutine cond_receptance
 
-    !> Receptance columns D_h^-1 P^T and D_h^-1 fe at frequency w, h = 0..H.
-    subroutine cond_receptance(sys, w, info, errmsg)
+    !> Receptance columns D_h^-1 P^T and D_h^-1 fe at frequency w from a banded LU of
+    !> D_h = K + i h w C - (h w)^2 M per harmonic.
+    subroutine receptance_banded(sys, w, info, errmsg)
         type(hbm_condensed), intent(inout) :: sys
         real(wp), intent(in) :: w
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
         integer(ip) :: h, i, k, j, ndof, nnl
         complex(wp), allocatable :: rhs(:, :)
-        real(wp) :: hw, t0
+        real(wp) :: hw
         logical :: ok
         info = FRIROM_OK
-        if (sys%modal) then
-            call cond_receptance_modal(sys, w)
-            return
-        end if
         if (.not. allocated(sys%d%ab)) then
             call zband_init(sys%d, sys%ndof, sys%bw, sys%bw, info, errmsg)
             if (info /= 0) return
         end if
-        t0 = wtime()
         ndof = sys%ndof
         nnl = sys%nnl
         ok = .true.
@@ -242,14 +259,8 @@ contains
                 sys%ye0(i, h) = rhs(sys%iperm(i), nnl + 1)
                 sys%ye1(i, h) = rhs(sys%iperm(i), nnl + 2)
             end do
-            do j = 1, nnl
-                sys%ar(j, :, h) = real(sys%ymat(sys%nl(j), :, h), wp)
-                sys%ai(j, :, h) = aimag(sys%ymat(sys%nl(j), :, h))
-            end do
         end do
-        sys%w_cache = w
-        sys%timers(T_REC) = sys%timers(T_REC) + wtime() - t0
-    end subroutine cond_receptance
+    end subroutine receptance_banded
 
     module procedure cond_eval
         real(wp) :: w, s, t0, nx, nxe, nhf

@@ -18,7 +18,7 @@ contains
 
     module procedure full_eval
         real(wp) :: w, s, t0, hw, nfe, ndx
-        integer(ip) :: nc, i, h, ca, cb, k, ii, jj
+        integer(ip) :: nc, i, h, ca, cb, k
         logical :: ok
         real(wp), allocatable :: dl(:, :)
         info = FRIROM_OK
@@ -62,28 +62,15 @@ contains
         ok = .true.
         call band_zero(this%jb)
         do i = 1, this%ndof
-            ii = nc*(this%iperm(i) - 1)
-            do k = this%k%p(i), this%k%p(i + 1) - 1
-                jj = nc*(this%iperm(this%k%i(k)) - 1)
-                do h = 1, nc
-                    call band_add(this%jb, ii + h, jj + h, this%k%x(k), ok)
-                end do
+            do k = 1, nc
+                call add_row(this%jb, this%k, this%iperm, nc, i, k, k, 1.0_wp, ok)
             end do
-            do k = this%m%p(i), this%m%p(i + 1) - 1
-                jj = nc*(this%iperm(this%m%i(k)) - 1)
-                do h = 1, this%nh
-                    hw = h*w
-                    call band_add(this%jb, ii + 2*h, jj + 2*h, -hw*hw*this%m%x(k), ok)
-                    call band_add(this%jb, ii + 2*h + 1, jj + 2*h + 1, -hw*hw*this%m%x(k), ok)
-                end do
-            end do
-            do k = this%c%p(i), this%c%p(i + 1) - 1
-                jj = nc*(this%iperm(this%c%i(k)) - 1)
-                do h = 1, this%nh
-                    hw = h*w
-                    call band_add(this%jb, ii + 2*h, jj + 2*h + 1, hw*this%c%x(k), ok)
-                    call band_add(this%jb, ii + 2*h + 1, jj + 2*h, -hw*this%c%x(k), ok)
-                end do
+            do h = 1, this%nh
+                hw = h*w
+                call add_row(this%jb, this%m, this%iperm, nc, i, 2*h, 2*h, -hw*hw, ok)
+                call add_row(this%jb, this%m, this%iperm, nc, i, 2*h + 1, 2*h + 1, -hw*hw, ok)
+                call add_row(this%jb, this%c, this%iperm, nc, i, 2*h, 2*h + 1, hw, ok)
+                call add_row(this%jb, this%c, this%iperm, nc, i, 2*h + 1, 2*h, -hw, ok)
             end do
         end do
         if (.not. ok) then
@@ -98,6 +85,21 @@ contains
         this%timers(T_FACT) = this%timers(T_FACT) + wtime() - t0
         this%timers(N_FACT) = this%timers(N_FACT) + 1
     end procedure full_eval
+
+    !> jb(slot r of DoF i, slot c of DoF j) += alpha A(i, j) over the entries of row i of
+    !> A; slot s of DoF j is unknown s + nc (iperm(j) - 1).
+    subroutine add_row(jb, a, iperm, nc, i, r, c, alpha, ok)
+        type(band_matrix), intent(inout) :: jb
+        type(csr_matrix), intent(in) :: a
+        integer(ip), intent(in) :: iperm(:), nc, i, r, c
+        real(wp), intent(in) :: alpha
+        logical, intent(inout) :: ok   !! set to .false. when an entry falls outside the band
+        integer(ip) :: k, ii
+        ii = nc*(iperm(i) - 1)
+        do k = a%p(i), a%p(i + 1) - 1
+            call band_add(jb, ii + r, nc*(iperm(a%i(k)) - 1) + c, alpha*a%x(k), ok)
+        end do
+    end subroutine add_row
 
     module procedure full_solve
         real(wp) :: t0

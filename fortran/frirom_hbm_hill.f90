@@ -49,41 +49,21 @@ contains
         call contact_assemble(sys%cs, kd=jm, info=info, errmsg=errmsg, colmap=colmap, ldc=nd)
         if (info /= 0) return
         do i = 1, nd
-            do k = sys%k%p(i), sys%k%p(i + 1) - 1
-                j = sys%k%i(k)
-                do c = 1, nc
-                    jm(i + nd*(c - 1), j + nd*(c - 1)) = jm(i + nd*(c - 1), j + nd*(c - 1)) + &
-                                                         sys%k%x(k)
-                end do
-            end do
             do k = sys%m%p(i), sys%m%p(i + 1) - 1
-                j = sys%m%i(k)
-                md(i, j) = md(i, j) + sys%m%x(k)
-                do h = 1, sys%nh
-                    hw = h*w
-                    jm(i + nd*(2*h - 1), j + nd*(2*h - 1)) = &
-                        jm(i + nd*(2*h - 1), j + nd*(2*h - 1)) - hw*hw*sys%m%x(k)
-                    jm(i + nd*(2*h), j + nd*(2*h)) = jm(i + nd*(2*h), j + nd*(2*h)) - &
-                                                     hw*hw*sys%m%x(k)
-                    d1(i + nd*(2*h - 1), j + nd*(2*h)) = d1(i + nd*(2*h - 1), j + nd*(2*h)) + &
-                                                         2*hw*sys%m%x(k)
-                    d1(i + nd*(2*h), j + nd*(2*h - 1)) = d1(i + nd*(2*h), j + nd*(2*h - 1)) - &
-                                                         2*hw*sys%m%x(k)
-                end do
+                md(i, sys%m%i(k)) = md(i, sys%m%i(k)) + sys%m%x(k)
             end do
-            do k = sys%c%p(i), sys%c%p(i + 1) - 1
-                j = sys%c%i(k)
-                do c = 1, nc
-                    d1(i + nd*(c - 1), j + nd*(c - 1)) = d1(i + nd*(c - 1), j + nd*(c - 1)) + &
-                                                         sys%c%x(k)
-                end do
-                do h = 1, sys%nh
-                    hw = h*w
-                    jm(i + nd*(2*h - 1), j + nd*(2*h)) = jm(i + nd*(2*h - 1), j + nd*(2*h)) + &
-                                                         hw*sys%c%x(k)
-                    jm(i + nd*(2*h), j + nd*(2*h - 1)) = jm(i + nd*(2*h), j + nd*(2*h - 1)) - &
-                                                         hw*sys%c%x(k)
-                end do
+            do c = 1, nc
+                call add_row(jm, sys%k, nd, i, c, c, 1.0_wp)
+                call add_row(d1, sys%c, nd, i, c, c, 1.0_wp)
+            end do
+            do h = 1, sys%nh
+                hw = h*w
+                call add_row(jm, sys%m, nd, i, 2*h, 2*h, -hw*hw)
+                call add_row(jm, sys%m, nd, i, 2*h + 1, 2*h + 1, -hw*hw)
+                call add_row(jm, sys%c, nd, i, 2*h, 2*h + 1, hw)
+                call add_row(jm, sys%c, nd, i, 2*h + 1, 2*h, -hw)
+                call add_row(d1, sys%m, nd, i, 2*h, 2*h + 1, 2*hw)
+                call add_row(d1, sys%m, nd, i, 2*h + 1, 2*h, -2*hw)
             end do
         end do
         ! M^-1 applied to every harmonic row block of J and D1 (Cholesky of M)
@@ -128,4 +108,19 @@ contains
         end do
         maxre = maxval(real(expo, wp))
     end procedure hbm_hill
+
+    !> a(slot r of DoF i, slot c of DoF j) += alpha s(i, j) over the entries of row i of s,
+    !> for a dense a whose slot c of DoF j is index j + nd (c - 1).
+    pure subroutine add_row(a, s, nd, i, r, c, alpha)
+        real(wp), intent(inout) :: a(:, :)
+        type(csr_matrix), intent(in) :: s
+        integer(ip), intent(in) :: nd, i, r, c
+        real(wp), intent(in) :: alpha
+        integer(ip) :: k, ia, ja
+        ia = i + nd*(r - 1)
+        do k = s%p(i), s%p(i + 1) - 1
+            ja = s%i(k) + nd*(c - 1)
+            a(ia, ja) = a(ia, ja) + alpha*s%x(k)
+        end do
+    end subroutine add_row
 end submodule frirom_hbm_hill
