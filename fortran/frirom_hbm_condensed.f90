@@ -10,7 +10,6 @@ submodule (frirom_hbm) frirom_hbm_condensed
 
 contains
 
-
     module procedure cond_init
         integer(ip) :: nnl, n, stat
         info = FRIROM_OK

@@ -7,7 +7,6 @@ submodule (frirom_hbm) frirom_hbm_full
 
 contains
 
-
     module procedure full_init
         integer(ip) :: kl
         sys%n = sys%ndof*sys%nc

@@ -10,7 +10,6 @@ submodule (frirom_hbm) frirom_hbm_run
 
 contains
 
-
     module procedure hbm_setup
         integer(ip) :: nc, ng, g, nrows, row, ip0, iw0, npar, nsl, ne, nd, i, k, ncol, nnl
         integer(ip), allocatable :: colmap(:), gi2(:)
