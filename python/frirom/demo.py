@@ -60,7 +60,8 @@ def hysteresis_figure(res) -> Figure:
     ax = axes[0]
     for a, u, f, e, c in zip(res["amps"], res["ut"], res["ft"], res["energy"], res["closed"]):
         ax.plot(np.append(u, u[0]) * 1e3, np.append(f, f[0]),
-                label=f"A = {a * 1e3:.1f} mm: W = {abs(e) * 1e3:.2f} mJ (closed form {c * 1e3:.2f})")
+                label=f"A = {a * 1e3:.1f} mm: W = {abs(e) * 1e3:.2f} mJ "
+                      f"(closed form {c * 1e3:.2f})")
     ax.set(xlabel="tangential relative displacement u [mm]", ylabel="tangential force [N]",
            title="Jenkins element, kt = 1e5 N/m, mu N = 30 N")
     ax.legend(fontsize=7, loc="upper left", framealpha=0.95)
@@ -143,7 +144,8 @@ def run(out: Path) -> list[Path]:
         print(f"Jenkins A = {a * 1e3:4.1f} mm: dissipated {abs(e) * 1e3:8.4f} mJ/cycle "
               f"(closed form {c * 1e3:8.4f}, {check})")
     s = res["liftoff_states"]
-    print(f"normal-load element: stick {s[0]:.0%}, slip {s[1]:.0%}, lift-off {s[2]:.0%} of the cycle")
+    print(f"normal-load element: stick {s[0]:.0%}, slip {s[1]:.0%}, lift-off {s[2]:.0%} "
+          "of the cycle")
     for p in paths:
         print(f"wrote {p}")
     return paths
