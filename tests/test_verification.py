@@ -331,6 +331,7 @@ def normal_h5():
     return _run(m, Excitation(N_F), 0.8, 1.3, opts)
 
 
+@pytest.mark.slow
 def test_normal1d_liftoff_peak_against_time_integration(normal_h5):
     r = normal_h5["frf"]
     assert r.complete, r.message
@@ -451,6 +452,7 @@ def test_huge_preload_and_mu_give_stuck_linear_frf():
         assert np.all(r.state_fractions[:, 0, 0] == 1.0)
 
 
+@pytest.mark.slow
 def test_bundled_joint_case_against_time_integration():
     """The README's case (cases/joint, SI units: 5 DoF blade, platform damper at 100 N)
     at its peak, the same criteria as above. Reached: amplitude 0.28 %, frequency 0.03 %."""
@@ -472,6 +474,7 @@ def test_bundled_joint_case_against_time_integration():
     assert abs(w_h / w_t - 1) < 2e-3, (w_h, w_t)
 
 
+@pytest.mark.slow
 def test_joint_liftoff_variant_against_time_integration():
     """cases/joint/joint_liftoff.toml (the joint's damper as a 1-D normal-load contact,
     100 N preload balanced by a static load, 8 N at the tip, H = 9, N = 256): the run
