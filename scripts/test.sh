@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# Run the whole test suite: pytest (Python layer, against independent references) and
-# meson test (one Fortran test program per module). Needs scripts/setup.sh first.
+# Run the whole test suite: meson test (one Fortran test program per module, and the C
+# interface) and pytest (Python layer, against independent references), the tests marked
+# slow included; pytest lists the ten slowest. Needs scripts/setup.sh first.
+# Extra arguments go to pytest (e.g. `bash scripts/test.sh -m "not slow"`).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export OPENBLAS_NUM_THREADS=${OPENBLAS_NUM_THREADS:-1}
 .venv/bin/python -c "import frirom._kernels"   # rebuilds build/py if sources changed
 .venv/bin/meson test -C build/py --print-errorlogs
-.venv/bin/python -m pytest -q tests
+.venv/bin/python -m pytest -q --durations=10 tests "$@"

@@ -47,7 +47,10 @@ def test_run_writes_results(deck, tmp_path, capsys):
     assert "points in" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_resume_continues_an_interrupted_run(deck, tmp_path):
+    # no figures (test_run_writes_results checks them): the runs here only write frf.h5
+    deck.write_text(deck.read_text().replace("[outputs]\n", "[outputs]\nplot = false\n"))
     full = tmp_path / "full"
     assert main(["run", str(deck), "--out", str(full), "--quiet"]) == 0
     ref = FRF.load(full / "frf.h5")

@@ -308,6 +308,7 @@ def test_deck_errors(sector_dir):
            "next sector\\)", interface='["FLANGE_C", "RIM_R"]', contact_extra=extra)
 
 
+@pytest.mark.slow
 def test_stuck_flange_frf_resonance_at_ccx_frequency(tmp_path, capsys):
     """End to end on the case cases/bladed_sector (its make script, its deck): the deck's
     CyclicModel through the solver (frirom.solver.frf). With kt = kn = 1e13 N/m and

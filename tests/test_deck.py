@@ -28,14 +28,30 @@ def write(deckdir, text):
     return p
 
 
+# cases/joint's matrices as its K.mtx and M.mtx write them (lower triangle mirrored), N/m, kg
+JOINT_K = np.array([[5.5e6, 0.0, -1.5e6, 0.0, 0.0],
+                    [0.0, 8e6, 0.0, 0.0, 0.0],
+                    [-1.5e6, 0.0, 2.5e6, -1e6, 0.0],
+                    [0.0, 0.0, -1e6, 1.6e6, -6e5],
+                    [0.0, 0.0, 0.0, -6e5, 6e5]])
+JOINT_M = np.diag([8e-2, 8e-2, 3e-2, 3e-2, 2e-2])
+COS30 = 0.8660254037844386      # the decks' direction component, as written
+
+
 def test_joint_deck_loads():
     d = load_deck(JOINT / "joint.toml")
     assert d.n_dof == 5 and d.harmonics == 5 and d.samples == 64
-    assert d.F[4, 1] == 2.0 and np.count_nonzero(d.F) == 1
+    assert d.title == "Blade with platform friction damper"
+    assert np.array_equal(d.K.toarray(), JOINT_K) and np.array_equal(d.M.toarray(), JOINT_M)
+    assert d.dof_labels == ["platform:x", "platform:y", "blade_low:x", "blade_mid:x", "tip:x"]
+    assert d.damping["type"] == "modal" and np.array_equal(d.damping["zeta"], [0.003] * 5)
+    assert d.F.shape == (5, 6) and d.F[4, 1] == 2.0 and np.count_nonzero(d.F) == 1
     c = d.contacts[0]
-    assert c.law == "jenkins" and c.G.shape == (1, 5)
-    assert np.allclose(c.G.toarray(), [[np.cos(np.pi / 6), 0.5, 0, 0, 0]])
-    assert np.allclose(c.params, [[1e7, 0.5, 100.0]])
+    assert c.name == "damper" and c.law == "jenkins" and c.G.shape == (1, 5)
+    # the frame is normalised: equal to the deck's unit vector to round-off
+    assert np.allclose(c.G.toarray(), [[COS30, 0.5, 0, 0, 0]], rtol=0, atol=1e-15)
+    assert np.array_equal(c.params, [[1e7, 0.5, 100.0]]) and c.w0 is None
+    assert d.formulation == "condensed" and d.frequency_unit == "hz"
     assert d.outputs == [4, 0, 1] and d.output_names[0] == "tip:x"
     assert np.isclose(d.omega_start, 2 * np.pi * 400) and np.isclose(d.omega_end,
                                                                      2 * np.pi * 520)
@@ -52,11 +68,20 @@ def test_normal1d_frame_and_solver_objects(deckdir):
     c = d.contacts[0]
     Gd = c.G.toarray()
     assert c.law == "normal1d" and np.allclose(Gd @ Gd.T, np.eye(2))   # orthonormal frame
-    assert np.allclose(c.params, [[1e7, 2e7, 0.5, 100.0]]) and np.allclose(c.w0, 1e-6)
+    assert np.allclose(Gd, [[COS30, 0.5, 0, 0, 0], [-0.5, COS30, 0, 0, 0]], rtol=0, atol=1e-15)
+    assert np.array_equal(c.params, [[1e7, 2e7, 0.5, 100.0]])
+    assert c.w0.shape == (1, 1) and np.all(c.w0 == 1e-6)
     model, exc, opts = d.model(), d.excitation(), d.options()
     assert model.n_dof == 5 and model.contacts[0].name == "damper"
-    assert exc.F.shape == (5, 6)
-    assert opts.harmonics == 5 and opts.samples == 64 and opts.ds_max == 0.04
+    assert np.array_equal(model.K.toarray(), JOINT_K)
+    assert np.array_equal(model.M.toarray(), JOINT_M)
+    g = model.contacts[0]
+    assert g.law == "normal1d" and np.array_equal(g.params, c.params)
+    assert np.array_equal(g.G.toarray(), Gd)
+    assert model.damping.kind == "modal" and np.all(model.damping.zeta == 0.003)
+    assert exc.F.shape == (5, 6) and np.array_equal(exc.F, d.F)
+    assert opts.harmonics == 5 and opts.samples == 64 and opts.formulation == "condensed"
+    assert (opts.ds, opts.ds_max, opts.max_points) == (0.02, 0.04, 1000)
     assert opts.stability
 
 
@@ -70,10 +95,13 @@ amplitude = 1.0
 [[excitation.load]]""")
     d = load_deck(write(deckdir, text))
     G = d.contacts[0].G.toarray()
-    assert np.allclose(G[:, 2:4], -G[:, :2])
-    ph = np.angle(d.F[[2, 3], 1])
-    assert np.allclose(ph, [0.0, -2 * np.pi / 3])
-    assert np.isclose(d.F[4, 1], 2.0 + np.exp(-4j * np.pi / 3))
+    # relative displacement a - b along the face: platform (x, y) minus blade_low, blade_mid
+    assert np.allclose(G, [[COS30, 0.5, -COS30, -0.5, 0.0]], rtol=0, atol=1e-15)
+    # engine order 1 over the 3 DoFs (3 sectors): unit loads, sector s lags by 2 pi s / 3
+    lag = np.exp(-2j * np.pi * np.arange(3) / 3)
+    assert np.allclose(d.F[[2, 3], 1], lag[:2], rtol=0, atol=1e-15)
+    assert np.isclose(d.F[4, 1], 2.0 + lag[2])
+    assert np.count_nonzero(d.F) == 3
 
 
 def test_engine_order_loads_pattern():
@@ -181,5 +209,6 @@ def test_per_element_frames_and_parameters(deckdir):
         'directions = [[0.0, 2.0]] } ]').replace("mu = 0.5 ", "mu = [0.5, 0.2] ")
     d = load_deck(write(deckdir, text))
     G = d.contacts[0].G.toarray()
-    assert np.allclose(G[0, :2], [np.cos(np.pi / 6), 0.5]) and np.allclose(G[1, :2], [0, 1])
-    assert np.allclose(d.contacts[0].params[:, 1], [0.5, 0.2])
+    # element 0 in the contact's frame, element 1 in its own (0, 2) made unit length
+    assert np.allclose(G, [[COS30, 0.5, 0, 0, 0], [0, 1, 0, 0, 0]], rtol=0, atol=1e-15)
+    assert np.array_equal(d.contacts[0].params, [[1e7, 0.5, 100.0], [1e7, 0.2, 100.0]])

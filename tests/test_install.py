@@ -83,6 +83,7 @@ def _tool(name):
     return str(here) if here.exists() else shutil.which(name)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(shutil.which("gfortran") is None or shutil.which("pkg-config") is None,
                     reason="needs gfortran and pkg-config")
 def test_legacy_fortran_program_links_installed_library(tmp_path):

@@ -5,6 +5,8 @@ map, written in each format. Formats that store 17 significant digits must give 
 matrix back exactly (bit for bit); ccx's .sti/.mas keep 14 digits, so 1e-13 relative.
 """
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -75,6 +77,34 @@ def test_abaqus_round_trip(tmp_path, fmt):
     _same(m.K, K)
     _same(m.M, M)
     assert np.array_equal(m.dofs, dofs)
+
+
+def test_abaqus_reads_a_hand_written_matrix_output_file():
+    """tests/data/abaqus_{STIF2,MASS2}.mtx, written by hand (not by write_abaqus_matrix) in
+    the layout of Abaqus's *MATRIX GENERATE + *MATRIX OUTPUT, FORMAT=MATRIX INPUT: one line
+    'row node, row dof, column node, column dof, value' per entry of the lower triangle,
+    column by column, 16 significant digits; the stiffness file with Abaqus's '7,1, 7,1,'
+    spacing, the mass file with blanks after every comma. Nodes 7, 12 and 40 carry only
+    the DoFs the files name (node 12 has x and z, node 40 only y), so the reader must
+    build the (node, direction) map from the labels. Decimal values parse to the same
+    doubles as the literals below: the comparison is exact."""
+    data = Path(__file__).resolve().parent / "data"
+    m = io.read_abaqus(data / "abaqus_STIF2.mtx", data / "abaqus_MASS2.mtx")
+    assert m.dofs.tolist() == [[7, 1], [7, 2], [12, 1], [12, 3], [40, 2]]
+    # the files' entries mirrored into the upper triangle, N/m and kg
+    K = np.array([[4.0e6, -1.5e6, -2.0e6, 0.0, 0.0],
+                  [-1.5e6, 3.0e6, 0.0, 5.0e5, -1.0e6],
+                  [-2.0e6, 0.0, 5.0e6, 0.0, -2.5e6],
+                  [0.0, 5.0e5, 0.0, 1.234567890123457e6, 0.0],
+                  [0.0, -1.0e6, -2.5e6, 0.0, 3.5e6]])
+    M = np.array([[0.2, 0.0, 0.05, 0.0, 0.0],
+                  [0.0, 0.2, 0.0, 0.0, 0.0],
+                  [0.05, 0.0, 0.3, 0.0, 0.0],
+                  [0.0, 0.0, 0.0, 1.0e-3, 0.0],
+                  [0.0, 0.0, 0.0, 0.0, 0.15]])
+    assert np.array_equal(m.K.toarray(), K)
+    assert np.array_equal(m.M.toarray(), M)
+    assert np.array_equal(m.dof_indices(nodes=[12], directions=(3,)), [3])
 
 
 def test_abaqus_square_storage_is_checked(tmp_path):

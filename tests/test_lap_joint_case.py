@@ -10,8 +10,12 @@ Run small: a coarser mesh (element size 12 mm: 65 node pairs, 390 interface DoFs
 preload per pair raised so that the bolt load stays 2.1 kN), H = 1, a 12 N shaker, 825-880
 Hz. The paper (Sec. 3.2.1) finds the GSI-reduced nonlinear FRF on top of the unreduced one
 with 40 GSI modes; measured here: 6e-4 in peak frequency and 4e-4 in peak amplitude, so
-the bounds are 2e-3 and 2e-2 (GSI with 10 modes misses them by far: see the printed table).
+the bounds are 2e-3 and 2e-2, which 60 modes meet too (1e-4, 5e-3). Where GSI breaks
+down: with 10 or 20 modes the joint opens over 35 % and 90 % of the period at the peak
+(CB: 3 %) and the peak amplitude is 6x and 11x the CB one; asserted as more than 2x with
+lift-off above 25 %.
 At the case's own size and H = 3, cases/lap_joint/convergence.py gives the same study.
+Slow (~25 s: the CB reference alone has 413 coordinates, 260 in contact).
 """
 
 import os
@@ -70,6 +74,7 @@ def run(case, name, text, capsys, complete=True):
         capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_gsi_lap_joint_matches_cb_and_reuses_its_reduction(case, capsys):
     (case / "gsi.toml").write_text(small(40))
     built = load_deck(case / "gsi.toml")
@@ -83,18 +88,22 @@ def test_gsi_lap_joint_matches_cb_and_reuses_its_reduction(case, capsys):
 
     f_c, a_c, st_c, log_cb = run(case, "cb", small(None), capsys)
     m_g, m_c = built.model(), load_deck(case / "cb.toml").model()
-    rows = [(n, *run(case, f"gsi{n}", small(n), capsys, complete=n > 20)[:2])
+    rows = [(n, *run(case, f"gsi{n}", small(n), capsys, complete=n > 20)[:3])
             for n in (10, 20, 60)]
-    rows.insert(2, (40, f_g, a_g))
+    rows.insert(2, (40, f_g, a_g, st))
     with capsys.disabled():
         print(f"\nlap joint (65 pairs, H = 1): CB only {m_c.n_dof} coordinates, "
               f"{len(m_c.nonlinear_dofs())} contact DoFs; peak {f_c:.2f} Hz {a_c:.4e} m, "
               f"stick/slip/lift-off {np.round(st_c, 2)}")
-        for n, f, a in rows:
+        for n, f, a, s in rows:
             print(f"  GSI {n:3d} modes: peak {f:8.2f} Hz {a:.4e} m  df {f / f_c - 1:+.1e}  "
-                  f"dA {a / a_c - 1:+.1e}")
+                  f"dA {a / a_c - 1:+.1e}  lift-off {s[2]:.2f}")
         print("  " + (log + log_cb).strip().replace("\n", "\n  "))
     assert len(m_g.nonlinear_dofs()) == 40 and m_g.contacts[0].n_elem == 65
     assert st[1] > 0.3 and st_c[1] > 0.3          # the joint slips at the peak
-    assert abs(f_g / f_c - 1) < 2e-3
-    assert abs(a_g / a_c - 1) < 2e-2
+    for n, f, a, s in rows:
+        if n >= 40:          # converged: on the CB curve
+            assert abs(f / f_c - 1) < 2e-3, (n, f, f_c)
+            assert abs(a / a_c - 1) < 2e-2, (n, a, a_c)
+        else:                # too few modes: the joint opens, the amplitude is far off
+            assert a > 2 * a_c and s[2] > 0.25, (n, a, a_c, s)

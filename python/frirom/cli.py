@@ -151,12 +151,15 @@ def cmd_run(args) -> int:
         full.save_csv(out / "frf.csv")
     written = [h5] + ([out / "frf.csv"] if deck.csv else [])
     if deck.plot and len(full) > 0:
-        written.append(plot_frf(full, out / "frf.png", output_names=deck.output_names,
-                                unit=deck.frequency_unit, title=deck.title))
+        figures = {"frf.png": plot_frf(full, output_names=deck.output_names,
+                                       unit=deck.frequency_unit, title=deck.title)}
         if deck.contacts:
-            written.append(plot_states(full, out / "states.png", contact_names=names,
-                                       unit=deck.frequency_unit,
-                                       title=f"{deck.title}: contact states"))
+            figures["states.png"] = plot_states(full, contact_names=names,
+                                                unit=deck.frequency_unit,
+                                                title=f"{deck.title}: contact states")
+        for name, fig in figures.items():
+            fig.savefig(out / name)
+            written.append(out / name)
     print(f"frirom: {len(full)} points in {elapsed:.1f} s; wrote "
           + ", ".join(str(p) for p in written))
     return 0

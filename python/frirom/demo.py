@@ -17,6 +17,7 @@ import csv
 from pathlib import Path
 
 import numpy as np
+from matplotlib.figure import Figure
 
 from . import contact, harmonics
 
@@ -51,19 +52,16 @@ def compute():
                 liftoff_forces=rl.forces[0], liftoff_states=rl.states[0])
 
 
-def plot(res, out: Path) -> list[Path]:
-    """Save the demo figures into ``out``; returns the paths written."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    out.mkdir(parents=True, exist_ok=True)
-    paths = []
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
+def hysteresis_figure(res) -> Figure:
+    """Jenkins hysteresis loops, the lift-off element's loop and its forces over one
+    period; `res` from :func:`compute`. Returns a new 15 x 4.6 in Figure."""
+    fig = Figure(figsize=(15, 4.6), layout="constrained")
+    axes = fig.subplots(1, 3)
     ax = axes[0]
     for a, u, f, e, c in zip(res["amps"], res["ut"], res["ft"], res["energy"], res["closed"]):
         ax.plot(np.append(u, u[0]) * 1e3, np.append(f, f[0]),
-                label=f"A = {a * 1e3:.1f} mm: W = {abs(e) * 1e3:.2f} mJ (closed form {c * 1e3:.2f})")
+                label=f"A = {a * 1e3:.1f} mm: W = {abs(e) * 1e3:.2f} mJ "
+                      f"(closed form {c * 1e3:.2f})")
     ax.set(xlabel="tangential relative displacement u [mm]", ylabel="tangential force [N]",
            title="Jenkins element, kt = 1e5 N/m, mu N = 30 N")
     ax.legend(fontsize=7, loc="upper left", framealpha=0.95)
@@ -86,12 +84,14 @@ def plot(res, out: Path) -> list[Path]:
            title=f"one period: stick {s[0]:.0%}, slip {s[1]:.0%}, lift-off {s[2]:.0%}")
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
-    p = out / "hysteresis.png"
-    fig.savefig(p, dpi=120)
-    plt.close(fig)
-    paths.append(p)
+    return fig
 
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4), constrained_layout=True)
+
+def harmonics_figure(res) -> Figure:
+    """Force harmonic amplitudes of the Jenkins and the lift-off cases (log bars); `res`
+    from :func:`compute`. Returns a new 11 x 4 in Figure."""
+    fig = Figure(figsize=(11, 4), layout="constrained")
+    axes = fig.subplots(1, 2)
     h = np.arange(N_HARM + 1)
     width = 0.8 / len(res["amps"])
     for i, (a, f) in enumerate(zip(res["amps"], res["jenkins_forces"])):
@@ -106,14 +106,16 @@ def plot(res, out: Path) -> list[Path]:
     axes[1].set(xlabel="harmonic h", ylabel="force amplitude [N]", yscale="log",
                 title="normal load variation: mean and even harmonics appear", ylim=(1e-2, None))
     axes[1].legend(fontsize=7)
-    p = out / "harmonics.png"
-    fig.savefig(p, dpi=120)
-    plt.close(fig)
-    paths.append(p)
-    return paths
+    return fig
+
+
+def figures(res) -> dict[str, Figure]:
+    """The demo's figures by file name (``hysteresis.png``, ``harmonics.png``)."""
+    return {"hysteresis.png": hysteresis_figure(res), "harmonics.png": harmonics_figure(res)}
 
 
 def write_csv(res, out: Path) -> Path:
+    """The force harmonics of both cases as ``harmonics.csv`` in `out`."""
     p = out / "harmonics.csv"
     with p.open("w", newline="") as fh:
         w = csv.writer(fh)
@@ -127,15 +129,23 @@ def write_csv(res, out: Path) -> Path:
 
 
 def run(out: Path) -> list[Path]:
+    """Compute, save the figures (120 dpi) and the CSV into `out`, print the energy check;
+    returns the paths written."""
     res = compute()
-    paths = plot(res, out) + [write_csv(res, out)]
+    out.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for name, fig in figures(res).items():
+        fig.savefig(out / name, dpi=120)
+        paths.append(out / name)
+    paths.append(write_csv(res, out))
     for a, e, c in zip(res["amps"], res["energy"], res["closed"]):
         check = (f"relative difference {abs(e - c) / c:.1e}" if c > 0
                  else "full stick: no dissipation")
         print(f"Jenkins A = {a * 1e3:4.1f} mm: dissipated {abs(e) * 1e3:8.4f} mJ/cycle "
               f"(closed form {c * 1e3:8.4f}, {check})")
     s = res["liftoff_states"]
-    print(f"normal-load element: stick {s[0]:.0%}, slip {s[1]:.0%}, lift-off {s[2]:.0%} of the cycle")
+    print(f"normal-load element: stick {s[0]:.0%}, slip {s[1]:.0%}, lift-off {s[2]:.0%} "
+          "of the cycle")
     for p in paths:
         print(f"wrote {p}")
     return paths

@@ -1,4 +1,7 @@
-"""PNG plots of a forced response (matplotlib, Agg backend; the CLI calls these).
+"""Figures of a forced response (matplotlib). Each function builds a
+:class:`matplotlib.figure.Figure` without pyplot, so no backend and no global state are
+involved, and returns it; the caller saves it (``fig.savefig(path)``, as `frirom run`
+does).
 
 Both functions take an FRF-like object with ``omega`` (n_pts,) rad/s, ``amp_max``
 (n_pts, n_out), ``stable`` (n_pts,) bool, ``fold`` (n_pts,) bool and
@@ -7,13 +10,9 @@ Both functions take an FRF-like object with ``omega`` (n_pts,) rad/s, ``amp_max`
 
 from __future__ import annotations
 
-from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib as mpl
+import numpy as np
+from matplotlib.figure import Figure
 
 __all__ = ["plot_frf", "plot_states", "frequency_axis"]
 
@@ -38,14 +37,35 @@ def _runs(mask):
     return [(int(a), int(b), bool(mask[a])) for a, b in zip(starts, ends)]
 
 
-def plot_frf(frf, path, *, output_names=None, unit: str = "hz", title: str | None = None,
-             amplitude_unit: str = "m", log: bool | None = None) -> Path:
+def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = None,
+             amplitude_unit: str = "m", log: bool | None = None, ax=None) -> Figure:
     """Max amplitude over a period against frequency, one curve per output.
 
     Stable stretches are solid, unstable dashed (Hill's method, ``frf.stable``); folds
-    (``frf.fold``) are marked with a black diamond. Returns the PNG path.
+    (``frf.fold``) are marked with a black diamond.
+
+    Parameters
+    ----------
+    frf : FRF-like
+        See the module docstring; ``amp_max`` may also be (n_pts,).
+    output_names : list of str, optional
+        Legend entry per output (n_out,); default ``output j``.
+    unit : {"hz", "rad/s"}
+        Frequency axis unit.
+    title : str, optional
+        Axes title; default "Forced response".
+    amplitude_unit : str
+        Unit shown on the amplitude axis.
+    log : bool, optional
+        Logarithmic amplitude axis; default when the amplitudes span more than 30x.
+    ax : matplotlib.axes.Axes, optional
+        Draw on these axes; default a new 7.5 x 4.6 in Figure at 130 dpi.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure drawn on (``ax.figure`` when `ax` is given).
     """
-    path = Path(path)
     f, xlabel = frequency_axis(frf.omega, unit)
     amp = np.asarray(frf.amp_max, float)
     if amp.ndim == 1:
@@ -55,8 +75,12 @@ def plot_frf(frf, path, *, output_names=None, unit: str = "hz", title: str | Non
     fold = (np.zeros(f.size, bool) if getattr(frf, "fold", None) is None
             else np.asarray(frf.fold, bool))
     names = output_names or [f"output {j}" for j in range(amp.shape[1])]
-    fig, ax = plt.subplots(figsize=(7.5, 4.6), dpi=130)
-    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    own = ax is None
+    if own:
+        fig = Figure(figsize=(7.5, 4.6), dpi=130)
+        ax = fig.add_subplot()
+    fig = ax.figure
+    colors = mpl.rcParams["axes.prop_cycle"].by_key()["color"]
     for j in range(amp.shape[1]):
         col = colors[j % len(colors)]
         for a, b, st in _runs(stable):
@@ -85,25 +109,41 @@ def plot_frf(frf, path, *, output_names=None, unit: str = "hz", title: str | Non
     ax.set_title(title or "Forced response")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    if own:
+        fig.tight_layout()
+    return fig
 
 
-def plot_states(frf, path, *, contact_names=None, unit: str = "hz",
-                title: str | None = None) -> Path:
+def plot_states(frf, *, contact_names=None, unit: str = "hz",
+                title: str | None = None) -> Figure:
     """Fraction of the period each contact group spends in stick, slip and lift-off
-    against frequency (stacked areas, one panel per group). Returns the PNG path."""
-    path = Path(path)
+    against frequency (stacked areas, one panel per group).
+
+    Parameters
+    ----------
+    frf : FRF-like
+        See the module docstring; ``state_fractions`` may also be (n_pts, 3).
+    contact_names : list of str, optional
+        Panel title per contact group (n_groups,); default ``contact g``.
+    unit : {"hz", "rad/s"}
+        Frequency axis unit (used when the frequency is monotone along the path; else
+        the panels are drawn against the point index).
+    title : str, optional
+        Figure title; default "Contact states".
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        A new 7.5 in wide Figure at 130 dpi, 2 in high per group.
+    """
     f, xlabel = frequency_axis(frf.omega, unit)
     sf = np.asarray(frf.state_fractions, float)
     if sf.ndim == 2:
         sf = sf[:, None, :]
     ng = sf.shape[1]
     names = contact_names or [f"contact {g}" for g in range(ng)]
-    fig, axes = plt.subplots(max(ng, 1), 1, figsize=(7.5, 1.2 + 2.0 * max(ng, 1)), dpi=130,
-                             sharex=True, squeeze=False)
+    fig = Figure(figsize=(7.5, 1.2 + 2.0 * max(ng, 1)), dpi=130)
+    axes = fig.subplots(max(ng, 1), 1, sharex=True, squeeze=False)
     # along a continuation path the frequency can turn back: plot against the point order
     # mapped to frequency only when it is monotone
     mono = np.all(np.diff(f) > 0) or np.all(np.diff(f) < 0)
@@ -123,6 +163,4 @@ def plot_states(frf, path, *, contact_names=None, unit: str = "hz",
     axes[-1, 0].set_xlabel(xlabel if mono else "point along the continuation path")
     fig.suptitle(title or "Contact states", fontsize=11)
     fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return fig
