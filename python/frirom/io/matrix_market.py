@@ -15,8 +15,14 @@ __all__ = ["read_mtx", "write_mtx", "read_matrix_market", "read_dof_table",
            "write_dof_table"]
 
 
-def read_mtx(path) -> sp.csr_matrix:
-    """Square symmetric matrix from a MatrixMarket coordinate file (full CSR storage)."""
+def read_mtx(path, symmetric: bool = True) -> sp.csr_matrix:
+    """Square matrix from a MatrixMarket coordinate file (full CSR storage).
+
+    symmetric : True (default) returns a symmetric matrix: a ``symmetric`` file, or a
+    ``general`` one holding one triangle, is mirrored; a ``general`` one holding both is
+    checked (InputError if it is not symmetric). False returns the matrix the file means:
+    a ``symmetric`` file mirrored, a ``general`` one entry by entry, unchecked.
+    """
     lines = read_lines(path)
     if not lines or not lines[0].lower().startswith("%%matrixmarket"):
         fail(path, 1, "the banner '%%MatrixMarket matrix coordinate real symmetric|general'",
@@ -47,6 +53,13 @@ def read_mtx(path) -> sp.csr_matrix:
         bad = int(np.argmax(r < c))
         fail(path, 0, "lower-triangle entries only in a symmetric MatrixMarket file",
              f"entry {bad + 1}: ({r[bad]}, {c[bad]})")
+    if not symmetric and banner[4] == "general":
+        if r.min() < 1 or c.min() < 1 or r.max() > n or c.max() > n:
+            fail(path, 0, f"entries with row and column in 1..{n}",
+                 f"({r.min()}..{r.max()}, {c.min()}..{c.max()})")
+        A = sp.csr_matrix((v, (r - 1, c - 1)), shape=(n, n))
+        A.sum_duplicates()
+        return A
     return symmetric_from_triplets(path, r - 1, c - 1, v, n)
 
 
