@@ -319,11 +319,8 @@ def _excitation(ctx, exc, H, fe, labels, cyc) -> list:
     loads = exc.get("load", [])
     if not isinstance(loads, list):
         raise ctx.error("excitation.load", "an array of tables [[excitation.load]]", loads)
-    for i, ld in enumerate(loads):
-        key = f"excitation.load[{i}]"
-        if not isinstance(ld, dict):
-            raise ctx.error(key, "a table", ld)
-        unknown(ctx, ld, {"dof", "harmonic", "amplitude", "phase"}, key)
+    for key, ld in _tables(ctx, loads, "excitation.load",
+                           {"dof", "harmonic", "amplitude", "phase"}):
         if "dof" not in ld:
             raise ctx.error(f"{key}.dof", "a DoF (missing)")
         d = dof_ref(ctx, ld["dof"], f"{key}.dof", fe, labels)
@@ -345,11 +342,8 @@ def _excitation(ctx, exc, H, fe, labels, cyc) -> list:
                         "travelling wave")
     if not isinstance(eos, list):
         raise ctx.error("excitation.engine_order", "an array of tables", eos)
-    for i, eo in enumerate(eos):
-        key = f"excitation.engine_order[{i}]"
-        if not isinstance(eo, dict):
-            raise ctx.error(key, "a table", eo)
-        unknown(ctx, eo, {"eo", "dofs", "n_sectors", "amplitude", "phase", "harmonic"}, key)
+    for key, eo in _tables(ctx, eos, "excitation.engine_order",
+                           {"eo", "dofs", "n_sectors", "amplitude", "phase", "harmonic"}):
         order = number(ctx, eo, "eo", f"{key}.eo", required=True, integer=True)
         dofs = eo.get("dofs")
         if not isinstance(dofs, list) or not dofs:
@@ -370,6 +364,16 @@ def _excitation(ctx, exc, H, fe, labels, cyc) -> list:
                 k = f"{key}.dofs[{s}]" + (f"[{j}]" if isinstance(ds, list) else "")
                 out.append(Load(dof_ref(ctx, v, k, fe, labels), h, a0 * phase))
     return out
+
+
+def _tables(ctx, entries: list, prefix: str, allowed):
+    """(key path, table) of each entry of an array of tables, checked for unknown keys."""
+    for i, t in enumerate(entries):
+        key = f"{prefix}[{i}]"
+        if not isinstance(t, dict):
+            raise ctx.error(key, "a table", t)
+        unknown(ctx, t, allowed, key)
+        yield key, t
 
 
 def _frequency(ctx, fr) -> FrequencySettings:
