@@ -27,6 +27,7 @@ import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+import h5py
 import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
@@ -35,6 +36,7 @@ from .. import io as fio
 from .._errors import InputError
 from ..io import DIRECTION_NAMES
 from .cb import craig_bampton
+from .cyclic import axis_rotation
 from .interface import ContactPairs, contact_matrix, gsi_basis, local_frames, reduce_interface
 from .multistage import harmonic_indices, ms_basis, radial_line_segments
 
@@ -321,7 +323,6 @@ class ReducedModel:
         return self.T @ np.asarray(q)
 
     def save(self, path, fingerprint: str) -> None:
-        import h5py
         with h5py.File(path, "w") as h:
             h.attrs["fingerprint"] = fingerprint
             h.attrs["version"] = CACHE_VERSION
@@ -352,7 +353,6 @@ class ReducedModel:
     @classmethod
     def load(cls, path, fingerprint: str):
         """The cached model, or None if absent, unreadable or built from other inputs."""
-        import h5py
         try:
             with h5py.File(path, "r") as h:
                 if (h.attrs.get("fingerprint") != fingerprint
@@ -428,7 +428,6 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
             if not spec.cyclic or not spec.sectors:
                 raise InputError(f"{where}{p.key}.b_sector: a contact with the next sector "
                                  "needs [reduction.cyclic]")
-            from .cyclic import axis_rotation
             rot[p.name] = axis_rotation(2 * np.pi / spec.sectors, spec.axis)
         try:
             prs[p.name] = pairs_from_node_sets(model, p.a, p.b, p.normal, p.kt, p.kn, p.n_dir,
@@ -591,7 +590,6 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
 
 
 def _read_matrix(node):
-    import h5py
     if isinstance(node, h5py.Group):
         return sp.csr_matrix((node["data"][()], node["indices"][()], node["indptr"][()]),
                              shape=tuple(node.attrs["shape"]))
