@@ -54,9 +54,11 @@ def read_mtx(path, symmetric: bool = True) -> sp.csr_matrix:
         fail(path, 0, "lower-triangle entries only in a symmetric MatrixMarket file",
              f"entry {bad + 1}: ({r[bad]}, {c[bad]})")
     if not symmetric and banner[4] == "general":
-        if r.min() < 1 or c.min() < 1 or r.max() > n or c.max() > n:
-            fail(path, 0, f"entries with row and column in 1..{n}",
-                 f"({r.min()}..{r.max()}, {c.min()}..{c.max()})")
+        out = (r < 1) | (c < 1) | (r > n) | (c > n)
+        if np.any(out):
+            bad = int(np.argmax(out))
+            fail(path, 0, f"row and column indices in 1..{n}",
+                 f"entry {bad + 1}: ({r[bad]}, {c[bad]})")
         A = sp.csr_matrix((v, (r - 1, c - 1)), shape=(n, n))
         A.sum_duplicates()
         return A
