@@ -99,7 +99,8 @@ class ContactGroup:
 
     G: (n_elem*n_dir, n_dof) sparse; row e*n_dir + d gives local relative displacement d of
     element e from the model's coordinates. params: (n_elem, n_par) in the law's order
-    (see :data:`frirom.contact.LAWS`). w0: (n_elem, n_slider) initial slider positions or None (zeros).
+    (see :data:`frirom.contact.LAWS`). w0: (n_elem, n_slider) initial slider positions or
+    None (zeros).
     """
 
     law: str

@@ -52,8 +52,8 @@ __all__ = ["TimeContact", "TimeResult", "integrate", "harmonics_from_samples",
 class TimeContact:
     """One group of contact elements of the same law.
 
-    law: one of :data:`frirom.contact.LAWS`; G: (n_elem*n_dir, n_dof) dense or sparse, row e*n_dir + d
-    gives local relative displacement d of element e; params: (n_elem, n_par);
+    law: one of :data:`frirom.contact.LAWS`; G: (n_elem*n_dir, n_dof) dense or sparse, row
+    e*n_dir + d gives local relative displacement d of element e; params: (n_elem, n_par);
     w0: (n_elem, n_slider) initial slider positions (default 0: spring unstretched at zero
     relative displacement).
     """

@@ -87,6 +87,7 @@ class Deck:
         return self.M.shape[0]
 
     def damping_object(self) -> Damping:
+        """The model's :class:`frirom.model.Damping` from the [damping] table."""
         d = self.damping
         if d["type"] == "rayleigh":
             return Damping.rayleigh(d["alpha"], d["beta"])
@@ -108,6 +109,7 @@ class Deck:
                      dof_labels=self.dof_labels)
 
     def excitation(self) -> Excitation:
+        """The solver's Excitation: the loads F (n_dof, H+1) [N]."""
         return Excitation(self.F)
 
     def options(self) -> SolverOptions:

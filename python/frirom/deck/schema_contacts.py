@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..contact import LAWS
-from .fields import Context, DofRef, dof_ref, number, per_element, string, unknown, vector
+from .fields import Context, dof_ref, number, per_element, string, unknown, vector
 from .schema_model import CyclicSettings
 
 #: parameters that must be >= 0 (n0 may be negative: an initial gap)

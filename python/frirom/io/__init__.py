@@ -20,7 +20,8 @@ from .matrix_market import (read_dof_table, read_matrix_market, read_mtx, write_
 from .op4 import read_op4
 
 __all__ = ["FEModel", "DIRECTION_NAMES", "DIRECTION_NUMBERS", "read_calculix", "read_inp",
-           "write_calculix_matrices", "read_ccx_eigenvalues", "read_matrix_market", "read_mtx", "write_mtx",
+           "write_calculix_matrices", "read_ccx_eigenvalues", "read_matrix_market", "read_mtx",
+           "write_mtx",
            "read_dof_table", "write_dof_table", "read_abaqus", "write_abaqus_matrix",
            "read_hbmat", "read_hb", "write_hb", "read_ansys_mapping", "write_ansys_mapping",
            "read_op4"]
