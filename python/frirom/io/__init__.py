@@ -1,7 +1,7 @@
 """Readers of assembled FE matrices: one module per format, one result type (FEModel).
 
     read_calculix(job)                       ccx .sti/.mas/.dof + .inp (nodes, node sets)
-    read_matrix_market(K, M, dofs)           MatrixMarket coordinate + optional DoF table
+    read_matrix_market(K, M, dofs)           MatrixMarket coordinate/array + optional DoFs
     read_abaqus(K, M, fmt, dofs, inp)        Abaqus *MATRIX OUTPUT (MATRIX INPUT/COORDINATE)
     read_hbmat(K, M, mapping)                ANSYS HBMAT Harwell-Boeing (RSA/RUA) + .mapping
     read_op4(path, stiffness, mass, dofs)    NASTRAN OP4 (needs pyyeti)
