@@ -174,6 +174,15 @@ def test_bad_toml_and_bad_matrix(deckdir):
         load_deck(deckdir / "none.toml")
 
 
+def test_array_stiffness_loads_like_coordinate(deckdir):
+    """A dense MatrixMarket ``array`` K (column by column) gives the same deck."""
+    K = load_deck(write(deckdir, BASE)).K.toarray()
+    (deckdir / "K.mtx").write_text("%%MatrixMarket matrix array real general\n5 5\n"
+                                   + "".join(f"{x:.17g}\n" for x in K.ravel(order="F")))
+    d = load_deck(write(deckdir, BASE))
+    assert np.array_equal(d.K.toarray(), K) and d.K.nnz == np.count_nonzero(K)
+
+
 def test_nonsymmetric_stiffness(deckdir):
     (deckdir / "K.mtx").write_text("%%MatrixMarket matrix coordinate real general\n5 5 6\n"
                                    "1 1 1e6\n2 2 1e6\n3 3 1e6\n4 4 1e6\n5 5 1e6\n1 2 5e5\n")

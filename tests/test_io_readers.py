@@ -162,10 +162,62 @@ def test_op4_round_trip(tmp_path):
         io.read_op4(tmp_path / "km.op4", stiffness="KXX")
 
 
+# Small MatrixMarket files of each layout and field scipy reads; read_mtx must agree.
+_MTX = {
+    "array-general": "%%MatrixMarket matrix array real general\n% column by column\n3 3\n"
+                     "1.0\n4.0\n0.0\n2.0\n5.0\n7.0\n3.0\n-6.0\n9.5\n",
+    "array-symmetric": "%%MatrixMarket matrix array real symmetric\n3 3\n"
+                       "10.0\n-1.0\n2.5\n20.0\n0.0\n30.0\n",
+    "coordinate-symmetric-upper": "%%MatrixMarket matrix coordinate real symmetric\n"
+                                  "3 3 5\n1 1 4.0\n1 2 -1.5\n2 2 5.0\n1 3 0.25\n"
+                                  "3 3 6.0\n",
+    "coordinate-symmetric-lower": "%%MatrixMarket matrix coordinate real symmetric\n"
+                                  "3 3 5\n1 1 4.0\n2 1 -1.5\n2 2 5.0\n3 1 0.25\n"
+                                  "3 3 6.0\n",
+    "coordinate-integer": "%%MatrixMarket matrix coordinate integer general\n"
+                          "3 3 4\n1 1 7\n2 1 -3\n1 2 -3\n3 3 12\n",
+    "array-integer": "%%MatrixMarket matrix array integer symmetric\n2 2\n3\n-1\n8\n",
+}
+
+
+@pytest.mark.parametrize("name", list(_MTX))
+def test_read_mtx_agrees_with_scipy(tmp_path, name):
+    import scipy.io
+    p = tmp_path / f"{name}.mtx"
+    p.write_text(_MTX[name])
+    ref = scipy.io.mmread(p)
+    ref = ref.toarray() if sp.issparse(ref) else np.asarray(ref)
+    A = io.read_mtx(p, symmetric=False)
+    assert sp.isspmatrix_csr(A) and A.dtype == np.float64
+    assert np.array_equal(A.toarray(), ref)
+    if np.array_equal(ref, ref.T):
+        assert np.array_equal(io.read_mtx(p).toarray(), ref)
+    else:                                       # array-general holds both triangles
+        with pytest.raises(InputError, match="not symmetric"):
+            io.read_mtx(p)
+
+
+def test_read_mtx_refuses_both_triangles_of_a_pair_and_pattern(tmp_path):
+    p = tmp_path / "both.mtx"
+    p.write_text("%%MatrixMarket matrix coordinate real symmetric\n3 3 4\n1 1 4.0\n"
+                 "3 1 0.5\n2 2 5.0\n1 3 0.5\n")
+    with pytest.raises(InputError, match=r"both.mtx, line 6: .*line 4 holds the other"):
+        io.read_mtx(p, symmetric=False)
+    p = tmp_path / "pattern.mtx"
+    p.write_text("%%MatrixMarket matrix coordinate pattern symmetric\n2 2 2\n1 1\n2 1\n")
+    with pytest.raises(InputError, match=r"pattern.mtx, line 1: .*pattern file holds no "
+                                         r"values"):
+        io.read_mtx(p)
+    p = tmp_path / "short.mtx"
+    p.write_text("%%MatrixMarket matrix array real symmetric\n3 3\n1.0\n2.0\n")
+    with pytest.raises(InputError, match=r"short.mtx, line 4: expected 6 values"):
+        io.read_mtx(p)
+
+
 @pytest.mark.parametrize("case", [
     ("k.mtx", "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1.0\n2 1 x\n",
      "line 4", lambda p: io.read_mtx(p)),
-    ("k.mtx", "%%MatrixMarket matrix array real general\n2 2\n",
+    ("k.mtx", "%%MatrixMarket matrix coordinate complex general\n1 1 1\n1 1 1.0 0.0\n",
      "line 1", lambda p: io.read_mtx(p)),
     ("k.mtx", "%%MatrixMarket matrix coordinate real general\n2 2 2\n1 1 1.0\n2 2\n",
      "line 4", lambda p: io.read_mtx(p)),

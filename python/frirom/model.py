@@ -12,16 +12,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ._errors import NonFiniteError, ParameterError, SizeError
-
-#: Laws known to the AFT kernel: number of local directions, parameter names, sliders.
-LAWS = {
-    "jenkins": (1, ("kt", "mu", "fn0"), 1),
-    "normal1d": (2, ("kt", "kn", "mu", "n0"), 1),
-    "normal2d": (3, ("kt", "kn", "mu", "n0"), 2),
-    "cubic": (1, ("k1", "k3"), 0),
-}
-LAW_CODES = {"jenkins": 1, "normal1d": 2, "normal2d": 3, "cubic": 4}
-
+from .contact import LAWS
+from .reduction.damping import modal_damping
 
 def _as_matrix(a, name: str, n: int | None = None) -> sp.csr_matrix:
     """A square real matrix as CSR, checked for shape and finite values."""
@@ -94,14 +86,10 @@ class Damping:
         if self.kind == "rayleigh":
             return (self.alpha * M + self.beta * K).tocsr()
         if self.kind == "modal":
-            import scipy.linalg as sla
             nm = self.zeta.size
             if nm > n:
                 raise SizeError(f"damping.zeta: {nm} ratios for a model with {n} DoFs")
-            w2, phi = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, nm - 1])
-            w = np.sqrt(np.maximum(w2, 0.0))
-            mp = M @ phi
-            return sp.csr_matrix((mp * (2.0 * self.zeta * w)) @ mp.T)
+            return sp.csr_matrix(modal_damping(K, M, self.zeta, n_modes=nm)[0])
         raise ParameterError(f"damping.kind: unknown kind {self.kind!r}")
 
 
@@ -111,7 +99,8 @@ class ContactGroup:
 
     G: (n_elem*n_dir, n_dof) sparse; row e*n_dir + d gives local relative displacement d of
     element e from the model's coordinates. params: (n_elem, n_par) in the law's order
-    (see LAWS). w0: (n_elem, n_slider) initial slider positions or None (zeros).
+    (see :data:`frirom.contact.LAWS`). w0: (n_elem, n_slider) initial slider positions or
+    None (zeros).
     """
 
     law: str
@@ -124,7 +113,8 @@ class ContactGroup:
         if self.law not in LAWS:
             raise ParameterError(f"contact {self.name!r}: law {self.law!r} unknown; expected "
                                  f"one of {sorted(LAWS)}")
-        ndir, names, nsl = LAWS[self.law]
+        law = LAWS[self.law]
+        ndir, names, nsl = law.n_dir, law.parameters, law.n_slider
         try:
             self.G = sp.csr_matrix(self.G, dtype=float)
         except (TypeError, ValueError) as exc:
@@ -169,7 +159,7 @@ class ContactGroup:
 
     @property
     def n_dir(self) -> int:
-        return LAWS[self.law][0]
+        return LAWS[self.law].n_dir
 
     @property
     def n_elem(self) -> int:

@@ -27,9 +27,11 @@ import scipy.sparse as sp
 
 from . import _kernels
 from ._errors import ParameterError, SizeError, raise_for_status
-from .model import LAW_CODES, CyclicModel, Excitation, Model
+from .contact import LAWS
+from .model import CyclicModel, Excitation, Model
 from .results import FRF, FRFPoint, amplitude_max
 
+LAW_CODES = {name: law.code for name, law in LAWS.items()}   # Fortran law codes
 FORMULATIONS = {"condensed": 1, "banded": 2}
 #: Largest Hill eigenproblem (2 n_dof (2H+1)) computed; above it stability is skipped.
 HILL_MAX = 4000

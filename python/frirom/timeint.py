@@ -41,20 +41,19 @@ import numpy as np
 import scipy.linalg
 
 from ._errors import InputError
+from .contact import LAWS
 
-__all__ = ["TimeContact", "TimeResult", "integrate", "LAWS", "harmonics_from_samples",
+__all__ = ["TimeContact", "TimeResult", "integrate", "harmonics_from_samples",
            "state_from_harmonics"]
 
-#: law -> (number of local directions, number of parameters, number of slider coordinates)
-LAWS = {"jenkins": (1, 3, 1), "normal1d": (2, 4, 1), "normal2d": (3, 4, 2), "cubic": (1, 2, 0)}
 
 
 @dataclass
 class TimeContact:
     """One group of contact elements of the same law.
 
-    law: one of :data:`LAWS`; G: (n_elem*n_dir, n_dof) dense or sparse, row e*n_dir + d
-    gives local relative displacement d of element e; params: (n_elem, n_par);
+    law: one of :data:`frirom.contact.LAWS`; G: (n_elem*n_dir, n_dof) dense or sparse, row
+    e*n_dir + d gives local relative displacement d of element e; params: (n_elem, n_par);
     w0: (n_elem, n_slider) initial slider positions (default 0: spring unstretched at zero
     relative displacement).
     """
@@ -69,7 +68,8 @@ class TimeContact:
         if self.law not in LAWS:
             raise InputError(f"timeint: unknown contact law {self.law!r}; expected one of "
                              f"{sorted(LAWS)}")
-        ndir, npar, nsl = LAWS[self.law]
+        law = LAWS[self.law]
+        ndir, npar, nsl = law.n_dir, len(law.parameters), law.n_slider
         G = self.G.toarray() if hasattr(self.G, "toarray") else np.asarray(self.G, float)
         params = np.atleast_2d(np.asarray(self.params, float))
         if G.ndim != 2 or G.shape[0] % ndir:
@@ -89,11 +89,11 @@ class TimeContact:
 
     @property
     def n_elem(self) -> int:
-        return self.G.shape[0] // LAWS[self.law][0]
+        return self.G.shape[0] // LAWS[self.law].n_dir
 
     def stuck_stiffness(self) -> np.ndarray:
         """(n_dof, n_dof) stiffness the group adds when every element sticks and is closed."""
-        ndir = LAWS[self.law][0]
+        ndir = LAWS[self.law].n_dir
         p = self.params
         if self.law == "jenkins":
             k = p[:, [0]]
@@ -281,7 +281,7 @@ def integrate(M, C, K, contacts, F, omega, *, H: int = 5, periods: int = 200,
 
     groups = []
     for gi, c in enumerate(contacts):
-        ndir, _, nsl = LAWS[c.law]
+        ndir, nsl = LAWS[c.law].n_dir, LAWS[c.law].n_slider
         p = [c.params[:, j] for j in range(c.params.shape[1])]
         if w0 is not None and w0[gi] is not None:
             w = np.broadcast_to(np.asarray(w0[gi], float),

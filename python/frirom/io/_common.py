@@ -13,6 +13,8 @@ from .._errors import InputError
 
 #: Direction numbers used in ``FEModel.dofs[:, 1]``: 1-3 translations, 4-6 rotations.
 DIRECTION_NAMES = {1: "UX", 2: "UY", 3: "UZ", 4: "ROTX", 5: "ROTY", 6: "ROTZ"}
+#: The inverse map: direction name ("UX".."ROTZ") -> direction number 1..6.
+DIRECTION_NUMBERS = {name: d for d, name in DIRECTION_NAMES.items()}
 
 
 @dataclass

@@ -12,6 +12,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ._common import FEModel, fail, parse_table, read_lines, symmetric_from_triplets
+from .calculix import read_inp
 
 __all__ = ["read_abaqus", "write_abaqus_matrix"]
 
@@ -88,7 +89,6 @@ def read_abaqus(stiffness, mass=None, fmt: str = "auto", dofs=None, inp=None) ->
     model = FEModel(K=mats[0], M=mats[1] if mass is not None else None,
                     dofs=dof_map.astype(np.int64), source=[str(f) for f in files])
     if inp is not None:
-        from .calculix import read_inp
         model.node_ids, model.coords, model.node_sets, _ = read_inp(inp)
         model.source.append(str(inp))
     return model

@@ -14,6 +14,7 @@ import os
 from pathlib import Path
 
 import numpy as np
+import scipy.sparse as sp
 
 from ._common import (FEModel, fail, parse_table, read_lines, read_text,
                       symmetric_from_triplets)
@@ -222,8 +223,6 @@ def read_calculix(path, inp=None, mass: bool = True) -> FEModel:
 
 def write_calculix_matrices(job, K, M, dofs) -> None:
     """Write ``job.sti``, ``job.mas`` (upper triangles) and ``job.dof`` as ccx does."""
-    import scipy.sparse as sp
-
     job = _jobname(job)
     for A, ext in ((K, ".sti"), (M, ".mas")):
         if A is None:

@@ -16,11 +16,11 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
-from ._common import FEModel, fail, read_lines, symmetric_from_triplets
+from ._common import (DIRECTION_NAMES, DIRECTION_NUMBERS, FEModel, fail, read_lines,
+                      symmetric_from_triplets)
 
 __all__ = ["read_hb", "write_hb", "read_ansys_mapping", "write_ansys_mapping", "read_hbmat"]
 
-_LABELS = {"UX": 1, "UY": 2, "UZ": 3, "ROTX": 4, "ROTY": 5, "ROTZ": 6}
 _FMT = re.compile(r"(\d*)\s*([IEDFG])\s*(\d+)", re.IGNORECASE)
 
 
@@ -168,11 +168,11 @@ def read_ansys_mapping(path, n: int | None = None) -> np.ndarray:
         if len(parts) != 3 or not parts[1].lstrip("-").isdigit():
             fail(path, i + 1, "'equation node DoF-label'", raw)
         lab = parts[2].upper()
-        if lab not in _LABELS:
-            fail(path, i + 1, f"a structural DoF label {sorted(_LABELS)}", parts[2])
+        if lab not in DIRECTION_NUMBERS:
+            fail(path, i + 1, f"a structural DoF label {sorted(DIRECTION_NUMBERS)}", parts[2])
         eq.append(int(parts[0]))
         nd.append(int(parts[1]))
-        dr.append(_LABELS[lab])
+        dr.append(DIRECTION_NUMBERS[lab])
     if not eq:
         fail(path, len(lines), "'equation node DoF-label' lines", "none")
     eq = np.array(eq)
@@ -187,11 +187,10 @@ def read_ansys_mapping(path, n: int | None = None) -> np.ndarray:
 
 
 def write_ansys_mapping(path, dofs) -> None:
-    names = {v: k for k, v in _LABELS.items()}
     with open(path, "w") as fh:
         fh.write(" Matrix Eqn   Node       DOF\n")
         for i, (nd, d) in enumerate(np.asarray(dofs)):
-            fh.write(f"{i + 1:11d} {nd:8d} {names[int(d)]:>9}\n")
+            fh.write(f"{i + 1:11d} {nd:8d} {DIRECTION_NAMES[int(d)]:>9}\n")
 
 
 def read_hbmat(stiffness, mass=None, mapping=None) -> FEModel:

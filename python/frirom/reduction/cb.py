@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 from .._errors import InputError
 from .eigen import default_ncv, eigsh_shift_invert
@@ -185,7 +186,6 @@ def craig_bampton(model, n_modes: int, interface=None, active=None, directions=(
 def _scipy_modes_and_statics(Kss, Mss, Ksm, n_modes, sigma, tol, ncv):
     """scipy reference: eigsh in shift-invert mode on a SuperLU factor of K_ss - sigma M_ss
     (the factor eigsh would make itself), reused for the constraint modes when sigma = 0."""
-    import scipy.sparse.linalg as spla
 
     A = (Kss - sigma * Mss).tocsc() if sigma else Kss.tocsc()
     lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A")

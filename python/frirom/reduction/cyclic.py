@@ -37,7 +37,7 @@ from ..model import CyclicModel, Damping, SectorModes
 from .multistage import cylindrical_frame
 
 __all__ = ["CyclicSector", "cyclic_sector", "axis_rotation", "tran_reduce", "sector_modes",
-           "cyclic_model", "needed_indices"]
+           "cyclic_model", "needed_indices", "engine_order_loads"]
 
 
 def axis_rotation(angle: float, axis=(0.0, 0.0, 1.0)) -> np.ndarray:
@@ -383,6 +383,23 @@ def sector_modes(sector: CyclicSector, K, M, k: int, damping=None, n_modes=None,
     omega = np.sqrt(lam)
     return SectorModes(k=int(k) % sector.n_sectors, psi=psi, omega=omega,
                        zeta=_ratios(damping, omega))
+
+
+def engine_order_loads(n_dof: int, dofs, eo: int, n_sectors: int, amplitude: complex,
+                       harmonic: int = 1, H: int = 1) -> np.ndarray:
+    """Complex loads (n_dof, H+1) [N] of an engine-order travelling wave on a whole rotor.
+
+    ``dofs``: one DoF index per sector (or one list of DoFs per sector, all loaded alike);
+    sector s gets amplitude * exp(-i 2 pi eo s / n_sectors) on harmonic ``harmonic``, so
+    that f_s(t) = |A| cos(h omega t + arg A - 2 pi eo s / n_sectors): sector s lags sector
+    0 by 2 pi eo s / n_sectors (a forward travelling wave for eo > 0).
+    """
+    F = np.zeros((n_dof, H + 1), complex)
+    for s, d in enumerate(dofs):
+        phase = np.exp(-2j * np.pi * eo * s / n_sectors)
+        for j in np.atleast_1d(d):
+            F[int(j), harmonic] += amplitude * phase
+    return F
 
 
 def needed_indices(engine_order: int, n_sectors: int, harmonics: int, sign: int = -1,

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .. import _kernels
 from .._errors import InputError, NonFiniteError, raise_for_status
 
 
@@ -52,7 +53,6 @@ def eigsh_shift_invert(K, M, n_modes: int, sigma: float = 0.0, rhs=None, tol: fl
     for A, name in ((K, "K"), (M, "M")):
         if not np.all(np.isfinite(A.data)):
             raise NonFiniteError(f"{name} holds NaN or Inf")
-    from .. import _kernels
 
     kr, kc, kv = _upper_coo(K, "K")
     mr, mc, mv = _upper_coo(M, "M")

@@ -27,6 +27,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .._errors import InputError, NumericalError, SingularMatrixError, SizeError
+from ..model import ContactGroup
 
 #: reduced models up to this size are returned as dense matrices, larger ones as CSR
 DENSE_LIMIT = 3000
@@ -387,7 +388,6 @@ class InterfaceReduction:
 
     def contact_group(self, pairs: ContactPairs, law: str, params, w0=None, name: str = ""):
         """frirom.model.ContactGroup of the physical elements on the reduced coordinates."""
-        from ..model import ContactGroup   # the solver's model contract
         return ContactGroup(law=law, G=self.contact_matrix(pairs), params=params, w0=w0,
                             name=name)
 

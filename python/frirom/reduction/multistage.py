@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.linalg import block_diag
 
 from .._errors import InputError, SizeError
 from .interface import InterfaceReduction
@@ -365,7 +366,6 @@ def assemble(parts) -> InterfaceReduction:
     parts: InterfaceReduction objects; the assembled R maps to the stacked physical DoFs of
     the parts in the given order; ``kept``/``interface`` are offset accordingly.
     """
-    from scipy.linalg import block_diag
     K = block_diag(*[p.K for p in parts])
     M = block_diag(*[p.M for p in parts])
     R = sp.block_diag([p.R for p in parts]).tocsr()

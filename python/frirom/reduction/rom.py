@@ -27,11 +27,18 @@ import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+import h5py
 import numpy as np
 import scipy.sparse as sp
+from scipy.spatial import cKDTree
 
+from .. import io as fio
 from .._errors import InputError
+from ..io import DIRECTION_NAMES
+from .cb import craig_bampton
+from .cyclic import axis_rotation
 from .interface import ContactPairs, contact_matrix, gsi_basis, local_frames, reduce_interface
+from .multistage import harmonic_indices, ms_basis, radial_line_segments
 
 __all__ = ["FESource", "PairSpec", "ReductionSpec", "ReducedModel", "build_reduced_model",
            "read_fe_model", "pairs_from_node_sets", "FORMATS"]
@@ -117,7 +124,6 @@ class ReductionSpec:
 
 def read_fe_model(src: FESource):
     """The FEModel of a :class:`FESource` (through the readers of frirom.io)."""
-    from .. import io as fio
     f, o = src.files, src.options
     if src.format == "calculix":
         model = fio.read_calculix(f["job"], inp=f.get("inp"))
@@ -178,7 +184,6 @@ def pairs_from_node_sets(model, set_a: str, set_b: str | None, normal, kt: float
             xb = (xb - o) @ np.asarray(b_rotation, float).T + o
         scale = max(np.abs(xa).max(), np.abs(xb).max(), 1e-300)
         tol = 1e-6 * scale if tol is None else tol
-        from scipy.spatial import cKDTree
         dist, j = cKDTree(xb).query(xa)
         far = np.nonzero(dist > tol)[0]
         if far.size:
@@ -217,9 +222,6 @@ def pairs_from_node_sets(model, set_a: str, set_b: str | None, normal, kt: float
 # --------------------------------------------------------------------------------------------
 # the reduced model
 # --------------------------------------------------------------------------------------------
-
-_DIRECTIONS = {1: "UX", 2: "UY", 3: "UZ", 4: "ROTX", 5: "ROTY", 6: "ROTZ"}
-
 
 @dataclass
 class ReducedModel:
@@ -291,15 +293,17 @@ class ReducedModel:
         """(n, 3) reduced coordinates of the x y z DoFs of nodes kept physical ('N12:UX'),
         -1 where the DoF is absent (constrained in the FE model)."""
         pos = {lab: i for i, lab in enumerate(self.labels)}
-        return np.array([[pos.get(f"N{int(nd)}:{d}", -1) for d in ("UX", "UY", "UZ")]
+        xyz = [DIRECTION_NAMES[d] for d in (1, 2, 3)]
+        return np.array([[pos.get(f"N{int(nd)}:{d}", -1) for d in xyz]
                          for nd in np.asarray(nodes).ravel()], dtype=np.int64).reshape(-1, 3)
 
     def fe_index(self, node: int, direction: int) -> int:
         """Row of the FE DoF (node, direction) in T; InputError if absent/constrained."""
         hit = np.nonzero((self.fe_dofs[:, 0] == node) & (self.fe_dofs[:, 1] == direction))[0]
         if hit.size == 0:
-            raise InputError(f"node {node} has no DoF {_DIRECTIONS.get(direction, direction)} "
-                             "in the FE matrices (unknown node or constrained DoF)")
+            name = DIRECTION_NAMES.get(direction, direction)
+            raise InputError(f"node {node} has no DoF {name} in the FE matrices "
+                             "(unknown node or constrained DoF)")
         return int(hit[0])
 
     def dof_index(self, label: str) -> int:
@@ -319,7 +323,6 @@ class ReducedModel:
         return self.T @ np.asarray(q)
 
     def save(self, path, fingerprint: str) -> None:
-        import h5py
         with h5py.File(path, "w") as h:
             h.attrs["fingerprint"] = fingerprint
             h.attrs["version"] = CACHE_VERSION
@@ -350,7 +353,6 @@ class ReducedModel:
     @classmethod
     def load(cls, path, fingerprint: str):
         """The cached model, or None if absent, unreadable or built from other inputs."""
-        import h5py
         try:
             with h5py.File(path, "r") as h:
                 if (h.attrs.get("fingerprint") != fingerprint
@@ -377,7 +379,7 @@ class ReducedModel:
 
 def _label(model, i):
     nd, d = model.dofs[i]
-    return f"N{nd}:{_DIRECTIONS.get(int(d), d)}"
+    return f"N{nd}:{DIRECTION_NAMES.get(int(d), d)}"
 
 
 def _fingerprint(source: FESource, spec: ReductionSpec, pairs: list) -> str:
@@ -408,9 +410,6 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
     Errors name ``deck_path`` and the deck key concerned (``reduction.interface``,
     ``contacts[i]``, ...).
     """
-    from .cb import craig_bampton
-    from .multistage import harmonic_indices, ms_basis, radial_line_segments
-
     where = f"{deck_path}: "
     cache = spec.cache or Path(deck_path).with_suffix(".rom.h5")
     fp = _fingerprint(source, spec, list(pairs))
@@ -429,7 +428,6 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
             if not spec.cyclic or not spec.sectors:
                 raise InputError(f"{where}{p.key}.b_sector: a contact with the next sector "
                                  "needs [reduction.cyclic]")
-            from .cyclic import axis_rotation
             rot[p.name] = axis_rotation(2 * np.pi / spec.sectors, spec.axis)
         try:
             prs[p.name] = pairs_from_node_sets(model, p.a, p.b, p.normal, p.kt, p.kn, p.n_dir,
@@ -592,7 +590,6 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
 
 
 def _read_matrix(node):
-    import h5py
     if isinstance(node, h5py.Group):
         return sp.csr_matrix((node["data"][()], node["indices"][()], node["indptr"][()]),
                              shape=tuple(node.attrs["shape"]))

@@ -1,0 +1,351 @@
+"""The deck's build step: settings in, the model's matrices and the solver's objects out.
+
+:func:`build_deck` turns a :class:`frirom.deck.schema.DeckSettings` into a :class:`Deck`:
+it reads the matrices of ``[model]`` (or builds or reuses the reduced model of
+``[fe_model]``), resolves every DoF reference against them, assembles the contact
+matrices G and the load matrix F, and with ``[reduction.cyclic]`` computes the sector's
+modes (:mod:`frirom.deck.build_cyclic`). :meth:`Deck.model`, :meth:`Deck.excitation` and
+:meth:`Deck.options` then give the solver's objects.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse as sp
+
+from .._errors import InputError
+from ..contact import LAWS
+from ..io import DIRECTION_NAMES, read_mtx
+from ..model import ContactGroup, CyclicModel, Damping, Excitation, Model
+from ..reduction.rom import PairSpec, build_reduced_model
+from ..solver import SolverOptions
+from .build_cyclic import check_sector_contacts, cyclic_modes, cyclic_sector_of
+from .fields import Context, DofRef
+from .schema import DeckSettings
+from .schema_model import MATRIX_FORMATS
+
+
+@dataclass
+class ContactSpec:
+    """One contact group on the model's coordinates (no solver objects).
+
+    name, law : str
+        The group's name and law (a key of :data:`frirom.contact.LAWS`).
+    G : scipy.sparse.csr_matrix, (n_elem*n_dir, n_dof)
+        Row e*n_dir + d: local relative displacement d of element e.
+    params : ndarray, (n_elem, n_par)
+        Law parameters (SI units).
+    w0 : ndarray, (n_elem, n_slider), or None
+        Initial slider positions [m].
+    """
+
+    name: str
+    law: str
+    G: sp.csr_matrix
+    params: np.ndarray
+    w0: np.ndarray | None
+
+
+@dataclass
+class Deck:
+    """A checked and built deck. Frequencies in rad/s; F complex (n_dof, H+1);
+    continuation steps are the solver's dimensionless arc-length steps."""
+
+    path: Path
+    title: str
+    M: sp.csr_matrix
+    K: sp.csr_matrix
+    damping: dict             # {'type': 'rayleigh', 'alpha':, 'beta':} | modal | matrix
+    F: np.ndarray
+    contacts: list            # ContactSpec
+    harmonics: int
+    samples: int | None       # None: the solver's default
+    formulation: str
+    omega_start: float
+    omega_end: float
+    frequency_unit: str
+    continuation: dict        # the [continuation] keys given
+    solver: dict              # the [solver] tolerances given, and 'stability'
+    outputs: list             # DoF indices
+    output_names: list
+    dof_labels: list | None = None
+    plot: bool = True
+    csv: bool = True
+    raw: dict = field(default_factory=dict, repr=False)
+    reduced: object = None    # frirom.reduction.rom.ReducedModel with [fe_model]
+    log: list = field(default_factory=list)   # what the reduction did (built / reused)
+    #: with [reduction.cyclic]: {'sector': CyclicSector, 'modes': {k: SectorModes},
+    #: 'engine_order', 'single_index' (None or k*), 'sign', 'seconds'}
+    cyclic: dict | None = None
+    settings: DeckSettings | None = field(default=None, repr=False)
+
+    @property
+    def n_dof(self) -> int:
+        return self.M.shape[0]
+
+    def damping_object(self) -> Damping:
+        """The model's :class:`frirom.model.Damping` from the [damping] table."""
+        d = self.damping
+        if d["type"] == "rayleigh":
+            return Damping.rayleigh(d["alpha"], d["beta"])
+        if d["type"] == "modal":
+            return Damping.modal(d["zeta"])
+        return Damping.matrix(d["C"])
+
+    def model(self):
+        """The solver's Model, or its CyclicModel with [reduction.cyclic]."""
+        groups = [ContactGroup(law=c.law, G=c.G, params=c.params, w0=c.w0, name=c.name)
+                  for c in self.contacts]
+        if self.cyclic is not None:
+            c = self.cyclic
+            return CyclicModel(n_dof=self.n_dof, n_sectors=c["sector"].n_sectors,
+                               engine_order=c["engine_order"], modes=c["modes"],
+                               contacts=groups, sign=c["sign"],
+                               single_index=c["single_index"], dof_labels=self.dof_labels)
+        return Model(self.M, self.K, self.damping_object(), groups,
+                     dof_labels=self.dof_labels)
+
+    def excitation(self) -> Excitation:
+        """The solver's Excitation: the loads F (n_dof, H+1) [N]."""
+        return Excitation(self.F)
+
+    def options(self) -> SolverOptions:
+        """The solver's SolverOptions from the [solver] and [continuation] tables."""
+        kw = {"harmonics": self.harmonics, "samples": self.samples,
+              "formulation": self.formulation}
+        for key, name in (("tol_residual", "tol_residual"), ("tol_update", "tol_update"),
+                          ("max_iterations", "max_iter"), ("stability", "stability")):
+            if key in self.solver:
+                kw[name] = self.solver[key]
+        for key, name in (("step", "ds"), ("min_step", "ds_min"), ("max_step", "ds_max"),
+                          ("max_points", "max_points")):
+            if key in self.continuation:
+                kw[name] = self.continuation[key]
+        opts = SolverOptions(**kw)
+        if opts.ds_min > opts.ds_max or not opts.ds_min <= opts.ds <= opts.ds_max:
+            # keep the user's steps consistent with the solver's defaults for the others
+            lo, hi = min(opts.ds_min, opts.ds), max(opts.ds_max, opts.ds)
+            opts.ds_min, opts.ds_max = lo, hi
+        return opts
+
+
+def read_matrix(path: Path, fmt: str, what: str, deck_path: Path | None = None):
+    """One matrix file as scipy CSR, as stored; ``fmt`` is one of :data:`MATRIX_FORMATS`.
+
+    ``what`` names the matrix in messages (its deck key); errors in the file name the file
+    and the line (:func:`frirom.io.read_mtx`).
+    """
+    where = f"{deck_path}: " if deck_path else ""
+    if fmt != "mtx":
+        raise InputError(f"{where}model.format: expected one of {MATRIX_FORMATS}, got {fmt!r}")
+    if not path.is_file():
+        raise InputError(f"{where}{what}: matrix file {path} does not exist")
+    return read_mtx(path, symmetric=False)
+
+
+class _Builder:
+    """The state of one build: the settings, the model so far and how to name DoFs."""
+
+    def __init__(self, s: DeckSettings):
+        self.s = s
+        self.ctx = Context(s.path)
+        self.n = self.labels = self.rom = None
+        self.partner = {}         # cyclic: left-boundary node -> its right-boundary image
+
+    def run(self) -> Deck:
+        s, ctx = self.s, self.ctx
+        H = s.solver.harmonics
+        damping = {"type": s.damping.type}
+        if s.damping.type == "rayleigh":
+            damping.update(alpha=s.damping.alpha, beta=s.damping.beta)
+        elif s.damping.type == "modal":
+            damping["zeta"] = s.damping.zeta
+        rom, log, cyclic = None, [], None
+        if not s.fe:
+            M, K = self.matrices()
+            n = self.n
+            if s.damping.type == "matrix":
+                damping["C"] = self.damping_matrix(M)
+            elif s.damping.type == "modal" and s.damping.zeta.size > n:
+                raise ctx.error("damping.zeta", f"at most {n} modal ratios",
+                                s.damping.zeta.size)
+            contacts = [self.dof_contact(c) for c in s.contacts]
+        else:
+            # everything checked: build (or reuse) the reduced model, resolve the nodes
+            pairs = [PairSpec(name=c.name, a=c.a, b=c.b, normal=c.normal, tangent=c.tangent,
+                              n_dir=LAWS[c.law].n_dir, kt=c.stick[0], kn=c.stick[1],
+                              tol=c.tol, key=c.key, b_sector=c.b_sector) for c in s.contacts]
+            rom = build_reduced_model(s.fe_model, s.reduction, pairs, s.path, log=log.append)
+            M, K, n = rom.M, rom.K, rom.K.shape[0]
+            self.n, self.rom = n, rom
+            if s.cyclic is not None:
+                sector = cyclic_sector_of(s.path, rom, s.reduction, s.cyclic)
+                self.partner = check_sector_contacts(s.path, rom, sector, s.contacts)
+            contacts = [self.reduced_contact(c) for c in s.contacts]
+            if s.damping.type == "modal" and s.damping.zeta.size > n:
+                raise ctx.error("damping.zeta", f"at most {n} modal ratios (the reduced "
+                                "model's size)", s.damping.zeta.size)
+        if s.damping.type == "modal" and s.damping.every_mode and s.cyclic is None:
+            damping["zeta"] = np.full(n, s.damping.zeta[0])
+        F = np.zeros((n, H + 1), complex)
+        for ld in s.loads:
+            self.add_load(F, ld.dof, ld.harmonic, ld.amplitude)
+        if not np.any(F[:, 1:]):
+            raise ctx.error("excitation", "at least one load on a harmonic >= 1 "
+                            "([[excitation.load]] or [[excitation.engine_order]])")
+        outputs = [self.coordinate(ref) for ref in s.outputs.dofs]
+        labels = self.labels
+        onames = [ref.value.text if s.fe else (labels[j] if labels else f"dof{j}")
+                  for ref, j in zip(s.outputs.dofs, outputs)]
+        if s.cyclic is not None:
+            cyclic = cyclic_modes(s.path, sector, rom, s.cyclic, damping, H, log.append)
+        sol = s.solver
+        solver = {k: getattr(sol, k) for k in ("tol_residual", "tol_update", "max_iterations")
+                  if getattr(sol, k) is not None}
+        solver["stability"] = sol.stability
+        cont = {k: v for k, v in vars(s.continuation).items() if v is not None}
+        return Deck(path=s.path, title=s.title, M=M, K=K, damping=damping, F=F,
+                    contacts=contacts, harmonics=H, samples=sol.samples,
+                    formulation=sol.formulation, omega_start=s.frequency.omega_start,
+                    omega_end=s.frequency.omega_end, frequency_unit=s.frequency.unit,
+                    continuation=cont, solver=solver, outputs=outputs, output_names=onames,
+                    dof_labels=labels if not s.fe else list(rom.labels),
+                    plot=s.outputs.plot, csv=s.outputs.csv, raw=s.raw, reduced=rom, log=log,
+                    cyclic=cyclic, settings=s)
+
+    # ---- [model]: matrices used as they are ----
+    def matrices(self):
+        """(M, K) of [model]; sets the model's size and DoF labels."""
+        ctx, m, path = self.ctx, self.s.model, self.s.path
+        M = read_matrix(m.mass, m.format, "model.mass", path)
+        K = read_matrix(m.stiffness, m.format, "model.stiffness", path)
+        if M.shape != K.shape:
+            raise ctx.error("model.stiffness", f"a matrix of the mass matrix's shape "
+                            f"{M.shape}", K.shape)
+        n = M.shape[0]
+        if np.any(M.diagonal() <= 0):
+            i = int(np.argmax(M.diagonal() <= 0))
+            raise ctx.error("model.mass", f"a mass matrix with a positive diagonal "
+                            f"(DoF {i} has {M.diagonal()[i]})")
+        for A, key in ((M, "model.mass"), (K, "model.stiffness")):
+            asym = abs(A - A.T).max() if A.nnz else 0.0
+            if asym > 1e-8 * max(abs(A).max(), 1e-300):
+                raise ctx.error(key, "a symmetric matrix", f"max |A - A^T| = {asym:.3g}")
+        labels = None
+        if m.dof_labels is not None:
+            lp = m.dof_labels
+            labels = [s.strip() for s in lp.read_text().splitlines() if s.strip()]
+            if len(labels) != n:
+                raise ctx.error("model.dof_labels", f"{n} labels (one per line, matrix "
+                                f"order) in {lp}", f"{len(labels)} labels")
+            if len(set(labels)) != n:
+                raise ctx.error("model.dof_labels", f"unique labels in {lp}")
+        self.n, self.labels = n, labels
+        return M, K
+
+    def damping_matrix(self, M):
+        C = read_matrix(self.s.damping.file, "mtx", "damping.file", self.s.path)
+        if C.shape != M.shape:
+            raise self.ctx.error("damping.file", f"a matrix of shape {M.shape}", C.shape)
+        return C
+
+    def index(self, ref: DofRef) -> int:
+        """The 0-based DoF index of a [model] reference (an index or a label)."""
+        v, key = ref.value, ref.key
+        if isinstance(v, int):
+            if not 0 <= v < self.n:
+                raise self.ctx.error(key, f"a DoF index in 0..{self.n - 1}", v)
+            return v
+        try:
+            return self.labels.index(v)
+        except ValueError:
+            raise self.ctx.error(key, "a DoF label listed in model.dof_labels", v) from None
+
+    def dof_contact(self, c) -> ContactSpec:
+        """ContactSpec of a [model] contact: G from its elements' DoFs and frames."""
+        ndir = LAWS[c.law].n_dir
+        rows, cols, vals = [], [], []
+        for e, el in enumerate(c.elements):
+            a = [self.index(r) for r in el.a]
+            b = None if el.b is None else [self.index(r) for r in el.b]
+            if b is not None and len(b) != len(a):
+                raise self.ctx.error(f"{el.key}.b", f"{len(a)} DoFs like {el.key}.a, or "
+                                     "\"ground\"", b)
+            if b is not None and set(a) & set(b):
+                raise self.ctx.error(f"{el.key}.b", f"DoFs different from {el.key}.a", b)
+            D = el.frame
+            for d in range(ndir):
+                for j in range(len(a)):
+                    if D[d, j] != 0.0:
+                        rows.append(e * ndir + d)
+                        cols.append(a[j])
+                        vals.append(D[d, j])
+                        if b is not None:
+                            rows.append(e * ndir + d)
+                            cols.append(b[j])
+                            vals.append(-D[d, j])
+        G = sp.csr_matrix((vals, (rows, cols)), shape=(len(c.elements) * ndir, self.n))
+        return ContactSpec(name=c.name, law=c.law, G=G, params=c.params, w0=c.w0)
+
+    # ---- [fe_model]: node sets of the reduced model ----
+    def reduced_contact(self, c) -> ContactSpec:
+        """ContactSpec of a node-set contact: its physical pairs mapped by the reduction."""
+        G = self.rom.contact_matrix(c.name)
+        ne = self.rom.pairs[c.name].n_elem
+        return ContactSpec(name=c.name, law=c.law, G=G, params=np.tile(c.params, (ne, 1)),
+                           w0=None if c.w0 is None else np.tile(c.w0, (ne, 1)))
+
+    def add_load(self, F, ref: DofRef, h: int, amp: complex):
+        """Add a load to F (n, H+1); with [fe_model] a node set loads each of its nodes."""
+        if not self.s.fe:
+            F[self.index(ref), h] += amp
+            return
+        nodes = self.fe_nodes(ref)
+        key, nd = ref.key, ref.value
+        if self.partner:
+            both = sorted(a for a in nodes if self.partner.get(a) in nodes)
+            if both:
+                raise self.ctx.error(key, "a node set holding each node of the rotor once; "
+                                     f"node {both[0]} (left cyclic boundary) and node "
+                                     f"{self.partner[both[0]]} (its image on the right one) "
+                                     "would both be loaded", nd.text)
+        try:
+            for node in nodes:
+                F[:, h] += amp * self.rom.load_row(node, nd.direction)
+        except InputError as exc:
+            raise InputError(f"{self.s.path}: {key}: {exc}") from None
+
+    def coordinate(self, ref: DofRef) -> int:
+        """Model coordinate of an output DoF (a kept physical DoF of a reduced model)."""
+        if not self.s.fe:
+            return self.index(ref)
+        nodes = self.fe_nodes(ref)
+        nd = ref.value
+        if len(nodes) != 1:
+            raise self.ctx.error(ref.key, f"one node (set {nd.node} has {len(nodes)})",
+                                 nd.text)
+        lab = f"N{nodes[0]}:{DIRECTION_NAMES[nd.direction]}"
+        if lab not in self.rom.labels:
+            raise self.ctx.error(ref.key, "a DoF kept by the reduction (a node of "
+                                 "reduction.active, or of reduction.interface without "
+                                 "interface modes)", nd.text)
+        return self.rom.labels.index(lab)
+
+    def fe_nodes(self, ref: DofRef) -> list:
+        """Node ids of a "NODE:DIR" reference (a node, or every node of a set)."""
+        nd = ref.value
+        if not isinstance(nd.node, str):
+            return [nd.node]
+        ids = self.rom.node_sets.get(nd.node.upper())
+        if ids is None:
+            raise self.ctx.error(ref.key, "a node id or a node set name (known sets: "
+                                 + ", ".join(sorted(self.rom.node_sets)) + ")", nd.text)
+        return [int(i) for i in ids]
+
+
+def build_deck(settings: DeckSettings) -> Deck:
+    """The matrices, contacts, loads and outputs of checked settings, as a :class:`Deck`."""
+    return _Builder(settings).run()

@@ -1,0 +1,411 @@
+"""The deck as settings: TOML in, plain validated objects out (see docs/deck.md).
+
+:func:`parse_deck` checks every field of a deck and returns a :class:`DeckSettings`. It
+reads no matrix and reduces nothing: what needs the model (a DoF index in range, a label
+in ``model.dof_labels``, a node of a node set) is checked by :mod:`frirom.deck.build`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .._errors import InputError
+from ..reduction.rom import FESource, ReductionSpec
+from .fields import Context, DofRef, boolean, dof_ref, file, number, string, table, unknown
+from .schema_contacts import parse_contacts
+from .schema_model import (CyclicSettings, MatrixModel, parse_fe_model, parse_matrix_model,
+                           parse_reduction)
+
+try:                                   # Python >= 3.11
+    import tomllib
+except ModuleNotFoundError:            # pragma: no cover - Python 3.10 with tomli
+    try:
+        import tomli as tomllib
+    except ModuleNotFoundError:
+        tomllib = None
+
+#: frequency unit -> factor to rad/s
+FREQUENCY_UNITS = {"hz": 2.0 * math.pi, "rad/s": 1.0}
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """``[solver]``.
+
+    harmonics : int
+        H >= 1, the highest harmonic.
+    samples : int or None
+        N >= 2H+1 time samples per period of the AFT (None: the solver's default).
+    formulation : str
+        ``"condensed"`` or ``"banded"``.
+    tol_residual, tol_update : float or None
+        Newton tolerances (None: the solver's defaults).
+    max_iterations : int or None
+        Newton iterations per point (None: the solver's default).
+    stability : bool
+        Hill stability of every point (false with [reduction.cyclic]).
+    """
+
+    harmonics: int
+    samples: int | None
+    formulation: str
+    tol_residual: float | None
+    tol_update: float | None
+    max_iterations: int | None
+    stability: bool
+
+
+@dataclass(frozen=True)
+class DampingSettings:
+    """``[damping]``.
+
+    type : str
+        ``"rayleigh"``, ``"modal"`` or ``"matrix"``.
+    alpha, beta : float
+        Rayleigh C = alpha M + beta K; alpha [1/s], beta [s].
+    zeta : ndarray, (n_modes,), or None
+        Modal damping ratios in [0, 1), lowest mode first.
+    every_mode : bool
+        ``zeta`` was one number for every mode of the model.
+    file : Path or None
+        MatrixMarket file of C [N s/m], (n_dof, n_dof).
+    """
+
+    type: str
+    alpha: float = 0.0
+    beta: float = 0.0
+    zeta: np.ndarray | None = None
+    every_mode: bool = False
+    file: Path | None = None
+
+
+@dataclass(frozen=True)
+class Load:
+    """One harmonic load of ``[[excitation.load]]`` or ``[[excitation.engine_order]]``.
+
+    dof : DofRef
+        The loaded DoF (with [fe_model] a node set loads each of its nodes).
+    harmonic : int
+        h in 0..H (0: a static load).
+    amplitude : complex
+        Complex amplitude [N] (phase included): f(t) = Re(amplitude exp(i h omega t)).
+    """
+
+    dof: DofRef
+    harmonic: int
+    amplitude: complex
+
+
+@dataclass(frozen=True)
+class FrequencySettings:
+    """``[frequency]``: the range swept, in the deck's unit.
+
+    start, end : float
+        Start and end frequency (> 0, different) in ``unit``.
+    unit : str
+        ``"hz"`` or ``"rad/s"``.
+    """
+
+    start: float
+    end: float
+    unit: str
+
+    @property
+    def omega_start(self) -> float:
+        """Start [rad/s]."""
+        return self.start * FREQUENCY_UNITS[self.unit]
+
+    @property
+    def omega_end(self) -> float:
+        """End [rad/s]."""
+        return self.end * FREQUENCY_UNITS[self.unit]
+
+
+@dataclass(frozen=True)
+class ContinuationSettings:
+    """``[continuation]`` (None: the solver's default).
+
+    step, min_step, max_step : float or None
+        The solver's dimensionless arc-length steps (first, smallest, largest).
+    max_points : int or None
+        Points of the curve at most.
+    """
+
+    step: float | None = None
+    min_step: float | None = None
+    max_step: float | None = None
+    max_points: int | None = None
+
+
+@dataclass(frozen=True)
+class OutputSettings:
+    """``[outputs]``.
+
+    dofs : tuple of DofRef
+        DoFs whose harmonics are written.
+    plot, csv : bool
+        Write frf.png/states.png, frf.csv.
+    """
+
+    dofs: tuple
+    plot: bool = True
+    csv: bool = True
+
+
+@dataclass(frozen=True)
+class DeckSettings:
+    """A whole deck, checked.
+
+    path : Path
+        The deck file. title : str.
+    model : MatrixModel or None
+        ``[model]`` (None with ``[fe_model]``).
+    fe_model : FESource or None, reduction : ReductionSpec or None
+        ``[fe_model]`` and ``[reduction]`` (None with ``[model]``).
+    cyclic : CyclicSettings or None
+        ``[reduction.cyclic]``.
+    solver, damping, frequency, continuation, outputs
+        The tables of those names.
+    loads : tuple of Load
+        Every load of ``[excitation]`` (engine-order entries expanded per sector).
+    contacts : tuple of DofContact (with [model]) or NodeSetContact (with [fe_model])
+    raw : dict
+        The TOML as read.
+    """
+
+    path: Path
+    title: str
+    model: MatrixModel | None
+    fe_model: FESource | None
+    reduction: ReductionSpec | None
+    cyclic: CyclicSettings | None
+    solver: SolverSettings
+    damping: DampingSettings
+    loads: tuple
+    contacts: tuple
+    frequency: FrequencySettings
+    continuation: ContinuationSettings
+    outputs: OutputSettings
+    raw: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def fe(self) -> bool:
+        """True with [fe_model] (DoFs are FE nodes and directions)."""
+        return self.model is None
+
+
+def read_toml(path: Path) -> dict:
+    """The deck file's TOML as a dict; InputError if missing, unreadable or not TOML."""
+    if tomllib is None:
+        raise InputError(f"{path}: reading a deck needs Python >= 3.11 (tomllib) "
+                         "or the 'tomli' package")
+    try:
+        with open(path, "rb") as fh:
+            return tomllib.load(fh)
+    except FileNotFoundError:
+        raise InputError(f"{path}: deck file does not exist") from None
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read the deck ({exc.strerror})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: not valid TOML: {exc}") from None
+
+
+def parse_deck(path) -> DeckSettings:
+    """Read and check a deck file; raises :class:`frirom.InputError` on any bad field."""
+    path = Path(path)
+    raw = read_toml(path)
+    ctx = Context(path)
+    unknown(ctx, raw, {"title", "model", "fe_model", "reduction", "damping", "excitation",
+                       "contacts", "solver", "frequency", "continuation", "outputs"}, "")
+    title = string(ctx, raw, "title", "title", default=path.stem)
+
+    # structure: [model] (matrices as they are) or [fe_model] + [reduction]
+    model = source = spec = cyc = None
+    if "fe_model" in raw or "reduction" in raw:
+        if "model" in raw:
+            raise ctx.error("model", "either [model] (matrices used as they are) or "
+                            "[fe_model] + [reduction] (FE matrices to reduce), not both")
+        source = parse_fe_model(ctx, table(ctx, raw, "fe_model"))
+        spec, cyc = parse_reduction(ctx, table(ctx, raw, "reduction"))
+    else:
+        model = parse_matrix_model(ctx, table(ctx, raw, "model"))
+    fe = model is None
+    labels = not fe and model.dof_labels is not None
+
+    solver = _solver(ctx, table(ctx, raw, "solver"), cyc)
+    H = solver.harmonics
+    damping = _damping(ctx, table(ctx, raw, "damping"), fe)
+    loads = _excitation(ctx, table(ctx, raw, "excitation"), H, fe, labels, cyc)
+    contacts = parse_contacts(ctx, raw, fe, labels, cyc)
+    frequency = _frequency(ctx, table(ctx, raw, "frequency"))
+    continuation = _continuation(ctx, table(ctx, raw, "continuation", required=False))
+    outputs = _outputs(ctx, table(ctx, raw, "outputs"), fe, labels)
+    return DeckSettings(path=path, title=title, model=model, fe_model=source, reduction=spec,
+                        cyclic=cyc, solver=solver, damping=damping, loads=tuple(loads),
+                        contacts=tuple(contacts), frequency=frequency,
+                        continuation=continuation, outputs=outputs, raw=raw)
+
+
+def _solver(ctx, sol, cyc) -> SolverSettings:
+    unknown(ctx, sol, {"harmonics", "samples", "formulation", "tol_residual",
+                       "tol_update", "max_iterations", "stability"}, "solver")
+    H = number(ctx, sol, "harmonics", "solver.harmonics", required=True, integer=True,
+               minimum=1)
+    N = number(ctx, sol, "samples", "solver.samples", integer=True)
+    if N is not None and N < 2 * H + 1:
+        raise ctx.error("solver.samples", f"an integer >= 2*harmonics+1 = {2 * H + 1}", N)
+    form = string(ctx, sol, "formulation", "solver.formulation", default="condensed",
+                  choices=("condensed", "banded"))
+    tols = []
+    for k in ("tol_residual", "tol_update"):
+        v = number(ctx, sol, k, f"solver.{k}", positive=True)
+        tols.append(None if v is None else float(v))
+    max_it = number(ctx, sol, "max_iterations", "solver.max_iterations", integer=True,
+                    minimum=1)
+    stability = boolean(ctx, sol, "stability", "solver.stability", True)
+    if cyc is not None:
+        if form != "condensed":
+            raise ctx.error("solver.formulation", "'condensed' with [reduction.cyclic] "
+                            "(a cyclic sector is solved on its modal receptances)", form)
+        if sol.get("stability") is True:
+            raise ctx.error("solver.stability", "false with [reduction.cyclic] (Hill "
+                            "stability is not implemented for cyclic sectors)", True)
+        stability = False
+    return SolverSettings(harmonics=H, samples=N, formulation=form, tol_residual=tols[0],
+                          tol_update=tols[1], max_iterations=max_it, stability=stability)
+
+
+def _damping(ctx, damp, fe) -> DampingSettings:
+    dtype = string(ctx, damp, "type", "damping.type", required=True,
+                   choices=("rayleigh", "modal", "matrix"))
+    if dtype == "rayleigh":
+        unknown(ctx, damp, {"type", "alpha", "beta"}, "damping")
+        return DampingSettings(
+            "rayleigh",
+            alpha=float(number(ctx, damp, "alpha", "damping.alpha", default=0.0, nonneg=True)),
+            beta=float(number(ctx, damp, "beta", "damping.beta", default=0.0, nonneg=True)))
+    if dtype == "modal":
+        unknown(ctx, damp, {"type", "zeta"}, "damping")
+        z = damp.get("zeta")
+        if isinstance(z, (int, float)) and not isinstance(z, bool):
+            zeta = number(ctx, damp, "zeta", "damping.zeta", nonneg=True)
+            if zeta >= 1:
+                raise ctx.error("damping.zeta", "a damping ratio in [0, 1)", zeta)
+            return DampingSettings("modal", zeta=np.array([float(zeta)]), every_mode=True)
+        if isinstance(z, list) and z:
+            zeta = np.array([number(ctx, {"z": zi}, "z", f"damping.zeta[{i}]", nonneg=True)
+                             for i, zi in enumerate(z)], float)
+            if np.any(zeta >= 1):
+                i = int(np.argmax(zeta >= 1))
+                raise ctx.error(f"damping.zeta[{i}]", "a damping ratio in [0, 1)", z[i])
+            return DampingSettings("modal", zeta=zeta)
+        raise ctx.error("damping.zeta", "a damping ratio or a list of ratios "
+                        "(one per mode, lowest first)", z)
+    unknown(ctx, damp, {"type", "file"}, "damping")
+    if fe:
+        raise ctx.error("damping.type", "'rayleigh' or 'modal' with [fe_model] (a damping "
+                        "matrix file needs [model])", dtype)
+    return DampingSettings("matrix", file=file(ctx, damp, "file", "damping.file"))
+
+
+def _excitation(ctx, exc, H, fe, labels, cyc) -> list:
+    """Every load, engine-order entries expanded to one load per sector DoF."""
+    unknown(ctx, exc, {"load", "engine_order"}, "excitation")
+    out = []
+    loads = exc.get("load", [])
+    if not isinstance(loads, list):
+        raise ctx.error("excitation.load", "an array of tables [[excitation.load]]", loads)
+    for key, ld in _tables(ctx, loads, "excitation.load",
+                           {"dof", "harmonic", "amplitude", "phase"}):
+        if "dof" not in ld:
+            raise ctx.error(f"{key}.dof", "a DoF (missing)")
+        d = dof_ref(ctx, ld["dof"], f"{key}.dof", fe, labels)
+        h = number(ctx, ld, "harmonic", f"{key}.harmonic", default=1, integer=True, minimum=0)
+        if h > H:
+            raise ctx.error(f"{key}.harmonic", f"a harmonic in 0..solver.harmonics={H}", h)
+        amp = number(ctx, ld, "amplitude", f"{key}.amplitude", required=True)
+        ph = number(ctx, ld, "phase", f"{key}.phase", default=0.0)
+        if h == 0 and ph not in (0, 0.0):
+            raise ctx.error(f"{key}.phase", "0 for a static load (harmonic 0)", ph)
+        out.append(Load(d, h, amp * np.exp(1j * np.deg2rad(ph))))
+    eos = exc.get("engine_order", [])
+    if isinstance(eos, dict):
+        eos = [eos]
+    if eos and cyc is not None:
+        raise ctx.error("excitation.engine_order", "no [[excitation.engine_order]] with "
+                        "[reduction.cyclic]: give sector 0's loads in "
+                        "[[excitation.load]]; reduction.cyclic.engine_order makes them a "
+                        "travelling wave")
+    if not isinstance(eos, list):
+        raise ctx.error("excitation.engine_order", "an array of tables", eos)
+    for key, eo in _tables(ctx, eos, "excitation.engine_order",
+                           {"eo", "dofs", "n_sectors", "amplitude", "phase", "harmonic"}):
+        order = number(ctx, eo, "eo", f"{key}.eo", required=True, integer=True)
+        dofs = eo.get("dofs")
+        if not isinstance(dofs, list) or not dofs:
+            raise ctx.error(f"{key}.dofs", "a non-empty list: one DoF (or list of DoFs) "
+                            "per sector", dofs)
+        ns = number(ctx, eo, "n_sectors", f"{key}.n_sectors", default=len(dofs), integer=True,
+                    minimum=1)
+        h = number(ctx, eo, "harmonic", f"{key}.harmonic", default=1, integer=True, minimum=1)
+        if h > H:
+            raise ctx.error(f"{key}.harmonic", f"a harmonic in 1..solver.harmonics={H}", h)
+        amp = number(ctx, eo, "amplitude", f"{key}.amplitude", required=True)
+        ph = number(ctx, eo, "phase", f"{key}.phase", default=0.0)
+        a0 = amp * np.exp(1j * np.deg2rad(ph))
+        for s, ds in enumerate(dofs):
+            phase = np.exp(-2j * np.pi * order * s / ns)     # as engine_order_loads
+            items = ds if isinstance(ds, list) else [ds]
+            for j, v in enumerate(items):
+                k = f"{key}.dofs[{s}]" + (f"[{j}]" if isinstance(ds, list) else "")
+                out.append(Load(dof_ref(ctx, v, k, fe, labels), h, a0 * phase))
+    return out
+
+
+def _tables(ctx, entries: list, prefix: str, allowed):
+    """(key path, table) of each entry of an array of tables, checked for unknown keys."""
+    for i, t in enumerate(entries):
+        key = f"{prefix}[{i}]"
+        if not isinstance(t, dict):
+            raise ctx.error(key, "a table", t)
+        unknown(ctx, t, allowed, key)
+        yield key, t
+
+
+def _frequency(ctx, fr) -> FrequencySettings:
+    unknown(ctx, fr, {"start", "end", "unit"}, "frequency")
+    unit = string(ctx, fr, "unit", "frequency.unit", default="hz",
+                  choices=tuple(FREQUENCY_UNITS))
+    f0 = number(ctx, fr, "start", "frequency.start", required=True, positive=True)
+    f1 = number(ctx, fr, "end", "frequency.end", required=True, positive=True)
+    if f1 == f0:
+        raise ctx.error("frequency.end", "a frequency different from frequency.start", f1)
+    return FrequencySettings(start=f0, end=f1, unit=unit)
+
+
+def _continuation(ctx, con) -> ContinuationSettings:
+    unknown(ctx, con, {"step", "min_step", "max_step", "max_points"}, "continuation")
+    steps = {}
+    for k in ("step", "min_step", "max_step"):
+        v = number(ctx, con, k, f"continuation.{k}", positive=True)
+        if v is not None:
+            steps[k] = float(v)
+    if "min_step" in steps and "max_step" in steps and steps["min_step"] > steps["max_step"]:
+        raise ctx.error("continuation.min_step", "a value <= continuation.max_step",
+                        con["min_step"])
+    n = number(ctx, con, "max_points", "continuation.max_points", integer=True, minimum=2)
+    return ContinuationSettings(**steps, max_points=n)
+
+
+def _outputs(ctx, out, fe, labels) -> OutputSettings:
+    unknown(ctx, out, {"dofs", "plot", "csv"}, "outputs")
+    od = out.get("dofs")
+    if not isinstance(od, list) or not od:
+        raise ctx.error("outputs.dofs", "a non-empty list of DoFs", od)
+    dofs = tuple(dof_ref(ctx, v, f"outputs.dofs[{i}]", fe, labels) for i, v in enumerate(od))
+    return OutputSettings(dofs=dofs, plot=boolean(ctx, out, "plot", "outputs.plot", True),
+                          csv=boolean(ctx, out, "csv", "outputs.csv", True))

@@ -1,0 +1,242 @@
+"""The deck's ``[[contacts]]`` tables as settings: elements between DoFs (with [model]) or
+pairs between node sets (with [fe_model]). The law table is :data:`frirom.contact.LAWS`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..contact import LAWS
+from .fields import Context, dof_ref, number, per_element, string, unknown, vector
+from .schema_model import CyclicSettings
+
+#: parameters that must be >= 0 (n0 may be negative: an initial gap)
+_NONNEGATIVE = {"kt", "kn", "mu", "fn0"}
+
+
+@dataclass(frozen=True)
+class ContactElement:
+    """One element of a ``[[contacts]]`` table with [model].
+
+    a : tuple of DofRef
+        The node DoFs of side a (n_nd of them).
+    b : tuple of DofRef or None
+        As many DoFs of side b, or None for the ground.
+    frame : ndarray, (n_dir, n_nd)
+        Unit vectors of the law's local directions in the node DoFs.
+    key : str
+        Key path of the element (``contacts[0].elements[1]``).
+    """
+
+    a: tuple
+    b: tuple | None
+    frame: np.ndarray
+    key: str
+
+
+@dataclass(frozen=True)
+class DofContact:
+    """A ``[[contacts]]`` table with [model]: elements joining DoFs of the matrices.
+
+    name, law : str
+        The group's name and its law (a key of :data:`frirom.contact.LAWS`).
+    elements : tuple of ContactElement
+        n_elem elements.
+    params : ndarray, (n_elem, n_par)
+        Law parameters in the order of ``LAWS[law].parameters`` (SI units).
+    w0 : ndarray, (n_elem, n_slider), or None
+        Initial slider positions [m] (None: zeros).
+    """
+
+    name: str
+    law: str
+    elements: tuple
+    params: np.ndarray
+    w0: np.ndarray | None
+
+
+@dataclass(frozen=True)
+class NodeSetContact:
+    """A ``[[contacts]]`` table with [fe_model]: pairs between node sets.
+
+    name, law : str
+        As for :class:`DofContact`.
+    a, b : str, str or None
+        Node sets of the two sides (b None: the ground).
+    normal : str or tuple
+        A 3-vector, or ``"axial"``, ``"radial"`` or ``"tangential"`` (about reduction.axis).
+    tangent : tuple or None
+        A 3-vector for the first tangential direction.
+    tol : float or None
+        Pair matching distance [m].
+    params : ndarray, (n_par,)
+        Law parameters, the same for every pair.
+    w0 : ndarray, (n_slider,), or None
+        Initial slider position [m].
+    stick : tuple of 2 float
+        (kt, kn) [N/m] of the full-stick interface modes (kn 0 for a law without).
+    key : str
+        Key path of the table (``contacts[0]``).
+    b_sector : int
+        0: side b in sector 0; 1: side b in the next sector (cyclic).
+    """
+
+    name: str
+    law: str
+    a: str
+    b: str | None
+    normal: object
+    tangent: tuple | None
+    tol: float | None
+    params: np.ndarray
+    w0: np.ndarray | None
+    stick: tuple
+    key: str
+    b_sector: int = 0
+
+
+def parse_contacts(ctx: Context, raw: dict, fe: bool, labels: bool,
+                   cyclic: CyclicSettings | None) -> list:
+    """Every ``[[contacts]]`` table, checked (``fe``, ``labels`` as :func:`dof_ref`)."""
+    cons = raw.get("contacts", [])
+    if not isinstance(cons, list):
+        raise ctx.error("contacts", "an array of tables [[contacts]]", cons)
+    if cyclic is not None and not cons:
+        raise ctx.error("contacts", "at least one [[contacts]] table with "
+                        "[reduction.cyclic] (a cyclic sector is solved for its contacts)")
+    contacts = [_contact(ctx, c, f"contacts[{i}]", fe, labels, cyclic)
+                for i, c in enumerate(cons)]
+    names = [c.name for c in contacts]
+    for i, nm in enumerate(names):
+        if nm in names[:i]:
+            raise ctx.error(f"contacts[{i}].name", "a name not used by another contact", nm)
+    return contacts
+
+
+def _contact(ctx, c, key, fe, labels, cyclic):
+    if not isinstance(c, dict):
+        raise ctx.error(key, "a table [[contacts]]", c)
+    law = string(ctx, c, "law", f"{key}.law", required=True, choices=tuple(LAWS))
+    if fe:
+        return _node_set_contact(ctx, c, key, law, cyclic)
+    dirs, pnames = LAWS[law].directions, LAWS[law].parameters
+    ndir = len(dirs)
+    unknown(ctx, c, {"name", "law", "elements", "directions", "w0"} | set(pnames), key)
+    name = string(ctx, c, "name", f"{key}.name", default=key)
+    els = c.get("elements")
+    if not isinstance(els, list) or not els:
+        raise ctx.error(f"{key}.elements", "a non-empty list of {a = ..., b = ...} "
+                        "tables", els)
+    # local frame: directions (ndir vectors, node-DoF length) shared or per element
+    dv = c.get("directions")
+    elements = []
+    for e, el in enumerate(els):
+        ek = f"{key}.elements[{e}]"
+        if not isinstance(el, dict):
+            raise ctx.error(ek, "a table {a = [DoFs], b = [DoFs] | \"ground\"}", el)
+        unknown(ctx, el, {"a", "b", "directions"}, ek)
+        a = _side(ctx, el.get("a"), f"{ek}.a", labels, allow_ground=False)
+        b = _side(ctx, el.get("b", "ground"), f"{ek}.b", labels, allow_ground=True)
+        frame = el.get("directions", dv)
+        fk = f"{ek}.directions" if "directions" in el else f"{key}.directions"
+        if frame is None:
+            if len(a) == ndir:
+                frame = np.eye(ndir).tolist()
+            else:
+                raise ctx.error(f"{key}.directions", f"{ndir} direction vectors "
+                                f"({', '.join(dirs)}) of length {len(a)} (node DoFs)")
+        elements.append(ContactElement(a=a, b=b, frame=_frame(ctx, frame, fk, len(a), dirs),
+                                       key=ek))
+    params, w0 = _law_parameters(ctx, c, key, law, len(els))
+    return DofContact(name=name, law=law, elements=tuple(elements), params=params, w0=w0)
+
+
+def _side(ctx, v, key, labels, allow_ground):
+    """The DoFs of one side of an element (None: the ground)."""
+    if v is None:
+        raise ctx.error(key, "a DoF or list of DoFs (missing)")
+    if isinstance(v, str) and v.lower() == "ground":
+        if allow_ground:
+            return None
+        raise ctx.error(key, "DoFs (only side b may be \"ground\")", v)
+    items = v if isinstance(v, list) else [v]
+    if not items:
+        raise ctx.error(key, "a non-empty list of DoFs", v)
+    return tuple(dof_ref(ctx, x, f"{key}[{i}]" if isinstance(v, list) else key, False, labels)
+                 for i, x in enumerate(items))
+
+
+def _frame(ctx, frame, key, nd, dirs) -> np.ndarray:
+    """(n_dir, nd) unit direction vectors of a local frame."""
+    ndir = len(dirs)
+    if not isinstance(frame, list) or len(frame) != ndir:
+        raise ctx.error(key, f"{ndir} direction vectors ({', '.join(dirs)})", frame)
+    D = np.empty((ndir, nd))
+    for d, vec in enumerate(frame):
+        if (not isinstance(vec, list) or len(vec) != nd
+                or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in vec)):
+            raise ctx.error(f"{key}[{d}]", f"a list of {nd} numbers (one per node DoF)", vec)
+        D[d] = vec
+        nrm = np.linalg.norm(D[d])
+        if not np.isfinite(nrm) or nrm == 0.0:
+            raise ctx.error(f"{key}[{d}]", "a non-zero finite vector", vec)
+        D[d] /= nrm
+    return D
+
+
+def _law_parameters(ctx, c, key, law, ne):
+    """(params (ne, n_par), w0 (ne, n_slider) or None) of a contact table."""
+    pnames, nsl = LAWS[law].parameters, LAWS[law].n_slider
+    params = np.empty((ne, len(pnames)))
+    for j, p in enumerate(pnames):
+        params[:, j] = per_element(ctx, c, p, f"{key}.{p}", ne, required=True,
+                                   nonneg=p in _NONNEGATIVE)
+    if "kt" in pnames and np.any(params[:, 0] <= 0):
+        raise ctx.error(f"{key}.kt", "a positive tangential stiffness (N/m)")
+    if "kn" in pnames and np.any(params[:, 1] <= 0):
+        raise ctx.error(f"{key}.kn", "a positive normal stiffness (N/m)")
+    w0 = None
+    if "w0" in c:
+        if nsl == 0:
+            raise ctx.error(f"{key}.w0", f"no initial slider for law {law!r} (it has none)")
+        w0 = np.repeat(per_element(ctx, c, "w0", f"{key}.w0", ne)[:, None], nsl, axis=1)
+    return params, w0
+
+
+def _node_set_contact(ctx, c, key, law, cyclic):
+    """A [[contacts]] table of a reduced model: node sets a, b, a normal."""
+    pnames = LAWS[law].parameters
+    unknown(ctx, c, {"name", "law", "a", "b", "b_sector", "normal", "tangent", "tol",
+                     "w0"} | set(pnames), key)
+    name = string(ctx, c, "name", f"{key}.name", default=f"contacts{key[9:-1]}")
+    a = string(ctx, c, "a", f"{key}.a", required=True)
+    b = string(ctx, c, "b", f"{key}.b", default="ground")
+    b = None if b.lower() == "ground" else b
+    bs = number(ctx, c, "b_sector", f"{key}.b_sector", default=0, integer=True)
+    if bs not in (0, 1):
+        raise ctx.error(f"{key}.b_sector", "0 (side b in sector 0) or 1 (side b in the "
+                        "next sector)", bs)
+    if bs == 1 and cyclic is None:
+        raise ctx.error(f"{key}.b_sector", "0 without [reduction.cyclic] (a contact with "
+                        "the next sector needs a cyclic sector)", bs)
+    if bs == 1 and b is None:
+        raise ctx.error(f"{key}.b", "a node set of the next sector with b_sector = 1, "
+                        "not the ground", "ground")
+    normal = c.get("normal")
+    if isinstance(normal, str):
+        normal = string(ctx, c, "normal", f"{key}.normal",
+                        choices=("axial", "radial", "tangential"))
+    else:
+        normal = vector(ctx, c, "normal", f"{key}.normal")
+    tangent = vector(ctx, c, "tangent", f"{key}.tangent") if "tangent" in c else None
+    tol = number(ctx, c, "tol", f"{key}.tol", positive=True)
+    for p in [*pnames, "w0"]:
+        if isinstance(c.get(p), list):
+            raise ctx.error(f"{key}.{p}", "a number (the same for every pair of the "
+                            "node sets)", c[p])
+    params, w0 = _law_parameters(ctx, c, key, law, 1)
+    stick = (params[0, 0], params[0, 1] if "kn" in pnames else 0.0)
+    return NodeSetContact(name=name, law=law, a=a, b=b, normal=normal, tangent=tangent,
+                          tol=tol, params=params[0], w0=None if w0 is None else w0[0],
+                          stick=tuple(float(x) for x in stick), key=key, b_sector=bs)

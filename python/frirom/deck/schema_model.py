@@ -1,0 +1,197 @@
+"""The deck's structure tables as settings: ``[model]``, or ``[fe_model]`` + ``[reduction]``
+(+ ``[reduction.cyclic]``). Checked, not read: no matrix file is opened here."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..reduction.rom import FORMATS, FESource, ReductionSpec
+from .fields import Context, boolean, file, integers, names, number, string, table, unknown, \
+    vector
+
+#: formats of the matrix files of [model]
+MATRIX_FORMATS = ("mtx",)
+
+
+@dataclass(frozen=True)
+class MatrixModel:
+    """``[model]``: assembled matrices used as they are.
+
+    format : str
+        One of :data:`MATRIX_FORMATS` (``"mtx"``: MatrixMarket coordinate).
+    mass, stiffness : Path
+        Absolute paths of M [kg] and K [N/m], (n_dof, n_dof) each.
+    dof_labels : Path or None
+        A text file of n_dof labels, one per line in matrix order.
+    """
+
+    format: str
+    mass: Path
+    stiffness: Path
+    dof_labels: Path | None
+
+
+@dataclass(frozen=True)
+class CyclicSettings:
+    """``[reduction.cyclic]``: the reduced model is sector 0 of a tuned rotor.
+
+    sectors : int
+        N >= 2 sectors.
+    left, right : str
+        Node sets of the sector's cyclic boundaries.
+    dependent : str
+        ``"right"`` or ``"left"``: the boundary eliminated by the cyclic constraint.
+    engine_order : int
+        EO of the travelling-wave excitation.
+    boundary_modes : int or None
+        Tran interface modes of the boundary (None: the boundary DoFs are kept).
+    modes : int or None
+        Sector modes per harmonic index (None: all).
+    tol : float or None
+        Boundary matching distance [m] (None: relative to the model size).
+    single_index : int or None
+        None: every harmonic on its own index k_h; k* in 0..N-1: the one-index
+        approximation.
+    """
+
+    sectors: int
+    left: str
+    right: str
+    dependent: str
+    engine_order: int
+    boundary_modes: int | None
+    modes: int | None
+    tol: float | None
+    single_index: int | None
+
+
+def parse_matrix_model(ctx: Context, mdl: dict) -> MatrixModel:
+    """The checked ``[model]`` table."""
+    unknown(ctx, mdl, {"format", "mass", "stiffness", "dof_labels"}, "model")
+    fmt = string(ctx, mdl, "format", "model.format", default="mtx", choices=MATRIX_FORMATS)
+    mass = file(ctx, mdl, "mass", "model.mass")
+    stiffness = file(ctx, mdl, "stiffness", "model.stiffness")
+    labels = file(ctx, mdl, "dof_labels", "model.dof_labels") if "dof_labels" in mdl \
+        else None
+    return MatrixModel(format=fmt, mass=mass, stiffness=stiffness, dof_labels=labels)
+
+
+def parse_fe_model(ctx: Context, fe: dict) -> FESource:
+    """The checked ``[fe_model]`` table (its files must exist)."""
+    fmt = string(ctx, fe, "format", "fe_model.format", required=True, choices=tuple(FORMATS))
+    roles, required = FORMATS[fmt]
+    opts = {"abaqus": ("layout",), "op4": ("stiffness_name", "mass_name")}.get(fmt, ())
+    unknown(ctx, fe, {"format", *roles, *opts}, "fe_model")
+    files = {}
+    for r in roles:
+        if r in fe or r in required:
+            files[r] = file(ctx, fe, r, f"fe_model.{r}")
+    options = {}
+    for o in opts:
+        v = string(ctx, fe, o, f"fe_model.{o}",
+                   choices=("auto", "matrix", "coordinate") if o == "layout" else None)
+        if v is not None:
+            options[o] = v
+    for r, f in files.items():
+        if fmt == "calculix" and r == "job":
+            for sfx in (".sti", ".mas", ".dof") + ((".inp",) if "inp" not in files else ()):
+                if not f.with_suffix(sfx).is_file():
+                    raise ctx.error("fe_model.job", f"a job name whose {sfx} file exists "
+                                    "(run ccx with *FREQUENCY, SOLVER=MATRIXSTORAGE)",
+                                    str(f.with_suffix(sfx)))
+        elif not f.is_file():
+            raise ctx.error(f"fe_model.{r}", "an existing file", str(f))
+    return FESource(fmt, files, options)
+
+
+def parse_reduction(ctx: Context, red: dict) -> tuple[ReductionSpec, CyclicSettings | None]:
+    """The checked ``[reduction]`` table and its ``[reduction.cyclic]`` (or None)."""
+    if "pairs" in red:
+        raise ctx.error("reduction.pairs", "no [[reduction.pairs]]: contact pairs are "
+                        "[[contacts]] tables with node sets a, b and a normal")
+    unknown(ctx, red, {"interface", "active", "fixed_interface_modes", "cache",
+                       "interface_modes", "cyclic", "axis", "origin"}, "reduction")
+    iface = names(ctx, red, "interface", "reduction.interface", required=True)
+    active = names(ctx, red, "active", "reduction.active", required=False)
+    n_cb = number(ctx, red, "fixed_interface_modes", "reduction.fixed_interface_modes",
+                  integer=True, minimum=0)
+    cache = file(ctx, red, "cache", "reduction.cache") if "cache" in red else \
+        ctx.path.with_suffix(".rom.h5")
+    pre = "reduction.interface_modes"
+    im = table(ctx, red, pre, required=False)
+    method = string(ctx, im, "method", f"{pre}.method", default="none",
+                    choices=("none", "gsi", "ms"))
+    allowed = {"none": {"method"}, "gsi": {"method", "free", "stick", "per_side"},
+               "ms": {"method", "sectors", "engine_orders", "time_harmonics", "axis",
+                      "origin"}}[method]
+    unknown(ctx, im, allowed, pre)
+    kw = {}
+    if method == "gsi":
+        kw["free"] = number(ctx, im, "free", f"{pre}.free", default=0, integer=True, minimum=0)
+        kw["stick"] = number(ctx, im, "stick", f"{pre}.stick", default=0, integer=True,
+                             minimum=0)
+        if kw["free"] + kw["stick"] == 0:
+            raise ctx.error(f"{pre}.free", "free + stick >= 1 GSI modes")
+        kw["per_side"] = boolean(ctx, im, "per_side", f"{pre}.per_side", False)
+    axis = vector(ctx, red, "axis", "reduction.axis", (0.0, 0.0, 1.0))
+    origin = vector(ctx, red, "origin", "reduction.origin", (0.0, 0.0, 0.0), nonzero=False)
+    kw["axis"], kw["origin"] = axis, origin
+    cyc = None
+    if "cyclic" in red:
+        if method == "ms":
+            raise ctx.error(f"{pre}.method", "'none' or 'gsi' with [reduction.cyclic] "
+                            "(multi-stage modes are for whole 360-degree stages)", method)
+        cyc = parse_cyclic(ctx, table(ctx, red, "reduction.cyclic"))
+        kw["sectors"] = cyc.sectors
+        kw["cyclic"] = (cyc.left, cyc.right)
+    if method == "ms":
+        kw["sectors"] = number(ctx, im, "sectors", f"{pre}.sectors", required=True,
+                               integer=True, minimum=1)
+        kw["engine_orders"] = integers(ctx, im, "engine_orders", f"{pre}.engine_orders",
+                                       required=True)
+        th = integers(ctx, im, "time_harmonics", f"{pre}.time_harmonics", minimum=0)
+        kw["time_harmonics"] = th or (1,)
+        kw["axis"] = vector(ctx, im, "axis", f"{pre}.axis", axis)
+        kw["origin"] = vector(ctx, im, "origin", f"{pre}.origin", origin, nonzero=False)
+    spec = ReductionSpec(interface=tuple(iface), active=tuple(active),
+                         fixed_interface_modes=n_cb, method=method, cache=cache, **kw)
+    return spec, cyc
+
+
+def parse_cyclic(ctx: Context, cy: dict) -> CyclicSettings:
+    """The checked ``[reduction.cyclic]`` table."""
+    pre = "reduction.cyclic"
+    unknown(ctx, cy, {"sectors", "left", "right", "dependent", "engine_order",
+                      "boundary_modes", "modes", "harmonic_index", "tol"}, pre)
+    n = number(ctx, cy, "sectors", f"{pre}.sectors", required=True, integer=True, minimum=2)
+    sides = {}
+    for side in ("left", "right"):
+        v = string(ctx, cy, side, f"{pre}.{side}", required=True)
+        if not v:
+            raise ctx.error(f"{pre}.{side}", "a node-set name", v)
+        sides[side] = v
+    if sides["left"].upper() == sides["right"].upper():
+        raise ctx.error(f"{pre}.right", "a node set other than reduction.cyclic.left",
+                        sides["right"])
+    dependent = string(ctx, cy, "dependent", f"{pre}.dependent", default="right",
+                       choices=("right", "left"))
+    eo = number(ctx, cy, "engine_order", f"{pre}.engine_order", required=True, integer=True)
+    boundary_modes = number(ctx, cy, "boundary_modes", f"{pre}.boundary_modes", integer=True,
+                            minimum=1)
+    modes = number(ctx, cy, "modes", f"{pre}.modes", integer=True, minimum=1)
+    tol = number(ctx, cy, "tol", f"{pre}.tol", positive=True)
+    hi = cy.get("harmonic_index", "per_harmonic")
+    expected = (f"\"per_harmonic\" or an integer nodal diameter k* in 0..{n - 1} (the "
+                "one-index approximation)")
+    if isinstance(hi, str):
+        if hi.lower() != "per_harmonic":
+            raise ctx.error(f"{pre}.harmonic_index", expected, hi)
+        single = None
+    elif isinstance(hi, int) and not isinstance(hi, bool) and 0 <= hi < n:
+        single = hi
+    else:
+        raise ctx.error(f"{pre}.harmonic_index", expected, hi)
+    return CyclicSettings(sectors=n, left=sides["left"], right=sides["right"],
+                          dependent=dependent, engine_order=eo, boundary_modes=boundary_modes,
+                          modes=modes, tol=tol, single_index=single)
