@@ -244,6 +244,7 @@ end subroutine hbm_continue
 !> GFLOP/s of the dgemm the library links (reps products of n x n matrices), for benchmarks
 !> that compare factorisation rates with the BLAS actually used.
 subroutine hbm_dgemm_rate(n, reps, gflops)
+    use frirom_lapack, only: dgemm
     implicit none
     integer(4), intent(in) :: n, reps
     real(8), intent(out) :: gflops
