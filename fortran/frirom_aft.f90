@@ -137,6 +137,9 @@ module frirom_aft
         end subroutine aft_histories
     end interface aft_time
 
+    ! Private procedures that one submodule calls in another. (A private procedure of the
+    ! parent that only submodules call must be declared here too: gfortran drops private
+    ! module procedures its own unit does not use.)
     interface
         !> Elements e0..e0+m-1: displacement harmonics to time samples (input slots), then
         !> the law marched until their cycles close (frirom_aft_march).
