@@ -244,6 +244,7 @@ end subroutine hbm_continue
 !> GFLOP/s of the dgemm the library links (reps products of n x n matrices), for benchmarks
 !> that compare factorisation rates with the BLAS actually used.
 subroutine hbm_dgemm_rate(n, reps, gflops)
+    use frirom_lapack, only: dgemm
     implicit none
     integer(4), intent(in) :: n, reps
     real(8), intent(out) :: gflops
@@ -302,3 +303,23 @@ subroutine eigen_shift_invert(n, nk, krow, kcol, kval, nm, mrow, mcol, mval, mpt
     call eigen_destroy(work)
     info = int(st, 4)
 end subroutine eigen_shift_invert
+
+! ---- the contact-law table -----------------------------------------------------------
+
+!> frirom_aft's contact-law table for one code: number of directions, parameters and
+!> slider components, and the name (zeros and a blank name for an unknown code); nlaw:
+!> the number of laws, whose codes are 1..nlaw. Python checks its table against this.
+subroutine law_info(law, ndir, npar, nslider, name, nlaw)
+    use frirom_kinds, only: ip
+    use frirom_aft, only: LAW_CODES, frirom_law_info => law_info
+    implicit none
+    integer(4), intent(in) :: law
+    integer(4), intent(out) :: ndir, npar, nslider, nlaw
+    character(len=16), intent(out) :: name
+    integer(ip) :: nd, np, ns
+    call frirom_law_info(int(law, ip), nd, np, ns, name)
+    ndir = int(nd, 4)
+    npar = int(np, 4)
+    nslider = int(ns, 4)
+    nlaw = int(size(LAW_CODES), 4)
+end subroutine law_info

@@ -63,6 +63,8 @@ program test_aft
     p(1, 1) = kt
     call aft_eval(plan, 7_ip, x, p, w0, f, info, msg)
     if (info /= FRIROM_ERR_LAW) error stop 'unknown law'
+    if (index(msg, 'law 7 (expected 1 jenkins, 2 normal1d, 3 normal2d, 4 cubic)') == 0) &
+        error stop 'unknown law: the message lists the laws of the table'
     call aft_eval(plan, LAW_NORMAL1D, x, p, w0, f, info, msg)
     if (info /= FRIROM_ERR_SIZE) error stop 'wrong number of directions'
     x(1, 1, 1) = ieee_nan()

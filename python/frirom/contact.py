@@ -1,18 +1,10 @@
 """Contact laws and the AFT kernel on numpy arrays.
 
-Laws (one group of elements = one law; parameters per element, SI units):
+Laws (one group of elements = one law; parameters per element, SI units). The table is
+made at import from :data:`LAWS`, whose codes and sizes come from the Fortran law table
+(frirom_aft):
 
-============  ===================  ===========================  ========  ==================
-law           directions (ndir)    parameters (n_par)           slider    description
-============  ===================  ===========================  ========  ==================
-``jenkins``   u                    kt [N/m], mu, fn0 [N]         1         elastic Coulomb,
-                                                                           constant normal load
-``normal1d``  u, v                 kt, kn [N/m], mu, n0 [N]      1         1-D with normal load
-                                                                           variation, lift-off
-``normal2d``  u1, u2, v            kt, kn, mu, n0                2         in-plane tangential,
-                                                                           circular limit
-``cubic``     u                    k1 [N/m], k3 [N/m^3]          0         f = k1 u + k3 u^3
-============  ===================  ===========================  ========  ==================
+{law_table}
 
 Normal force f_n = max(n0 + kn v, 0): v > 0 closes the contact, n0 < 0 is an initial gap
 -n0/kn. Forces are those the element exerts against the relative displacement (f_t = kt u
@@ -61,12 +53,67 @@ class Law:
         return len(self.directions)
 
 
-LAWS: dict[str, Law] = {
-    "jenkins": Law("jenkins", 1, ("u",), ("kt", "mu", "fn0"), 1),
-    "normal1d": Law("normal1d", 2, ("u", "v"), ("kt", "kn", "mu", "n0"), 1),
-    "normal2d": Law("normal2d", 3, ("u1", "u2", "v"), ("kt", "kn", "mu", "n0"), 2),
-    "cubic": Law("cubic", 4, ("u",), ("k1", "k3"), 0),
+# What Python adds to frirom_aft's law table: the names of the directions and parameters
+# of each law, and a description. The codes, sizes and slider sizes come from Fortran.
+_NAMES: dict[str, tuple[tuple[str, ...], tuple[str, ...], str]] = {
+    "jenkins": (("u",), ("kt", "mu", "fn0"), "elastic Coulomb, constant normal load"),
+    "normal1d": (("u", "v"), ("kt", "kn", "mu", "n0"),
+                 "1-D with normal load variation, lift-off"),
+    "normal2d": (("u1", "u2", "v"), ("kt", "kn", "mu", "n0"),
+                 "in-plane tangential, circular limit"),
+    "cubic": (("u",), ("k1", "k3"), "f = k1 u + k3 u^3"),
 }
+# Units of the parameters, for the table in the module docstring.
+_UNITS = {"kt": "N/m", "kn": "N/m", "fn0": "N", "n0": "N", "k1": "N/m", "k3": "N/m^3"}
+
+
+def _build_laws() -> dict[str, Law]:
+    """LAWS from frirom_aft's table (Fortran: codes 1..n_law, sizes, names) and _NAMES.
+
+    Raises RuntimeError at import when the two disagree, so that Python and Fortran can
+    never hold different laws.
+    """
+    *_, n_law = _kernels.law_info(0)
+    laws = {}
+    for code in range(1, n_law + 1):
+        n_dir, n_par, n_slider, name, _ = _kernels.law_info(code)
+        name = name.decode().strip()
+        if name not in _NAMES:
+            raise RuntimeError(f"contact law {code} {name!r} of frirom_aft has no direction "
+                               f"and parameter names in frirom.contact._NAMES")
+        directions, parameters, _ = _NAMES[name]
+        if (len(directions), len(parameters)) != (n_dir, n_par):
+            raise RuntimeError(f"contact law {name!r}: frirom_aft has {n_dir} directions and "
+                               f"{n_par} parameters, frirom.contact names {directions} and "
+                               f"{parameters}")
+        laws[name] = Law(name, int(code), directions, parameters, int(n_slider))
+    extra = set(_NAMES) - set(laws)
+    if extra:
+        raise RuntimeError(f"contact laws {sorted(extra)} are not in frirom_aft's table")
+    return laws
+
+
+LAWS: dict[str, Law] = _build_laws()
+
+
+def _law_table(laws: dict[str, Law]) -> str:
+    """The reStructuredText table of the laws for the module docstring."""
+    head = ("law", "code", "directions (n_dir)", "parameters (n_par)", "slider",
+            "description")
+    rows = [(f"``{law.name}``", str(law.code), ", ".join(law.directions),
+             ", ".join(f"{p} [{_UNITS[p]}]" if p in _UNITS else p for p in law.parameters),
+             str(law.n_slider), _NAMES[law.name][2]) for law in laws.values()]
+    widths = [max(len(r[i]) for r in [head, *rows]) for i in range(len(head))]
+    rule = "  ".join("=" * w for w in widths)
+
+    def line(row):
+        return "  ".join(c.ljust(w) for c, w in zip(row, widths)).rstrip()
+
+    return "\n".join([rule, line(head), rule, *map(line, rows), rule])
+
+
+if __doc__:   # None under python -OO
+    __doc__ = __doc__.replace("{law_table}", _law_table(LAWS))
 
 DEFAULT_SAMPLES = 256
 

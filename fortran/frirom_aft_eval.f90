@@ -1,0 +1,253 @@
+!> AFT entry points: forces and Jacobian (aft_eval), time histories (aft_time), and the
+!> checks of their arguments before any work. See frirom_aft for the method.
+submodule (frirom_aft) frirom_aft_eval
+    use frirom_status, only: FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, FRIROM_ERR_LAW, &
+                             FRIROM_ERR_NONFINITE, FRIROM_ERR_NOCLOSE, set_status, &
+                             frirom_status_message
+    use frirom_fourier, only: exec_r2c, harmonics_of
+    use frirom_contact, only: STATE_STICK, STATE_SLIP, STATE_LIFTOFF
+    implicit none
+
+contains
+
+    module procedure aft_forces
+        integer(ip) :: ne, nd, nc, nb, e0, m, j, e, d, s, np, nper, nfail, base, mp
+        real(wp) :: tl
+        logical :: want_jac
+        character(len=200) :: buf
+
+        call check_call(plan, law, x, params, w0, f, info, errmsg, jac, periods, states, &
+                        index_base, slider)
+        if (info /= FRIROM_OK) return
+        call defaults(tol, max_periods, index_base, tl, mp, base)
+        want_jac = present(jac)
+        nd = NDIR_OF(law)
+        ne = size(x, 3)
+        nc = plan%fp%ncoef
+        nb = plan%fp%nbatch
+        np = nd
+        nfail = 0
+        if (want_jac) jac = 0.0_wp
+
+        do e0 = 1, ne, nb
+            m = min(nb, ne - e0 + 1)
+            call time_batch(plan, law, x, params, w0, e0, m, tl, mp)
+            do j = 1, m
+                e = e0 + j - 1
+                nper = plan%closed_at(j)
+                if (nper > mp .and. nfail == 0) then
+                    nfail = e
+                    write (buf, '(a,i0,a,i0,a)') 'element ', e - 1 + base, ': not closed after ', &
+                        mp, ' periods'
+                end if
+                if (present(periods)) periods(e) = min(nper, mp)
+                if (present(states)) call state_fractions(plan%state(j, :), states(:, e))
+                if (present(slider) .and. NSLIDER_OF(law) > 0) &
+                    slider(1:NSLIDER_OF(law), e) = plan%w(j, 1:NSLIDER_OF(law))
+            end do
+            if (want_jac) call fill_series(plan, law, m)
+            do s = 1, np
+                call exec_r2c(plan%fp, s)
+            end do
+            do j = 1, m
+                e = e0 + j - 1
+                do d = 1, nd
+                    call harmonics_of(plan%fp, d, j, f(:, d, e))
+                end do
+                if (want_jac) call element_jacobian(plan, law, j, params(:, e), w0(:, e), tl, &
+                                                    mp, jac(:, :, e))
+            end do
+        end do
+        if (nfail /= 0) call set_status(info, FRIROM_ERR_NOCLOSE, errmsg, trim(buf))
+    end procedure aft_forces
+
+    module procedure aft_histories
+        real(wp), allocatable :: fh(:, :, :)
+        integer(ip) :: ne, nd, nb, e0, m, j, e, d, mp, base
+        real(wp) :: tl
+
+        allocate (fh(size(x, 1), size(x, 2), size(x, 3)))
+        call check_call(plan, law, x, params, w0, fh, info, errmsg, index_base=index_base)
+        if (info /= FRIROM_OK) return
+        if (size(xt, 1) /= plan%fp%nsamp .or. size(ft, 1) /= plan%fp%nsamp .or. &
+            any(shape(xt) /= shape(ft)) .or. size(xt, 2) /= size(x, 2) .or. &
+            size(xt, 3) /= size(x, 3)) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'xt and ft must be (N, ndir, ne)')
+            return
+        end if
+        call defaults(tol, max_periods, index_base, tl, mp, base)
+        nd = NDIR_OF(law)
+        ne = size(x, 3)
+        nb = plan%fp%nbatch
+        do e0 = 1, ne, nb
+            m = min(nb, ne - e0 + 1)
+            call time_batch(plan, law, x, params, w0, e0, m, tl, mp)
+            do j = 1, m
+                e = e0 + j - 1
+                if (plan%closed_at(j) > mp .and. info == FRIROM_OK) then
+                    info = FRIROM_ERR_NOCLOSE
+                    if (present(errmsg)) write (errmsg, '(a,a,i0)') &
+                        frirom_status_message(info), ': element ', e - 1 + base
+                end if
+                do d = 1, nd
+                    xt(:, d, e) = plan%fp%rin(j, :, d)
+                    ft(:, d, e) = plan%fp%rout(j, :, d)
+                end do
+            end do
+        end do
+    end procedure aft_histories
+
+    !> The optional settings of an AFT call, or their defaults.
+    pure subroutine defaults(tol, max_periods, index_base, tl, mp, base)
+        real(wp), intent(in), optional :: tol
+        integer(ip), intent(in), optional :: max_periods, index_base
+        real(wp), intent(out) :: tl
+        integer(ip), intent(out) :: mp, base
+        tl = DEFAULT_TOL
+        if (present(tol)) tl = tol
+        mp = DEFAULT_MAX_PERIODS
+        if (present(max_periods)) mp = max_periods
+        base = 1
+        if (present(index_base)) base = index_base
+    end subroutine defaults
+
+    !> Shapes, law and parameters of an AFT call, checked before any work.
+    subroutine check_call(plan, law, x, params, w0, f, info, errmsg, jac, periods, states, &
+                          index_base, slider)
+        type(aft_plan), intent(in) :: plan
+        integer(ip), intent(in) :: law
+        real(wp), intent(in) :: x(:, :, :), params(:, :), w0(:, :), f(:, :, :)
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout), optional :: errmsg
+        real(wp), intent(in), optional :: jac(:, :, :)
+        integer(ip), intent(in), optional :: periods(:)
+        real(wp), intent(in), optional :: states(:, :)
+        integer(ip), intent(in), optional :: index_base
+        real(wp), intent(in), optional :: slider(:, :)
+        integer(ip) :: ne, nc, nd, e, base
+        character(len=200) :: buf, why
+
+        info = FRIROM_OK
+        base = 1
+        if (present(index_base)) base = index_base
+        if (plan%fp%nsamp <= 0) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'AFT plan not created')
+            return
+        end if
+        if (.not. any(LAW_CODES == law)) then
+            write (buf, '(a,i0,a,a,a)') 'law ', law, ' (expected ', law_list(), ')'
+            call set_status(info, FRIROM_ERR_LAW, errmsg, trim(buf))
+            return
+        end if
+        nc = plan%fp%ncoef
+        nd = NDIR_OF(law)
+        ne = size(x, 3)
+        if (size(x, 1) /= nc .or. size(x, 2) /= nd) then
+            write (buf, '(a,i0,a,i0,a,i0,a,i0,a)') 'x is (', size(x, 1), ', ', size(x, 2), &
+                ', ne); expected (2H+1 = ', nc, ', ndir = ', nd, ', ne)'
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, trim(buf))
+        else if (any(shape(f) /= shape(x))) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'f must have the shape of x')
+        else if (size(params, 1) /= NPAR_OF(law) .or. size(params, 2) /= ne) then
+            write (buf, '(a,i0,a,i0,a,i0,a)') 'params is (', size(params, 1), ', ', &
+                size(params, 2), '); expected (', NPAR_OF(law), ', ne)'
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, trim(buf))
+        else if (size(w0, 1) < NSLIDER_OF(law) .or. &
+                 (NSLIDER_OF(law) > 0 .and. size(w0, 2) /= ne)) then
+            write (buf, '(a,i0,a)') 'w0 must be (', NSLIDER_OF(law), ', ne)'
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, trim(buf))
+        end if
+        if (info /= FRIROM_OK) return
+        if (present(jac)) then
+            if (size(jac, 1) /= nc*nd .or. size(jac, 2) /= nc*nd .or. size(jac, 3) /= ne) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, &
+                                'jac must be (ndir(2H+1), ndir(2H+1), ne)')
+                return
+            end if
+        end if
+        if (present(periods)) then
+            if (size(periods) /= ne) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'periods must be (ne)')
+                return
+            end if
+        end if
+        if (present(states)) then
+            if (size(states, 1) /= 3 .or. size(states, 2) /= ne) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'states must be (3, ne)')
+                return
+            end if
+        end if
+        if (present(slider)) then
+            if (size(slider, 1) < NSLIDER_OF(law) .or. size(slider, 2) /= ne) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'slider must be (nslider, ne)')
+                return
+            end if
+        end if
+        do e = 1, ne
+            if (.not. all(abs(x(:, :, e)) <= huge(1.0_wp))) then
+                write (buf, '(a,i0,a)') 'displacement harmonics of element ', e - 1 + base, &
+                    ' are not finite'
+                call set_status(info, FRIROM_ERR_NONFINITE, errmsg, trim(buf))
+                return
+            end if
+            if (NSLIDER_OF(law) > 0) then
+                if (.not. all(abs(w0(1:NSLIDER_OF(law), e)) <= huge(1.0_wp))) then
+                    write (buf, '(a,i0,a)') 'initial slider of element ', e - 1 + base, &
+                        ' is not finite'
+                    call set_status(info, FRIROM_ERR_NONFINITE, errmsg, trim(buf))
+                    return
+                end if
+            end if
+            call check_params(law, params(:, e), why)
+            if (len_trim(why) > 0) then
+                write (buf, '(a,i0,a,a)') 'element ', e - 1 + base, ': ', trim(why)
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, trim(buf))
+                return
+            end if
+        end do
+    end subroutine check_call
+
+    !> Empty `why` when the parameters of one element are admissible for its law.
+    pure subroutine check_params(law, p, why)
+        integer(ip), intent(in) :: law
+        real(wp), intent(in) :: p(:)
+        character(len=*), intent(out) :: why
+        why = ''
+        if (.not. all(abs(p) <= huge(1.0_wp))) then
+            why = 'parameters are not finite'
+            return
+        end if
+        select case (law)
+        case (LAW_JENKINS)
+            if (p(1) <= 0.0_wp) why = 'kt must be > 0'
+            if (p(2) < 0.0_wp) why = 'mu must be >= 0'
+            if (p(3) < 0.0_wp) why = 'normal load fn0 must be >= 0'
+        case (LAW_NORMAL1D, LAW_NORMAL2D)
+            if (p(1) <= 0.0_wp) why = 'kt must be > 0'
+            if (p(2) < 0.0_wp) why = 'kn must be >= 0'
+            if (p(3) < 0.0_wp) why = 'mu must be >= 0'
+        end select
+    end subroutine check_params
+
+    !> Fractions of the samples of one element in each contact state.
+    pure subroutine state_fractions(st, frac)
+        integer(ip), intent(in) :: st(:)
+        real(wp), intent(out) :: frac(3)  !! stick, slip, lift-off
+        frac(1) = real(count(st == STATE_STICK), wp)/real(size(st), wp)
+        frac(2) = real(count(st == STATE_SLIP), wp)/real(size(st), wp)
+        frac(3) = real(count(st == STATE_LIFTOFF), wp)/real(size(st), wp)
+    end subroutine state_fractions
+
+    !> The codes and names of all laws for messages: '1 jenkins, 2 normal1d, ...'.
+    pure function law_list() result(text)
+        character(len=:), allocatable :: text
+        character(len=12) :: code
+        integer(ip) :: k
+        text = ''
+        do k = 1, NLAW
+            write (code, '(i0)') LAW_CODES(k)
+            if (k > 1) text = text//', '
+            text = text//trim(code)//' '//trim(LAW_NAMES(k))
+        end do
+    end function law_list
+end submodule frirom_aft_eval

@@ -1,0 +1,289 @@
+!> AFT Jacobian: the analytical d(force harmonics)/d(displacement harmonics) of one
+!> element, from the same-sample coefficient series (Toeplitz blocks built from run trig
+!> sums) plus the terms of the slider anchors (1-D laws) or the propagated slider tangent
+!> (2-D law). See frirom_aft for the method.
+submodule (frirom_aft) frirom_aft_jacobian
+    use frirom_fourier, only: run_trig_sums, toeplitz_add, segment_sum
+    use frirom_contact, only: STATE_STICK, STATE_SLIP, STATE_LIFTOFF, friction2d_march
+    implicit none
+
+contains
+
+    module procedure fill_series
+        integer(ip) :: k
+        associate (rout => plan%fp%rout, st => plan%state, par => plan%par)
+            do k = 1, plan%fp%nsamp
+                select case (law)
+                case (LAW_JENKINS)
+                    rout(1:m, k, 2) = merge(par(1:m, 1), 0.0_wp, st(1:m, k) == STATE_STICK)
+                case (LAW_NORMAL1D)
+                    rout(1:m, k, 3) = merge(par(1:m, 1), 0.0_wp, st(1:m, k) == STATE_STICK)
+                    rout(1:m, k, 5) = merge(par(1:m, 2), 0.0_wp, st(1:m, k) /= STATE_LIFTOFF)
+                case (LAW_NORMAL2D)
+                    rout(1:m, k, 4) = merge(par(1:m, 1), 0.0_wp, st(1:m, k) == STATE_STICK)
+                    rout(1:m, k, 5) = merge(par(1:m, 2), 0.0_wp, st(1:m, k) /= STATE_LIFTOFF)
+                end select
+            end do
+        end associate
+    end procedure fill_series
+
+    module procedure element_jacobian
+        select case (law)
+        case (LAW_JENKINS)
+            call jac_friction1d(plan, j, p(1), .false., jac)
+        case (LAW_NORMAL1D)
+            call jac_friction1d(plan, j, p(1), .true., jac)
+        case (LAW_NORMAL2D)
+            call jac_friction2d(plan, j, p(1), w0j, tol, max_periods, jac)
+        case (LAW_CUBIC)
+            call jac_diagonal(plan, j, 2_ip, jac, 0_ip, 0_ip)
+        end select
+    end procedure element_jacobian
+
+    !> Add the multiplication matrix of the series of element j in output slot `slot`
+    !> (time samples, not transformed) to the block at (r0, c0) of jac.
+    pure subroutine jac_diagonal(plan, j, slot, jac, r0, c0)
+        type(aft_plan), intent(in) :: plan
+        integer(ip), intent(in) :: j, slot, r0, c0
+        real(wp), intent(inout) :: jac(:, :)
+        real(wp) :: cm(0:2*plan%fp%nharm), sm(0:2*plan%fp%nharm)
+        call run_trig_sums(plan%fp, plan%fp%rout(j, :, slot), cm, sm)
+        call toeplitz_add(plan%fp%nharm, plan%fp%nsamp, cm, sm, jac, r0, c0)
+    end subroutine jac_diagonal
+
+    !> Jacobian of the Jenkins (normal = .false.) or 1-D normal-load element.
+    !> Stick samples after anchor a: f_t(k) = kt (u_k - u_a) + f_t(a), where f_t(a) =
+    !> s mu (n0 + kn v_a) at a slip anchor and 0 at a lift-off anchor; slip: f_t(k) =
+    !> s mu (n0 + kn v_k); f_n(k) = n0 + kn v_k in contact. The anchor of the first stick
+    !> samples is the last anchor of the period, since the cycle is closed.
+    subroutine jac_friction1d(plan, j, kt, normal, jac)
+        type(aft_plan), intent(inout) :: plan
+        integer(ip), intent(in) :: j
+        real(wp), intent(in) :: kt
+        logical, intent(in) :: normal
+        real(wp), intent(inout) :: jac(:, :)  !! (nd nc, nd nc)
+        integer(ip) :: n, nc, nh, k, k0, a, nev, i, i1, i2, c
+        real(wp) :: g(plan%fp%ncoef), dtv, kn
+        real(wp), dimension(0:2*plan%fp%nharm) :: ctu, stu, ctv, stv, cnv, snv
+        n = plan%fp%nsamp
+        nc = plan%fp%ncoef
+        nh = plan%fp%nharm
+        kn = plan%par(j, 2)
+        ctu = 0.0_wp; stu = 0.0_wp; ctv = 0.0_wp; stv = 0.0_wp; cnv = 0.0_wp; snv = 0.0_wp
+        associate (st => plan%state, bas => plan%fp%basis, ev => plan%events, &
+                   dtvs => plan%fp%rout(j, :, 4))
+            ! One pass: runs of equal state (and slip sign) give the trig sums of the
+            ! same-sample series kt [stick], d ft/dv [slip], kn [contact]; events are the
+            ! slip and lift-off samples that anchor the following stick segments.
+            nev = 0
+            k0 = 1
+            do k = 1, n + 1
+                if (k <= n) then
+                    if (st(j, k) /= STATE_STICK) then
+                        nev = nev + 1
+                        ev(nev) = k
+                    end if
+                    if (st(j, k) == st(j, k0)) then
+                        if (.not. (normal .and. st(j, k) == STATE_SLIP)) cycle
+                        if (dtvs(k) == dtvs(k0)) cycle
+                    end if
+                end if
+                select case (st(j, k0))
+                case (STATE_STICK)
+                    call add_run(kt, k0, k - 1, ctu, stu)
+                    if (normal) call add_run(kn, k0, k - 1, cnv, snv)
+                case (STATE_SLIP)
+                    if (normal) then
+                        call add_run(dtvs(k0), k0, k - 1, ctv, stv)
+                        call add_run(kn, k0, k - 1, cnv, snv)
+                    end if
+                end select
+                k0 = k
+            end do
+            call toeplitz_add(nh, n, ctu, stu, jac, 0_ip, 0_ip)
+            if (normal) then
+                call toeplitz_add(nh, n, ctv, stv, jac, 0_ip, nc)
+                call toeplitz_add(nh, n, cnv, snv, jac, nc, nc)
+            end if
+            if (nev == 0) then
+                ! Stuck all cycle. If the slider moved while the march settled, every
+                ! sample is anchored there: the whole-period sum of P is the mean row.
+                a = plan%anchor(j)
+                if (a == 0) return
+                jac(1, 1:nc) = jac(1, 1:nc) - kt*bas(a, :)
+                if (normal .and. plan%anchor_state(j) == STATE_SLIP) &
+                    jac(1, nc + 1:2*nc) = jac(1, nc + 1:2*nc) + plan%anchor_dtv(j)*bas(a, :)
+                return
+            end if
+            do i = 1, nev
+                ! stick segment after event a, up to the next event (cyclic)
+                a = ev(i)
+                i1 = mod(a, n) + 1
+                if (i < nev) then
+                    i2 = ev(i + 1) - 1
+                else
+                    i2 = ev(1) - 1
+                    if (i2 == 0) i2 = n
+                end if
+                if ((i < nev .and. i2 < i1) .or. (i == nev .and. i1 == ev(1))) cycle
+                call segment_sum(plan%fp, i1, i2, g)
+                do c = 1, nc
+                    jac(1:nc, c) = jac(1:nc, c) - kt*bas(a, c)*g
+                end do
+                if (normal .and. st(j, a) == STATE_SLIP) then
+                    dtv = dtvs(a)
+                    do c = 1, nc
+                        jac(1:nc, nc + c) = jac(1:nc, nc + c) + dtv*bas(a, c)*g
+                    end do
+                end if
+            end do
+        end associate
+    contains
+        !> C_m, S_m += value * sums of cos(m tau), sin(m tau) over samples k1..k2.
+        pure subroutine add_run(value, k1, k2, cm, sm)
+            real(wp), intent(in) :: value
+            integer(ip), intent(in) :: k1, k2
+            real(wp), intent(inout) :: cm(0:), sm(0:)
+            integer(ip) :: m
+            associate (pre => plan%fp%prefix)
+                cm(0) = cm(0) + value*real(k2 - k1 + 1, wp)
+                do m = 1, 2*nh
+                    cm(m) = cm(m) + value*(pre(2*m, k2) - pre(2*m, k1 - 1))
+                    sm(m) = sm(m) + value*(pre(2*m + 1, k2) - pre(2*m + 1, k1 - 1))
+                end do
+            end associate
+        end subroutine add_run
+    end subroutine jac_friction1d
+
+    !> Jacobian of the 2-D element. The slip direction depends on the whole history, so
+    !> the slider tangent dw (2 x 3(2H+1)) is propagated through the period, repeated until
+    !> it closes (slip contracts it; lift-off resets it), then once more accumulating.
+    !> The propagation starts from the tangent the settling periods leave (marched again
+    !> from w0): a contact that slipped while the march settled and then sticks all cycle,
+    !> or only touches the friction limit, keeps a slider that depends on that history
+    !> (along the limit circle the recursion does not contract).
+    subroutine jac_friction2d(plan, j, kt, w0j, tol, max_periods, jac)
+        type(aft_plan), intent(inout) :: plan
+        integer(ip), intent(in) :: j, max_periods
+        real(wp), intent(in) :: kt, tol
+        real(wp), intent(in) :: w0j(:)        !! (2) the element's initial slider
+        real(wp), intent(inout) :: jac(:, :)  !! (3 nc, 3 nc)
+        integer(ip) :: nc, pass
+        nc = plan%fp%ncoef
+        call jac_diagonal(plan, j, 4_ip, jac, 0_ip, 0_ip)       ! d f1/du1, stick
+        call jac_diagonal(plan, j, 4_ip, jac, nc, nc)           ! d f2/du2, stick
+        call jac_diagonal(plan, j, 5_ip, jac, 2*nc, 2*nc)       ! d fn/dv, contact
+        plan%dw = 0.0_wp
+        if (plan%closed_at(j) > 1 .and. any(plan%w(j, 1:2) /= w0j(1:2))) &
+            call settle2d(plan, j, kt, w0j, jac)
+        if (all(plan%state(j, :) == STATE_STICK)) then
+            if (any(plan%dw /= 0.0_wp)) call propagate2d(plan, j, kt, .true., jac)
+            return
+        end if
+        do pass = 1, max_periods
+            plan%dw0 = plan%dw
+            call propagate2d(plan, j, kt, .false., jac)
+            if (maxval(abs(plan%dw - plan%dw0)) <= tol*max(1.0_wp, maxval(abs(plan%dw)))) exit
+        end do
+        call propagate2d(plan, j, kt, .true., jac)
+    end subroutine jac_friction2d
+
+    !> Slider tangent dw that the settling periods of element j leave: march them again
+    !> from w0j (dw = 0 there), propagating the tangent through each.
+    subroutine settle2d(plan, j, kt, w0j, jac)
+        type(aft_plan), intent(inout) :: plan
+        integer(ip), intent(in) :: j
+        real(wp), intent(in) :: kt, w0j(:)
+        real(wp), intent(inout) :: jac(:, :)
+        integer(ip) :: n, per
+        integer(ip), allocatable :: st(:, :), st_keep(:)
+        real(wp), allocatable :: w(:, :), f(:, :, :), tg(:, :, :), tg_keep(:, :)
+        n = plan%fp%nsamp
+        allocate (st(1, n), w(1, 2), f(1, n, 3), tg(1, 6, n))
+        st_keep = plan%state(j, :)
+        tg_keep = plan%tangent(j, :, :)
+        w(1, :) = w0j(1:2)
+        plan%dw = 0.0_wp
+        associate (rin => plan%fp%rin, par => plan%par)
+            do per = 1, plan%closed_at(j) - 1
+                call friction2d_march(rin(j:j, :, 1), rin(j:j, :, 2), rin(j:j, :, 3), &
+                                      par(j:j, 1), par(j:j, 2), par(j:j, 3), par(j:j, 4), w, &
+                                      f(:, :, 1), f(:, :, 2), f(:, :, 3), st, tg)
+                plan%state(j, :) = st(1, :)
+                plan%tangent(j, :, :) = tg(1, :, :)
+                call propagate2d(plan, j, kt, .false., jac)
+            end do
+        end associate
+        plan%state(j, :) = st_keep
+        plan%tangent(j, :, :) = tg_keep
+    end subroutine settle2d
+
+    !> One period of the 2-D slider tangent recursion (see friction2d_march):
+    !> stick: d f = kt (dU_k - dw), dw kept; slip: d f = A_k (dU_k - dw) + b_k dV_k,
+    !> dw = dU_k - d f / kt; lift-off: d f = 0, dw = dU_k. The same-sample stick part is in
+    !> the Toeplitz blocks already; here only the terms in dw and the slip samples.
+    subroutine propagate2d(plan, j, kt, accumulate, jac)
+        type(aft_plan), intent(inout) :: plan
+        integer(ip), intent(in) :: j
+        real(wp), intent(in) :: kt
+        logical, intent(in) :: accumulate
+        real(wp), intent(inout) :: jac(:, :)
+        integer(ip) :: n, nc, k, i, c
+        real(wp) :: gsum(plan%fp%ncoef), pk(plan%fp%ncoef)
+        logical :: open_seg
+        n = plan%fp%nsamp
+        nc = plan%fp%ncoef
+        associate (st => plan%state(j, :), tg => plan%tangent(j, :, :), bas => plan%fp%basis, &
+                   wgt => plan%fp%weight, dw => plan%dw, dft => plan%dft)
+            gsum = 0.0_wp
+            open_seg = .false.
+            do k = 1, n
+                if (st(k) == STATE_STICK) then
+                    if (accumulate) gsum = gsum + wgt*bas(k, :)
+                    open_seg = .true.
+                    cycle
+                end if
+                if (open_seg .and. accumulate) call flush_stick(gsum)
+                open_seg = .false.
+                if (st(k) == STATE_SLIP) then
+                    dft(1, :) = -(tg(1, k)*dw(1, :) + tg(3, k)*dw(2, :))
+                    dft(2, :) = -(tg(2, k)*dw(1, :) + tg(4, k)*dw(2, :))
+                    dft(1, 1:nc) = dft(1, 1:nc) + tg(1, k)*bas(k, :)
+                    dft(2, 1:nc) = dft(2, 1:nc) + tg(2, k)*bas(k, :)
+                    dft(1, nc + 1:2*nc) = dft(1, nc + 1:2*nc) + tg(3, k)*bas(k, :)
+                    dft(2, nc + 1:2*nc) = dft(2, nc + 1:2*nc) + tg(4, k)*bas(k, :)
+                    dft(1, 2*nc + 1:3*nc) = dft(1, 2*nc + 1:3*nc) + tg(5, k)*bas(k, :)
+                    dft(2, 2*nc + 1:3*nc) = dft(2, 2*nc + 1:3*nc) + tg(6, k)*bas(k, :)
+                    if (accumulate) then
+                        pk = wgt*bas(k, :)
+                        do i = 1, 2
+                            do c = 1, 3*nc
+                                jac((i - 1)*nc + 1:i*nc, c) = jac((i - 1)*nc + 1:i*nc, c) &
+                                                              + pk*dft(i, c)
+                            end do
+                        end do
+                    end if
+                    dw = -dft/kt
+                else
+                    dw = 0.0_wp
+                end if
+                dw(1, 1:nc) = dw(1, 1:nc) + bas(k, :)
+                dw(2, nc + 1:2*nc) = dw(2, nc + 1:2*nc) + bas(k, :)
+            end do
+            if (open_seg .and. accumulate) call flush_stick(gsum)
+        end associate
+    contains
+        !> Stick samples since the last event: d f_i = -kt dw_i, summed by analysis weights.
+        subroutine flush_stick(g)
+            real(wp), intent(inout) :: g(:)
+            integer(ip) :: ii, cc
+            do ii = 1, 2
+                do cc = 1, 3*nc
+                    jac((ii - 1)*nc + 1:ii*nc, cc) = jac((ii - 1)*nc + 1:ii*nc, cc) &
+                                                     - kt*g*plan%dw(ii, cc)
+                end do
+            end do
+            g = 0.0_wp
+        end subroutine flush_stick
+    end subroutine propagate2d
+end submodule frirom_aft_jacobian
