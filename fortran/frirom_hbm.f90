@@ -16,7 +16,8 @@
 !> receptances may instead come from modes: the same real modes for every harmonic
 !> (hbm_set_modes) or complex modes of their own per harmonic (hbm_set_modes_harmonic, a
 !> cyclic sector whose harmonic h lives on nodal diameter h EO mod N); K, M, C are then
-!> not used and may be empty.!>
+!> not used and may be empty.
+!>
 !> The module holds the types, the named constants and the interfaces; the work is done in
 !> its submodules, one file each:
 !>   frirom_hbm_contacts.f90   CSR helpers, contact set (contact_eval, contact_assemble),
@@ -31,6 +32,8 @@ module frirom_hbm
     use frirom_banded, only: band_matrix, zband_matrix
     use frirom_newton, only: nl_system, cont_options
     use frirom_aft, only: aft_plan
+    ! Explicit LAPACK/BLAS interfaces for every call the submodules make.
+    use frirom_lapack, only: dgemm, zgemm, dgetrf, dgetrs, dgeev, dpotrf, dpotrs
     implicit none
     private
     public :: csr_matrix, contact_group, contact_set, hbm_system, hbm_condensed, hbm_full, &
