@@ -58,6 +58,8 @@ _RCONT = {f: _int_constant("RCONT_" + f.upper()) - 1 for f in (
 _ICONT = {f: _int_constant("ICONT_" + f.upper()) - 1 for f in ("max_iter", "reuse_jac")}
 if (len(_RCONT) != _int_constant("N_RCONT") or len(_ICONT) != _int_constant("N_ICONT")):
     raise ImportError("frirom._pack: hbm_continue has option slots this module does not fill")
+_RCONT_AT = np.array(list(_RCONT.values()))     # slots in the order of the keys above
+_ICONT_AT = np.array(list(_ICONT.values()))
 
 #: Timer/counter names of each run (seconds, counts) by their 0-based slot in `timings`.
 _TIMER_SLOTS = {name: _int_constant(slot) - 1 for name, slot in (
@@ -262,15 +264,11 @@ class _Packed:
         """One hbm_continue call from the current contact history self.w0; the history
         the last point leaves becomes self.w0 for the next call."""
         o, m = self.opts, self.modes
-        ropt = np.zeros(len(_RCONT))
-        for f, v in (("tol_r", o.tol_residual), ("tol_x", o.tol_update),
-                     ("tol_stall", o.tol_stall), ("yscale", yscale), ("lscale", lscale),
-                     ("ds", ds), ("ds_min", o.ds_min), ("ds_max", o.ds_max),
-                     ("lam_end", lam_end), ("lam_lo", lam_lo)):
-            ropt[_RCONT[f]] = v
-        iopt = np.zeros(len(_ICONT), np.int32)
-        iopt[_ICONT["max_iter"]] = o.max_iter
-        iopt[_ICONT["reuse_jac"]] = int(o.reuse_jacobian)
+        ropt = np.empty(len(_RCONT))
+        ropt[_RCONT_AT] = (o.tol_residual, o.tol_update, o.tol_stall, yscale, lscale, ds,
+                           o.ds_min, o.ds_max, lam_end, lam_lo)
+        iopt = np.empty(len(_ICONT), np.int32)
+        iopt[_ICONT_AT] = (o.max_iter, int(o.reuse_jacobian))
         nl = (self.nl + 1).astype(np.int32) if self.nl.size else np.ones(1, np.int32)
         (kp, ki, kx), (mp, mi, mx), (cp, ci, cx), (gp, gi, gx) = self.K, self.M, self.C, self.G
         res = _kernels.hbm_continue(
@@ -286,8 +284,7 @@ class _Packed:
             stability=int(self.stability), history=int(o.history), maxpts=maxpts,
             netot=max(self.ne_tot, 1), ntim=len(_TIMER_SLOTS), nh=self.H, ndof=self.n_dof,
             nnl=self.nl.size or 1)
-        r = _CallResult._make(res)
-        r = r._replace(msg=r.msg.decode(errors="replace"))
+        r = _CallResult(*res[:-1], msg=res[-1].decode(errors="replace"))
         if r.npts > 0 and self.nw and o.history:
             self.w0 = r.sliders[:self.nw, r.npts - 1].copy()
         return r

@@ -26,13 +26,11 @@ from typing import Callable
 import numpy as np
 
 from ._errors import CODES, ParameterError, SizeError, raise_for_status
-from ._pack import (HILL_MAX, START_CONTINUE, START_RESUME, START_SOLVE_ONLY, TIMER_NAMES,
-                    YSCALE_RELATIVE, _Packed, _split_load, add_timings, pack)
+from ._pack import HILL_MAX, TIMER_NAMES  # noqa: F401 - public here, defined with the packing
+from ._pack import (START_CONTINUE, START_RESUME, START_SOLVE_ONLY, YSCALE_RELATIVE, _Packed,
+                    _split_load, add_timings, pack)
 from .model import CyclicModel, Excitation, Model
 from .results import FRF, FRFPoint
-
-__all__ = ["SolverOptions", "frf", "load_curve", "solve_point", "FORMULATIONS", "HILL_MAX",
-           "TIMER_NAMES"]
 
 #: Names of the formulations (SolverOptions.formulation).
 FORMULATIONS = ("condensed", "banded")
@@ -348,16 +346,34 @@ def _homotopy_start(packed: _Packed, omega: float):
 def frf(model: Model | CyclicModel, excitation: Excitation, omega_start: float,
         omega_end: float, options: SolverOptions | None = None, outputs=None, sink=None,
         start=None, start_harmonics: int | None = None) -> FRF:
-    """Forced response from omega_start to omega_end (rad/s) by pseudo-arc-length
-    continuation in frequency, through turning points.
+    """Forced response from omega_start to omega_end by pseudo-arc-length continuation in
+    frequency, through turning points.
 
-    outputs: DoF indices (0-based) whose harmonics are kept (default: all DoFs up to 100,
-    else the contact DoFs). sink(point) receives every converged FRFPoint as it comes.
-    start: resume from {'parameter' (or 'omega'), 'unknowns', 'tangent'} of a saved point
-    (e.g. FRFWriter.resume_point); with start_harmonics != options.harmonics the unknowns
-    of that lower-H solution are padded and re-solved first.
-    A run that cannot continue returns the points made so far (frf.complete False,
-    frf.message says why) and warns.
+    Parameters
+    ----------
+    model : Model or CyclicModel
+    excitation : Excitation
+    omega_start, omega_end : float
+        Frequency range, rad/s (either direction).
+    options : SolverOptions, optional
+        Its ``parameter`` is set to 'frequency'.
+    outputs : array_like of int, optional
+        DoF indices (0-based) whose harmonics are kept; default all DoFs up to 100, else
+        the contact DoFs.
+    sink : callable, optional
+        ``sink(point)`` receives every converged FRFPoint as it comes.
+    start : FRFPoint or dict, optional
+        Resume from a saved point: {'parameter' (or 'omega'), 'unknowns', 'tangent',
+        'slider', 'yscale'} (e.g. FRFWriter.resume_point).
+    start_harmonics : int, optional
+        H of the start's unknowns when it differs from options.harmonics: they are padded
+        or cut and re-solved first.
+
+    Returns
+    -------
+    FRF
+        A run that cannot continue returns the points made so far (``complete`` False,
+        ``message`` says why) and warns.
     """
     options = options or SolverOptions()
     if options.parameter != "frequency":
@@ -375,9 +391,25 @@ def frf(model: Model | CyclicModel, excitation: Excitation, omega_start: float,
 def load_curve(model: Model | CyclicModel, excitation: Excitation, omega: float,
                scale_start: float, scale_end: float, options: SolverOptions | None = None,
                outputs=None, sink=None, start=None, part: str = "dynamic") -> FRF:
-    """Continuation in a load factor s at fixed frequency omega: the excitation is
-    F_other + s F_part, where part is 'dynamic' (harmonics >= 1: excitation level) or
-    'static' (harmonic 0: preload)."""
+    """Continuation in a load factor s at a fixed frequency: the excitation is
+    F_other + s F_part.
+
+    Parameters
+    ----------
+    omega : float
+        Frequency, rad/s.
+    scale_start, scale_end : float
+        Range of the load factor s (dimensionless).
+    part : {'dynamic', 'static'}
+        The scaled part: harmonics >= 1 (excitation level) or harmonic 0 (preload).
+    model, excitation, options, outputs, sink, start
+        As in :func:`frf` (``options.parameter`` is set to 'load').
+
+    Returns
+    -------
+    FRF
+        ``parameter`` holds s, ``omega`` the fixed frequency.
+    """
     options = options or SolverOptions()
     options = dataclasses.replace(options, parameter="load")
     if not (np.isfinite(omega) and omega > 0):
@@ -391,14 +423,29 @@ def load_curve(model: Model | CyclicModel, excitation: Excitation, omega: float,
 def solve_point(model: Model | CyclicModel, excitation: Excitation, omega: float,
                 options: SolverOptions | None = None, outputs=None, start=None,
                 start_harmonics: int | None = None) -> FRFPoint:
-    """The periodic response at one frequency omega (rad/s), Newton from the linear
-    solution, or from start (an FRFPoint, or a dict with 'unknowns' of a solution with
-    start_harmonics harmonics, default options.harmonics, padded with zeros, and/or
-    'slider', the contact history to start from: FRFPoint.slider; without 'unknowns'
-    Newton starts from the linear solution). Without a slider the model's w0 is the
-    history. If Newton from the linear solution fails, the point is
-    reached by continuation in the excitation level. The returned point's slider is the
-    history it leaves (pass the point as the next start to follow a path)."""
+    """The periodic response at one frequency, by Newton's method.
+
+    Newton starts from the linear solution, or from `start`; if Newton from the linear
+    solution fails, the point is reached by continuation in the excitation level.
+
+    Parameters
+    ----------
+    omega : float
+        Frequency, rad/s.
+    start : FRFPoint or dict, optional
+        'unknowns' of a solution with `start_harmonics` harmonics (default
+        options.harmonics; padded with zeros or cut) and/or 'slider', the contact history
+        to start from (FRFPoint.slider). Without 'unknowns' Newton starts from the linear
+        solution; without 'slider' the model's w0 is the history.
+    model, excitation, options, outputs, start_harmonics
+        As in :func:`frf`.
+
+    Returns
+    -------
+    FRFPoint
+        Its ``slider`` is the history it leaves: pass the point as the next start to
+        follow a path. ``timings`` holds the Fortran time split (TIMER_NAMES).
+    """
     options = options or SolverOptions()
     options = dataclasses.replace(options, parameter="frequency")
     if not (np.isfinite(omega) and omega > 0):
