@@ -1,7 +1,9 @@
 ! The only source f2py reads. Plain subroutines with explicit-shape arrays and real(8) /
 ! integer(4) dummies (f2py would map a real(wp) from another module to C float). Each one
 ! unpacks its arguments, calls the library and returns `info` plus the library's message.
-! Derived types never cross this file.
+! Derived types never cross this file. Python types no number of this boundary: option
+! slots, start modes, timer slots and status codes are read by name (int_constant,
+! real_constant) when frirom is imported.
 
 !> Text of a frirom status code.
 subroutine status_message(info, msg)

@@ -8,8 +8,10 @@ from __future__ import annotations
 from . import _kernels
 
 
-def _fortran_code(name: str) -> int:
-    """The status code frirom_status names `name` (e.g. ``'FRIROM_ERR_CONT'``)."""
+def int_constant(name: str) -> int:
+    """A named integer constant of the Fortran interface (frirom_f2py int_constant: status
+    codes such as ``'FRIROM_ERR_CONT'``, option and timer slots, start modes); ImportError
+    if the library has no constant of that name."""
     value, info, msg = _kernels.int_constant(name)
     if info != 0:
         raise ImportError(msg.decode(errors="replace").strip())
@@ -17,7 +19,7 @@ def _fortran_code(name: str) -> int:
 
 
 #: Status codes Python tests for, by their Fortran names.
-CODES = {name: _fortran_code(name) for name in (
+CODES = {name: int_constant(name) for name in (
     "FRIROM_ERR_SIZE", "FRIROM_ERR_PARAM", "FRIROM_ERR_NONFINITE", "FRIROM_ERR_SAMPLES",
     "FRIROM_ERR_NOCONV", "FRIROM_ERR_SINGULAR", "FRIROM_ERR_LAW", "FRIROM_ERR_NOCLOSE",
     "FRIROM_ERR_CONT", "FRIROM_ERR_MODEL", "FRIROM_ERR_FACTOR")}

@@ -18,7 +18,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import eigsh
 
 from . import _kernels
-from ._errors import ParameterError, SizeError, raise_for_status
+from ._errors import ParameterError, SizeError, int_constant, raise_for_status
 from .contact import LAWS
 from .model import CyclicModel, Excitation, Model
 from .results import FRFPoint, amplitude_max
@@ -30,39 +30,34 @@ if TYPE_CHECKING:
 HILL_MAX = 4000
 
 
-def _int_constant(name: str) -> int:
-    value, info, msg = _kernels.int_constant(name)
-    raise_for_status(info, msg.decode(errors="replace"))
-    return int(value)
-
-
 def _real_constant(name: str) -> float:
     value, info, msg = _kernels.real_constant(name)
-    raise_for_status(info, msg.decode(errors="replace"))
+    if info != 0:
+        raise ImportError(msg.decode(errors="replace").strip())
     return float(value)
 
 
 #: hbm_continue's start modes: solve at lam0 then continue, resume from a converged point
 #: and its tangent, or solve at lam0 only.
-START_CONTINUE = _int_constant("HBM_START_CONTINUE")
-START_RESUME = _int_constant("HBM_START_RESUME")
-START_SOLVE_ONLY = _int_constant("HBM_START_SOLVE_ONLY")
+START_CONTINUE = int_constant("HBM_START_CONTINUE")
+START_RESUME = int_constant("HBM_START_RESUME")
+START_SOLVE_ONLY = int_constant("HBM_START_SOLVE_ONLY")
 #: yscale of a first solve: a purely relative update test (no solution size known yet).
 YSCALE_RELATIVE = _real_constant("YSCALE_RELATIVE")
 
 #: 0-based slots of the real (RCONT_*) and integer (ICONT_*) option arrays, by the
 #: frirom_newton cont_options field they fill (lam_lo: cont_run's lower bound).
-_RCONT = {f: _int_constant("RCONT_" + f.upper()) - 1 for f in (
+_RCONT = {f: int_constant("RCONT_" + f.upper()) - 1 for f in (
     "tol_r", "tol_x", "tol_stall", "yscale", "lscale", "ds", "ds_min", "ds_max", "lam_end",
     "lam_lo")}
-_ICONT = {f: _int_constant("ICONT_" + f.upper()) - 1 for f in ("max_iter", "reuse_jac")}
-if (len(_RCONT) != _int_constant("N_RCONT") or len(_ICONT) != _int_constant("N_ICONT")):
+_ICONT = {f: int_constant("ICONT_" + f.upper()) - 1 for f in ("max_iter", "reuse_jac")}
+if (len(_RCONT) != int_constant("N_RCONT") or len(_ICONT) != int_constant("N_ICONT")):
     raise ImportError("frirom._pack: hbm_continue has option slots this module does not fill")
 _RCONT_AT = np.array(list(_RCONT.values()))     # slots in the order of the keys above
 _ICONT_AT = np.array(list(_ICONT.values()))
 
 #: Timer/counter names of each run (seconds, counts) by their 0-based slot in `timings`.
-_TIMER_SLOTS = {name: _int_constant(slot) - 1 for name, slot in (
+_TIMER_SLOTS = {name: int_constant(slot) - 1 for name, slot in (
     ("aft", "T_AFT"), ("assembly", "T_ASM"), ("factorization", "T_FACT"),
     ("solve", "T_SOLVE"), ("receptance", "T_REC"), ("evaluations", "N_EVAL"),
     ("factorizations", "N_FACT"), ("fortran_total", "N_TIMERS"))}
