@@ -1,7 +1,9 @@
 ! The only source f2py reads. Plain subroutines with explicit-shape arrays and real(8) /
 ! integer(4) dummies (f2py would map a real(wp) from another module to C float). Each one
 ! unpacks its arguments, calls the library and returns `info` plus the library's message.
-! Derived types never cross this file.
+! Derived types never cross this file. Python types no number of this boundary: option
+! slots, start modes, timer slots and status codes are read by name (int_constant,
+! real_constant) when frirom is imported.
 
 !> Text of a frirom status code.
 subroutine status_message(info, msg)
@@ -101,50 +103,46 @@ subroutine hbm_rcm(n, nnz, indptr, indices, perm, info, msg)
 end subroutine hbm_rcm
 
 !> Harmonic balance solve and pseudo-arc-length continuation (frirom_hbm hbm_run).
-!> form: 1 condensed, 2 full banded. K, M, C: CSR, 1-based, ndof x ndof, symmetric.
+!> formulation: 'condensed' or 'banded'; lam_kind: 'frequency' (lam = omega) or 'load'
+!> (lam scales fe1 at omega_fix). K, M, C: CSR, 1-based, ndof x ndof, symmetric.
 !> perm: RCM order of the DoFs. nl: nonlinear DoFs (condensed). fe0, fe1: real harmonic
-!> excitation (ndof, 2H+1) (frequency mode: fe0; load mode: fe0 + lam fe1 at omega_fix).
+!> excitation (ndof, 2H+1) (frequency: fe0; load: fe0 + lam fe1).
 !> ginfo(3, ngroup): law, n_elem, n_dir; G rows group by group, element, direction (CSR over
 !> the full DoFs); params (npar, ne) and w0 (nslider, ne) per group, concatenated.
-!> start_mode: 0 solve at lam0 from y0 then continue, 1 resume from (y0, lam0, tan0),
-!> 2 solve at lam0 only. Outputs: npts points; timings: AFT, assembly, factorisation, solve,
-!> receptances (s), residual evaluations, factorisations, total (s).
-subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, mx, nnzc, cp, &
-                        ci, cx, perm, nnl, nl, fe0, fe1, mode, omega_fix, ngroup, ginfo, nrows, &
-                        nnzg, gp, gi, gx, npart, params, nw0, w0, nout, outdofs, ny, y0, lam0, &
-                        tan0, start_mode, ds, ds_min, ds_max, lam_end, lam_lo, tol_r, tol_x, &
-                        tol_stall, max_iter, reuse, yscale, lscale, maxpts, netot, stability, &
-                        nmodes, phi, wmodes, zmodes, hmodes, psi, wharm, zharm, history, ys, &
-                        lams, tans, iters, xo, states, hill_re, sliders, npts, finished, &
-                        ds_out, timings, info, msg)
+!> start_mode (HBM_START_*): solve at lam0 from y0 then continue, resume from (y0, lam0,
+!> tan0), or solve at lam0 only. ropt, iopt: Newton and continuation settings by slot
+!> (RCONT_*, ICONT_* of frirom_newton; Python reads all of these names with int_constant).
+!> Outputs: npts points; timings(T_*): AFT, assembly, factorisation, solve, receptances (s),
+!> residual evaluations, factorisations; timings(N_TIMERS): total (s).
+subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, &
+                        mi, mx, nnzc, cp, ci, cx, perm, nnl, nl, fe0, fe1, omega_fix, ngroup, &
+                        ginfo, nrows, nnzg, gp, gi, gx, npart, params, nw0, w0, nout, outdofs, &
+                        nmodes, phi, wmodes, zmodes, hmodes, psi, wharm, zharm, ny, y0, lam0, &
+                        tan0, start_mode, nropt, ropt, niopt, iopt, stability, history, &
+                        maxpts, netot, ntim, ys, lams, tans, iters, xo, states, hill_re, &
+                        sliders, npts, finished, ds_out, timings, info, msg)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
-    use frirom_newton, only: cont_options
+    use frirom_newton, only: cont_options, cont_options_from, N_RCONT, N_ICONT, RCONT_DS, &
+                             RCONT_LAM_LO
     use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
-                          hbm_set_modes_harmonic, hbm_run, N_TIMERS
+                          hbm_set_modes_harmonic, hbm_run, HBM_FREQUENCY, HBM_LOAD, N_TIMERS
     implicit none
-    integer(4), intent(in) :: form, nh, nsamp, ndof, nnzk, nnzm, nnzc
+    character(len=*), intent(in) :: formulation  !! 'condensed' (Eq. 5-9) or 'banded'
+    character(len=*), intent(in) :: lam_kind     !! the parameter lam: 'frequency' or 'load'
+    integer(4), intent(in) :: nh, nsamp, ndof, nnzk, nnzm, nnzc
     integer(4), intent(in) :: kp(ndof + 1), ki(nnzk), mp(ndof + 1), mi(nnzm), cp(ndof + 1), &
                               ci(nnzc)
     real(8), intent(in) :: kx(nnzk), mx(nnzm), cx(nnzc)
     integer(4), intent(in) :: perm(ndof), nnl, nl(nnl)
     real(8), intent(in) :: fe0(ndof, 2*nh + 1), fe1(ndof, 2*nh + 1)
-    integer(4), intent(in) :: mode
-    real(8), intent(in) :: omega_fix
+    real(8), intent(in) :: omega_fix     !! rad/s, the frequency of a load continuation
     integer(4), intent(in) :: ngroup, ginfo(3, ngroup), nrows, nnzg, gp(nrows + 1), gi(nnzg)
     real(8), intent(in) :: gx(nnzg)
     integer(4), intent(in) :: npart, nw0
     real(8), intent(in) :: params(npart), w0(nw0)
-    integer(4), intent(in) :: nout, outdofs(nout), ny
-    real(8), intent(in) :: y0(ny), lam0, tan0(ny + 1)
-    integer(4), intent(in) :: start_mode
-    real(8), intent(in) :: ds, ds_min, ds_max, lam_end, lam_lo, tol_r, tol_x, tol_stall
-    integer(4), intent(in) :: max_iter, reuse
-    real(8), intent(in) :: yscale, lscale
-    integer(4), intent(in) :: maxpts, netot
-    integer(4), intent(in) :: stability    !! 1: Hill stability of every point
+    integer(4), intent(in) :: nout, outdofs(nout)
     integer(4), intent(in) :: nmodes       !! > 0: condensed receptances by modal superposition
-    integer(4), intent(in) :: history      !! 1: carry contact sliders from point to point
     real(8), intent(in) :: phi(ndof, max(nmodes, 1)), wmodes(max(nmodes, 1)), &
                            zmodes(max(nmodes, 1))
     !> > 0: modes of their own for every harmonic h (cyclic sectors: nodal diameter h EO
@@ -152,6 +150,15 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     integer(4), intent(in) :: hmodes
     complex(8), intent(in) :: psi(ndof, max(hmodes, 1), nh + 1)
     real(8), intent(in) :: wharm(max(hmodes, 1), nh + 1), zharm(max(hmodes, 1), nh + 1)
+    integer(4), intent(in) :: ny
+    real(8), intent(in) :: y0(ny), lam0, tan0(ny + 1)
+    integer(4), intent(in) :: start_mode   !! one of HBM_START_*
+    integer(4), intent(in) :: nropt, niopt
+    real(8), intent(in) :: ropt(nropt)     !! (N_RCONT) real settings by RCONT_* slot
+    integer(4), intent(in) :: iopt(niopt)  !! (N_ICONT) integer settings by ICONT_* slot
+    integer(4), intent(in) :: stability    !! 1: Hill stability of every point
+    integer(4), intent(in) :: history      !! 1: carry contact sliders from point to point
+    integer(4), intent(in) :: maxpts, netot, ntim   !! ntim = N_TIMERS
     real(8), intent(out) :: ys(ny, maxpts), lams(maxpts), tans(ny + 1, maxpts)
     integer(4), intent(out) :: iters(maxpts)
     real(8), intent(out) :: xo(nout, 2*nh + 1, maxpts), states(3, netot, maxpts)
@@ -160,14 +167,14 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     !> layout of w0 (the w0 to restart a run from that point)
     real(8), intent(out) :: sliders(nw0, maxpts)
     integer(4), intent(out) :: npts, finished
-    real(8), intent(out) :: ds_out, timings(8)
+    real(8), intent(out) :: ds_out, timings(ntim)
     integer(4), intent(out) :: info
     character(len=512), intent(out) :: msg
     class(hbm_system), allocatable :: sys
     type(cont_options) :: opts
     real(wp), allocatable :: y(:), t(:)
     real(wp) :: lam, dsl
-    integer(ip) :: linfo, np, itl(maxpts)
+    integer(ip) :: linfo, np, itl(maxpts), mode
     integer(8) :: c0, c1, rate
     logical :: fin
     call system_clock(c0, rate)
@@ -175,7 +182,7 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     info = 0
     npts = 0
     finished = 0
-    ds_out = ds
+    ds_out = 0.0d0
     timings = 0.0d0
     ys = 0.0d0
     lams = 0.0d0
@@ -184,13 +191,29 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     xo = 0.0d0
     states = 0.0d0
     sliders = 0.0d0
-    if (form == 1) then
-        allocate (hbm_condensed :: sys)
-    else if (form == 2) then
-        allocate (hbm_full :: sys)
+    hill_re = 0.0d0
+    linfo = 0
+    if (nropt /= N_RCONT .or. niopt /= N_ICONT .or. ntim /= N_TIMERS) then
+        call set_status(linfo, FRIROM_ERR_SIZE, msg, 'hbm_continue: ropt, iopt and timings '// &
+                        'need N_RCONT, N_ICONT and N_TIMERS entries')
+    else if (lam_kind == 'frequency') then
+        mode = HBM_FREQUENCY
+    else if (lam_kind == 'load') then
+        mode = HBM_LOAD
     else
-        call set_status(linfo, FRIROM_ERR_PARAM, msg, 'formulation must be 1 (condensed) '// &
-                        'or 2 (banded)')
+        call set_status(linfo, FRIROM_ERR_PARAM, msg, "lam_kind must be 'frequency' or 'load'")
+    end if
+    if (linfo == 0) then
+        if (formulation == 'condensed') then
+            allocate (hbm_condensed :: sys)
+        else if (formulation == 'banded') then
+            allocate (hbm_full :: sys)
+        else
+            call set_status(linfo, FRIROM_ERR_PARAM, msg, "formulation must be 'condensed' "// &
+                            "or 'banded'")
+        end if
+    end if
+    if (linfo /= 0) then
         info = linfo
         return
     end if
@@ -207,29 +230,18 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
         return
     end if
     sys%carry = history /= 0
-    opts%tol_r = tol_r
-    opts%tol_x = tol_x
-    opts%tol_stall = tol_stall
-    opts%max_iter = max_iter
-    opts%reuse_jac = reuse /= 0
-    opts%yscale = yscale
-    opts%lscale = lscale
-    opts%ds = ds
-    opts%ds_min = ds_min
-    opts%ds_max = ds_max
-    opts%lam_end = lam_end
+    opts = cont_options_from(ropt, iopt)
     opts%max_points = maxpts
     y = y0
     t = tan0
     lam = lam0
-    dsl = ds
-    hill_re = 0.0d0
+    dsl = ropt(RCONT_DS)
     if (stability /= 0) then
-        call hbm_run(sys, start_mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itl, xo, &
-                     states, np, fin, linfo, msg, hill_re, sliders=sliders)
+        call hbm_run(sys, start_mode, y, lam, t, dsl, ropt(RCONT_LAM_LO), opts, ys, lams, &
+                     tans, itl, xo, states, np, fin, linfo, msg, hill_re, sliders=sliders)
     else
-        call hbm_run(sys, start_mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itl, xo, &
-                     states, np, fin, linfo, msg, sliders=sliders)
+        call hbm_run(sys, start_mode, y, lam, t, dsl, ropt(RCONT_LAM_LO), opts, ys, lams, &
+                     tans, itl, xo, states, np, fin, linfo, msg, sliders=sliders)
     end if
     npts = np
     iters = itl
@@ -238,8 +250,114 @@ subroutine hbm_continue(form, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, m
     info = linfo
     timings(1:N_TIMERS - 1) = sys%timers(1:N_TIMERS - 1)
     call system_clock(c1)
-    timings(8) = real(c1 - c0, 8)/real(rate, 8)
+    timings(N_TIMERS) = real(c1 - c0, 8)/real(rate, 8)
 end subroutine hbm_continue
+
+!> Value of a named integer constant of this interface, so that Python reads slots, modes
+!> and codes from Fortran instead of typing their numbers: RCONT_*, N_RCONT, ICONT_*,
+!> N_ICONT (option slots of hbm_continue, frirom_newton), HBM_START_* (start modes),
+!> T_*, N_EVAL, N_FACT, N_TIMERS (timings slots, frirom_hbm) and the FRIROM_* status codes.
+!> An unknown name returns info = FRIROM_ERR_PARAM.
+subroutine int_constant(name, value, info, msg)
+    use frirom_kinds, only: ip
+    use frirom_status, only: FRIROM_ERR_PARAM, frirom_status_code, set_status
+    use frirom_newton, only: RCONT_TOL_R, RCONT_TOL_X, RCONT_TOL_STALL, RCONT_YSCALE, &
+                             RCONT_LSCALE, RCONT_DS, RCONT_DS_MIN, RCONT_DS_MAX, RCONT_LAM_END, &
+                             RCONT_LAM_LO, N_RCONT, ICONT_MAX_ITER, ICONT_REUSE_JAC, N_ICONT
+    use frirom_hbm, only: T_AFT, T_ASM, T_FACT, T_SOLVE, T_REC, N_EVAL, N_FACT, N_TIMERS, &
+                          HBM_START_CONTINUE, HBM_START_RESUME, HBM_START_SOLVE_ONLY
+    implicit none
+    character(len=*), intent(in) :: name
+    integer(4), intent(out) :: value
+    integer(4), intent(out) :: info
+    character(len=512), intent(out) :: msg
+    integer(ip) :: linfo
+    msg = ''
+    info = 0
+    select case (name)
+    case ('RCONT_TOL_R')
+        value = RCONT_TOL_R
+    case ('RCONT_TOL_X')
+        value = RCONT_TOL_X
+    case ('RCONT_TOL_STALL')
+        value = RCONT_TOL_STALL
+    case ('RCONT_YSCALE')
+        value = RCONT_YSCALE
+    case ('RCONT_LSCALE')
+        value = RCONT_LSCALE
+    case ('RCONT_DS')
+        value = RCONT_DS
+    case ('RCONT_DS_MIN')
+        value = RCONT_DS_MIN
+    case ('RCONT_DS_MAX')
+        value = RCONT_DS_MAX
+    case ('RCONT_LAM_END')
+        value = RCONT_LAM_END
+    case ('RCONT_LAM_LO')
+        value = RCONT_LAM_LO
+    case ('N_RCONT')
+        value = N_RCONT
+    case ('ICONT_MAX_ITER')
+        value = ICONT_MAX_ITER
+    case ('ICONT_REUSE_JAC')
+        value = ICONT_REUSE_JAC
+    case ('N_ICONT')
+        value = N_ICONT
+    case ('HBM_START_CONTINUE')
+        value = HBM_START_CONTINUE
+    case ('HBM_START_RESUME')
+        value = HBM_START_RESUME
+    case ('HBM_START_SOLVE_ONLY')
+        value = HBM_START_SOLVE_ONLY
+    case ('T_AFT')
+        value = T_AFT
+    case ('T_ASM')
+        value = T_ASM
+    case ('T_FACT')
+        value = T_FACT
+    case ('T_SOLVE')
+        value = T_SOLVE
+    case ('T_REC')
+        value = T_REC
+    case ('N_EVAL')
+        value = N_EVAL
+    case ('N_FACT')
+        value = N_FACT
+    case ('N_TIMERS')
+        value = N_TIMERS
+    case default
+        value = frirom_status_code(name)
+        if (value < 0) then
+            call set_status(linfo, FRIROM_ERR_PARAM, msg, 'int_constant: no constant named '// &
+                            trim(name))
+            info = linfo
+        end if
+    end select
+end subroutine int_constant
+
+!> Value of a named real constant of this interface: YSCALE_RELATIVE (frirom_newton), the
+!> yscale of a first solve whose update test is purely relative. Unknown: FRIROM_ERR_PARAM.
+subroutine real_constant(name, value, info, msg)
+    use frirom_kinds, only: ip
+    use frirom_status, only: FRIROM_ERR_PARAM, set_status
+    use frirom_newton, only: YSCALE_RELATIVE
+    implicit none
+    character(len=*), intent(in) :: name
+    real(8), intent(out) :: value
+    integer(4), intent(out) :: info
+    character(len=512), intent(out) :: msg
+    integer(ip) :: linfo
+    msg = ''
+    info = 0
+    value = 0.0d0
+    if (name == 'YSCALE_RELATIVE') then
+        value = YSCALE_RELATIVE
+    else
+        call set_status(linfo, FRIROM_ERR_PARAM, msg, 'real_constant: no constant named '// &
+                        trim(name))
+        info = linfo
+    end if
+end subroutine real_constant
 
 !> GFLOP/s of the dgemm the library links (reps products of n x n matrices), for benchmarks
 !> that compare factorisation rates with the BLAS actually used.

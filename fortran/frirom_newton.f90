@@ -13,6 +13,22 @@ module frirom_newton
     implicit none
     private
     public :: nl_system, cont_options, newton_correct, cont_tangent, cont_run
+    public :: cont_options_from, YSCALE_RELATIVE
+    public :: RCONT_TOL_R, RCONT_TOL_X, RCONT_TOL_STALL, RCONT_YSCALE, RCONT_LSCALE, &
+              RCONT_DS, RCONT_DS_MIN, RCONT_DS_MAX, RCONT_LAM_END, RCONT_LAM_LO, N_RCONT
+    public :: ICONT_MAX_ITER, ICONT_REUSE_JAC, N_ICONT
+
+    !> Slots of the continuation settings as one real and one integer array, for callers
+    !> that cannot pass a cont_options across their boundary (frirom_f2py, C): the fields
+    !> of the same names, and RCONT_LAM_LO, the lower parameter bound cont_run takes.
+    integer(ip), parameter :: RCONT_TOL_R = 1, RCONT_TOL_X = 2, RCONT_TOL_STALL = 3, &
+                              RCONT_YSCALE = 4, RCONT_LSCALE = 5, RCONT_DS = 6, &
+                              RCONT_DS_MIN = 7, RCONT_DS_MAX = 8, RCONT_LAM_END = 9, &
+                              RCONT_LAM_LO = 10, N_RCONT = 10
+    integer(ip), parameter :: ICONT_MAX_ITER = 1, ICONT_REUSE_JAC = 2, N_ICONT = 2
+    !> yscale of a solve before any solution size is known: the update test becomes purely
+    !> relative, ||dy|| / ||y|| (arc lengths in this scaling mean nothing)
+    real(wp), parameter :: YSCALE_RELATIVE = 1.0e-300_wp
 
     !> A nonlinear system R(y, lam) = 0 with n unknowns y and one parameter lam.
     type, abstract :: nl_system
@@ -72,6 +88,25 @@ module frirom_newton
     end type cont_options
 
 contains
+
+    !> Continuation settings from their flat layout (slots RCONT_*, ICONT_*; reuse_jac is
+    !> true for a nonzero integer); fields without a slot keep their defaults.
+    pure function cont_options_from(rv, iv) result(opts)
+        real(wp), intent(in) :: rv(N_RCONT)     !! real settings by RCONT_* slot
+        integer(ip), intent(in) :: iv(N_ICONT)  !! integer settings by ICONT_* slot
+        type(cont_options) :: opts
+        opts%tol_r = rv(RCONT_TOL_R)
+        opts%tol_x = rv(RCONT_TOL_X)
+        opts%tol_stall = rv(RCONT_TOL_STALL)
+        opts%yscale = rv(RCONT_YSCALE)
+        opts%lscale = rv(RCONT_LSCALE)
+        opts%ds = rv(RCONT_DS)
+        opts%ds_min = rv(RCONT_DS_MIN)
+        opts%ds_max = rv(RCONT_DS_MAX)
+        opts%lam_end = rv(RCONT_LAM_END)
+        opts%max_iter = iv(ICONT_MAX_ITER)
+        opts%reuse_jac = iv(ICONT_REUSE_JAC) /= 0
+    end function cont_options_from
 
     !> Called once per converged point (y, lam), before its tangent is computed: a system
     !> with history (friction sliders) updates the state that R depends on here, so that

@@ -5,7 +5,7 @@ module frirom_status
     use frirom_kinds, only: ip
     implicit none
     private
-    public :: frirom_status_message, set_status
+    public :: frirom_status_message, frirom_status_code, set_status
     public :: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, FRIROM_ERR_NONFINITE, &
               FRIROM_ERR_SAMPLES, FRIROM_ERR_ALLOC, FRIROM_ERR_FFTW, FRIROM_ERR_LAPACK, &
               FRIROM_ERR_ARPACK, FRIROM_ERR_NOCONV, FRIROM_ERR_SINGULAR, FRIROM_ERR_LAW, &
@@ -74,6 +74,49 @@ contains
             msg = 'unknown status code'
         end select
     end function frirom_status_message
+
+    !> The code of a status by its name here ('FRIROM_ERR_CONT', ...), -1 for an unknown
+    !> name: callers in other languages look codes up instead of copying them.
+    pure function frirom_status_code(name) result(code)
+        character(len=*), intent(in) :: name  !! parameter name, as in this module
+        integer(ip) :: code
+        select case (name)
+        case ('FRIROM_OK')
+            code = FRIROM_OK
+        case ('FRIROM_ERR_SIZE')
+            code = FRIROM_ERR_SIZE
+        case ('FRIROM_ERR_PARAM')
+            code = FRIROM_ERR_PARAM
+        case ('FRIROM_ERR_NONFINITE')
+            code = FRIROM_ERR_NONFINITE
+        case ('FRIROM_ERR_SAMPLES')
+            code = FRIROM_ERR_SAMPLES
+        case ('FRIROM_ERR_ALLOC')
+            code = FRIROM_ERR_ALLOC
+        case ('FRIROM_ERR_FFTW')
+            code = FRIROM_ERR_FFTW
+        case ('FRIROM_ERR_LAPACK')
+            code = FRIROM_ERR_LAPACK
+        case ('FRIROM_ERR_ARPACK')
+            code = FRIROM_ERR_ARPACK
+        case ('FRIROM_ERR_NOCONV')
+            code = FRIROM_ERR_NOCONV
+        case ('FRIROM_ERR_SINGULAR')
+            code = FRIROM_ERR_SINGULAR
+        case ('FRIROM_ERR_LAW')
+            code = FRIROM_ERR_LAW
+        case ('FRIROM_ERR_NOCLOSE')
+            code = FRIROM_ERR_NOCLOSE
+        case ('FRIROM_ERR_CONT')
+            code = FRIROM_ERR_CONT
+        case ('FRIROM_ERR_MODEL')
+            code = FRIROM_ERR_MODEL
+        case ('FRIROM_ERR_FACTOR')
+            code = FRIROM_ERR_FACTOR
+        case default
+            code = -1
+        end select
+    end function frirom_status_code
 
     !> Set `info` and, when the caller passed one, a message naming what went wrong.
     pure subroutine set_status(info, code, errmsg, detail)

@@ -93,8 +93,8 @@ def fact_flops(form: str, n_unk: int, kl: int | None) -> float:
 
 
 def band_kl(model: Model, H: int) -> int:
-    from frirom.solver import _Packed
-    pk = _Packed(model, Excitation(np.zeros((model.n_dof, 1))), SolverOptions(harmonics=H,
+    from frirom._pack import pack
+    pk = pack(model, Excitation(np.zeros((model.n_dof, 1))), SolverOptions(harmonics=H,
                  formulation="banded"), outputs=[0])
     iperm = np.empty_like(pk.perm)
     iperm[pk.perm - 1] = np.arange(model.n_dof)

@@ -1,0 +1,435 @@
+"""The model as the arrays of the Fortran solver (fortran/frirom_f2py.f90 hbm_continue).
+
+:func:`pack` turns a Model or a CyclicModel, an Excitation and SolverOptions into a
+:class:`_Packed`; :meth:`_Packed.call` makes one hbm_continue call from it. Option slots,
+start modes and timer slots are read from Fortran at import (``int_constant``), so no
+number of the boundary is typed here.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, NamedTuple
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+from scipy.sparse.linalg import eigsh
+
+from . import _kernels
+from ._errors import ParameterError, SizeError, int_constant, raise_for_status
+from .contact import LAWS
+from .model import CyclicModel, Excitation, Model
+from .results import FRFPoint, amplitude_max
+
+if TYPE_CHECKING:
+    from .solver import SolverOptions
+
+#: Largest Hill eigenproblem (2 n_dof (2H+1)) computed; above it stability is skipped.
+HILL_MAX = 4000
+
+
+def _real_constant(name: str) -> float:
+    value, info, msg = _kernels.real_constant(name)
+    if info != 0:
+        raise ImportError(msg.decode(errors="replace").strip())
+    return float(value)
+
+
+#: hbm_continue's start modes: solve at lam0 then continue, resume from a converged point
+#: and its tangent, or solve at lam0 only.
+START_CONTINUE = int_constant("HBM_START_CONTINUE")
+START_RESUME = int_constant("HBM_START_RESUME")
+START_SOLVE_ONLY = int_constant("HBM_START_SOLVE_ONLY")
+#: yscale of a first solve: a purely relative update test (no solution size known yet).
+YSCALE_RELATIVE = _real_constant("YSCALE_RELATIVE")
+
+#: 0-based slots of the real (RCONT_*) and integer (ICONT_*) option arrays, by the
+#: frirom_newton cont_options field they fill (lam_lo: cont_run's lower bound).
+_RCONT = {f: int_constant("RCONT_" + f.upper()) - 1 for f in (
+    "tol_r", "tol_x", "tol_stall", "yscale", "lscale", "ds", "ds_min", "ds_max", "lam_end",
+    "lam_lo")}
+_ICONT = {f: int_constant("ICONT_" + f.upper()) - 1 for f in ("max_iter", "reuse_jac")}
+if (len(_RCONT) != int_constant("N_RCONT") or len(_ICONT) != int_constant("N_ICONT")):
+    raise ImportError("frirom._pack: hbm_continue has option slots this module does not fill")
+_RCONT_AT = np.array(list(_RCONT.values()))     # slots in the order of the keys above
+_ICONT_AT = np.array(list(_ICONT.values()))
+
+#: Timer/counter names of each run (seconds, counts) by their 0-based slot in `timings`.
+_TIMER_SLOTS = {name: int_constant(slot) - 1 for name, slot in (
+    ("aft", "T_AFT"), ("assembly", "T_ASM"), ("factorization", "T_FACT"),
+    ("solve", "T_SOLVE"), ("receptance", "T_REC"), ("evaluations", "N_EVAL"),
+    ("factorizations", "N_FACT"), ("fortran_total", "N_TIMERS"))}
+TIMER_NAMES = tuple(sorted(_TIMER_SLOTS, key=_TIMER_SLOTS.get))
+
+
+def add_timings(acc: dict, timings: np.ndarray) -> None:
+    """Add one call's timings (N_TIMERS,) to acc (name -> total, TIMER_NAMES order)."""
+    for name in TIMER_NAMES:
+        acc[name] = acc.get(name, 0.0) + float(timings[_TIMER_SLOTS[name]])
+
+
+def _csr(a) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(indptr, indices, data) of a, 1-based, sorted; one explicit zero if a is empty."""
+    a = sp.csr_matrix(a)
+    a.sort_indices()
+    idx = a.indices.astype(np.int32) + 1
+    x = a.data.astype(float)
+    if idx.size == 0:     # f2py needs at least one entry
+        idx, x = np.ones(1, np.int32), np.zeros(1)
+    return a.indptr.astype(np.int32) + 1, idx, x
+
+
+@dataclass
+class _Modes:
+    """Modes for receptances by superposition, as hbm_continue takes them; arrays of the
+    kind not used (count 0) keep one column so that f2py gets their shapes.
+
+    Attributes
+    ----------
+    nmodes : real modes (SolverOptions.modes), 0 for none
+    phi : (n_dof, max(nmodes, 1)) mass-normalised shapes
+    omega, zeta : (max(nmodes, 1),) natural frequencies (rad/s), damping ratios
+    hmodes : modes per harmonic (a cyclic sector's nodal diameters), 0 for none
+    psi : (n_dof, max(hmodes, 1), H + 1) complex shapes of harmonic h's nodal diameter
+    omega_h, zeta_h : (max(hmodes, 1), H + 1) their frequencies (rad/s), damping ratios
+    """
+
+    nmodes: int
+    phi: np.ndarray
+    omega: np.ndarray
+    zeta: np.ndarray
+    hmodes: int
+    psi: np.ndarray
+    omega_h: np.ndarray
+    zeta_h: np.ndarray
+
+    @classmethod
+    def none(cls, nrows: int, H: int) -> _Modes:
+        return cls(0, np.zeros((nrows, 1)), np.ones(1), np.zeros(1),
+                   0, np.zeros((nrows, 1, H + 1), complex, order="F"),
+                   np.ones((1, H + 1)), np.zeros((1, H + 1)))
+
+
+def _lowest_modes(model: Model, nm: int, H: int) -> _Modes:
+    """Lowest nm mass-normalised modes, natural frequencies (rad/s) and damping ratios."""
+    n = model.n_dof
+    if nm > n:
+        raise ParameterError(f"options.modes: {nm} modes for a model with {n} DoFs")
+    if n <= 3000 or nm > n // 2:
+        w2, phi = sla.eigh(model.K.toarray(), model.M.toarray(), subset_by_index=[0, nm - 1])
+    else:
+        w2, phi = eigsh(model.K.tocsc(), k=nm, M=model.M.tocsc(), sigma=0.0, which="LM")
+        order = np.argsort(w2)
+        w2, phi = w2[order], phi[:, order]
+        phi = phi / np.sqrt(np.einsum("ir,ir->r", phi, model.M @ phi))
+    if np.any(w2 <= 0):
+        raise ParameterError("options.modes: the model has rigid-body (zero-frequency) modes; "
+                             "modal superposition needs a constrained model")
+    w = np.sqrt(w2)
+    if model.damping.kind == "modal" and model.damping.zeta.size >= nm:
+        z = model.damping.zeta[:nm].copy()
+    else:
+        z = np.einsum("ir,ir->r", phi, model.C @ phi) / (2.0 * w)
+    m = _Modes.none(n, H)
+    m.nmodes, m.phi, m.omega, m.zeta = w.size, np.asfortranarray(phi), w, z
+    return m
+
+
+class _Contacts(NamedTuple):
+    """The contact groups packed: stacked G (rows, ncol), law/size table, parameters and
+    sliders concatenated group by group."""
+
+    G: sp.csr_matrix
+    ginfo: np.ndarray        # (3, n_groups) int32: law code, n_elem, n_dir
+    params: np.ndarray       # (sum n_elem n_par,), at least one entry
+    w0: np.ndarray           # (nw,), at least one entry
+    nw: int                  # sliders in all
+    names: list[str]
+    sizes: list[int]         # n_elem per group
+
+
+def _pack_contacts(groups, ncol: int) -> _Contacts:
+    names, sizes = [g.name for g in groups], [g.n_elem for g in groups]
+    if not groups:
+        return _Contacts(sp.csr_matrix((0, ncol)), np.zeros((3, 0), np.int32, order="F"),
+                         np.zeros(1), np.zeros(1), 0, names, sizes)
+    ginfo = np.array([[LAWS[g.law].code, g.n_elem, g.n_dir] for g in groups],
+                     dtype=np.int32).T.copy(order="F")
+    params = np.concatenate([g.params.ravel() for g in groups])
+    w0 = [g.w0.ravel() for g in groups]
+    nw = int(sum(a.size for a in w0))
+    G = sp.vstack([sp.csr_matrix(g.G, shape=(g.G.shape[0], ncol)) if g.G.shape[1] == ncol
+                   else sp.hstack([g.G, sp.csr_matrix((g.G.shape[0], ncol - g.G.shape[1]))])
+                   for g in groups]).tocsr()
+    return _Contacts(G, ginfo, params, np.concatenate(w0) if nw else np.zeros(1), nw,
+                     names, sizes)
+
+
+def _check_outputs(outputs, n: int) -> np.ndarray:
+    out = np.asarray(outputs, dtype=int).ravel()
+    if out.size == 0:
+        out = np.zeros(1, dtype=int)
+    if np.any(out < 0) or np.any(out >= n):
+        raise SizeError(f"outputs: DoF indices must be in 0..{n - 1}")
+    return out
+
+
+class _CallResult(NamedTuple):
+    """What one hbm_continue call returns (maxpts columns, the first npts filled)."""
+
+    ys: np.ndarray           # (ny, maxpts) unknowns
+    lams: np.ndarray         # (maxpts,) parameter
+    tans: np.ndarray         # (ny + 1, maxpts) unit tangents in scaled variables
+    iters: np.ndarray        # (maxpts,) Newton iterations
+    xo: np.ndarray           # (n_out, 2H+1, maxpts) output harmonics, m
+    states: np.ndarray       # (3, ne_tot, maxpts) stick/slip/open fractions per element
+    hill_re: np.ndarray      # (maxpts,) max real part of the Floquet exponents, 1/s
+    sliders: np.ndarray      # (nw, maxpts) contact history each point leaves
+    npts: int
+    finished: int            # 1: reached lam_end (or a solve-only call)
+    ds_out: float            # arc-length step to continue with
+    timings: np.ndarray      # (N_TIMERS,) seconds and counts, see TIMER_NAMES
+    info: int
+    msg: str
+
+
+@dataclass
+class _Packed:
+    """The model as the Fortran arrays of hbm_continue (built once per run by
+    :func:`pack`); w0 is the contact history the next call starts from.
+
+    Rows are the model's DoFs, or for a cyclic sector the DoFs the solver reads (contact
+    DoFs of the sector and of the next one, outputs and loaded DoFs). Index arrays for
+    Fortran are 1-based (K, M, C, G as (indptr, indices, data); perm), others 0-based.
+    """
+
+    opts: SolverOptions       # opts.parameter: 'frequency' or 'load'
+    H: int
+    n_dof: int                # rows
+    fe0: np.ndarray           # (n_dof, 2H+1) N: fixed excitation
+    fe1: np.ndarray           # (n_dof, 2H+1) N: excitation scaled by a load parameter
+    K: tuple                  # CSR, 1-based, (n_dof, n_dof), N/m
+    M: tuple                  # kg
+    C: tuple                  # N s/m
+    perm: np.ndarray          # (n_dof,) int32, RCM order, 1-based
+    nl: np.ndarray            # (nnl,) contact DoFs (rows), 0-based
+    G: tuple                  # CSR, 1-based, (contact rows, n_dof)
+    ginfo: np.ndarray         # (3, n_groups) int32: law code, n_elem, n_dir
+    params: np.ndarray        # contact parameters, groups concatenated
+    w0: np.ndarray            # (max(nw, 1),) sliders the next call starts from
+    nw: int
+    group_names: list
+    group_sizes: list
+    outputs: np.ndarray       # (n_out,) output DoFs of the model, 0-based
+    out_f: np.ndarray         # (n_out,) their rows, 0-based
+    stability: bool
+    modes: _Modes
+
+    @property
+    def nc(self) -> int:
+        return 2 * self.H + 1
+
+    @property
+    def ny(self) -> int:
+        """Unknowns: harmonics of the contact DoFs (condensed) or of all rows (banded)."""
+        return (self.nl.size if self.opts.formulation == "condensed" else self.n_dof) * self.nc
+
+    @property
+    def ne_tot(self) -> int:
+        return int(sum(self.group_sizes))
+
+    def set_history(self, slider) -> None:
+        """Initial sliders of all contact elements (the history of the point a run starts
+        from; the layout of FRFPoint.slider); None keeps the model's w0."""
+        if slider is None:
+            return
+        slider = np.asarray(slider, dtype=float).ravel()
+        if slider.size != self.nw:
+            raise SizeError(f"start.slider: {slider.size} values, the model's contact "
+                            f"elements have {self.nw} sliders")
+        if not np.all(np.isfinite(slider)):
+            raise ParameterError("start.slider: contains NaN or Inf")
+        if self.nw:
+            self.w0 = slider.copy()
+
+    def call(self, y0, lam0, tan0, start_mode, ds, lam_end, lam_lo, yscale, lscale, maxpts,
+             omega_fix=0.0) -> _CallResult:
+        """One hbm_continue call from the current contact history self.w0; the history
+        the last point leaves becomes self.w0 for the next call."""
+        o, m = self.opts, self.modes
+        ropt = np.empty(len(_RCONT))
+        ropt[_RCONT_AT] = (o.tol_residual, o.tol_update, o.tol_stall, yscale, lscale, ds,
+                           o.ds_min, o.ds_max, lam_end, lam_lo)
+        iopt = np.empty(len(_ICONT), np.int32)
+        iopt[_ICONT_AT] = (o.max_iter, int(o.reuse_jacobian))
+        nl = (self.nl + 1).astype(np.int32) if self.nl.size else np.ones(1, np.int32)
+        (kp, ki, kx), (mp, mi, mx), (cp, ci, cx), (gp, gi, gx) = self.K, self.M, self.C, self.G
+        res = _kernels.hbm_continue(
+            formulation=o.formulation, lam_kind=o.parameter, nsamp=o.n_samples,
+            kp=kp, ki=ki, kx=kx, mp=mp, mi=mi, mx=mx, cp=cp, ci=ci, cx=cx, perm=self.perm,
+            nl=nl, fe0=np.asfortranarray(self.fe0), fe1=np.asfortranarray(self.fe1),
+            omega_fix=omega_fix, ginfo=self.ginfo, gp=gp, gi=gi, gx=gx, params=self.params,
+            w0=self.w0, outdofs=(self.out_f + 1).astype(np.int32),
+            nmodes=m.nmodes, phi=np.asfortranarray(m.phi), wmodes=m.omega, zmodes=m.zeta,
+            hmodes=m.hmodes, psi=np.asfortranarray(m.psi),
+            wharm=np.asfortranarray(m.omega_h), zharm=np.asfortranarray(m.zeta_h),
+            y0=y0, lam0=lam0, tan0=tan0, start_mode=start_mode, ropt=ropt, iopt=iopt,
+            stability=int(self.stability), history=int(o.history), maxpts=maxpts,
+            netot=max(self.ne_tot, 1), ntim=len(_TIMER_SLOTS), nh=self.H, ndof=self.n_dof,
+            nnl=self.nl.size or 1)
+        r = _CallResult(*res[:-1], msg=res[-1].decode(errors="replace"))
+        if r.npts > 0 and self.nw and o.history:
+            self.w0 = r.sliders[:self.nw, r.npts - 1].copy()
+        return r
+
+    def pad_start(self, y, H_from: int) -> np.ndarray:
+        """Unknowns of a solution with H_from harmonics, extended or cut to this H."""
+        y = np.asarray(y, dtype=float)
+        condensed = self.opts.formulation == "condensed"
+        nrow = self.nl.size if condensed else self.n_dof
+        nc_from = 2 * H_from + 1
+        if y.size != nrow * nc_from:
+            raise SizeError(f"start: {y.size} unknowns do not match H = {H_from} for this "
+                            "model and formulation")
+        m = min(nc_from, self.nc)
+        out = np.zeros(self.ny)
+        if condensed:           # harmonic-major: y[j + nnl c]
+            out[:nrow * m] = y[:nrow * m]
+        else:                   # DoF-major in RCM order: y[c + nc p]
+            out.reshape(nrow, self.nc)[:, :m] = y.reshape(nrow, nc_from)[:, :m]
+        return out
+
+    def points(self, res: _CallResult, omega_fix, t_call) -> list[FRFPoint]:
+        """The converged points of one call; t_call (s) is shared out among them."""
+        pts = []
+        for k in range(res.npts):
+            st = np.zeros((len(self.group_sizes), 3))
+            e0 = 0
+            for g, ne in enumerate(self.group_sizes):
+                st[g] = res.states[:, e0:e0 + ne, k].mean(axis=1)
+                e0 += ne
+            X = np.array(res.xo[:, :, k])
+            om = res.lams[k] if self.opts.parameter == "frequency" else omega_fix
+            pts.append(FRFPoint(omega=float(om), parameter=float(res.lams[k]),
+                                unknowns=res.ys[:, k].copy(), tangent=res.tans[:, k].copy(),
+                                X=X, amp_max=amplitude_max(X), state_fractions=st,
+                                iterations=int(res.iters[k]), time_s=t_call / max(res.npts, 1),
+                                stable=bool(res.hill_re[k] <= 1e-7 * max(abs(om), 1.0)),
+                                floquet_max_re=float(res.hill_re[k]),
+                                slider=res.sliders[:self.nw, k].copy()))
+        return pts
+
+
+def _split_load(fe: np.ndarray, part: str) -> tuple[np.ndarray, np.ndarray]:
+    """(fixed, scaled) parts of a real harmonic excitation (n, 2H+1): part 'static' scales
+    harmonic 0, 'dynamic' the harmonics >= 1."""
+    mask = np.zeros(fe.shape[1], bool)
+    mask[0 if part == "static" else slice(1, None)] = True
+    fe1 = np.where(mask, fe, 0.0)
+    return fe - fe1, fe1
+
+
+def pack(model: Model | CyclicModel, excitation: Excitation, opts: SolverOptions, outputs,
+         load_part: str = "dynamic") -> _Packed:
+    """Check the inputs and pack them for hbm_continue; outputs: DoF indices (0-based) or
+    None for the default (all DoFs up to 100, else the contact DoFs)."""
+    if not isinstance(model, (Model, CyclicModel)):
+        raise ParameterError("model: expected a frirom.model.Model or CyclicModel")
+    if not isinstance(excitation, Excitation):
+        raise ParameterError("excitation: expected a frirom.model.Excitation")
+    opts.check()
+    fe = excitation.real_harmonic(model.n_dof, opts.harmonics)
+    if load_part not in ("static", "dynamic"):
+        raise ParameterError("load_part: expected 'static' or 'dynamic'")
+    if opts.parameter == "frequency":
+        fe0, fe1 = fe, np.zeros_like(fe)
+    else:
+        fe0, fe1 = _split_load(fe, load_part)
+    if isinstance(model, CyclicModel):
+        return _pack_sector(model, opts, fe0, fe1, outputs)
+    return _pack_model(model, opts, fe0, fe1, outputs)
+
+
+def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed:
+    H, n = opts.harmonics, model.n_dof
+    nl = model.nonlinear_dofs()
+    if opts.formulation == "condensed" and nl.size == 0:
+        raise ParameterError("formulation 'condensed' needs contact DoFs; the model has "
+                             "no contact group (use 'banded')")
+    groups = model.contacts
+    c = _pack_contacts(groups, n)
+    # RCM over K, M, C and the contact couplings
+    pat = (abs(model.K) + abs(model.M) + abs(model.C)).tocsr()
+    if groups:
+        pat = pat + (abs(c.G).T @ abs(c.G))
+    pat = (pat + pat.T + sp.identity(n)).tocsr()
+    pat.sort_indices()
+    perm, info, msg = _kernels.hbm_rcm(pat.indptr.astype(np.int32) + 1,
+                                       pat.indices.astype(np.int32) + 1)
+    raise_for_status(info, msg.decode(errors="replace"))
+    out = _check_outputs((np.arange(n) if n <= 100 else nl) if outputs is None else outputs, n)
+    stability = bool(opts.stability)
+    if stability and 2 * n * (2 * H + 1) > HILL_MAX:
+        warnings.warn(f"frirom: Hill stability skipped: its dense eigenproblem would have "
+                      f"size 2 n_dof (2H+1) = {2 * n * (2 * H + 1)} > {HILL_MAX}",
+                      RuntimeWarning, stacklevel=4)
+        stability = False
+    modes = _lowest_modes(model, int(opts.modes), H) if opts.modes else _Modes.none(n, H)
+    return _Packed(opts=opts, H=H, n_dof=n, fe0=fe0, fe1=fe1,
+                   K=_csr(model.K), M=_csr(model.M), C=_csr(model.C), perm=perm, nl=nl,
+                   G=_csr(c.G), ginfo=c.ginfo, params=c.params, w0=c.w0, nw=c.nw,
+                   group_names=c.names, group_sizes=c.sizes, outputs=out, out_f=out,
+                   stability=stability, modes=modes)
+
+
+def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Packed:
+    """A cyclic sector as a condensed system on the DoFs the solver reads: contact DoFs
+    of sector 0 and of the next sector (columns n.. of G, shapes times exp(i k_h alpha)),
+    outputs and loaded DoFs; receptances from the modes of each harmonic's nodal
+    diameter (hbm_set_modes_harmonic); K, M, C are not used (empty)."""
+    n, H = model.n_dof, o.harmonics
+    if o.formulation != "condensed":
+        raise ParameterError("options.formulation: a cyclic sector is solved in the "
+                             "'condensed' formulation (receptances per nodal diameter)")
+    if o.modes:
+        raise ParameterError("options.modes: a cyclic model brings its own modes per "
+                             "nodal diameter (frirom.reduction.cyclic.cyclic_model)")
+    if o.stability:
+        raise ParameterError("options.stability: Hill's method is not implemented for "
+                             "cyclic sectors (perturbations of every nodal diameter)")
+    c = _pack_contacts(model.contacts, 2 * n)
+    cols = np.unique(c.G.indices)
+    if outputs is None:
+        outputs = np.arange(n) if n <= 100 else cols[cols < n]
+    out = _check_outputs(outputs, n)
+    loaded = np.nonzero(np.any(fe0 != 0, axis=1) | np.any(fe1 != 0, axis=1))[0]
+    rows = np.unique(np.concatenate([cols, out, loaded]))
+    nr = rows.size
+    at = -np.ones(2 * n, dtype=np.int64)
+    at[rows] = np.arange(nr)
+    G = sp.csr_matrix((c.G.data, at[c.G.indices], c.G.indptr), shape=(c.G.shape[0], nr))
+    real = rows[rows < n]
+    fe0_r, fe1_r = np.zeros((nr, 2 * H + 1)), np.zeros((nr, 2 * H + 1))
+    fe0_r[at[real]], fe1_r[at[real]] = fe0[real], fe1[real]
+    alpha = 2 * np.pi / model.n_sectors
+    per = [model.modes_of(model.harmonic_index(h)) for h in range(H + 1)]
+    nm = max(m.omega.size for m in per)
+    modes = _Modes.none(nr, H)
+    modes.hmodes = nm
+    modes.psi = np.zeros((nr, nm, H + 1), complex, order="F")
+    modes.omega_h = np.ones((nm, H + 1), order="F")
+    modes.zeta_h = np.zeros((nm, H + 1), order="F")
+    nb = rows >= n
+    for h, m in enumerate(per):
+        r = m.omega.size
+        modes.psi[~nb, :r, h] = m.psi[rows[~nb]]
+        modes.psi[nb, :r, h] = m.psi[rows[nb] - n] * np.exp(1j * m.k * alpha)
+        modes.omega_h[:r, h], modes.zeta_h[:r, h] = m.omega, m.zeta
+    empty = _csr(sp.csr_matrix((nr, nr)))
+    return _Packed(opts=o, H=H, n_dof=nr, fe0=fe0_r, fe1=fe1_r,
+                   K=empty, M=empty, C=empty, perm=np.arange(1, nr + 1, dtype=np.int32),
+                   nl=at[cols], G=_csr(G), ginfo=c.ginfo, params=c.params, w0=c.w0,
+                   nw=c.nw, group_names=c.names, group_sizes=c.sizes, outputs=out,
+                   out_f=at[out], stability=False, modes=modes)
