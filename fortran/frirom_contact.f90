@@ -68,7 +68,8 @@ contains
     !> (the only same-sample derivative besides kt in stick and kn in contact).
     pure subroutine friction1d_march(u, v, kt, kn, mu, n0, w, ft, fn, state, dft_dv)
         real(wp), intent(in) :: u(:, :)          !! (m, N) tangential relative displacement, m
-        real(wp), intent(in) :: v(:, :)          !! (m, N) normal relative displacement, m (+ closes)
+        real(wp), intent(in) :: v(:, :)          !! (m, N) normal relative displacement, m
+                                                 !! (positive closes)
         real(wp), intent(in) :: kt(:), kn(:), mu(:), n0(:)  !! (m) N/m, N/m, -, N
         real(wp), intent(inout) :: w(:)          !! (m) slider position: start in, end out, m
         real(wp), intent(out) :: ft(:, :), fn(:, :)  !! (m, N) tangential and normal force, N

@@ -19,7 +19,8 @@ module frirom_fourier
     include 'fftw3.f03'
 
     public :: fourier_plan, fourier_plan_create, fourier_plan_destroy
-    public :: clear_input, load_harmonics, exec_c2r, exec_r2c, harmonics_of, trig_sums, toeplitz_add
+    public :: clear_input, load_harmonics, exec_c2r, exec_r2c, harmonics_of, trig_sums, &
+              toeplitz_add
     public :: segment_sum, run_trig_sums
 
     !> Batched real FFTs of length N plus the trigonometric tables of H harmonics.
@@ -34,13 +35,14 @@ module frirom_fourier
         type(c_ptr) :: m_rin = c_null_ptr, m_cin = c_null_ptr
         type(c_ptr) :: m_rout = c_null_ptr, m_cout = c_null_ptr
         real(c_double), pointer, contiguous :: rin(:, :, :) => null()  !! (nbatch, N, nslot_in)
-        complex(c_double_complex), pointer, contiguous :: cin(:, :, :) => null() !! (nbatch, N/2+1, .)
+        !> (nbatch, N/2+1, .)
+        complex(c_double_complex), pointer, contiguous :: cin(:, :, :) => null()
         real(c_double), pointer, contiguous :: rout(:, :, :) => null() !! (nbatch, N, nslot_out)
         complex(c_double_complex), pointer, contiguous :: cout(:, :, :) => null()
         real(wp), allocatable :: basis(:, :)   !! (N, 2H+1): row k = [1, cos tau_k, sin tau_k, ...]
         real(wp), allocatable :: weight(:)     !! (2H+1): 1/N for a0, 2/N for the others
         real(wp), allocatable :: prefix(:, :)  !! (4H+1, 0:N): running sums over the samples of
-                                               !! [1, cos tau, sin tau, ..., cos 2H tau, sin 2H tau]
+                                               !! [1, cos tau, sin tau, .., cos 2H tau, sin 2H tau]
     end type fourier_plan
 
 contains
@@ -330,7 +332,8 @@ contains
                 cm(0) = cm(0) + val*real(k - k0, wp)
                 do m = 1, 2*plan%nharm
                     cm(m) = cm(m) + val*(plan%prefix(2*m, k - 1) - plan%prefix(2*m, k0 - 1))
-                    sm(m) = sm(m) + val*(plan%prefix(2*m + 1, k - 1) - plan%prefix(2*m + 1, k0 - 1))
+                    sm(m) = sm(m) + val*(plan%prefix(2*m + 1, k - 1) &
+                                         - plan%prefix(2*m + 1, k0 - 1))
                 end do
             end if
             k0 = k

@@ -8,6 +8,7 @@ cd "$(dirname "$0")/.."
 apt_packages=(
   gfortran pkg-config libopenblas-dev libarpack2-dev libfftw3-dev   # Fortran core
   libmumps-seq-dev                                                  # sparse LDL^T (eigen)
+  fypp                                                              # Fortran templates
   calculix-ccx                                                      # FE reference
   libglu1-mesa libgl1 libxcursor1 libxft2 libxinerama1              # gmsh wheel
 )
