@@ -30,14 +30,14 @@
 !> frirom_aft_jacobian (the analytical Jacobian).
 module frirom_aft
     use frirom_kinds, only: wp, ip
-    use frirom_status, only: FRIROM_OK
+    use frirom_status, only: FRIROM_OK, FRIROM_ERR_LAW, set_status
     use frirom_fourier, only: fourier_plan, fourier_plan_create, fourier_plan_destroy
     implicit none
     private
 
     public :: aft_plan, aft_plan_create, aft_plan_destroy, aft_eval, aft_time
     public :: LAW_JENKINS, LAW_NORMAL1D, LAW_NORMAL2D, LAW_CUBIC, LAW_CODES
-    public :: law_info, law_ndir, law_npar, law_nslider
+    public :: law_info, law_check, law_ndir, law_npar, law_nslider
 
     ! The contact-law table: the one source of the codes and sizes (the Python package
     ! checks its own table, with the names of directions and parameters, against it).
@@ -188,6 +188,32 @@ contains
             if (known(law)) name = LAW_NAMES(law)
         end if
     end subroutine law_info
+
+    !> FRIROM_OK for a law code of the table, else FRIROM_ERR_LAW with a message listing
+    !> the laws: 'law 9 (expected 1 jenkins, 2 normal1d, ...)'.
+    pure subroutine law_check(law, info, errmsg)
+        integer(ip), intent(in) :: law                     !! the code to check
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout), optional :: errmsg
+        character(len=200) :: buf
+        info = FRIROM_OK
+        if (any(LAW_CODES == law)) return
+        write (buf, '(a,i0,a,a,a)') 'law ', law, ' (expected ', law_list(), ')'
+        call set_status(info, FRIROM_ERR_LAW, errmsg, trim(buf))
+    end subroutine law_check
+
+    !> The codes and names of all laws for messages: '1 jenkins, 2 normal1d, ...'.
+    pure function law_list() result(text)
+        character(len=:), allocatable :: text
+        character(len=12) :: code
+        integer(ip) :: k
+        text = ''
+        do k = 1, NLAW
+            write (code, '(i0)') LAW_CODES(k)
+            if (k > 1) text = text//', '
+            text = text//trim(code)//' '//trim(LAW_NAMES(k))
+        end do
+    end function law_list
 
     !> Number of directions of a law (0 for an unknown code).
     pure integer(ip) function law_ndir(law)

@@ -1,7 +1,7 @@
 !> AFT entry points: forces and Jacobian (aft_eval), time histories (aft_time), and the
 !> checks of their arguments before any work. See frirom_aft for the method.
 submodule (frirom_aft) frirom_aft_eval
-    use frirom_status, only: FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, FRIROM_ERR_LAW, &
+    use frirom_status, only: FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, &
                              FRIROM_ERR_NONFINITE, FRIROM_ERR_NOCLOSE, set_status, &
                              frirom_status_message
     use frirom_fourier, only: exec_r2c, harmonics_of
@@ -134,11 +134,8 @@ contains
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'AFT plan not created')
             return
         end if
-        if (.not. any(LAW_CODES == law)) then
-            write (buf, '(a,i0,a,a,a)') 'law ', law, ' (expected ', law_list(), ')'
-            call set_status(info, FRIROM_ERR_LAW, errmsg, trim(buf))
-            return
-        end if
+        call law_check(law, info, errmsg)
+        if (info /= FRIROM_OK) return
         nc = plan%fp%ncoef
         nd = NDIR_OF(law)
         ne = size(x, 3)
@@ -237,17 +234,4 @@ contains
         frac(2) = real(count(st == STATE_SLIP), wp)/real(size(st), wp)
         frac(3) = real(count(st == STATE_LIFTOFF), wp)/real(size(st), wp)
     end subroutine state_fractions
-
-    !> The codes and names of all laws for messages: '1 jenkins, 2 normal1d, ...'.
-    pure function law_list() result(text)
-        character(len=:), allocatable :: text
-        character(len=12) :: code
-        integer(ip) :: k
-        text = ''
-        do k = 1, NLAW
-            write (code, '(i0)') LAW_CODES(k)
-            if (k > 1) text = text//', '
-            text = text//trim(code)//' '//trim(LAW_NAMES(k))
-        end do
-    end function law_list
 end submodule frirom_aft_eval

@@ -58,14 +58,15 @@ contains
         text = ''
         nd = law_ndir(int(law, ip))
         nc = 2*nharm + 1
-        if (nd == 0) then
-            call set_status(st, FRIROM_ERR_LAW, text, 'law must be 1..4')
-        else if (ne < 0 .or. nharm < 0) then
-            call set_status(st, FRIROM_ERR_PARAM, text, 'ne and nharm must be >= 0')
-        else if (.not. (c_associated(x) .and. c_associated(params) .and. c_associated(f))) then
-            call set_status(st, FRIROM_ERR_PARAM, text, 'x, params and f must not be NULL')
-        else
-            st = FRIROM_OK
+        ! an unknown law is reported with the codes and names of frirom_aft's law table
+        call law_check(int(law, ip), st, text)
+        if (st == FRIROM_OK) then
+            if (ne < 0 .or. nharm < 0) then
+                call set_status(st, FRIROM_ERR_PARAM, text, 'ne and nharm must be >= 0')
+            else if (.not. (c_associated(x) .and. c_associated(params) &
+                            .and. c_associated(f))) then
+                call set_status(st, FRIROM_ERR_PARAM, text, 'x, params and f must not be NULL')
+            end if
         end if
         if (st == FRIROM_OK) then
             ns = max(law_nslider(int(law, ip)), 1_ip)

@@ -2,6 +2,7 @@
 !> matrices, and the reverse Cuthill-McKee order on a randomly numbered chain and grid.
 program test_banded
     use frirom_kinds, only: wp, ip
+    use frirom_check, only: check, check_done
     use frirom_banded
     implicit none
     integer(ip), parameter :: n = 60, kl = 3, ku = 5
@@ -56,18 +57,9 @@ program test_banded
     call check(info /= 0 .and. index(msg, 'dgbtrf') > 0, 'singular reported')
     call rcm_chain()
     call rcm_grid()
-    print '(a)', 'test_banded: all checks passed'
+    call check_done('test_banded')
 
 contains
-
-    subroutine check(cond, what)
-        logical, intent(in) :: cond
-        character(len=*), intent(in) :: what
-        if (.not. cond) then
-            print '(a)', 'FAILED: '//what
-            error stop 1
-        end if
-    end subroutine check
 
     !> A chain numbered at random has a large bandwidth; RCM must bring it back to 1.
     subroutine rcm_chain()

@@ -38,7 +38,9 @@ int main(void) {
         fprintf(stderr, "bad kt: info %d msg %s\n", info, msg); return 1;
     }
     info = frirom_aft_eval(9, H, N, 1, x, params, NULL, f, NULL, NULL, msg, 256);
-    if (info != 11) { fprintf(stderr, "bad law: %d\n", info); return 1; }
+    if (info != 11 || strstr(msg, "law 9 (expected 1 jenkins, 2 normal1d") == NULL) {
+        fprintf(stderr, "bad law: info %d msg %s\n", info, msg); return 1;
+    }
     puts("test_capi: ok");
     return 0;
 }

@@ -13,6 +13,7 @@
 !> would change the branch are skipped (the law has a kink there).
 program test_contact
     use frirom_kinds, only: wp, ip
+    use frirom_check, only: check, check_done
     use frirom_contact
     implicit none
     real(wp), parameter :: pi = acos(-1.0_wp)
@@ -26,19 +27,9 @@ program test_contact
     call friction2d_limit_and_in_plane()
     call friction2d_derivatives()
     call cubic_closed_form()
-    print '(a)', 'test_contact: ok'
+    call check_done('test_contact')
 
 contains
-
-    !> Stop with a message naming the check that failed.
-    subroutine check(ok, what)
-        logical, intent(in) :: ok              !! the condition that must hold
-        character(len=*), intent(in) :: what   !! what it checks
-        if (.not. ok) then
-            print '(2a)', 'test_contact: FAILED: ', what
-            error stop 1
-        end if
-    end subroutine check
 
     !> True when |a - b| <= tol elementwise.
     pure logical function near(a, b, tol)

@@ -5,6 +5,7 @@
 !! static solves with several right-hand sides, and bad input returning a status.
 program test_eigen
     use frirom_kinds, only: wp, ip
+    use frirom_check, only: check, check_done
     use frirom_status, only: FRIROM_OK
     use frirom_eigen, only: eigen_work, eigen_factor, eigen_solve, eigen_modes, eigen_destroy
     implicit none
@@ -77,7 +78,7 @@ program test_eigen
     call eigen_modes(work, mptr, mind, mval, n, lam, phi, info, msg)
     call check(info /= FRIROM_OK, 'nev >= n rejected')
     call eigen_destroy(work)
-    print '(a)', 'test_eigen: all checks passed'
+    call check_done('test_eigen')
 
 contains
 
@@ -102,12 +103,4 @@ contains
         end do
     end function eye
 
-    subroutine check(ok, what)
-        logical, intent(in) :: ok
-        character(len=*), intent(in) :: what
-        if (.not. ok) then
-            print '(2a)', 'FAILED: ', what
-            error stop 1
-        end if
-    end subroutine check
 end program test_eigen

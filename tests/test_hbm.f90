@@ -4,6 +4,7 @@
 !> force is smooth and finite differences are accurate to ~1e-8).
 program test_hbm
     use frirom_kinds, only: wp, ip
+    use frirom_check, only: check, check_done
     use frirom_newton, only: cont_options, newton_correct
     use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
                           hbm_set_modes_harmonic
@@ -127,18 +128,9 @@ program test_hbm
     call hbm_setup(sbad, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
                    fe1, 1, 0.0_wp, ginfo, gp, gi, gx, params, w0, outd, info, msg)
     call check(info /= 0 .and. index(msg, 'perm') > 0, 'bad perm reported')
-    print '(a)', 'test_hbm: all checks passed'
+    call check_done('test_hbm')
 
 contains
-
-    subroutine check(ok, what)
-        logical, intent(in) :: ok
-        character(len=*), intent(in) :: what
-        if (.not. ok) then
-            print '(a)', 'FAILED: '//what
-            error stop 1
-        end if
-    end subroutine check
 
     !> J^-1 (R(y + e v) - R(y - e v)) / 2e must give v back, for v = each unit vector, at a
     !> random y; and rlam must match the central difference in lam. Tolerance 1e-6:

@@ -51,6 +51,34 @@ def _frf(K, M, G, f, om):
     return ((phi.T @ f)[None, :] / den) @ np.asarray(G @ phi).T
 
 
+def _gsi_frfs(cb, iface, active, pairs, n_free, n_stick, fq, om, groups=None):
+    """CB + GSI with n_free free and n_stick full-stick interface modes: its basis B
+    (n_q, n_k) and its stuck and free interface FRFs (n_om, n_iface), as _frf."""
+    B, _ = gsi_basis(cb.K, cb.M, iface, active, pairs, n_free, n_stick, groups=groups)
+    red = reduce_interface(cb.K, cb.M, iface, B)
+    G = red.contact_matrix(pairs)
+    ks = sp.diags(pairs.stiffness.ravel())
+    f = red.project(fq)
+    stuck = _frf(red.K + (G.T @ ks @ G).toarray(), red.M, G, f, om)
+    return B, stuck, _frf(red.K, red.M, G, f, om)
+
+
+def _rel(x, ref):
+    """||x - ref|| / ||ref|| (Frobenius norms)."""
+    return np.linalg.norm(x - ref) / np.linalg.norm(ref)
+
+
+def _error_table(capsys, title, labels, rows):
+    """Print rows (n_k, error 1, error 2) under title, past pytest's capture; return the
+    two error columns (n_rows,)."""
+    with capsys.disabled():
+        print("\n" + title)
+        for nk, e1, e2 in rows:
+            print(f"  n_k = {nk:3d}: {labels[0]} {e1:.2e}, {labels[1]} {e2:.2e}")
+    table = np.array(rows)
+    return table[:, 1], table[:, 2]
+
+
 def test_cb_then_gsi(fe, capsys):
     model, pairs = fe
     n = model.n_dof
@@ -81,22 +109,14 @@ def test_cb_then_gsi(fe, capsys):
     fq[active] = f[act_fe]
     g_cb = contact_matrix(pairs_cb, cb.K.shape[0])
     x_cb = _frf(cb.K + stick_stiffness(pairs_cb, cb.K.shape[0]).toarray(), cb.M, g_cb, fq, om)
-    e_cb = np.linalg.norm(x_cb - ref) / np.linalg.norm(ref)
+    e_cb = _rel(x_cb, ref)
     rows = []
     for nf, ns in ((2, 2), (4, 4), (8, 8), (16, 16), (38, iface.size - 38)):
-        B, _ = gsi_basis(cb.K, cb.M, iface, active, pairs_cb, nf, ns)
-        red = reduce_interface(cb.K, cb.M, iface, B)
-        G = red.contact_matrix(pairs_cb)
-        ks = sp.diags(pairs_cb.stiffness.ravel())
-        x = _frf(red.K + (G.T @ ks @ G).toarray(), red.M, G, red.project(fq), om)
-        rows.append((B.shape[1], np.linalg.norm(x - x_cb) / np.linalg.norm(x_cb),
-                     np.linalg.norm(x - ref) / np.linalg.norm(ref)))
-    with capsys.disabled():
-        print(f"\nccx block, {iface.size} interface DoFs, CB 40 modes (CB vs FE stuck "
-              f"interface FRF error {e_cb:.2e}); CB+GSI:")
-        for nk, ecb, efe in rows:
-            print(f"  n_k = {nk:3d}: vs CB {ecb:.2e}, vs FE {efe:.2e}")
-    e = np.array([r[1] for r in rows])
+        B, x, _ = _gsi_frfs(cb, iface, active, pairs_cb, nf, ns, fq, om)
+        rows.append((B.shape[1], _rel(x, x_cb), _rel(x, ref)))
+    e, _ = _error_table(capsys, f"ccx block, {iface.size} interface DoFs, CB 40 modes (CB vs "
+                        f"FE stuck interface FRF error {e_cb:.2e}); CB+GSI:",
+                        ("vs CB", "vs FE"), rows)
     assert np.all(np.diff(e) < 0)
     assert e[-1] < 1e-10                 # complete interface basis: the CB model itself
     assert e[-2] < 2e-2 and e_cb < 1e-2  # 32 GSI modes for 3x25 DoFs: within 2 %
@@ -135,20 +155,11 @@ def test_gsi_on_gmsh_lap_joint(tmp_path, capsys):
     ref_f = _frf(cb.K, cb.M, g1, fq, om)
     rows = []
     for n in (2, 4, 8, 16):
-        B, _ = gsi_basis(cb.K, cb.M, iface, active, pq, n, n, groups=groups)
+        B, xs, xf = _gsi_frfs(cb, iface, active, pq, n, n, fq, om, groups=groups)
         assert np.abs(B.T @ B - np.eye(B.shape[1])).max() < 1e-12
-        red = reduce_interface(cb.K, cb.M, iface, B)
-        G = red.contact_matrix(pq)
-        xs = _frf(red.K + (G.T @ ks @ G).toarray(), red.M, G, red.project(fq), om)
-        xf = _frf(red.K, red.M, G, red.project(fq), om)
-        rows.append((B.shape[1], np.linalg.norm(xs - ref_s) / np.linalg.norm(ref_s),
-                     np.linalg.norm(xf - ref_f) / np.linalg.norm(ref_f)))
-    with capsys.disabled():
-        print(f"\ngmsh lap joint: {pairs.n_elem} contact pairs, {iface.size} interface DoFs, "
-              f"CB 40 modes; GSI (free + stick per side) interface FRF error vs CB:")
-        for nk, es, ef in rows:
-            print(f"  n_k = {nk:3d}: stuck {es:.2e}  free {ef:.2e}")
-    es = np.array([r[1] for r in rows])
-    ef = np.array([r[2] for r in rows])
+        rows.append((B.shape[1], _rel(xs, ref_s), _rel(xf, ref_f)))
+    es, ef = _error_table(capsys, f"gmsh lap joint: {pairs.n_elem} contact pairs, {iface.size} "
+                          "interface DoFs, CB 40 modes; GSI (free + stick per side) interface "
+                          "FRF error vs CB:", ("stuck", "free"), rows)
     assert np.all(np.diff(es) < 0) and np.all(np.diff(ef) < 0)
     assert es[-1] < 2e-2 and ef[-1] < 2e-2

@@ -67,6 +67,7 @@ end module newton_test_system
 
 program test_newton
     use frirom_kinds, only: wp, ip
+    use frirom_check, only: check, check_done
     use frirom_newton, only: cont_options, newton_correct, cont_tangent, cont_run
     use newton_test_system
     implicit none
@@ -129,14 +130,5 @@ program test_newton
     call cont_run(s, y, lam, t, ds, -4.5_wp, o, yout, lout, tout, it, npts, fin, info, msg, hf)
     call check(info == 20 .and. npts == 0 .and. index(msg, 'stopped') > 0, &
                'stop diagnostic: '//trim(msg))
-    print '(a)', 'test_newton: all checks passed'
-contains
-    subroutine check(cond, what)
-        logical, intent(in) :: cond
-        character(len=*), intent(in) :: what
-        if (.not. cond) then
-            print '(a)', 'FAILED: '//what
-            error stop 1
-        end if
-    end subroutine check
+    call check_done('test_newton')
 end program test_newton

@@ -124,45 +124,49 @@ def test_gsi_deck_builds_composes_and_caches(block_dir):
     assert not other.from_cache and not np.allclose(other.K, rom.K)
 
 
-def test_deck_errors_name_the_key(block_dir):
+#: One edit of the good GSI deck each (old text -> new text), and what the error must say.
+BAD_DECK_EDITS = [
+    # [fe_model] and [reduction]
+    ('format = "calculix"', 'format = "nastran"', "fe_model.format"),
+    ('job = "block"', 'job = "blob"', "fe_model.job: expected a job name"),
+    ('method = "gsi"', 'method = "pod"',
+     "reduction.interface_modes.method: expected one of 'none', 'gsi', 'ms'"),
+    ("free = 6", "free = -1", "reduction.interface_modes.free"),
+    ("fixed_interface_modes = 30", "fixed_modes = 30",
+     "reduction.fixed_modes: expected one of the known keys"),
+    ('interface = "IFACE"\nactive = ["ACTIVE"]', 'interface = "ACTIVE"',
+     "is not in the node sets of reduction.interface"),
+    # [[contacts]]
+    ('a = "IFACE"', 'a = "NOPE"', "contacts[0]: unknown node set"),
+    ("kn = 8.0e8", "kn = -1.0", "contacts[0].kn: expected a number >= 0"),
+    ("mu = 0.5", "mu = [0.5]", "contacts[0].mu: expected a number"),
+    ("normal = [1.0, 0.0, 0.0]", 'normal = "up"', "contacts[0].normal: expected one of 'axial'"),
+    ("normal = [1.0, 0.0, 0.0]", "normal = [1.0, 0.0, 0.0]\ntangent = [2.0, 0.0, 0.0]",
+     "contacts[0]: local_frames: a tangent"),
+    # loads and outputs by node
+    ('dof = "ACTIVE:z"', 'dof = "ACTIVE:w"', 'excitation.load[0].dof: expected a DoF "NODE:DIR"'),
+    ('dof = "ACTIVE:z"', 'dof = "TIP:z"',
+     "excitation.load[0].dof: expected a node id or a node set name"),
+    ('dofs = ["ACTIVE:z", "ACTIVE:x"]', 'dofs = ["ACTIVE:z", "IFACE:x"]',
+     "outputs.dofs[1]: expected one node (set IFACE has"),
+    ('dofs = ["ACTIVE:z", "ACTIVE:x"]', 'dofs = ["2:z"]',
+     "outputs.dofs[0]: expected a DoF kept by the reduction"),
+    # tables that do not go with [fe_model]
+    ("[reduction]", "[model]\nmass = 'M.mtx'\n\n[reduction]", "model: expected either [model]"),
+    ("[[contacts]]", "[[reduction.pairs]]", "reduction.pairs: expected no"),
+    ('type = "modal"\nzeta = 0.01', 'type = "matrix"\nfile = "C.mtx"',
+     "damping.type: expected 'rayleigh' or 'modal' with [fe_model]"),
+]
+
+
+@pytest.mark.parametrize("old, new, expected", BAD_DECK_EDITS)
+def test_deck_errors_name_the_key(block_dir, old, new, expected):
     good = GSI_DECK.format(kt="2.0e8", h=3, mu=0.5)
-    cases = [
-        (good.replace('method = "gsi"', 'method = "pod"'),
-         "reduction.interface_modes.method: expected one of 'none', 'gsi', 'ms'"),
-        (good.replace("free = 6", "free = -1"), "reduction.interface_modes.free"),
-        (good.replace("fixed_interface_modes = 30", "fixed_modes = 30"),
-         "reduction.fixed_modes: expected one of the known keys"),
-        (good.replace('a = "IFACE"', 'a = "NOPE"'), "contacts[0]: unknown node set"),
-        (good.replace('format = "calculix"', 'format = "nastran"'), "fe_model.format"),
-        (good.replace('job = "block"', 'job = "blob"'), "fe_model.job: expected a job name"),
-        (good.replace("kn = 8.0e8", "kn = -1.0"), "contacts[0].kn: expected a number >= 0"),
-        (good.replace("mu = 0.5", "mu = [0.5]"), "contacts[0].mu: expected a number"),
-        (good.replace("normal = [1.0, 0.0, 0.0]", 'normal = "up"'),
-         "contacts[0].normal: expected one of 'axial'"),
-        (good.replace('dof = "ACTIVE:z"', 'dof = "ACTIVE:w"'),
-         "excitation.load[0].dof: expected a DoF \"NODE:DIR\""),
-        (good.replace('dof = "ACTIVE:z"', 'dof = "TIP:z"'),
-         "excitation.load[0].dof: expected a node id or a node set name"),
-        (good.replace('dofs = ["ACTIVE:z", "ACTIVE:x"]', 'dofs = ["ACTIVE:z", "IFACE:x"]'),
-         "outputs.dofs[1]: expected one node (set IFACE has"),
-        (good.replace('dofs = ["ACTIVE:z", "ACTIVE:x"]', 'dofs = ["2:z"]'),
-         "outputs.dofs[0]: expected a DoF kept by the reduction"),
-        (good.replace("[reduction]", "[model]\nmass = 'M.mtx'\n\n[reduction]"),
-         "model: expected either [model]"),
-        (good.replace("[[contacts]]", "[[reduction.pairs]]"), "reduction.pairs: expected no"),
-        (good.replace('interface = "IFACE"\nactive = ["ACTIVE"]', 'interface = "ACTIVE"'),
-         "is not in the node sets of reduction.interface"),
-        (good.replace("normal = [1.0, 0.0, 0.0]", "normal = [1.0, 0.0, 0.0]\n"
-                      "tangent = [2.0, 0.0, 0.0]"), "contacts[0]: local_frames: a tangent"),
-        (good.replace('type = "modal"', 'type = "matrix"').replace("zeta = 0.01",
-                                                                   'file = "C.mtx"'),
-         "damping.type: expected 'rayleigh' or 'modal' with [fe_model]"),
-    ]
-    for text, msg in cases:
-        deck = _write(block_dir / "bad.toml", text)
-        with pytest.raises(InputError) as exc:
-            load_deck(deck)
-        assert msg in str(exc.value) and "bad.toml" in str(exc.value), str(exc.value)
+    assert old in good
+    deck = _write(block_dir / "bad.toml", good.replace(old, new))
+    with pytest.raises(InputError) as exc:
+        load_deck(deck)
+    assert expected in str(exc.value) and "bad.toml" in str(exc.value), str(exc.value)
 
 
 def test_ms_deck_on_a_rotor_is_exact_for_its_engine_order(tmp_path):

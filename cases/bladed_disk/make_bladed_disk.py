@@ -15,13 +15,15 @@ response to an engine-order load is a travelling wave with equal amplitude on ev
 Run `python make_bladed_disk.py` in this folder to rewrite M.mtx, K.mtx and dofs.txt.
 """
 
+import sys
 from pathlib import Path
 
 import numpy as np
-import scipy.io
 import scipy.sparse as sp
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "models"))
+from lumped import write_lumped_case  # noqa: E402
 
 N_SECTORS = 12
 MASS = (0.40, 0.06, 0.03)      # kg: rim, platform, tip (per sector)
@@ -58,11 +60,7 @@ def labels():
 
 def main():
     M, K = matrices()
-    scipy.io.mmwrite(str(HERE / "M.mtx"), M, comment="bladed disk mass matrix, kg",
-                     symmetry="symmetric")
-    scipy.io.mmwrite(str(HERE / "K.mtx"), K, comment="bladed disk stiffness matrix, N/m",
-                     symmetry="symmetric")
-    (HERE / "dofs.txt").write_text("\n".join(labels()) + "\n")
+    write_lumped_case(HERE, M, K, labels(), "bladed disk")
 
 
 if __name__ == "__main__":

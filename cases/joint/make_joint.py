@@ -18,13 +18,15 @@ the peak on).
 Run `python make_joint.py` in this folder to rewrite M.mtx, K.mtx and dofs.txt.
 """
 
+import sys
 from pathlib import Path
 
 import numpy as np
-import scipy.io
 import scipy.sparse as sp
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "models"))
+from lumped import write_lumped_case  # noqa: E402
 
 MASS = [0.080, 0.080, 0.030, 0.030, 0.020]          # kg
 GROUND = {0: 4.0e6, 1: 8.0e6}                         # N/m, platform to disk
@@ -46,11 +48,7 @@ def matrices():
 
 def main():
     M, K = matrices()
-    scipy.io.mmwrite(str(HERE / "M.mtx"), M, comment="joint case mass matrix, kg",
-                     symmetry="symmetric")
-    scipy.io.mmwrite(str(HERE / "K.mtx"), K, comment="joint case stiffness matrix, N/m",
-                     symmetry="symmetric")
-    (HERE / "dofs.txt").write_text("\n".join(LABELS) + "\n")
+    write_lumped_case(HERE, M, K, LABELS, "joint case")
 
 
 if __name__ == "__main__":

@@ -43,48 +43,57 @@ class InputError(FriromError, ValueError):
     """Bad input: wrong shape, out-of-range parameter, malformed file or deck field."""
 
 
-class SizeError(InputError):
-    code = CODES["FRIROM_ERR_SIZE"]
-
-
-class ParameterError(InputError):
-    code = CODES["FRIROM_ERR_PARAM"]
-
-
-class NonFiniteError(InputError):
-    code = CODES["FRIROM_ERR_NONFINITE"]
-
-
-class SamplesError(InputError):
-    code = CODES["FRIROM_ERR_SAMPLES"]
-
-
 class NumericalError(FriromError, ArithmeticError):
     """A numerical procedure failed (factorisation, eigen-solve, non-convergence)."""
 
 
+class SizeError(InputError):
+    """Array sizes or shapes do not match."""
+
+
+class ParameterError(InputError):
+    """A parameter is out of range, a contact law is unknown, or the model data are
+    inconsistent."""
+
+
+class NonFiniteError(InputError):
+    """NaN or Inf in the input."""
+
+
+class SamplesError(InputError):
+    """Too few time samples for the harmonics (N < 2H+1)."""
+
+
 class ConvergenceError(NumericalError):
-    code = CODES["FRIROM_ERR_NOCONV"]
+    """An iteration did not converge: Newton, the hysteresis cycle, or continuation at
+    the minimum step."""
 
 
 class SingularMatrixError(NumericalError):
-    code = CODES["FRIROM_ERR_SINGULAR"]
+    """A matrix is singular."""
 
 
 class FactorizationError(NumericalError):
     """The sparse factorisation (MUMPS) of K - sigma M failed: out of memory, or a
     structurally singular matrix (a free body without masters, a zero-stiffness DoF)."""
-    code = CODES["FRIROM_ERR_FACTOR"]
 
 
-_BY_CODE = {cls.code: cls for cls in (SizeError, ParameterError, NonFiniteError,
-                                      SamplesError, ConvergenceError, SingularMatrixError,
-                                      FactorizationError)}
-_BY_CODE[CODES["FRIROM_ERR_LAW"]] = ParameterError       # unknown contact law
-_BY_CODE[CODES["FRIROM_ERR_NOCLOSE"]] = ConvergenceError  # hysteresis cycle did not close
-_BY_CODE[CODES["FRIROM_ERR_CONT"]] = ConvergenceError     # continuation at the minimum step
-_BY_CODE[CODES["FRIROM_ERR_MODEL"]] = ParameterError      # inconsistent model data (solver)
-# every other code (allocation, FFTW, LAPACK, ARPACK) is a NumericalError
+#: The Fortran statuses each class is raised for; ``cls.code`` is the first. Every other
+#: nonzero code (allocation, FFTW, LAPACK, ARPACK) is a NumericalError.
+_RAISED_FOR = {
+    SizeError: ("FRIROM_ERR_SIZE",),
+    ParameterError: ("FRIROM_ERR_PARAM", "FRIROM_ERR_LAW", "FRIROM_ERR_MODEL"),
+    NonFiniteError: ("FRIROM_ERR_NONFINITE",),
+    SamplesError: ("FRIROM_ERR_SAMPLES",),
+    ConvergenceError: ("FRIROM_ERR_NOCONV", "FRIROM_ERR_NOCLOSE", "FRIROM_ERR_CONT"),
+    SingularMatrixError: ("FRIROM_ERR_SINGULAR",),
+    FactorizationError: ("FRIROM_ERR_FACTOR",),
+}
+_BY_CODE = {}
+for _cls, _names in _RAISED_FOR.items():
+    _cls.code = CODES[_names[0]]
+    _BY_CODE.update((CODES[name], _cls) for name in _names)
+del _cls, _names
 
 
 def raise_for_status(info: int, message: str) -> None:
