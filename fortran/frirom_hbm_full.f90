@@ -19,7 +19,8 @@ contains
         real(wp) :: w, s, t0, hw, nfe, ndx
         integer(ip) :: nc, i, h, ca, cb, k
         logical :: ok
-        real(wp), allocatable :: dl(:, :)
+        real(wp), allocatable :: dl(:, :), kfac(:), ma(:), cfac(:)
+        integer(ip), allocatable :: kslot(:), mslot(:), cr(:), cc(:)
         info = FRIROM_OK
         nc = this%nc
         call freq_load(this, lam, w, s)
@@ -60,17 +61,24 @@ contains
         t0 = wtime()
         ok = .true.
         call band_zero(this%jb)
+        ! The slots each matrix fills in a DoF pair's nc x nc block: K on the diagonal,
+        ! -(h w)^2 M on the cosine and sine slots of harmonic h, h w C across them.
+        allocate (kslot(nc), mslot(2*this%nh), cr(2*this%nh), cc(2*this%nh))
+        allocate (kfac(nc), ma(2*this%nh), cfac(2*this%nh))
+        kslot = [(k, k = 1, nc)]
+        kfac = 1.0_wp
+        do h = 1, this%nh
+            hw = h*w
+            mslot(2*h - 1:2*h) = [2*h, 2*h + 1]
+            ma(2*h - 1:2*h) = -hw*hw
+            cr(2*h - 1:2*h) = [2*h, 2*h + 1]
+            cc(2*h - 1:2*h) = [2*h + 1, 2*h]
+            cfac(2*h - 1:2*h) = [hw, -hw]
+        end do
         do i = 1, this%ndof
-            do k = 1, nc
-                call add_row(this%jb, this%k, this%iperm, nc, i, k, k, 1.0_wp, ok)
-            end do
-            do h = 1, this%nh
-                hw = h*w
-                call add_row(this%jb, this%m, this%iperm, nc, i, 2*h, 2*h, -hw*hw, ok)
-                call add_row(this%jb, this%m, this%iperm, nc, i, 2*h + 1, 2*h + 1, -hw*hw, ok)
-                call add_row(this%jb, this%c, this%iperm, nc, i, 2*h, 2*h + 1, hw, ok)
-                call add_row(this%jb, this%c, this%iperm, nc, i, 2*h + 1, 2*h, -hw, ok)
-            end do
+            call add_row(this%jb, this%k, this%iperm, nc, i, kslot, kslot, kfac, ok)
+            call add_row(this%jb, this%m, this%iperm, nc, i, mslot, mslot, ma, ok)
+            call add_row(this%jb, this%c, this%iperm, nc, i, cr, cc, cfac, ok)
         end do
         if (.not. ok) then
             call set_status(info, FRIROM_ERR_MODEL, errmsg, 'full Jacobian: entry outside band')
@@ -85,18 +93,23 @@ contains
         this%timers(N_FACT) = this%timers(N_FACT) + 1
     end procedure full_eval
 
-    !> jb(slot r of DoF i, slot c of DoF j) += alpha A(i, j) over the entries of row i of
-    !> A; slot s of DoF j is unknown s + nc (iperm(j) - 1).
+    !> jb(slot r(q) of DoF i, slot c(q) of DoF j) += alpha(q) A(i, j) for every entry of
+    !> row i of A and every q; slot s of DoF j is unknown s + nc (iperm(j) - 1). The slots
+    !> run innermost, so one entry's additions fall in one block of the band.
     subroutine add_row(jb, a, iperm, nc, i, r, c, alpha, ok)
         type(band_matrix), intent(inout) :: jb
         type(csr_matrix), intent(in) :: a
-        integer(ip), intent(in) :: iperm(:), nc, i, r, c
-        real(wp), intent(in) :: alpha
+        integer(ip), intent(in) :: iperm(:), nc, i
+        integer(ip), intent(in) :: r(:), c(:)     !! (nq) row and column slots
+        real(wp), intent(in) :: alpha(:)          !! (nq) factors
         logical, intent(inout) :: ok   !! set to .false. when an entry falls outside the band
-        integer(ip) :: k, ii
+        integer(ip) :: k, q, ii, jj
         ii = nc*(iperm(i) - 1)
         do k = a%p(i), a%p(i + 1) - 1
-            call band_add(jb, ii + r, nc*(iperm(a%i(k)) - 1) + c, alpha*a%x(k), ok)
+            jj = nc*(iperm(a%i(k)) - 1)
+            do q = 1, size(r)
+                call band_add(jb, ii + r(q), jj + c(q), alpha(q)*a%x(k), ok)
+            end do
         end do
     end subroutine add_row
 
