@@ -18,13 +18,6 @@ def int_constant(name: str) -> int:
     return int(value)
 
 
-#: Status codes Python tests for, by their Fortran names.
-CODES = {name: int_constant(name) for name in (
-    "FRIROM_ERR_SIZE", "FRIROM_ERR_PARAM", "FRIROM_ERR_NONFINITE", "FRIROM_ERR_SAMPLES",
-    "FRIROM_ERR_NOCONV", "FRIROM_ERR_SINGULAR", "FRIROM_ERR_LAW", "FRIROM_ERR_NOCLOSE",
-    "FRIROM_ERR_CONT", "FRIROM_ERR_MODEL", "FRIROM_ERR_FACTOR")}
-
-
 class FriromError(Exception):
     """Base class of every error frirom raises on purpose.
 
@@ -89,10 +82,11 @@ _RAISED_FOR = {
     SingularMatrixError: ("FRIROM_ERR_SINGULAR",),
     FactorizationError: ("FRIROM_ERR_FACTOR",),
 }
-_BY_CODE = {}
+#: Status codes Python raises for, by their Fortran names.
+CODES = {name: int_constant(name) for names in _RAISED_FOR.values() for name in names}
+_BY_CODE = {CODES[name]: cls for cls, names in _RAISED_FOR.items() for name in names}
 for _cls, _names in _RAISED_FOR.items():
     _cls.code = CODES[_names[0]]
-    _BY_CODE.update((CODES[name], _cls) for name in _names)
 del _cls, _names
 
 
