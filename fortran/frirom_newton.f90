@@ -293,7 +293,7 @@ contains
         real(wp), allocatable :: y1(:), yp(:), t1(:), cy(:)
         real(wp) :: lam1, lp, dirn, frac, cl
         integer(ip) :: n, iters
-        logical :: last
+        logical :: last, turned
         integer(ip) :: nf, effort
         type(cont_options) :: fresh_opts
         character(len=len(errmsg)) :: why
@@ -347,6 +347,10 @@ contains
                 call newton_correct(sys, y1, lam1, yp, lp, cy, cl, fresh_opts, iters, info, &
                                     errmsg, have_fact, nf)
             end if
+            turned = .false.
+            if (info /= 0 .and. .not. last) call turn_corner(sys, y, lam, t, ds, fresh_opts, &
+                                                             y1, lam1, t1, iters, nf, turned, &
+                                                             info, errmsg, have_fact)
             if (info == 0 .and. .not. last) then
                 ! a corrector that wandered far from the predictor found another branch
                 if (sqrt(sum(((y1 - y)/opts%yscale)**2) + ((lam1 - lam)/opts%lscale)**2) > &
@@ -370,6 +374,8 @@ contains
                 cycle
             end if
             call sys%accept(y1, lam1, info, errmsg)
+            ! after a corner the new tangent is oriented along the branch taken (t1)
+            if (turned) t = t1
             if (info == 0) call cont_tangent(sys, y1, lam1, opts, t, dirn, t1, info, errmsg)
             if (info /= 0) then
                 have_fact = .false.
@@ -399,4 +405,61 @@ contains
             end if
         end do
     end subroutine cont_run
+    !> Corrector past a corner of the solution curve, after the one across the tangent t
+    !> at (y, lam) failed. A contact state switching at one AFT sample makes R piecewise
+    !> smooth; near a resonance the curve can turn there by 90 degrees or more, and then
+    !> no hyperplane across t meets the branch beyond the corner, at any step. The
+    !> tangent tc at the predictor (on the far side of the corner) gives the new
+    !> direction: the corrector runs across tc, oriented along t first, then against it.
+    !> A point is taken (turned true, tc its direction) only if it lies within 3 ds and
+    !> its chord turns by less than 120 degrees from t (never back along the curve).
+    subroutine turn_corner(sys, y, lam, t, ds, opts, y1, lam1, tc, iters, nf, turned, info, &
+                           errmsg, have_fact)
+        class(nl_system), intent(inout) :: sys
+        real(wp), intent(in) :: y(:), lam     !! (n) last converged point
+        real(wp), intent(in) :: t(:)          !! (n+1) its unit tangent (scaled)
+        real(wp), intent(in) :: ds            !! step (scaled)
+        type(cont_options), intent(in) :: opts
+        real(wp), intent(out) :: y1(:), lam1  !! (n) the point past the corner
+        real(wp), intent(out) :: tc(:)        !! (n+1) direction taken (unit, scaled)
+        integer(ip), intent(out) :: iters, nf
+        logical, intent(out) :: turned
+        integer(ip), intent(inout) :: info    !! in: the failed corrector's status
+        character(len=*), intent(inout) :: errmsg
+        logical, intent(inout) :: have_fact
+        real(wp), allocatable :: yp(:), ch(:)
+        real(wp) :: lp, dch
+        integer(ip) :: n, k, info2
+        character(len=len(errmsg)) :: msg2
+        n = size(y)
+        turned = .false.
+        allocate (yp(n), ch(n + 1))
+        yp = y + ds*t(1:n)*opts%yscale
+        lp = lam + ds*t(n + 1)*opts%lscale
+        msg2 = ''
+        call cont_tangent(sys, yp, lp, opts, t, 1.0_wp, tc, info2, msg2)
+        have_fact = .false.
+        ! no corner: the tangent hardly turns (the failure has another cause)
+        if (info2 /= 0 .or. dot_product(tc, t) > 0.9_wp) return
+        do k = 1, 2
+            if (k == 2) tc = -tc
+            yp = y + ds*tc(1:n)*opts%yscale
+            lp = lam + ds*tc(n + 1)*opts%lscale
+            y1 = yp
+            lam1 = lp
+            msg2 = ''
+            call newton_correct(sys, y1, lam1, yp, lp, tc(1:n), tc(n + 1), opts, iters, info2, &
+                                msg2, have_fact, nf)
+            if (info2 /= 0) cycle
+            ch(1:n) = (y1 - y)/opts%yscale
+            ch(n + 1) = (lam1 - lam)/opts%lscale
+            dch = norm2(ch)
+            if (dch <= 3.0_wp*ds .and. dot_product(ch, t) >= -0.5_wp*dch) then
+                turned = .true.
+                info = FRIROM_OK
+                return
+            end if
+        end do
+        have_fact = .false.
+    end subroutine turn_corner
 end module frirom_newton
