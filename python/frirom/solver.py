@@ -18,6 +18,7 @@ travelling-wave response of the whole rotor, at the cost of one sector.
 from __future__ import annotations
 
 import dataclasses
+import re
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -276,10 +277,7 @@ class _Continuation:
     def _stopped(self, info: int, message: str) -> str:
         """Explain a run Fortran stopped; raise if it made no point at all."""
         if info == CODES["FRIROM_ERR_CONT"] and self.packed.nw:
-            message += (" [with friction contacts this is usually a corner of the "
-                        "solution curve: a contact state switching at one of the "
-                        f"N = {self.packed.opts.n_samples} AFT samples, e.g. lift-off "
-                        "onset; more samples (256 recommended) make the corners milder]")
+            message += _contact_advice(self.packed.opts, message)
         if not self.points:
             raise_for_status(info, message)
         warnings.warn(f"frirom: continuation stopped early, {len(self.points)} points kept: "
@@ -315,6 +313,56 @@ class _Continuation:
             out._last_unknowns = pts[-1].unknowns
             out._last_slider = pts[-1].slider
         return out
+
+
+#: The stalled residual |R|/rref the Fortran corrector reports when it gives up.
+_STALLED = re.compile(r"\|R\|/rref\s*=\s*([0-9.Ee+-]+)")
+
+
+def _contact_advice(opts: SolverOptions, message: str) -> str:
+    """What to change after a continuation with friction contacts stopped at ds_min: only
+    settings that would change the outcome, computed from the options in use and the
+    failure (the last corrector's |R|/rref in `message`).
+
+    The AFT samples the contacts at N points per period; a contact state switching at one
+    of them makes the equations piecewise smooth and Newton can stall at a residual below
+    the sampling error (which falls like 1/N^2). Advised: tol_stall above a stalled
+    residual below 1/N^2 (such a point is then accepted); max_iter when the residual had
+    met tol_residual and only the update test was missing; ds_min when it is so large
+    that the step could not shrink much; the default N for this H when fewer samples are
+    in use.
+    """
+    N = opts.n_samples
+    default_N = dataclasses.replace(opts, samples=None).n_samples
+    tips = []
+    m = _STALLED.search(message)
+    stalled = float(m.group(1)) if m and _is_float(m.group(1)) else None
+    if stalled is not None and opts.tol_stall < stalled <= 1.0 / N**2:
+        tips.append(f"tol_stall = {float(f'{2.0 * stalled:.0e}'):g} (now "
+                    f"{opts.tol_stall:g}): a corrector stalling below it is accepted (the "
+                    f"last one stalled at |R|/rref = {stalled:.2e})")
+    if stalled is not None and stalled <= opts.tol_residual:
+        tips.append(f"max_iter = {2 * opts.max_iter} (now {opts.max_iter}): the last "
+                    "corrector had met tol_residual and missed only the update test")
+    if opts.ds_min > 1e-4:
+        tips.append(f"ds_min = {opts.ds_min / 100:g} (now {opts.ds_min:g}): the step "
+                    "could not shrink further")
+    if N < default_N:
+        tips.append(f"samples = {default_N} (the default for H = {opts.harmonics}; now "
+                    f"{N}): smaller corners where a contact state switches")
+    text = (f" [N = {N} AFT samples per period (samples = {opts.samples}); where a "
+            "contact state switches at one of them the curve has a corner")
+    if tips:
+        return text + "; try " + "; or ".join(tips) + "]"
+    return text + "]"
+
+
+def _is_float(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
