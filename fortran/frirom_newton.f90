@@ -405,6 +405,7 @@ contains
             end if
         end do
     end subroutine cont_run
+
     !> Corrector past a corner of the solution curve, after the one across the tangent t
     !> at (y, lam) failed. A contact state switching at one AFT sample makes R piecewise
     !> smooth; near a resonance the curve can turn there by 90 degrees or more, and then
@@ -433,6 +434,8 @@ contains
         character(len=len(errmsg)) :: msg2
         n = size(y)
         turned = .false.
+        iters = 0
+        nf = 0
         allocate (yp(n), ch(n + 1))
         yp = y + ds*t(1:n)*opts%yscale
         lp = lam + ds*t(n + 1)*opts%lscale
