@@ -1,6 +1,8 @@
 !> frirom_newton: continuation of the closed-form curve lam = y1^3 - 3 y1, y2 = y1^2 from
 !> lam = -4 to lam = 4 through its two turning points (y1 = -1, lam = 2 and y1 = 1,
-!> lam = -2), with a dense 2x2 system extending nl_system.
+!> lam = -2), with a dense 2x2 system extending nl_system; and of the corner of the
+!> piecewise linear curve y = a (1 - |lam|) (a = 1.5: it turns by 113 degrees at lam = 0,
+!> as a contact state switching at one AFT sample can make a harmonic balance curve turn).
 module newton_test_system
     use frirom_kinds, only: wp, ip
     use frirom_newton, only: nl_system
@@ -16,6 +18,12 @@ module newton_test_system
         procedure :: solve => cc_solve
         procedure :: accept => cc_accept
     end type cubic_curve
+    type, extends(nl_system) :: vee_curve
+        real(wp) :: a = 1.5_wp
+    contains
+        procedure :: eval => vee_eval
+        procedure :: solve => vee_solve
+    end type vee_curve
 contains
     !> The hook must see every converged point once, at the converged (y, lam).
     subroutine cc_accept(this, y, lam, info, errmsg)
@@ -63,6 +71,30 @@ contains
         b(1, :) = b(1, :)/this%j(1, 1)
         b(2, :) = (b(2, :) - this%j(2, 1)*b(1, :))/this%j(2, 2)
     end subroutine cc_solve
+    !> R = y - a (1 - |lam|), one unknown: no hyperplane across the tangent before the
+    !> corner meets the branch after it (the tangents make 113 degrees).
+    subroutine vee_eval(this, y, lam, r, rref, jac, rlam, info, errmsg)
+        class(vee_curve), intent(inout) :: this
+        real(wp), intent(in) :: y(:), lam
+        real(wp), intent(out) :: r(:), rref, rlam(:)
+        logical, intent(in) :: jac
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        info = 0
+        r(1) = y(1) - this%a*(1.0_wp - abs(lam))
+        rref = this%a
+        rlam(1) = this%a*sign(1.0_wp, lam)
+        if (jac .and. .false.) errmsg = ''
+    end subroutine vee_eval
+    subroutine vee_solve(this, b, info, errmsg)
+        class(vee_curve), intent(inout) :: this
+        real(wp), intent(inout) :: b(:, :)
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        info = 0      ! dR/dy = 1
+        if (.false.) errmsg = ''
+        if (.false.) b = b*this%a
+    end subroutine vee_solve
 end module newton_test_system
 
 program test_newton
@@ -72,6 +104,7 @@ program test_newton
     use newton_test_system
     implicit none
     type(cubic_curve) :: s
+    type(vee_curve) :: v
     type(cont_options) :: o
     real(wp) :: y(2), lam, t(3), ds, yout(2, 500), lout(500), tout(3, 500), y1ref
     integer(ip) :: it(500), npts, info, k, iters, nfold
@@ -130,5 +163,22 @@ program test_newton
     call cont_run(s, y, lam, t, ds, -4.5_wp, o, yout, lout, tout, it, npts, fin, info, msg, hf)
     call check(info == 20 .and. npts == 0 .and. index(msg, 'stopped') > 0, &
                'stop diagnostic: '//trim(msg))
+    ! the corner of y = a (1 - |lam|), from lam = 1 down to lam = -1
+    v%n = 1
+    o = cont_options(lam_end=-1.0_wp, ds=0.05_wp, ds_max=0.05_wp, max_points=500, &
+                     tol_r=1.0e-12_wp, tol_x=1.0e-10_wp)
+    y(1) = 0.0_wp
+    lam = 1.0_wp
+    call cont_tangent(v, y(1:1), lam, o, [0.0_wp, 0.0_wp], -1.0_wp, t(1:2), info, msg)
+    ds = o%ds
+    hf = .true.
+    call cont_run(v, y(1:1), lam, t(1:2), ds, 1.1_wp, o, yout(1:1, :), lout, tout(1:2, :), &
+                  it, npts, fin, info, msg, hf)
+    call check(info == 0 .and. fin .and. lout(npts) == -1.0_wp, 'corner turned: '//trim(msg))
+    call check(all(abs(yout(1, 1:npts) - v%a*(1.0_wp - abs(lout(1:npts)))) < 1.0e-10_wp), &
+               'every point on the V')
+    call check(all(lout(2:npts) < lout(1:npts - 1)), 'lam decreases monotonically')
+    call check(count(lout(1:npts) < 0.0_wp) > 10 .and. maxval(yout(1, 1:npts)) > 1.4_wp, &
+               'the branch beyond the corner followed')
     call check_done('test_newton')
 end program test_newton
