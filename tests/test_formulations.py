@@ -99,6 +99,28 @@ def _assert_same_points(points, again, what):
         assert err < SAME_POINT, f"{what} at {p.omega:.4f} rad/s: rel. difference {err:.2e}"
 
 
+def _both_runs(model, exc, lam0, lam1, options):
+    """{formulation: (options, points)} of a complete run in each formulation."""
+    runs = {}
+    for form in ("condensed", "banded"):
+        opts = SolverOptions(**{**options.__dict__, "formulation": form})
+        pts = []
+        r = frf(model, exc, lam0, lam1, opts, sink=pts.append)
+        assert r.complete, f"{form}: {r.message}"
+        assert r.omega[-1] == lam1
+        runs[form] = (opts, pts)
+    return runs
+
+
+def _cross_check(model, exc, runs, every, what):
+    """Every `every`-th point of each run (and its peak) re-solved by the other."""
+    for form, other in (("banded", "condensed"), ("condensed", "banded")):
+        opts, pts = runs[form]
+        sel = _every(pts, every)
+        _assert_same_points(sel, _resolved(model, exc, sel, opts, other),
+                            f"{what}: {form} point re-solved by {other}")
+
+
 def _every(points, k):
     """Every k-th point, the last one and the one of largest first output."""
     ip = int(np.argmax([p.amp_max.max() for p in points]))
@@ -110,21 +132,12 @@ def test_nlvib_beam_both_formulations_trace_the_same_curve(samples):
     """Both runs reach 330 rad/s through the corner at 398.78 rad/s; every 6th point of
     each (and its peak) is a solution of the other formulation to SAME_POINT."""
     model, exc, dof, tip = nlvib_friction_beam()
-    runs = {}
-    for form in ("condensed", "banded"):
-        opts = SolverOptions(harmonics=7, samples=samples, formulation=form)
-        pts = []
-        r = frf(model, exc, 430.0, 330.0, opts, sink=pts.append)
-        assert r.complete, f"{form}: {r.message}"
-        assert r.omega[-1] == 330.0
+    runs = _both_runs(model, exc, 430.0, 330.0, SolverOptions(harmonics=7, samples=samples))
+    for _, pts in runs.values():
         # stuck all cycle at the start, slipping over a third of it near the resonance
-        assert r.state_fractions[0, 0, 1] == 0 and r.state_fractions[:, 0, 1].max() > 0.3
-        runs[form] = (opts, pts)
-    for form, other in (("banded", "condensed"), ("condensed", "banded")):
-        opts, pts = runs[form]
-        sel = _every(pts, 6)
-        _assert_same_points(sel, _resolved(model, exc, sel, opts, other),
-                            f"{form} point re-solved by {other}")
+        slip = np.array([p.state_fractions[0, 1] for p in pts])
+        assert slip[0] == 0 and slip.max() > 0.3
+    _cross_check(model, exc, runs, 6, "beam")
     # and their peaks (the largest sampled tip amplitude): same height to 1e-3 (two
     # different sets of points on a flat top), within 1.5 rad/s of each other
     peaks = {f: max(pts, key=lambda p: p.amp_max[tip]) for f, (_, pts) in runs.items()}
@@ -172,18 +185,8 @@ def test_bundled_deck_same_curve_in_both_formulations(deck):
 
     d = load_deck(Path(__file__).resolve().parents[1] / "cases" / deck)
     model, exc = d.model(), d.excitation()
-    runs = {}
-    for form in ("condensed", "banded"):
-        opts = SolverOptions(**{**d.options().__dict__, "formulation": form})
-        pts = []
-        r = frf(model, exc, d.omega_start, d.omega_end, opts, sink=pts.append)
-        assert r.complete, f"{form}: {r.message}"
-        runs[form] = (opts, pts)
-    for form, other in (("banded", "condensed"), ("condensed", "banded")):
-        opts, pts = runs[form]
-        sel = _every(pts, 10)
-        _assert_same_points(sel, _resolved(model, exc, sel, opts, other),
-                            f"{deck}: {form} point re-solved by {other}")
+    runs = _both_runs(model, exc, d.omega_start, d.omega_end, d.options())
+    _cross_check(model, exc, runs, 10, deck)
     out = int(np.argmax(runs["condensed"][1][0].amp_max))
     curves = [np.array([[p.omega, p.amp_max[out]] for p in runs[f][1]]) for f in runs]
     gap = max(_curve_gap(curves[0], curves[1]), _curve_gap(curves[1], curves[0]))
