@@ -19,12 +19,12 @@
 !> one inverse and one forward real FFT of length N per direction, and for the Jacobian
 !> an O(N) scan plus O(H^2) per run and per stick segment.
 !>
-!> Choice of N: N >= 2H+1 is required. Friction laws are non-smooth, so the force
-!> harmonics converge like O(N^-2) once the sampling resolves the stick/slip transitions;
-!> N = 256 keeps the first harmonics of a Jenkins element within about 1e-5 relative for
-!> H <= 7 and is the recommended default; use N >= 4H+1 for the cubic law to be exact.
-!> The 2-D law's radial return is first order on curved slip paths (energy error ~ 1/N
-!> relative under circular motion): N >= 1024 there.
+!> Choice of N: N >= 2H+1 is required. Friction forces are continuous with kinks, and
+!> the march locates lift-off and re-contact between samples (frirom_contact), so the
+!> force harmonics of the 1-D laws converge like O(N^-2) in every regime; the default N
+!> is chosen from measurements in the Python package (frirom.harmonics.default_samples).
+!> Use N >= 4H+1 for the cubic law to be exact. The 2-D law's radial return is first
+!> order on curved slip paths (energy error ~ 1/N relative under circular motion).
 !>
 !> Layout: this parent module holds the law table, the plan and the interfaces; the work
 !> is in submodules by job: frirom_aft_eval (the two entry points and the checks of their
