@@ -54,7 +54,7 @@ def test_jenkins_describing_function_and_energy(amp):
 
 @pytest.mark.parametrize("amp", [1e-3, 5e-3])
 def test_jenkins_error_decays_as_n_minus_2(amp):
-    """The accuracy table behind the recommended N (printed with pytest -s).
+    """The Jenkins element's accuracy table (printed with pytest -s).
 
     Where the stick/slip transitions fall between samples makes the error jitter with N,
     so the test bounds its envelope: error <= 10 N^-2 (a first-order method would exceed
@@ -68,7 +68,7 @@ def test_jenkins_error_decays_as_n_minus_2(amp):
     print("N, relative error of the first harmonic:", table)
     for n, err in table:
         assert err <= 10.0 / n ** 2, (n, err)
-    assert dict(table)[256] < 2e-4                  # the recommended N = 256
+    assert dict(table)[256] < 2e-4
 
 
 # ---- limits ------------------------------------------------------------------------------

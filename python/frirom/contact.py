@@ -21,10 +21,11 @@ Arrays of harmonic coefficients have shape (n_elem, n_dir, 2H+1) in the ordering
 flat index d*(2H+1) + c, entry [e, i, j] = d force_i / d displacement_j.
 
 Choice of N (time samples per period): N >= 2H+1 is required. Friction forces have kinks,
-so the 1-D laws' harmonics converge like N^-2 (error <= 10 N^-2 relative for a Jenkins
-element, measured); N = 256 is the recommended default for H <= 7. The 2-D law's radial
-return is first order on curved slip paths (relative energy error ~ 1/N under circular
-motion): use N >= 1024 where in-plane slip paths curve and 0.1 % matters.
+so the 1-D laws' harmonics converge like N^-2 in every regime (error <= 20 N^-2 relative,
+measured in tests/test_aft_convergence.py); the default N is the solver's,
+:func:`frirom.harmonics.default_samples`. The 2-D law's radial return is first order on
+curved slip paths (relative energy error ~ 1/N under circular motion): use N >= 1024 where
+in-plane slip paths curve and 0.1 % matters.
 """
 
 from __future__ import annotations
