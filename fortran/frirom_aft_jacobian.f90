@@ -52,10 +52,10 @@ contains
     end subroutine jac_diagonal
 
     !> Jacobian of the Jenkins (normal = .false.) or 1-D normal-load element.
-    !> Stick samples after anchor a: f_t(k) = kt (u_k - w_a), where w_a = u_a - f_t(a)/kt,
-    !> f_t(a) = s mu (n0 + kn v_a), at a slip anchor and the re-contact point at a lift-off
-    !> anchor (anchor_rows); slip: f_t(k) = s mu (n0 + kn v_k); f_n(k) = n0 + kn v_k in
-    !> contact. The anchor of the first stick samples is the last anchor of the period,
+    !> Stick samples after anchor a: f_t(k) = kt (u_k - w_a), the slider w_a = u_a - f_t(a)/kt
+    !> with f_t(a) = s mu (n0 + kn v_a) at a slip anchor, the re-contact point after a
+    !> lift-off anchor (anchor_rows); slip: f_t(k) = s mu (n0 + kn v_k); f_n(k) = n0 + kn v_k
+    !> in contact. The anchor of the first stick samples is the last anchor of the period,
     !> since the cycle is closed.
     subroutine jac_friction1d(plan, j, kt, normal, jac)
         type(aft_plan), intent(inout) :: plan
@@ -171,8 +171,12 @@ contains
         integer(ip) :: a1
         real(wp) :: g0, g1, theta, du
         associate (bas => plan%fp%basis, rin => plan%fp%rin, par => plan%par)
-            if (state /= STATE_LIFTOFF .or. .not. normal) then
-                ru = bas(a, :)
+            ru = bas(a, :)
+            if (.not. normal) then
+                rv = 0.0_wp
+                return
+            end if
+            if (state /= STATE_LIFTOFF) then
                 rv = -(dtv/kt)*bas(a, :)
                 return
             end if
@@ -180,7 +184,6 @@ contains
             g0 = par(j, 4) + par(j, 2)*rin(j, a, 2)
             g1 = par(j, 4) + par(j, 2)*rin(j, a1, 2)
             if (g1 <= 0.0_wp .or. g0 > 0.0_wp) then   ! no re-contact at a+1: w = u_a
-                ru = bas(a, :)
                 rv = 0.0_wp
                 return
             end if
