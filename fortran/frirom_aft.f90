@@ -10,19 +10,21 @@
 !> built from the 4H+1 trigonometric sums of c; c is constant over runs of samples
 !> (kt in stick, +-mu kn in slip, kn in contact), so the sums come from a prefix table
 !> in O(H) per run. Dependence on an earlier sample (the slider, fixed at the last slip
-!> or lift-off sample, the "anchor") adds a rank-one term per stick segment. The 2-D
-!> law, whose slip direction remembers the past, propagates the slider tangent instead.
+!> sample or at the re-contact point after the last lift-off sample, the "anchor") adds
+!> a rank-one term per stick segment (rank two after a re-contact, which moves with u and
+!> v at the two samples around it). The 2-D law, whose slip direction remembers the past,
+!> propagates the slider tangent instead.
 !>
 !> Cost per element: O(N) marching per period (usually 2 periods from a cold slider),
 !> one inverse and one forward real FFT of length N per direction, and for the Jacobian
 !> an O(N) scan plus O(H^2) per run and per stick segment.
 !>
-!> Choice of N: N >= 2H+1 is required. Friction laws are non-smooth, so the force
-!> harmonics converge like O(N^-2) once the sampling resolves the stick/slip transitions;
-!> N = 256 keeps the first harmonics of a Jenkins element within about 1e-5 relative for
-!> H <= 7 and is the recommended default; use N >= 4H+1 for the cubic law to be exact.
-!> The 2-D law's radial return is first order on curved slip paths (energy error ~ 1/N
-!> relative under circular motion): N >= 1024 there.
+!> Choice of N: N >= 2H+1 is required. Friction forces are continuous with kinks, and
+!> the march locates lift-off and re-contact between samples (frirom_contact), so the
+!> force harmonics of the 1-D laws converge like O(N^-2) in every regime; the default N
+!> is chosen from measurements in the Python package (frirom.harmonics.default_samples).
+!> Use N >= 4H+1 for the cubic law to be exact. The 2-D law's radial return is first
+!> order on curved slip paths (energy error ~ 1/N relative under circular motion).
 !>
 !> Layout: this parent module holds the law table, the plan and the interfaces; the work
 !> is in submodules by job: frirom_aft_eval (the two entry points and the checks of their
@@ -65,6 +67,8 @@ module frirom_aft
         type(fourier_plan) :: fp
         integer(ip), allocatable :: state(:, :)      !! (nbatch, N) contact state per sample
         real(wp), allocatable :: tangent(:, :, :)    !! (nbatch, 6, N) 2-D slip tangents
+        real(wp), allocatable :: follow(:, :, :)     !! (nbatch, N, 2) u the sliders follow
+                                                     !! (frirom_contact recontact_follow)
         real(wp), allocatable :: par(:, :)           !! (nbatch, 4) parameters of the batch
         real(wp), allocatable :: w(:, :), wstart(:, :)  !! (nbatch, 2) slider positions
         real(wp), allocatable :: scale(:)            !! (nbatch) closure scale
@@ -264,7 +268,8 @@ contains
         if (info /= FRIROM_OK) return
         nb = plan%fp%nbatch
         nc = plan%fp%ncoef
-        allocate (plan%state(nb, nsamp), plan%tangent(nb, 6, nsamp), plan%par(nb, 4))
+        allocate (plan%state(nb, nsamp), plan%tangent(nb, 6, nsamp), plan%par(nb, 4), &
+                  plan%follow(nb, nsamp, 2))
         allocate (plan%w(nb, 2), plan%wstart(nb, 2), plan%scale(nb), plan%closed_at(nb))
         allocate (plan%anchor(nb), plan%anchor_state(nb), plan%anchor_dtv(nb), &
                   plan%events(nsamp))
@@ -279,7 +284,7 @@ contains
                                                   plan%scale, plan%closed_at)
         if (allocated(plan%anchor)) deallocate (plan%anchor, plan%anchor_state, plan%anchor_dtv, &
                                                    plan%events)
-        if (allocated(plan%tangent)) deallocate (plan%tangent)
+        if (allocated(plan%tangent)) deallocate (plan%tangent, plan%follow)
         if (allocated(plan%dw)) deallocate (plan%dw, plan%dw0, plan%dft)
     end subroutine aft_plan_destroy
 end module frirom_aft

@@ -52,10 +52,11 @@ contains
     end subroutine jac_diagonal
 
     !> Jacobian of the Jenkins (normal = .false.) or 1-D normal-load element.
-    !> Stick samples after anchor a: f_t(k) = kt (u_k - u_a) + f_t(a), where f_t(a) =
-    !> s mu (n0 + kn v_a) at a slip anchor and 0 at a lift-off anchor; slip: f_t(k) =
-    !> s mu (n0 + kn v_k); f_n(k) = n0 + kn v_k in contact. The anchor of the first stick
-    !> samples is the last anchor of the period, since the cycle is closed.
+    !> Stick samples after anchor a: f_t(k) = kt (u_k - w_a), the slider w_a = u_a - f_t(a)/kt
+    !> with f_t(a) = s mu (n0 + kn v_a) at a slip anchor, the re-contact point after a
+    !> lift-off anchor (anchor_rows); slip: f_t(k) = s mu (n0 + kn v_k); f_n(k) = n0 + kn v_k
+    !> in contact. The anchor of the first stick samples is the last anchor of the period,
+    !> since the cycle is closed.
     subroutine jac_friction1d(plan, j, kt, normal, jac)
         type(aft_plan), intent(inout) :: plan
         integer(ip), intent(in) :: j
@@ -63,7 +64,7 @@ contains
         logical, intent(in) :: normal
         real(wp), intent(inout) :: jac(:, :)  !! (nd nc, nd nc)
         integer(ip) :: n, nc, nh, k, k0, a, nev, i, i1, i2, c
-        real(wp) :: g(plan%fp%ncoef), dtv, kn
+        real(wp) :: g(plan%fp%ncoef), ru(plan%fp%ncoef), rv(plan%fp%ncoef), kn
         real(wp), dimension(0:2*plan%fp%nharm) :: ctu, stu, ctv, stv, cnv, snv
         n = plan%fp%nsamp
         nc = plan%fp%ncoef
@@ -110,9 +111,10 @@ contains
                 ! sample is anchored there: the whole-period sum of P is the mean row.
                 a = plan%anchor(j)
                 if (a == 0) return
-                jac(1, 1:nc) = jac(1, 1:nc) - kt*bas(a, :)
-                if (normal .and. plan%anchor_state(j) == STATE_SLIP) &
-                    jac(1, nc + 1:2*nc) = jac(1, nc + 1:2*nc) + plan%anchor_dtv(j)*bas(a, :)
+                call anchor_rows(plan, j, a, plan%anchor_state(j), plan%anchor_dtv(j), kt, &
+                                 normal, ru, rv)
+                jac(1, 1:nc) = jac(1, 1:nc) - kt*ru
+                if (normal) jac(1, nc + 1:2*nc) = jac(1, nc + 1:2*nc) - kt*rv
                 return
             end if
             do i = 1, nev
@@ -127,13 +129,13 @@ contains
                 end if
                 if ((i < nev .and. i2 < i1) .or. (i == nev .and. i1 == ev(1))) cycle
                 call segment_sum(plan%fp, i1, i2, g)
+                call anchor_rows(plan, j, a, st(j, a), dtvs(a), kt, normal, ru, rv)
                 do c = 1, nc
-                    jac(1:nc, c) = jac(1:nc, c) - kt*bas(a, c)*g
+                    jac(1:nc, c) = jac(1:nc, c) - kt*ru(c)*g
                 end do
-                if (normal .and. st(j, a) == STATE_SLIP) then
-                    dtv = dtvs(a)
+                if (normal) then
                     do c = 1, nc
-                        jac(1:nc, nc + c) = jac(1:nc, nc + c) + dtv*bas(a, c)*g
+                        jac(1:nc, nc + c) = jac(1:nc, nc + c) - kt*rv(c)*g
                     end do
                 end if
             end do
@@ -154,6 +156,43 @@ contains
             end associate
         end subroutine add_run
     end subroutine jac_friction1d
+
+    !> Derivative of the slider that anchors the stick samples after event sample a of
+    !> element j of a 1-D law: dw = ru . dU + rv . dV (U, V: harmonics of u and v).
+    !> Slip anchor: w = u_a - f_t(a)/kt with d f_t(a)/dv = dtv. Lift-off anchor (normal
+    !> law; the next sample a+1 recloses): w = u_a + theta (u_{a+1} - u_a), theta =
+    !> g_a/(g_a - g_{a+1}), g = n0 + kn v (frirom_contact), so theta moves with v_a, v_{a+1}.
+    pure subroutine anchor_rows(plan, j, a, state, dtv, kt, normal, ru, rv)
+        type(aft_plan), intent(in) :: plan
+        integer(ip), intent(in) :: j, a, state
+        real(wp), intent(in) :: dtv, kt
+        logical, intent(in) :: normal           !! normal1d (else Jenkins: rv unused)
+        real(wp), intent(out) :: ru(:), rv(:)   !! (nc)
+        integer(ip) :: a1
+        real(wp) :: g0, g1, theta, du
+        associate (bas => plan%fp%basis, rin => plan%fp%rin, par => plan%par)
+            ru = bas(a, :)
+            if (.not. normal) then
+                rv = 0.0_wp
+                return
+            end if
+            if (state /= STATE_LIFTOFF) then
+                rv = -(dtv/kt)*bas(a, :)
+                return
+            end if
+            a1 = mod(a, plan%fp%nsamp) + 1
+            g0 = par(j, 4) + par(j, 2)*rin(j, a, 2)
+            g1 = par(j, 4) + par(j, 2)*rin(j, a1, 2)
+            if (g1 <= 0.0_wp .or. g0 > 0.0_wp) then   ! no re-contact at a+1: w = u_a
+                rv = 0.0_wp
+                return
+            end if
+            theta = g0/(g0 - g1)
+            du = rin(j, a1, 1) - rin(j, a, 1)
+            ru = (1.0_wp - theta)*bas(a, :) + theta*bas(a1, :)
+            rv = du*par(j, 2)*(g0*bas(a1, :) - g1*bas(a, :))/(g0 - g1)**2
+        end associate
+    end subroutine anchor_rows
 
     !> Jacobian of the 2-D element. The slip direction depends on the whole history, so
     !> the slider tangent dw (2 x 3(2H+1)) is propagated through the period, repeated until
@@ -204,9 +243,9 @@ contains
         tg_keep = plan%tangent(j, :, :)
         w(1, :) = w0j(1:2)
         plan%dw = 0.0_wp
-        associate (rin => plan%fp%rin, par => plan%par)
+        associate (rin => plan%fp%rin, par => plan%par, uf => plan%follow)
             do per = 1, plan%closed_at(j) - 1
-                call friction2d_march(rin(j:j, :, 1), rin(j:j, :, 2), rin(j:j, :, 3), &
+                call friction2d_march(uf(j:j, :, 1), uf(j:j, :, 2), rin(j:j, :, 3), &
                                       par(j:j, 1), par(j:j, 2), par(j:j, 3), par(j:j, 4), w, &
                                       f(:, :, 1), f(:, :, 2), f(:, :, 3), st, tg)
                 plan%state(j, :) = st(1, :)
@@ -220,15 +259,17 @@ contains
 
     !> One period of the 2-D slider tangent recursion (see friction2d_march):
     !> stick: d f = kt (dU_k - dw), dw kept; slip: d f = A_k (dU_k - dw) + b_k dV_k,
-    !> dw = dU_k - d f / kt; lift-off: d f = 0, dw = dU_k. The same-sample stick part is in
-    !> the Toeplitz blocks already; here only the terms in dw and the slip samples.
+    !> dw = dU_k - d f / kt; lift-off: d f = 0, dw = dU_k; a closed sample after an open
+    !> one first puts the slider at the re-contact point (recontact). The same-sample
+    !> stick part is in the Toeplitz blocks already; here only the terms in dw and the
+    !> slip samples.
     subroutine propagate2d(plan, j, kt, accumulate, jac)
         type(aft_plan), intent(inout) :: plan
         integer(ip), intent(in) :: j
         real(wp), intent(in) :: kt
         logical, intent(in) :: accumulate
         real(wp), intent(inout) :: jac(:, :)
-        integer(ip) :: n, nc, k, i, c
+        integer(ip) :: n, nc, k, i, c, kp
         real(wp) :: gsum(plan%fp%ncoef), pk(plan%fp%ncoef)
         logical :: open_seg
         n = plan%fp%nsamp
@@ -238,6 +279,9 @@ contains
             gsum = 0.0_wp
             open_seg = .false.
             do k = 1, n
+                kp = k - 1
+                if (k == 1) kp = n
+                if (st(k) /= STATE_LIFTOFF .and. st(kp) == STATE_LIFTOFF) call recontact(kp, k)
                 if (st(k) == STATE_STICK) then
                     if (accumulate) gsum = gsum + wgt*bas(k, :)
                     open_seg = .true.
@@ -285,5 +329,25 @@ contains
             end do
             g = 0.0_wp
         end subroutine flush_stick
+
+        !> Slider tangent at the re-contact point between open sample kp and closed sample
+        !> k: w = u_kp + theta (u_k - u_kp), theta = g_kp/(g_kp - g_k), g = n0 + kn v.
+        subroutine recontact(kp, k)
+            integer(ip), intent(in) :: kp, k
+            real(wp) :: g0, g1, theta, dth(plan%fp%ncoef)
+            integer(ip) :: ii
+            associate (rin => plan%fp%rin, par => plan%par, bas => plan%fp%basis)
+                g0 = par(j, 4) + par(j, 2)*rin(j, kp, 3)
+                g1 = par(j, 4) + par(j, 2)*rin(j, k, 3)
+                theta = g0/(g0 - g1)
+                dth = par(j, 2)*(g0*bas(k, :) - g1*bas(kp, :))/(g0 - g1)**2
+                plan%dw = 0.0_wp
+                do ii = 1, 2
+                    plan%dw(ii, (ii - 1)*nc + 1:ii*nc) = (1.0_wp - theta)*bas(kp, :) &
+                                                         + theta*bas(k, :)
+                    plan%dw(ii, 2*nc + 1:3*nc) = (rin(j, k, ii) - rin(j, kp, ii))*dth
+                end do
+            end associate
+        end subroutine recontact
     end subroutine propagate2d
 end submodule frirom_aft_jacobian

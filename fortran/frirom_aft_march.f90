@@ -5,7 +5,7 @@
 submodule (frirom_aft) frirom_aft_march
     use frirom_fourier, only: clear_input, load_harmonics, exec_c2r
     use frirom_contact, only: STATE_STICK, jenkins_march, friction1d_march, friction2d_march, &
-                              cubic_spring
+                              cubic_spring, recontact_follow
     implicit none
 
 contains
@@ -36,7 +36,7 @@ contains
         integer(ip), intent(in) :: max_periods
         integer(ip) :: ns, d, j, i, nper
         associate (rin => plan%fp%rin, rout => plan%fp%rout, st => plan%state(1:m, :), &
-                   w => plan%w(1:m, :), par => plan%par(1:m, :))
+                   w => plan%w(1:m, :), par => plan%par(1:m, :), uf => plan%follow(1:m, :, :))
             ns = NSLIDER_OF(law)
             do i = 1, NPAR_OF(law)
                 par(:, i) = p(i, :)
@@ -60,6 +60,14 @@ contains
                     plan%scale(j) = max(plan%scale(j), maxval(abs(rin(j, :, d))))
                 end do
             end do
+            ! where the sliders follow the contact point while it is open: fixed in u and v,
+            ! so once for all periods
+            if (law /= LAW_JENKINS) then
+                do d = 1, ns
+                    call recontact_follow(rin(1:m, :, d), rin(1:m, :, NDIR_OF(law)), par(:, 2), &
+                                          par(:, 4), uf(:, :, d))
+                end do
+            end if
             plan%closed_at(1:m) = max_periods + 1
             do nper = 1, max_periods
                 plan%wstart(1:m, :) = w
@@ -68,11 +76,11 @@ contains
                     call jenkins_march(rin(1:m, :, 1), par(:, 1), par(:, 2), par(:, 3), w(:, 1), &
                                        rout(1:m, :, 1), st)
                 case (LAW_NORMAL1D)
-                    call friction1d_march(rin(1:m, :, 1), rin(1:m, :, 2), par(:, 1), par(:, 2), &
+                    call friction1d_march(uf(:, :, 1), rin(1:m, :, 2), par(:, 1), par(:, 2), &
                                           par(:, 3), par(:, 4), w(:, 1), rout(1:m, :, 1), &
                                           rout(1:m, :, 2), st, rout(1:m, :, 4))
                 case (LAW_NORMAL2D)
-                    call friction2d_march(rin(1:m, :, 1), rin(1:m, :, 2), rin(1:m, :, 3), &
+                    call friction2d_march(uf(:, :, 1), uf(:, :, 2), rin(1:m, :, 3), &
                                           par(:, 1), par(:, 2), par(:, 3), par(:, 4), w, &
                                           rout(1:m, :, 1), rout(1:m, :, 2), rout(1:m, :, 3), &
                                           st, plan%tangent(1:m, :, :))

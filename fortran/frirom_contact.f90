@@ -16,7 +16,13 @@
 !> the predictor-corrector used by Petrov and Ewins for the 2-D element):
 !> - normal force f_n = max(n0 + kn v, 0); n0 < 0 is an initial gap g0 = -n0/kn;
 !> - lift-off (f_n = 0): no tangential force, and the slider follows the contact point
-!>   (w = u), so that the contact recloses unstretched where it touches down;
+!>   (w = u), so that the contact recloses unstretched where it touches down, at the
+!>   re-contact instant between two samples: the marches take, in place of u, the
+!>   positions recontact_follow gives (u, except at the last open sample before the
+!>   contact recloses, where it is u at the instant the linearly interpolated normal force
+!>   crosses zero). Anchoring the slider at that open sample instead would be off by
+!>   O(1/N) for the whole stick that follows: a first-order AFT. Done before the march,
+!>   once for all its periods, the march itself stays as lean as without lift-off;
 !> - otherwise the trial force kt (u - w) sticks when it lies within the friction limit
 !>   mu f_n; beyond it the element slips, the force sits on the limit in the trial's
 !>   direction and the slider moves to w = u - f_t/kt. A normal load that drops during
@@ -28,6 +34,7 @@ module frirom_contact
 
     public :: STATE_LIFTOFF, STATE_STICK, STATE_SLIP
     public :: jenkins_march, friction1d_march, friction2d_march, cubic_spring
+    public :: recontact_follow
 
     integer(ip), parameter :: STATE_LIFTOFF = 0  !! open contact, no force
     integer(ip), parameter :: STATE_STICK = 1    !! tangential spring, slider fixed
@@ -67,7 +74,8 @@ contains
     !> dft_dv(j, k) = d f_t / d v at the same sample: s mu kn at slip samples, 0 elsewhere
     !> (the only same-sample derivative besides kt in stick and kn in contact).
     pure subroutine friction1d_march(u, v, kt, kn, mu, n0, w, ft, fn, state, dft_dv)
-        real(wp), intent(in) :: u(:, :)          !! (m, N) tangential relative displacement, m
+        real(wp), intent(in) :: u(:, :)          !! (m, N) tangential relative displacement
+                                                 !! (recontact_follow's uf), m
         real(wp), intent(in) :: v(:, :)          !! (m, N) normal relative displacement, m
                                                  !! (positive closes)
         real(wp), intent(in) :: kt(:), kn(:), mu(:), n0(:)  !! (m) N/m, N/m, -, N
@@ -109,7 +117,8 @@ contains
     !> b_k = mu kn n, n = t/|t|; tangent(j, 1:4, k) holds A_k column-major and
     !> tangent(j, 5:6, k) holds b_k (zero at other samples).
     pure subroutine friction2d_march(u1, u2, v, kt, kn, mu, n0, w, f1, f2, fn, state, tangent)
-        real(wp), intent(in) :: u1(:, :), u2(:, :)  !! (m, N) in-plane tangential displ., m
+        real(wp), intent(in) :: u1(:, :), u2(:, :)  !! (m, N) in-plane tangential displ.
+                                                    !! (recontact_follow's uf), m
         real(wp), intent(in) :: v(:, :)          !! (m, N) normal relative displacement, m
         real(wp), intent(in) :: kt(:), kn(:), mu(:), n0(:)  !! (m) N/m, N/m, -, N
         real(wp), intent(inout) :: w(:, :)       !! (m, 2) slider position: start in, end out
@@ -149,6 +158,33 @@ contains
             end do
         end do
     end subroutine friction2d_march
+
+    !> Positions the slider of an element with normal load variation follows: u, except at
+    !> an open sample k-1 followed by a closed sample k, where it is the re-contact point
+    !> u_{k-1} + theta (u_k - u_{k-1}), theta = g_{k-1}/(g_{k-1} - g_k), g = n0 + kn v
+    !> (sample 0 is sample N: the motion is periodic). The marches take uf in place of u:
+    !> the forces at open samples are zero whatever u, and the slider leaves the last open
+    !> sample where the contact closes.
+    pure subroutine recontact_follow(u, v, kn, n0, uf)
+        real(wp), intent(in) :: u(:, :)          !! (m, N) a tangential relative displ., m
+        real(wp), intent(in) :: v(:, :)          !! (m, N) normal relative displacement, m
+        real(wp), intent(in) :: kn(:), n0(:)     !! (m) N/m, N
+        real(wp), intent(out) :: uf(:, :)        !! (m, N) positions for the march, m
+        integer(ip) :: j, k, k1
+        real(wp) :: g, g1, theta
+        logical :: reclose
+        do k = 1, size(u, 2)
+            k1 = k + 1
+            if (k == size(u, 2)) k1 = 1
+            do j = 1, size(u, 1)
+                g = n0(j) + kn(j)*v(j, k)
+                g1 = n0(j) + kn(j)*v(j, k1)
+                reclose = g <= 0.0_wp .and. g1 > 0.0_wp
+                theta = g/merge(g - g1, -1.0_wp, reclose)
+                uf(j, k) = merge(u(j, k) + theta*(u(j, k1) - u(j, k)), u(j, k), reclose)
+            end do
+        end do
+    end subroutine recontact_follow
 
     !> Polynomial (cubic) spring f = k1 u + k3 u^3 and its derivative.
     elemental subroutine cubic_spring(u, k1, k3, f, dfdu)

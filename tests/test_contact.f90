@@ -95,23 +95,27 @@ contains
 
     !> 1-D element with normal load variation, kt = 100 N/m, kn = 200 N/m, mu = 0.5,
     !> n0 = 10 N, by hand: stick; the normal load drops under the stuck force (slip at the
-    !> lower limit); lift-off (slider on the contact point); reclosing unstretched; stick;
-    !> slip the other way under a raised normal load.
+    !> lower limit); lift-off (slider on the contact point); reclosing unstretched at the
+    !> interpolated re-contact point; stick; slip the other way under a raised normal load.
     subroutine friction1d_hand_sequence()
-        real(wp) :: u(1, 6), v(1, 6), w(1), ft(1, 6), fn(1, 6), dv(1, 6)
+        real(wp) :: u(1, 6), v(1, 6), w(1), ft(1, 6), fn(1, 6), dv(1, 6), uf(1, 6)
         integer(ip) :: state(1, 6)
         u(1, :) = [0.02_wp, 0.02_wp, 0.0_wp, 0.03_wp, -0.05_wp, -0.2_wp]
         v(1, :) = [0.0_wp, -0.04_wp, -0.06_wp, 0.0_wp, 0.05_wp, 0.05_wp]
         w = 0.0_wp
-        call friction1d_march(u, v, [100.0_wp], [200.0_wp], [0.5_wp], [10.0_wp], w, ft, fn, &
+        call recontact_follow(u, v, [200.0_wp], [10.0_wp], uf)
+        call check(near(uf(1, :) - u(1, :), [0.0_wp, 0.0_wp, 0.005_wp, 0.0_wp, 0.0_wp, 0.0_wp], &
+                        1.0e-15_wp), '1-D hand sequence: slider follows the re-contact point')
+        call friction1d_march(uf, v, [100.0_wp], [200.0_wp], [0.5_wp], [10.0_wp], w, ft, fn, &
                               state, dv)
         ! fn = max(10 + 200 v, 0) = 10, 2, 0, 10, 20, 20; limits 5, 1, 0, 5, 10, 10
         call check(near(fn(1, :), [10.0_wp, 2.0_wp, 0.0_wp, 10.0_wp, 20.0_wp, 20.0_wp], &
                         1.0e-12_wp), '1-D hand sequence: normal force max(n0 + kn v, 0)')
-        ! 1: t = 2 stick; 2: t = 2 > 1 slip, w = 0.01; 3: open, w = u = 0;
-        ! 4: t = 100 (0.03 - 0) = 3 stick (unstretched from where it touched down);
-        ! 5: t = -5 stick; 6: t = -20 slip at -10, w = -0.2 + 0.1 = -0.1
-        call check(near(ft(1, :), [2.0_wp, 1.0_wp, 0.0_wp, 3.0_wp, -5.0_wp, -10.0_wp], &
+        ! 1: t = 2 stick; 2: t = 2 > 1 slip, w = 0.01; 3: open; n0 + kn v goes -2 -> 10 to
+        ! sample 4, zero at 1/6 of the step: w = 0 + 0.03/6 = 0.005 (uf above);
+        ! 4: t = 100 (0.03 - 0.005) = 2.5 stick (unstretched from where it touched down);
+        ! 5: t = -5.5 stick; 6: t = -20.5 slip at -10, w = -0.2 + 0.1 = -0.1
+        call check(near(ft(1, :), [2.0_wp, 1.0_wp, 0.0_wp, 2.5_wp, -5.5_wp, -10.0_wp], &
                         1.0e-12_wp), '1-D hand sequence: tangential force')
         call check(all(state(1, :) == [STATE_STICK, STATE_SLIP, STATE_LIFTOFF, STATE_STICK, &
                                        STATE_STICK, STATE_SLIP]), '1-D hand sequence: states')
@@ -205,28 +209,32 @@ contains
     end subroutine f1d_sample
 
     !> 2-D element, kt = 100 N/m, kn = 200 N/m, mu = 0.5, n0 = 10 N, by hand: stick inside
-    !> the circle; slip on it along the trial force; lift-off; reclosing unstretched.
+    !> the circle; slip on it along the trial force; lift-off; reclosing unstretched at the
+    !> interpolated re-contact point.
     subroutine friction2d_hand_sequence()
         real(wp) :: u1(1, 4), u2(1, 4), v(1, 4), w(1, 2), f1(1, 4), f2(1, 4), fn(1, 4)
-        real(wp) :: tg(1, 6, 4)
+        real(wp) :: tg(1, 6, 4), uf1(1, 4), uf2(1, 4)
         integer(ip) :: state(1, 4)
         u1(1, :) = [0.03_wp, 0.06_wp, 0.03_wp, 0.0_wp]
         u2(1, :) = [0.04_wp, 0.08_wp, 0.04_wp, 0.04_wp]
         v(1, :) = [0.01_wp, 0.0_wp, -0.06_wp, 0.0_wp]
         w = 0.0_wp
-        call friction2d_march(u1, u2, v, [100.0_wp], [200.0_wp], [0.5_wp], [10.0_wp], w, &
+        call recontact_follow(u1, v, [200.0_wp], [10.0_wp], uf1)
+        call recontact_follow(u2, v, [200.0_wp], [10.0_wp], uf2)
+        call friction2d_march(uf1, uf2, v, [100.0_wp], [200.0_wp], [0.5_wp], [10.0_wp], w, &
                               f1, f2, fn, state, tg)
         ! 1: limit 6, t = (3, 4), |t| = 5 stick; 2: limit 5, t = (6, 8), |t| = 10 slip at
         ! 5 (0.6, 0.8), w = u - f/kt = (0.03, 0.04); 3: open, w = u = (0.03, 0.04);
-        ! 4: t = 100 (0 - 0.03, 0.04 - 0.04) = (-3, 0) stick
-        call check(near(f1(1, :), [3.0_wp, 3.0_wp, 0.0_wp, -3.0_wp], 1.0e-12_wp) .and. &
+        ! 4: n0 + kn v goes -2 -> 10, zero at 1/6 of the step: w = (0.03 - 0.03/6, 0.04),
+        ! t = 100 (0 - 0.025, 0.04 - 0.04) = (-2.5, 0) stick
+        call check(near(f1(1, :), [3.0_wp, 3.0_wp, 0.0_wp, -2.5_wp], 1.0e-12_wp) .and. &
                    near(f2(1, :), [4.0_wp, 4.0_wp, 0.0_wp, 0.0_wp], 1.0e-12_wp), &
                    '2-D hand sequence: forces')
         call check(near(fn(1, :), [12.0_wp, 10.0_wp, 0.0_wp, 10.0_wp], 1.0e-12_wp), &
                    '2-D hand sequence: normal force')
         call check(all(state(1, :) == [STATE_STICK, STATE_SLIP, STATE_LIFTOFF, STATE_STICK]), &
                    '2-D hand sequence: states')
-        call check(near(w(1, :), [0.03_wp, 0.04_wp], 1.0e-14_wp), '2-D hand sequence: slider')
+        call check(near(w(1, :), [0.025_wp, 0.04_wp], 1.0e-14_wp), '2-D hand sequence: slider')
         call check(all(tg(1, :, [1, 3, 4]) == 0.0_wp), '2-D: no slip tangent off slip samples')
     end subroutine friction2d_hand_sequence
 

@@ -33,7 +33,20 @@ def numpy_aft(x, kt, kn, mu, n0, n_samples, periods=2):
     p = e.T * np.where(np.arange(nc) == 0, 1.0, 2.0)[:, None] / n_samples   # (nc, N)
     u = x[:, 0] @ e.T                                       # (ne, N)
     v = x[:, 1] @ e.T
-    fn = np.maximum(n0[:, None] + kn[:, None] * v, 0.0)
+    gap = n0[:, None] + kn[:, None] * v
+    fn = np.maximum(gap, 0.0)
+    # an open sample before a closed one: the slider leaves it at the re-contact point,
+    # where the linear interpolant of the normal force crosses zero (and its derivative)
+    gap1, u1 = np.roll(gap, -1, axis=1), np.roll(u, -1, axis=1)
+    reclose = (gap <= 0.0) & (gap1 > 0.0)
+    theta = np.where(reclose, gap / np.where(reclose, gap - gap1, -1.0), 0.0)
+    uf = u + theta * (u1 - u)
+    e1 = np.roll(e, -1, axis=0)
+    dth = (kn[:, None, None] * (gap[:, :, None] * e1 - gap1[:, :, None] * e)
+           / np.where(reclose, gap - gap1, -1.0)[:, :, None] ** 2)
+    dwopen = np.zeros((ne, n_samples, 2 * nc))
+    dwopen[:, :, :nc] = (1 - theta[:, :, None]) * e + theta[:, :, None] * e1
+    dwopen[:, :, nc:] = np.where(reclose[:, :, None], (u1 - u)[:, :, None] * dth, 0.0)
     ft = np.empty_like(u)
     w = np.zeros(ne)
     state = np.empty(u.shape, dtype=np.int8)                # 0 lift, 1 stick, 2 slip
@@ -51,7 +64,7 @@ def numpy_aft(x, kt, kn, mu, n0, n_samples, periods=2):
             stick = ~open_ & ~slip
             f = np.where(stick, trial, np.sign(trial) * lim)
             f[open_] = 0.0
-            w = np.where(open_, u[:, k], np.where(slip, u[:, k] - f / kt, w))
+            w = np.where(open_, uf[:, k], np.where(slip, u[:, k] - f / kt, w))
             if last:
                 ft[:, k] = f
                 state[:, k] = np.where(open_, 0, np.where(stick, 1, 2))
@@ -63,7 +76,7 @@ def numpy_aft(x, kt, kn, mu, n0, n_samples, periods=2):
                 dft[:, k] = d
                 dwu = np.zeros((ne, 2 * nc))
                 dwu[:, :nc] = e[k]
-                dw = np.where(open_[:, None], dwu,
+                dw = np.where(open_[:, None], dwopen[:, k],
                               np.where(slip[:, None], dwu - d / kt[:, None], dw))
             else:
                 dwu = np.zeros((ne, 2 * nc))
@@ -71,7 +84,7 @@ def numpy_aft(x, kt, kn, mu, n0, n_samples, periods=2):
                 s = np.sign(trial) * mu * kn
                 dslip = dwu.copy()
                 dslip[:, nc:] -= (s / kt)[:, None] * e[k]
-                dw = np.where(open_[:, None], dwu, np.where(slip[:, None], dslip, dw))
+                dw = np.where(open_[:, None], dwopen[:, k], np.where(slip[:, None], dslip, dw))
     del rows
     forces = np.stack([harmonics.to_harmonics(ft, h), harmonics.to_harmonics(fn, h)], axis=1)
     jac = np.zeros((ne, 2 * nc, 2 * nc))

@@ -21,10 +21,11 @@ Arrays of harmonic coefficients have shape (n_elem, n_dir, 2H+1) in the ordering
 flat index d*(2H+1) + c, entry [e, i, j] = d force_i / d displacement_j.
 
 Choice of N (time samples per period): N >= 2H+1 is required. Friction forces have kinks,
-so the 1-D laws' harmonics converge like N^-2 (error <= 10 N^-2 relative for a Jenkins
-element, measured); N = 256 is the recommended default for H <= 7. The 2-D law's radial
-return is first order on curved slip paths (relative energy error ~ 1/N under circular
-motion): use N >= 1024 where in-plane slip paths curve and 0.1 % matters.
+so the 1-D laws' harmonics converge like N^-2 in every regime (error <= 20 N^-2 relative,
+measured in tests/test_aft_convergence.py); the default N is the solver's,
+:func:`frirom.harmonics.default_samples`. The 2-D law's radial return is first order on
+curved slip paths (relative energy error ~ 1/N under circular motion): use N >= 1024 where
+in-plane slip paths curve and 0.1 % matters.
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ import numpy as np
 
 from . import _kernels
 from ._errors import ParameterError, SizeError, raise_for_status
-from .harmonics import n_harmonics
+from .harmonics import default_samples, n_harmonics
 
 
 @dataclass(frozen=True)
@@ -115,9 +116,6 @@ def _law_table(laws: dict[str, Law]) -> str:
 if __doc__:   # None under python -OO
     __doc__ = __doc__.replace("{law_table}", _law_table(LAWS))
 
-DEFAULT_SAMPLES = 256
-
-
 @dataclass
 class AftResult:
     """Output of :func:`aft` for n_elem elements at H harmonics."""
@@ -177,6 +175,8 @@ def _prepare(law, x, params, n_samples, w0):
                         f"with directions {list(law.directions)}")
     h = n_harmonics(x.shape[2])
     n_elem = x.shape[0]
+    if n_samples is None:
+        n_samples = default_samples(h)
     if not isinstance(n_samples, (int, np.integer)) or n_samples < 2 * h + 1:
         raise_for_status(4, f"n_samples = {n_samples!r} for H = {h}: need an integer "
                             f">= 2H+1 = {2 * h + 1}")
@@ -195,10 +195,10 @@ def _prepare(law, x, params, n_samples, w0):
                             f"({n_elem}, {law.n_slider})")
         w = np.asfortranarray(w)
     xf = np.asfortranarray(np.transpose(x, (2, 1, 0)))
-    return law, xf, p, w, h, n_elem
+    return law, xf, p, w, h, n_elem, n_samples
 
 
-def aft(law: str | Law, x, params, n_samples: int = DEFAULT_SAMPLES, w0=None,
+def aft(law: str | Law, x, params, n_samples: int | None = None, w0=None,
         jacobian: bool = True, tol: float = 1e-12, max_periods: int = 200) -> AftResult:
     """Contact forces of n_elem elements from their relative displacement harmonics.
 
@@ -208,7 +208,8 @@ def aft(law: str | Law, x, params, n_samples: int = DEFAULT_SAMPLES, w0=None,
     x : (n_elem, n_dir, 2H+1) harmonic coefficients of the local relative displacements, m.
     params : dict of per-law parameters (scalars or (n_elem,) arrays) or an
         (n_elem, n_par) array in the order of ``LAWS[law].parameters``.
-    n_samples : time samples per period N (>= 2H+1; 256 recommended).
+    n_samples : time samples per period N (>= 2H+1); default
+        :func:`frirom.harmonics.default_samples` (H), the solver's default.
     w0 : initial slider positions (n_elem, n_slider), default 0 (see module doc). Along a
         continuation pass the previous point's ``result.slider``: a contact that enters
         stick-all-cycle then keeps its slider where it last slipped.
@@ -217,7 +218,7 @@ def aft(law: str | Law, x, params, n_samples: int = DEFAULT_SAMPLES, w0=None,
         displacement amplitude.
     max_periods : periods marched at most before :class:`frirom.ConvergenceError`.
     """
-    law, xf, p, w, h, n_elem = _prepare(law, x, params, n_samples, w0)
+    law, xf, p, w, h, n_elem, n_samples = _prepare(law, x, params, n_samples, w0)
     nj = law.n_dir * (2 * h + 1)
     f, jac, periods, states, slider, info, msg = _kernels.aft_eval(
         law.code, n_samples, nj, n_elem if jacobian else 0, xf, p, w, float(tol),
@@ -229,13 +230,13 @@ def aft(law: str | Law, x, params, n_samples: int = DEFAULT_SAMPLES, w0=None,
                      slider=np.asarray(slider).T[:, :law.n_slider])
 
 
-def time_histories(law: str | Law, x, params, n_samples: int = DEFAULT_SAMPLES, w0=None,
+def time_histories(law: str | Law, x, params, n_samples: int | None = None, w0=None,
                    tol: float = 1e-12, max_periods: int = 200):
     """Relative displacements and forces over the closed cycle, for hysteresis loops.
 
     Returns (tau, xt, ft): tau (N,) phases in rad; xt, ft (n_elem, n_dir, N).
     """
-    law, xf, p, w, h, n_elem = _prepare(law, x, params, n_samples, w0)
+    law, xf, p, w, h, n_elem, n_samples = _prepare(law, x, params, n_samples, w0)
     xt, ft, info, msg = _kernels.aft_time(law.code, n_samples, xf, p, w, float(tol),
                                           int(max_periods))
     raise_for_status(info, f"{law.name} AFT: " + msg.decode(errors="replace").strip())

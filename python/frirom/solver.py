@@ -30,6 +30,7 @@ from ._errors import CODES, ParameterError, SizeError, raise_for_status
 from ._pack import HILL_MAX, TIMER_NAMES  # noqa: F401 - public here, defined with the packing
 from ._pack import (START_CONTINUE, START_RESUME, START_SOLVE_ONLY, YSCALE_RELATIVE, _Packed,
                     _split_load, add_timings, pack)
+from .harmonics import default_samples
 from .model import CyclicModel, Excitation, Model
 from .results import FRF, FRFPoint
 
@@ -46,7 +47,8 @@ class SolverOptions:
     harmonics : int
         H: the response keeps harmonics 0..H (2H+1 real coefficients per DoF).
     samples : int or None
-        AFT time samples per period, >= 2H+1; None: max(64, 8(2H+1)) (:attr:`n_samples`).
+        AFT time samples per period, >= 2H+1; None: the default of
+        :func:`frirom.harmonics.default_samples` (:attr:`n_samples`).
     formulation : {'condensed', 'banded'}
         'condensed' (Eq. 5-9): unknowns are the contact DoFs' harmonics, receptances from
         the linear part; 'banded': all DoFs x harmonics, banded LU in RCM order.
@@ -133,8 +135,9 @@ class SolverOptions:
 
     @property
     def n_samples(self) -> int:
-        """AFT time samples per period actually used."""
-        return self.samples or max(64, 8 * (2 * self.harmonics + 1))
+        """AFT time samples per period actually used: `samples`, else the measured default
+        :func:`frirom.harmonics.default_samples` (1e-4 relative on a friction resonance)."""
+        return self.samples or default_samples(self.harmonics)
 
 
 @dataclass
