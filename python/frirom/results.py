@@ -12,16 +12,92 @@ import numpy as np
 from ._errors import InputError
 
 
-def amplitude_max(X: np.ndarray, n_time: int | None = None) -> np.ndarray:
-    """max over one period of |x(t)| for real harmonic coefficients X (..., 2H+1)."""
+def _series(X: np.ndarray, t: np.ndarray, order: int = 0) -> np.ndarray:
+    """d^order/dt^order of the real Fourier series X (..., 2H+1) at the times t (..., m)
+    (rad, one period = 2 pi): (..., m)."""
     H = (X.shape[-1] - 1) // 2
-    n_time = n_time or max(64, 16 * (2 * H + 1))
-    tau = 2 * np.pi * np.arange(n_time) / n_time
-    basis = np.ones((2 * H + 1, n_time))
-    for h in range(1, H + 1):
-        basis[2 * h - 1] = np.cos(h * tau)
-        basis[2 * h] = np.sin(h * tau)
-    return np.abs(X @ basis).max(axis=-1)
+    h = np.arange(1, H + 1)
+    ht = h * t[..., None]                             # (..., m, H)
+    c, s = np.cos(ht), np.sin(ht)
+    a, b = X[..., None, 1::2], X[..., None, 2::2]     # (..., 1, H)
+    # d/dt of (cos, sin) is h (-sin, cos): rotate by a quarter turn per order
+    q = order % 4
+    ca, cb = ((a, b), (b, -a), (-a, -b), (-b, a))[q]
+    out = ((ca * c + cb * s) * h ** order).sum(axis=-1)
+    if order == 0:
+        out = out + X[..., None, 0]
+    return out
+
+
+def amplitude_max(X: np.ndarray, return_time: bool = False):
+    """max over one period of |x(t)| for real harmonic coefficients X (..., 2H+1).
+
+    x(t) = a0 + sum_h a_h cos(h t) + b_h sin(h t) is a trigonometric polynomial of degree H:
+    its extrema are roots of x'(t), which in z = exp(i t) is z^-H times a polynomial of
+    degree 2H. Its roots (companion-matrix eigenvalues, batched over every row of X with
+    the same effective degree) give candidate times t = arg z, polished by two Newton steps
+    on x'; |x| is evaluated there and at 2(2H+1) equally spaced times, and the largest value
+    is kept. Every candidate is a real time, so the result never exceeds the true maximum,
+    and it equals it to round-off once a root is found (roots off the unit circle only
+    add harmless candidates).
+
+    Parameters
+    ----------
+    X : ndarray (..., 2H+1)
+        Real harmonics [a0, a1, b1, ..., aH, bH] (any unit).
+    return_time : bool
+        Also return where the maximum is reached.
+
+    Returns
+    -------
+    amp : ndarray (...)
+        max_t |x(t)|, the unit of X.
+    t : ndarray (...), only with return_time
+        A time of the maximum, rad in [0, 2 pi) (phase of the fundamental).
+    """
+    X = np.asarray(X, dtype=float)
+    lead = X.shape[:-1]
+    nc = X.shape[-1]
+    H = (nc - 1) // 2
+    Xf = X.reshape(-1, nc)
+    ns = 2 * (2 * H + 1)
+    t_s = np.broadcast_to(2 * np.pi * np.arange(ns) / ns, (Xf.shape[0], ns))
+    cands = [t_s]
+    if H > 0 and Xf.shape[0]:
+        mag = np.hypot(Xf[:, 1::2], Xf[:, 2::2])                    # (rows, H)
+        big = mag > 1e-12 * mag.max(axis=1, keepdims=True)
+        # effective degree: the highest harmonic that is not round-off (0: x constant)
+        deg = np.where(big.any(axis=1), H - np.argmax(big[:, ::-1], axis=1), 0)
+        t_r = np.zeros((Xf.shape[0], 2 * H))
+        for d in np.unique(deg[deg > 0]):
+            rows = np.flatnonzero(deg == d)
+            a, b = Xf[rows, 1:2 * d:2], Xf[rows, 2:2 * d + 1:2]
+            hh = np.arange(1, d + 1)
+            # z^d x'(t) = sum_h h/2 [(b_h + i a_h) z^(d+h) + (b_h - i a_h) z^(d-h)]
+            p = np.zeros((rows.size, 2 * d + 1), complex)          # p[k]: coeff of z^k
+            p[:, d + hh] = hh * (b + 1j * a) / 2
+            p[:, d - hh] = hh * (b - 1j * a) / 2
+            comp = np.zeros((rows.size, 2 * d, 2 * d), complex)
+            comp[:, 0, :] = -p[:, 2 * d - 1::-1] / p[:, 2 * d, None]
+            comp[:, np.arange(1, 2 * d), np.arange(2 * d - 1)] = 1.0
+            z = np.linalg.eigvals(comp)
+            t_r[rows, :2 * d] = np.angle(z)
+            t_r[rows, 2 * d:] = t_r[rows, :1]          # pad with a repeated candidate
+        cands.append(t_r)
+        t_n = t_r
+        for _ in range(2):
+            d1, d2 = _series(Xf, t_n, 1), _series(Xf, t_n, 2)
+            ok = np.abs(d2) > 0
+            t_n = t_n - np.where(ok, d1 / np.where(ok, d2, 1.0), 0.0)
+            cands.append(t_n)
+    t_all = np.concatenate(cands, axis=1)
+    v = np.abs(_series(Xf, t_all))
+    k = np.argmax(v, axis=1)
+    r = np.arange(Xf.shape[0])
+    amp = v[r, k].reshape(lead)
+    if return_time:
+        return amp, np.mod(t_all[r, k], 2 * np.pi).reshape(lead)
+    return amp
 
 
 @dataclass
