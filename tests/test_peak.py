@@ -5,7 +5,7 @@ value every FRF point reports."""
 import numpy as np
 import pytest
 
-from frirom.results import amplitude_max
+from frirom.results import FRF, Peak, amplitude_max
 from frirom.solver import SolverOptions, frf
 
 from test_solver_core import duffing
@@ -100,3 +100,25 @@ def test_frf_reports_the_true_maximum():
     pick = np.r_[np.argsort(r.amp_max[:, 0])[-3:], 0, len(r) - 1]
     ref = brute(r.X[pick, 0])
     np.testing.assert_allclose(r.amp_max[pick, 0], ref, rtol=1e-12)
+
+
+def test_frf_peak_between_points_and_in_files(tmp_path):
+    """FRF.peak without solved peaks: the parabola through the largest point and its
+    neighbours, exact for points on a parabola in omega (1e-12); a maximum at an end is
+    that point;
+    solved peaks (FRF.peaks) survive an HDF5 round trip."""
+    w = np.linspace(1.0, 2.0, 11)
+    a = 3.0 - 40.0 * (w - 1.437) ** 2
+    r = FRF(omega=w, X=np.zeros((11, 1, 3)), amp_max=np.c_[a, w],
+            state_fractions=np.zeros((11, 0, 3)), stable=np.ones(11, bool),
+            fold=np.zeros(11, bool), iterations=np.zeros(11, int), time_s=np.zeros(11),
+            output_dofs=np.array([0, 1]))
+    p = r.peak(0)
+    assert p.method == "parabola" and p.index == 4
+    assert p.amplitude == pytest.approx(3.0, rel=1e-12)
+    assert p.omega == pytest.approx(1.437, rel=1e-12)
+    q = r.peak(1)
+    assert (q.method, q.index, q.amplitude) == ("point", 10, 2.0)
+    r.peaks = [Peak(1.5, 3.1, 4, "solve"), q]
+    r.save_h5(tmp_path / "f.h5")
+    assert FRF.load(tmp_path / "f.h5").peaks == r.peaks

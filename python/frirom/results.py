@@ -125,6 +125,18 @@ class FRFPoint:
 
 
 @dataclass
+class Peak:
+    """Largest amplitude of one output over an FRF (:meth:`FRF.peak`)."""
+
+    omega: float        #: rad/s
+    amplitude: float    #: max over the period of |x(t)|, the unit of X
+    index: int          #: the point of largest amp_max
+    #: how it was found: 'point' (the largest point itself), 'parabola' (through it and its
+    #: neighbours, in chord length), 'solve' (solved on the curve between its neighbours)
+    method: str = "point"
+
+
+@dataclass
 class FRF:
     """Frequency (or load) response at the output DoFs.
 
@@ -154,10 +166,58 @@ class FRF:
     #: Fortran time split of the run: aft, assembly, factorization, solve, receptance (s),
     #: evaluations, factorizations (counts), fortran_total (s)
     timings: dict = field(default_factory=dict)
+    #: (n_out,) Peak per output solved on the curve by the solver (None: not computed)
+    peaks: list | None = None
 
     @property
     def harmonics(self) -> int:
         return (self.X.shape[-1] - 1) // 2
+
+    def peak(self, output: int = 0) -> Peak:
+        """The largest amplitude of one output over the curve, refined between points.
+
+        The solver's peak (``peaks``, solved on the curve) when there is one; otherwise the
+        point of largest ``amp_max`` and its two neighbours joined by a parabola in omega
+        (in the chord length of the curve, omega / frequency span and amplitude / largest
+        amplitude, when the three straddle a fold): its vertex gives the amplitude, the
+        parabola through the three frequencies the frequency. A maximum at an end of the
+        curve is the point itself.
+
+        Parameters
+        ----------
+        output : int
+            Column of ``amp_max`` (position in ``output_dofs``).
+
+        Returns
+        -------
+        Peak
+            omega (rad/s), amplitude (unit of X), index of the largest point, method.
+        """
+        if len(self) == 0:
+            raise InputError("FRF.peak: the curve has no points")
+        if not -self.amp_max.shape[1] <= output < self.amp_max.shape[1]:
+            raise InputError(f"FRF.peak: output {output} out of range "
+                             f"({self.amp_max.shape[1]} outputs)")
+        if self.peaks is not None:
+            return self.peaks[output]
+        a = np.asarray(self.amp_max[:, output], float)
+        w = np.asarray(self.omega, float)
+        i = int(np.argmax(a))
+        if not 0 < i < len(a) - 1 or a[i] <= 0:
+            return Peak(float(w[i]), float(a[i]), i)
+        ww, aa = w[i - 1:i + 2], a[i - 1:i + 2]
+        if (ww[1] - ww[0]) * (ww[2] - ww[1]) > 0:
+            s = ww                      # frequency increases (or decreases) through i
+        else:                           # a fold next to i: chord length of the curve
+            span = (w.max() - w.min()) or 1.0
+            s = np.r_[0.0, np.cumsum(np.hypot(np.diff(ww) / span, np.diff(aa) / a[i]))]
+        ca = np.polyfit(s - s[1], aa, 2)
+        if not ca[0] < 0:
+            return Peak(float(w[i]), float(a[i]), i)
+        sv = min(max(-ca[1] / (2 * ca[0]), s[0] - s[1]), s[2] - s[1])
+        cw = np.polyfit(s - s[1], ww, 2)
+        return Peak(float(np.polyval(cw, sv)), max(float(np.polyval(ca, sv)), float(a[i])),
+                    i, "parabola")
 
     def __len__(self) -> int:
         return self.omega.size
@@ -194,6 +254,11 @@ class FRF:
                 f.create_dataset(name, data=np.asarray(v if v is not None else self.omega))
             if self.slider is not None:
                 f.create_dataset("slider", data=np.asarray(self.slider, dtype=float))
+            if self.peaks is not None:
+                f.create_dataset("peak_omega", data=[p.omega for p in self.peaks])
+                f.create_dataset("peak_amplitude", data=[p.amplitude for p in self.peaks])
+                f.create_dataset("peak_index", data=[p.index for p in self.peaks])
+                f.attrs["peak_method"] = np.array([p.method for p in self.peaks], dtype="S")
             f.attrs["group_names"] = np.array(self.group_names, dtype="S")
             f.attrs["parameter_name"] = self.parameter_name
             f.attrs["complete"] = self.complete
@@ -239,6 +304,10 @@ class FRF:
             if kw["slider"] is not None and kw["slider"].shape[0] != kw["omega"].shape[0]:
                 raise InputError(f"{path}: 'slider' has {kw['slider'].shape[0]} rows for "
                                  f"{kw['omega'].shape[0]} points")
+            if "peak_omega" in f:
+                kw["peaks"] = [Peak(float(w), float(a), int(i), m.decode()) for w, a, i, m in
+                               zip(f["peak_omega"], f["peak_amplitude"], f["peak_index"],
+                                   f.attrs["peak_method"])]
             return cls(**kw,
                        group_names=[s.decode() for s in f.attrs.get("group_names", [])],
                        parameter_name=str(f.attrs.get("parameter_name", "omega")),
