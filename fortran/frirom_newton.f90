@@ -4,7 +4,9 @@
 !> The system (an extension of nl_system) evaluates R, factorises dR/dy and gives dR/dlam;
 !> this module owns the iteration: bordered Newton corrector with backtracking, residual
 !> and update tests that are relative (the same in N and mN), Jacobian reuse while the
-!> iteration contracts fast, tangent predictor, adaptive step, turning points, retries.
+!> iteration contracts fast, tangent predictor, steps adapted to the curve's shape (angle
+!> between successive tangents, predictor-corrector distance) and limited by the Newton
+!> effort, turning points, retries.
 module frirom_newton
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, &
@@ -12,7 +14,7 @@ module frirom_newton
                              set_status
     implicit none
     private
-    public :: nl_system, cont_options, newton_correct, cont_tangent, cont_run
+    public :: nl_system, cont_options, newton_correct, cont_tangent, cont_run, cont_step_factor
     public :: cont_options_from, YSCALE_RELATIVE
     public :: RCONT_TOL_R, RCONT_TOL_X, RCONT_TOL_STALL, RCONT_YSCALE, RCONT_LSCALE, &
               RCONT_DS, RCONT_DS_MIN, RCONT_DS_MAX, RCONT_LAM_END, RCONT_LAM_LO, N_RCONT
@@ -82,7 +84,13 @@ module frirom_newton
         real(wp) :: ds = 0.01_wp         !! initial arc-length step
         real(wp) :: ds_min = 1.0e-6_wp
         real(wp) :: ds_max = 0.1_wp
-        integer(ip) :: iter_target = 4   !! steps grow below, shrink above this
+        integer(ip) :: iter_target = 4   !! steps may grow below, shrink above this
+        !> step control on the curve's shape: the angle (rad) between the tangents at the
+        !> two ends of a step, and the distance from predictor to corrected point (scaled
+        !> variables), each aimed at per step; the angle grows like ds, the distance like ds^2
+        real(wp) :: angle_target = 0.2_wp
+        real(wp) :: dist_target = 0.02_wp
+        real(wp) :: grow_max = 2.0_wp    !! largest step growth factor per point
         real(wp) :: lam_end = 1.0_wp     !! continuation stops at this parameter value
         integer(ip) :: max_points = 1000 !! points per call
     end type cont_options
@@ -271,7 +279,10 @@ contains
     !> until lam reaches opts%lam_end (the last point is solved at lam_end exactly), the
     !> curve leaves the range through lam_lo, or max_points points were made. A failed
     !> corrector is retried with half the step; below ds_min the run stops with
-    !> FRIROM_ERR_CONT and every point made so far stays in the outputs.
+    !> FRIROM_ERR_CONT and every point made so far stays in the outputs. A converged step
+    !> longer than ds_max / 4 whose predictor-corrector distance says it was more than
+    !> twice too long for the curve's shape is retried once with the step
+    !> cont_step_factor gives.
     subroutine cont_run(sys, y, lam, t, ds, lam_lo, opts, yout, lout, tout, itout, npts, &
                         finished, info, errmsg, have_fact)
         class(nl_system), intent(inout) :: sys
@@ -291,9 +302,9 @@ contains
         character(len=*), intent(inout) :: errmsg
         logical, intent(inout) :: have_fact    !! the system holds J at (y, lam) (in/out)
         real(wp), allocatable :: y1(:), yp(:), t1(:), cy(:)
-        real(wp) :: lam1, lp, dirn, frac, cl
+        real(wp) :: lam1, lp, dirn, frac, cl, angle, dist
         integer(ip) :: n, iters
-        logical :: last, turned
+        logical :: last, turned, retried
         integer(ip) :: nf, effort
         type(cont_options) :: fresh_opts
         character(len=len(errmsg)) :: why
@@ -318,6 +329,7 @@ contains
         dirn = sign(1.0_wp, opts%lam_end - lam_lo)
         fresh_opts = opts
         fresh_opts%reuse_jac = .false.
+        retried = .false.
         do while (npts < opts%max_points)
             ds = min(max(ds, opts%ds_min), opts%ds_max)
             yp = y + ds*t(1:n)*opts%yscale
@@ -359,6 +371,22 @@ contains
                                     'more than 3 steps away from the predictor')
                 end if
             end if
+            if (info == 0 .and. .not. (last .or. retried .or. turned) .and. &
+                ds > 0.25_wp*opts%ds_max) then
+                ! a long step far too long for the curve's shape (the corrector moved off
+                ! the predictor by much more than the targets allow, e.g. across a resonance
+                ! narrower than the step) is retried once, shorter, before its point counts;
+                ! short steps are not (at a corner of the curve, a contact state switching,
+                ! the ratio stays whatever the step)
+                dist = sqrt(sum(((y1 - yp)/opts%yscale)**2) + ((lam1 - lp)/opts%lscale)**2)
+                frac = cont_step_factor(2.0_wp*atan2(dist, ds), dist, 0_ip, opts)
+                if (frac < 0.5_wp) then
+                    retried = .true.
+                    have_fact = .false.
+                    ds = frac*ds
+                    cycle
+                end if
+            end if
             if (info /= 0) then
                 why = errmsg
                 have_fact = .false.
@@ -382,7 +410,12 @@ contains
                 return
             end if
             have_fact = .true.
+            retried = .false.
             npts = npts + 1
+            angle = acos(max(-1.0_wp, min(1.0_wp, dot_product(t, t1))))
+            dist = 0.0_wp
+            if (.not. (last .or. turned)) dist = sqrt(sum(((y1 - yp)/opts%yscale)**2) + &
+                                        ((lam1 - lp)/opts%lscale)**2)
             y = y1
             lam = lam1
             t = t1
@@ -390,15 +423,12 @@ contains
             lout(npts) = lam
             tout(:, npts) = t
             itout(npts) = iters
-            ! step control on the work done: Newton iterations, or with Jacobian reuse the
-            ! factorisations (chord iterations are cheap)
+            ! the work done: Newton iterations, or with Jacobian reuse the factorisations
+            ! (chord iterations are cheap)
             effort = iters
             if (opts%reuse_jac) effort = min(iters, 2*nf)
-            if (effort <= opts%iter_target - 1) then
-                ds = min(1.6_wp*ds, opts%ds_max)
-            else if (effort > opts%iter_target + 2) then
-                ds = max(0.6_wp*ds, opts%ds_min)
-            end if
+            ds = min(max(ds*cont_step_factor(angle, dist, effort, opts), opts%ds_min), &
+                     opts%ds_max)
             if (last .or. (lam - lam_lo)*dirn < 0.0_wp) then
                 finished = .true.
                 return
@@ -465,4 +495,26 @@ contains
         end do
         have_fact = .false.
     end subroutine turn_corner
+
+    !> Factor on the arc-length step after a point: the curve's shape sets it (the angle
+    !> between the tangents at the step's ends grows like ds, the predictor-corrector
+    !> distance like ds^2: each is brought to its target), the Newton effort limits it
+    !> (no growth at iter_target or more, shrink by 0.6 above iter_target + 2), and it
+    !> lies in [1/4, grow_max]. Deterministic: no timing enters.
+    pure function cont_step_factor(angle, dist, effort, opts) result(f)
+        real(wp), intent(in) :: angle          !! rad between successive unit tangents
+        real(wp), intent(in) :: dist           !! predictor-corrector distance (scaled)
+        integer(ip), intent(in) :: effort      !! Newton iterations (or factorisations)
+        type(cont_options), intent(in) :: opts
+        real(wp) :: f
+        f = opts%grow_max
+        if (angle*f > opts%angle_target) f = opts%angle_target/angle
+        if (dist*f**2 > opts%dist_target) f = sqrt(opts%dist_target/dist)
+        if (effort > opts%iter_target + 2) then
+            f = min(f, 0.6_wp)
+        else if (effort > opts%iter_target - 1) then
+            f = min(f, 1.0_wp)
+        end if
+        f = max(f, 0.25_wp)
+    end function cont_step_factor
 end module frirom_newton

@@ -55,7 +55,7 @@ def test_joint_deck_loads():
     assert d.outputs == [4, 0, 1] and d.output_names[0] == "tip:x"
     assert np.isclose(d.omega_start, 2 * np.pi * 400) and np.isclose(d.omega_end,
                                                                      2 * np.pi * 520)
-    assert d.continuation == {"step": 0.02, "max_step": 0.04, "max_points": 1000}
+    assert d.continuation == {"step": 0.02, "max_step": 0.1, "max_points": 1000}
     assert d.solver["stability"] is True
 
 
@@ -81,7 +81,7 @@ def test_normal1d_frame_and_solver_objects(deckdir):
     assert model.damping.kind == "modal" and np.all(model.damping.zeta == 0.003)
     assert exc.F.shape == (5, 6) and np.array_equal(exc.F, d.F)
     assert opts.harmonics == 5 and opts.samples == 64 and opts.formulation == "condensed"
-    assert (opts.ds, opts.ds_max, opts.max_points) == (0.02, 0.04, 1000)
+    assert (opts.ds, opts.ds_max, opts.max_points) == (0.02, 0.1, 1000)
     assert opts.stability
 
 
@@ -144,7 +144,7 @@ BAD = [
      "different"),
     ('dofs = ["tip:x", "platform:x", "platform:y"]', 'dofs = []', "outputs.dofs",
      "non-empty"),
-    ('max_step = 0.04', 'max_step = 0.04\nmin_step = 0.5', "continuation.min_step",
+    ('max_step = 0.1 ', 'max_step = 0.1\nmin_step = 0.5 ', "continuation.min_step",
      "max_step"),
     ('formulation = "condensed"', 'formulation = "condensed"\nstability = 1',
      "solver.stability", "true or false"),

@@ -100,7 +100,8 @@ end module newton_test_system
 program test_newton
     use frirom_kinds, only: wp, ip
     use frirom_check, only: check, check_done
-    use frirom_newton, only: cont_options, newton_correct, cont_tangent, cont_run
+    use frirom_newton, only: cont_options, newton_correct, cont_tangent, cont_run, &
+                             cont_step_factor
     use newton_test_system
     implicit none
     type(cubic_curve) :: s
@@ -152,6 +153,18 @@ program test_newton
     call check(abs(yout(1, npts) - y1ref) < 1.0e-10_wp, 'end on the upper branch')
     call check(maxval(lout(1:npts)) < 2.0_wp + 1.0e-9_wp .or. yout(1, npts) > 1.0_wp, &
                'branch order')
+    ! step factors: each shape measure brought to its target (angle ~ ds, distance ~ ds^2),
+    ! the Newton effort limiting, growth and shrink bounded
+    call check(abs(cont_step_factor(2.0_wp*o%angle_target, 0.0_wp, 1_ip, o) - 0.5_wp) < &
+               1.0e-15_wp, 'twice the target angle halves the step')
+    call check(abs(cont_step_factor(0.0_wp, 4.0_wp*o%dist_target, 1_ip, o) - 0.5_wp) < &
+               1.0e-15_wp, 'four times the target distance halves the step')
+    call check(cont_step_factor(0.0_wp, 0.0_wp, 1_ip, o) == o%grow_max, 'a straight curve grows')
+    call check(cont_step_factor(0.0_wp, 0.0_wp, o%iter_target, o) == 1.0_wp, &
+               'no growth at the Newton iteration target')
+    call check(cont_step_factor(0.0_wp, 0.0_wp, o%iter_target + 3, o) == 0.6_wp, &
+               'hard Newton shrinks')
+    call check(cont_step_factor(100.0_wp, 100.0_wp, 1_ip, o) == 0.25_wp, 'shrink bounded')
     ! a failing corrector at the minimum step stops with a diagnostic, keeping points
     o%max_iter = 1
     o%ds_min = 0.04_wp

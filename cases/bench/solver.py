@@ -201,7 +201,7 @@ def main():
         results[reuse] = (len(r), dt)
         print(f"{nb_final} contacts, H=3, banded, reuse={reuse!s:5}: {len(r)} points, omega "
               f"{r.omega[0]:.0f}..{r.omega[-1]:.0f} rad/s (peak at "
-              f"{r.omega[np.argmax(r.amp_max[:, 0])]:.0f}), {r.iterations.mean():.1f} "
+              f"{r.peak(0).omega:.0f}), {r.iterations.mean():.1f} "
               f"iterations/point, {int(tm['factorizations'])} factorisations, {dt:.1f} s; "
               f"AFT {tm['aft'] / tot:.0%}, assembly {tm['assembly'] / tot:.0%}, "
               f"factorisation {tm['factorization'] / tot:.0%}, solves {tm['solve'] / tot:.0%}")

@@ -67,10 +67,10 @@ def run(out: Path, name: str, text: str):
     main(["run", str(deck), "--out", str(out / name), "--quiet"])
     t_frf = time.perf_counter() - t1
     r = FRF.load(out / name / "frf.h5")
-    i = int(np.argmax(r.amp_max[:, 0]))
+    p = r.peak(0)       # the file keeps the points: the peak between them (FRF.peak)
     return dict(n_r=m.n_dof, n_nl=len(m.nonlinear_dofs()), n_el=m.contacts[0].n_elem,
-                f=r.omega[i] / (2 * np.pi), a=r.amp_max[i, 0], t_red=t_red, t_frf=t_frf,
-                pts=len(r), slip=r.state_fractions[i, 0, 1])
+                f=p.omega / (2 * np.pi), a=p.amplitude, t_red=t_red, t_frf=t_frf,
+                pts=len(r), slip=r.state_fractions[p.index, 0, 1])
 
 
 def main(argv=None):

@@ -304,6 +304,8 @@ class _Packed:
     def points(self, res: _CallResult, omega_fix, t_call) -> list[FRFPoint]:
         """The converged points of one call; t_call (s) is shared out among them."""
         pts = []
+        # every point's maxima in one batch: (n_out, 2H+1, npts) -> (npts, n_out)
+        amps = amplitude_max(np.moveaxis(res.xo[:, :, :res.npts], 2, 0))
         for k in range(res.npts):
             st = np.zeros((len(self.group_sizes), 3))
             e0 = 0
@@ -314,7 +316,7 @@ class _Packed:
             om = res.lams[k] if self.opts.parameter == "frequency" else omega_fix
             pts.append(FRFPoint(omega=float(om), parameter=float(res.lams[k]),
                                 unknowns=res.ys[:, k].copy(), tangent=res.tans[:, k].copy(),
-                                X=X, amp_max=amplitude_max(X), state_fractions=st,
+                                X=X, amp_max=amps[k], state_fractions=st,
                                 iterations=int(res.iters[k]), time_s=t_call / max(res.npts, 1),
                                 stable=bool(res.hill_re[k] <= 1e-7 * max(abs(om), 1.0)),
                                 floquet_max_re=float(res.hill_re[k]),

@@ -162,7 +162,23 @@ def cmd_run(args) -> int:
             written.append(out / name)
     print(f"frirom: {len(full)} points in {elapsed:.1f} s; wrote "
           + ", ".join(str(p) for p in written))
+    # a resumed run's own peaks cover only its part: the whole file's then (between points)
+    _print_peaks(full if args.resume else result, deck)
     return 0
+
+
+def _print_peaks(result, deck) -> None:
+    """One line per output: its largest amplitude over the run (FRF.peak)."""
+    from .plots import frequency_axis
+    if len(result) == 0:
+        return
+    names = deck.output_names or [f"output {j}" for j in range(result.amp_max.shape[1])]
+    for j, name in enumerate(names):
+        p = result.peak(j)
+        f, label = frequency_axis(p.omega, deck.frequency_unit)
+        unit = label[label.index("[") + 1:-1]
+        print(f"frirom: peak of {name}: {p.amplitude:.6g} at {float(f):.6g} {unit} "
+              f"({p.method})")
 
 
 def main(argv: list[str] | None = None) -> int:

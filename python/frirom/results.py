@@ -4,6 +4,7 @@ writer for long runs that can be reopened to resume."""
 from __future__ import annotations
 
 import csv
+import functools
 import warnings
 from dataclasses import dataclass, field
 
@@ -12,16 +13,108 @@ import numpy as np
 from ._errors import InputError
 
 
-def amplitude_max(X: np.ndarray, n_time: int | None = None) -> np.ndarray:
-    """max over one period of |x(t)| for real harmonic coefficients X (..., 2H+1)."""
-    H = (X.shape[-1] - 1) // 2
-    n_time = n_time or max(64, 16 * (2 * H + 1))
-    tau = 2 * np.pi * np.arange(n_time) / n_time
-    basis = np.ones((2 * H + 1, n_time))
-    for h in range(1, H + 1):
-        basis[2 * h - 1] = np.cos(h * tau)
-        basis[2 * h] = np.sin(h * tau)
-    return np.abs(X @ basis).max(axis=-1)
+def _series(X: np.ndarray, t: np.ndarray) -> tuple:
+    """x, x' and x'' of the real Fourier series X (rows, 2H+1) at the times t (rows, m)
+    (rad, one period = 2 pi): three (rows, m) arrays."""
+    h = np.arange(1, (X.shape[-1] - 1) // 2 + 1)
+    ht = h * t[..., None]                             # (rows, m, H)
+    c, s = np.cos(ht), np.sin(ht)
+    a, b = X[:, None, 1::2], X[:, None, 2::2]         # (rows, 1, H)
+    even, odd = a * c + b * s, b * c - a * s          # d/dt (a cos + b sin) = h (b cos - a sin)
+    return (X[:, None, 0] + even.sum(axis=-1), (h * odd).sum(axis=-1),
+            -(h * h * even).sum(axis=-1))
+
+
+@functools.lru_cache(maxsize=None)
+def _tan_half_basis(d: int) -> np.ndarray:
+    """(2d+1, 2d+1) complex B with B[k, j] the coefficient of u^j in
+    (1 + i u)^k (1 - i u)^(2d - k): z^k (1 - i u)^(2d) for z = exp(i t), u = tan(t / 2)."""
+    up, dn = np.polynomial.polynomial.polypow, np.polynomial.polynomial.polymul
+    return np.array([dn(up([1, 1j], k), up([1, -1j], 2 * d - k)) for k in range(2 * d + 1)])
+
+
+def _derivative_roots(Xf: np.ndarray, H: int) -> np.ndarray:
+    """Times t of the real roots of x'(t) per row of Xf (rows, 2H+1), with more candidate
+    times from the complex roots: (rows, 2H) rad.
+
+    z^d x'(t) is a polynomial P(z) of degree 2d in z = exp(i t) (d: the row's effective
+    degree, its highest harmonic above round-off); with u = tan(t / 2),
+    P(z) (1 - i u)^(2d) = (1 + u^2)^d x'(t) is a real polynomial in u whose real roots are
+    the critical times t = 2 atan(u): a real companion matrix per row, batched by degree.
+    Rows of degree d < H are padded with their first candidate, constant rows get 0."""
+    mag = np.hypot(Xf[:, 1::2], Xf[:, 2::2])                        # (rows, H)
+    big = mag > 1e-12 * mag.max(axis=1, keepdims=True)
+    deg = np.where(big.any(axis=1), H - np.argmax(big[:, ::-1], axis=1), 0)
+    t_r = np.zeros((Xf.shape[0], 2 * H))
+    full = deg.min() == H                     # the usual case: one batch, no row picking
+    for d in ([H] if full else np.unique(deg[deg > 0])):
+        rows = slice(None) if full else np.flatnonzero(deg == d)
+        a, b = Xf[rows, 1:2 * d:2], Xf[rows, 2:2 * d + 1:2]
+        hh = np.arange(1, d + 1)
+        n = a.shape[0]
+        # z^d x'(t) = sum_h h/2 [(b_h + i a_h) z^(d+h) + (b_h - i a_h) z^(d-h)]
+        p = np.zeros((n, 2 * d + 1), complex)                        # p[k]: coeff of z^k
+        p[:, d + hh] = hh * (b + 1j * a) / 2
+        p[:, d - hh] = hh * (b - 1j * a) / 2
+        q = (p @ _tan_half_basis(d)).real                            # q[j]: coeff of u^j
+        # a vanishing u^(2d) coefficient is a root at t = pi (u infinite), which the
+        # equally spaced candidates hold: keep it from dividing by zero
+        top = np.abs(q).max(axis=1)
+        lead = np.where(np.abs(q[:, -1]) > 1e-13 * top, q[:, -1], 1e-13 * top + 1e-300)
+        comp = np.zeros((n, 2 * d, 2 * d))
+        comp[:, 0, :] = -q[:, 2 * d - 1::-1] / lead[:, None]
+        comp[:, np.arange(1, 2 * d), np.arange(2 * d - 1)] = 1.0
+        t = 2 * np.arctan(np.linalg.eigvals(comp).real)
+        t_r[rows] = np.concatenate([t, np.repeat(t[:, :1], 2 * (H - d), axis=1)], axis=1)
+    return t_r
+
+
+def amplitude_max(X: np.ndarray, return_time: bool = False):
+    """max over one period of |x(t)| for real harmonic coefficients X (..., 2H+1).
+
+    x(t) = a0 + sum_h a_h cos(h t) + b_h sin(h t) is a trigonometric polynomial of degree H:
+    its extrema are roots of x'(t), which times (1 + u^2)^H is a real polynomial of degree
+    2H in u = tan(t / 2). Its roots (companion-matrix eigenvalues, batched over every row
+    of X with the same effective degree) give candidate times t = 2 atan(u), also polished
+    by a Newton step on x'; |x| is evaluated there and at 2(2H+1) equally spaced times
+    (t = pi among them), and the largest value is kept. Every candidate is a real time, so
+    the result never exceeds the true maximum, and it equals it to round-off once a root is
+    found (complex roots only add harmless candidates).
+
+    Parameters
+    ----------
+    X : ndarray (..., 2H+1)
+        Real harmonics [a0, a1, b1, ..., aH, bH] (any unit).
+    return_time : bool
+        Also return where the maximum is reached.
+
+    Returns
+    -------
+    amp : ndarray (...)
+        max_t |x(t)|, the unit of X.
+    t : ndarray (...), only with return_time
+        A time of the maximum, rad in [0, 2 pi) (phase of the fundamental).
+    """
+    X = np.asarray(X, dtype=float)
+    lead, nc = X.shape[:-1], X.shape[-1]
+    H = (nc - 1) // 2
+    Xf = X.reshape(-1, nc)
+    ns = 2 * (2 * H + 1)
+    t = np.broadcast_to(2 * np.pi * np.arange(ns) / ns, (Xf.shape[0], ns))
+    if H > 0 and Xf.shape[0]:
+        t_r = _derivative_roots(Xf, H)
+        # a Newton step on x' polishes the roots (quadratic: from eigenvalue accuracy to
+        # round-off); the roots as found stay candidates too
+        _, d1, d2 = _series(Xf, t_r)
+        step = np.divide(d1, d2, out=np.zeros_like(d1), where=d2 != 0)
+        t = np.concatenate([t, t_r, t_r - np.clip(step, -0.5, 0.5)], axis=1)
+    v = np.abs(_series(Xf, t)[0])
+    k = np.argmax(v, axis=1)
+    r = np.arange(Xf.shape[0])
+    amp = v[r, k].reshape(lead)
+    if return_time:
+        return amp, np.mod(t[r, k], 2 * np.pi).reshape(lead)
+    return amp
 
 
 @dataclass
@@ -46,6 +139,18 @@ class FRFPoint:
     #: w0 a run restarted from this point needs; a contact stuck all cycle keeps it).
     #: With SolverOptions(history=False) it is the w0 every point started from.
     slider: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+
+@dataclass
+class Peak:
+    """Largest amplitude of one output over an FRF (:meth:`FRF.peak`)."""
+
+    omega: float        #: rad/s
+    amplitude: float    #: max over the period of |x(t)|, the unit of X
+    index: int          #: the point of largest amp_max
+    #: how it was found: 'point' (the largest point itself), 'parabola' (through it and its
+    #: neighbours, in chord length), 'solve' (solved on the curve between its neighbours)
+    method: str = "point"
 
 
 @dataclass
@@ -78,10 +183,58 @@ class FRF:
     #: Fortran time split of the run: aft, assembly, factorization, solve, receptance (s),
     #: evaluations, factorizations (counts), fortran_total (s)
     timings: dict = field(default_factory=dict)
+    #: (n_out,) Peak per output solved on the curve by the solver (None: not computed)
+    peaks: list | None = None
 
     @property
     def harmonics(self) -> int:
         return (self.X.shape[-1] - 1) // 2
+
+    def peak(self, output: int = 0) -> Peak:
+        """The largest amplitude of one output over the curve, refined between points.
+
+        The solver's peak (``peaks``, solved on the curve) when there is one; otherwise the
+        point of largest ``amp_max`` and its two neighbours joined by a parabola in omega
+        (in the chord length of the curve, omega / frequency span and amplitude / largest
+        amplitude, when the three straddle a fold): its vertex gives the amplitude, the
+        parabola through the three frequencies the frequency. A maximum at an end of the
+        curve is the point itself.
+
+        Parameters
+        ----------
+        output : int
+            Column of ``amp_max`` (position in ``output_dofs``).
+
+        Returns
+        -------
+        Peak
+            omega (rad/s), amplitude (unit of X), index of the largest point, method.
+        """
+        if len(self) == 0:
+            raise InputError("FRF.peak: the curve has no points")
+        if not -self.amp_max.shape[1] <= output < self.amp_max.shape[1]:
+            raise InputError(f"FRF.peak: output {output} out of range "
+                             f"({self.amp_max.shape[1]} outputs)")
+        if self.peaks is not None:
+            return self.peaks[output]
+        a = np.asarray(self.amp_max[:, output], float)
+        w = np.asarray(self.omega, float)
+        i = int(np.argmax(a))
+        if not 0 < i < len(a) - 1 or a[i] <= 0:
+            return Peak(float(w[i]), float(a[i]), i)
+        ww, aa = w[i - 1:i + 2], a[i - 1:i + 2]
+        if (ww[1] - ww[0]) * (ww[2] - ww[1]) > 0:
+            s = ww                      # frequency increases (or decreases) through i
+        else:                           # a fold next to i: chord length of the curve
+            span = (w.max() - w.min()) or 1.0
+            s = np.r_[0.0, np.cumsum(np.hypot(np.diff(ww) / span, np.diff(aa) / a[i]))]
+        ca = np.polyfit(s - s[1], aa, 2)
+        if not ca[0] < 0:
+            return Peak(float(w[i]), float(a[i]), i)
+        sv = min(max(-ca[1] / (2 * ca[0]), s[0] - s[1]), s[2] - s[1])
+        cw = np.polyfit(s - s[1], ww, 2)
+        return Peak(float(np.polyval(cw, sv)), max(float(np.polyval(ca, sv)), float(a[i])),
+                    i, "parabola")
 
     def __len__(self) -> int:
         return self.omega.size
@@ -118,6 +271,11 @@ class FRF:
                 f.create_dataset(name, data=np.asarray(v if v is not None else self.omega))
             if self.slider is not None:
                 f.create_dataset("slider", data=np.asarray(self.slider, dtype=float))
+            if self.peaks is not None:
+                f.create_dataset("peak_omega", data=[p.omega for p in self.peaks])
+                f.create_dataset("peak_amplitude", data=[p.amplitude for p in self.peaks])
+                f.create_dataset("peak_index", data=[p.index for p in self.peaks])
+                f.attrs["peak_method"] = np.array([p.method for p in self.peaks], dtype="S")
             f.attrs["group_names"] = np.array(self.group_names, dtype="S")
             f.attrs["parameter_name"] = self.parameter_name
             f.attrs["complete"] = self.complete
@@ -163,6 +321,10 @@ class FRF:
             if kw["slider"] is not None and kw["slider"].shape[0] != kw["omega"].shape[0]:
                 raise InputError(f"{path}: 'slider' has {kw['slider'].shape[0]} rows for "
                                  f"{kw['omega'].shape[0]} points")
+            if "peak_omega" in f:
+                kw["peaks"] = [Peak(float(w), float(a), int(i), m.decode()) for w, a, i, m in
+                               zip(f["peak_omega"], f["peak_amplitude"], f["peak_index"],
+                                   f.attrs["peak_method"])]
             return cls(**kw,
                        group_names=[s.decode() for s in f.attrs.get("group_names", [])],
                        parameter_name=str(f.attrs.get("parameter_name", "omega")),

@@ -1,0 +1,100 @@
+"""The peak of a continuation run solved on the curve: for each output, the largest
+max-over-the-period amplitude between the points around the largest one, found by a
+bounded Brent search along the curve whose every evaluation is one corrector solve.
+
+The curve near the largest point i is parameterised by the arc length s along the tangent
+of point i - 1 (pseudo-arc-length: the corrector solves R = 0 on the hyperplane at distance
+s along that tangent, as the continuation itself does), so a peak next to a fold, or at a
+corner of a friction curve (a contact state appearing there), is found like a smooth one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import scipy.optimize
+
+from ._pack import START_RESUME, _Packed
+from .results import FRFPoint, Peak
+
+#: local maxima of the points within this fraction of the largest are solved for too
+#: (at most MAX_CANDIDATES of them, the largest first)
+NEAR = 2e-3
+MAX_CANDIDATES = 3
+#: Brent's tolerance on the arc length, relative to the bracket (two steps): at a corner
+#: the amplitude error is this times the amplitude change over a step (~1e-5 relative)
+XTOL = 2e-3
+
+
+def _offset(base: FRFPoint, p: FRFPoint, lscale: float) -> float:
+    """Distance of p from base along base's tangent, in the scaled variables of the run."""
+    d = np.r_[(p.unknowns - base.unknowns) / base.yscale,
+              (p.parameter - base.parameter) / lscale]
+    return float(base.tangent @ d)
+
+
+def refine_peaks(packed: _Packed, points: list, lam_end: float, lam_lo: float,
+                 lscale: float, omega_fix: float = 0.0) -> list:
+    """Peak per output of a frequency continuation's points (FRFPoint list, in order).
+
+    Returns a list of :class:`frirom.results.Peak` (n_out,): the largest of the solved
+    local maxima (``method`` 'solve'; the interior local maxima of the points within NEAR
+    of the largest are solved for, at most MAX_CANDIDATES), or the largest point itself
+    when none is larger (an end of the curve, or a failed solve)."""
+    opts = dataclasses.replace(packed.opts, ds_max=1.0e3, ds_min=1e-12)
+    quiet = dataclasses.replace(packed, opts=opts, stability=False, w0=packed.w0.copy())
+    cache = {}
+
+    def solve(base_k: int, s: float) -> FRFPoint:
+        key = (base_k, s)
+        if key not in cache:
+            base = points[base_k]
+            if base.slider.size:
+                quiet.w0 = base.slider.copy()
+            res = quiet.call(base.unknowns, base.parameter, base.tangent, START_RESUME, s,
+                             lam_end, lam_lo, base.yscale, lscale, 1, omega_fix)
+            if res.info != 0 or res.npts != 1:
+                raise RuntimeError(res.msg)
+            p = quiet.points(res, omega_fix, 0.0)[0]
+            p.yscale = base.yscale
+            if abs(_offset(base, p, lscale) - s) > 1e-6 * s:
+                raise RuntimeError("the corrector did not keep the step")
+            cache[key] = p
+        return cache[key]
+
+    amp = np.array([p.amp_max for p in points])
+    peaks = []
+    for j in range(amp.shape[1]):
+        a = amp[:, j]
+        i = int(np.argmax(a))
+        best = Peak(points[i].omega, float(a[i]), i)
+        # every local maximum of the points close to the largest: two resonances of about
+        # the same height may swap once solved between the points
+        inner = np.flatnonzero((a[1:-1] >= a[:-2]) & (a[1:-1] >= a[2:])) + 1
+        inner = inner[a[inner] >= (1.0 - NEAR) * a[i]]
+        for k in inner[np.argsort(-a[inner], kind="stable")][:MAX_CANDIDATES]:
+            p = _solve_peak(solve, points, int(k), j, lscale)
+            if p is not None and p.amp_max[j] > best.amplitude:
+                best = Peak(p.omega, float(p.amp_max[j]), int(k), "solve")
+        peaks.append(best)
+    return peaks
+
+
+def _solve_peak(solve, points: list, i: int, j: int, lscale: float) -> FRFPoint | None:
+    """The point of largest amplitude of output j between points i - 1 and i + 1 (Brent's
+    method along the tangent of i - 1, started from the bracket the three points make);
+    None when a solve fails or the curve turns too much between them for that
+    parameterisation."""
+    base = points[i - 1]
+    s_i, s_hi = (_offset(base, points[k], lscale) for k in (i, i + 1))
+    if not 0 < s_i < s_hi or not points[i].amp_max[j] > 0:
+        return None
+    known = {0.0: base, s_i: points[i], s_hi: points[i + 1]}
+    try:
+        r = scipy.optimize.minimize_scalar(
+            lambda s: -(known[s] if s in known else solve(i - 1, s)).amp_max[j],
+            bracket=(0.0, s_i, s_hi), method="brent", tol=XTOL * s_hi / s_i)
+        return known[r.x] if r.x in known else solve(i - 1, float(r.x))
+    except (RuntimeError, ValueError):
+        return None
