@@ -329,9 +329,10 @@ def flange_roms(spec: FlangeSpec | None = None, work=None, log=print) -> dict:
     Keys: K, M (n_I, n_I) ROM_I; G (2 pairs, n_I) CSR normal1d map (rows t, n per pair);
     params (pairs, 4) kt kn mu n0; F (n_I, 2) complex loads (harmonics 0, 1); outputs (axial
     DoFs of the active nodes); contact_a, contact_b (pairs, 3) ROM_I positions of the x, y,
-    z DoFs of each pair's stage-1 and stage-2 node; K2, M2, G2, F2, outputs2: ROM_II; beta: Rayleigh
-    stiffness coefficient [s]; f_stuck, f_free: EO resonance [Hz] of the linear stuck / free
-    ROM_I; sizes (dict); t_ccx, t_reduce: generation times [s]; spec (dict).
+    z DoFs of each pair's stage-1 and stage-2 node; K2, M2, G2, F2, outputs2: ROM_II;
+    beta: Rayleigh stiffness coefficient [s]; f_stuck, f_free: EO resonance [Hz] of the linear stuck / free
+    ROM_I; sizes (dict); t_ccx, t_reduce: generation times [s]; spec (dict); cache (path);
+    generated (False when read from the cache).
     """
     spec = spec or FlangeSpec()
     work = Path(work or "/tmp/frirom_flange")
@@ -372,7 +373,9 @@ def flange_roms(spec: FlangeSpec | None = None, work=None, log=print) -> dict:
              contact_b=a["contact_b"], beta=beta, f_stuck=f_stuck, f_free=f_free,
              t_ccx=t_ccx, t_reduce=t_reduce, sizes=json.dumps(sizes),
              spec=json.dumps(asdict(spec)))
-    return _load(cache)
+    out = _load(cache)
+    out["generated"] = True
+    return out
 
 
 def _load(path) -> dict:
@@ -386,6 +389,7 @@ def _load(path) -> dict:
     for k in ("beta", "f_stuck", "f_free", "t_ccx", "t_reduce"):
         out[k] = float(out[k])
     out["cache"] = str(path)
+    out["generated"] = False
     return out
 
 
