@@ -207,15 +207,6 @@ def pick(pts, n):
     return [pts[i] for i in idx][:max(n, 1)]
 
 
-def frf_points(res):
-    """FRFPoint-like records (omega, X, amp_max, slider, unknowns) of an FRF."""
-    out = []
-    for k in range(len(res)):
-        out.append(type("P", (), dict(omega=res.omega[k], X=res.X[k], amp_max=res.amp_max[k],
-                                      slider=res.slider[k], unknowns=None))())
-    return out
-
-
 def run_route(name, kw, model, exc, outputs, band, n_eval_frf, ref_kw, a, label):
     """One route on one ROM: a dict of the row's numbers (or the reason it was skipped)."""
     gb = estimated_gb(model, kw)
@@ -233,15 +224,16 @@ def run_route(name, kw, model, exc, outputs, band, n_eval_frf, ref_kw, a, label)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             t0 = time.perf_counter()
+            got = []          # every point with its unknowns and history, for the checks
             res = frf(model, exc, 2 * np.pi * f1, 2 * np.pi * f2, options(kw, model),
-                      outputs=outputs)
+                      outputs=outputs, sink=got.append)
             row["frf_s"] = time.perf_counter() - t0
         row.update(points=len(res), evals=int(res.timings.get("evaluations", 0)),
                    complete=res.complete, pe=per_eval(res.timings), extrap=False,
                    peak=float(np.max(res.amp_max)),
                    f_peak=float(res.omega[np.argmax(np.max(res.amp_max, axis=1))]
                                 / 2 / np.pi))
-        check = pick(frf_points(res), a.checks)
+        check = pick(got, a.checks)
     else:
         freqs = np.linspace(f1, f2, a.samples + 2)[1:-1]
         pts2, t2, _ = sampled(model, exc, outputs, kw, freqs)
