@@ -260,6 +260,8 @@ def print_row(r):
     pts = "-" if r["points"] is None else str(r["points"])
     frf_s = f"{r['frf_s']:9.1f}" + (" extrap." if r["extrap"] else "        ")
     diff = "reference" if r["diff"] == 0.0 else f"{r['diff']:.1e} ({r['n_checks']} pts)"
+    if r["extrap"]:
+        diff += f"; sampled: {r['sampled_evals']} evaluations"
     print(f"  {r['rom']:<7} {r['route']:<22} {r['unknowns']:8d} {pe['fortran_total']:10.4f} "
           f"{fmt_split(pe)}  {frf_s} {pts:>6} {r['evals']:6d}  {diff}")
 
