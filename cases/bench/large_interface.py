@@ -62,7 +62,12 @@ def _parse(argv=None):
     ap.add_argument("--scaling", default=SCALING,
                     help="contact pairs of the scaling study ('' to skip)")
     ap.add_argument("--band", default=None, help="sweep 'f1,f2' in Hz")
-    ap.add_argument("--mem-limit", type=float, default=3.0,
+    ap.add_argument("--roms", default="II,I",
+                    help="ROMs of the per-route table ('' for the scaling alone)")
+    ap.add_argument("--evals", type=int, default=None,
+                    help="evaluations of an FRF for extrapolations when the table does not "
+                         "run a ROM_II FRF (e.g. 768, today's condensed ROM_II count)")
+    ap.add_argument("--mem-limit", type=float, default=2.0,
                     help="GB: a route whose estimated matrices exceed it is skipped")
     return ap.parse_args(argv)
 
@@ -316,21 +321,27 @@ def main(a):
           f"route {a.reference!r} by solve_point from the route's points)")
     header()
     rows = {}
+    want = {v.strip() for v in a.roms.split(",") if v.strip()}
+    skipped = dict(skip="not asked (--roms)")
     for name, kw in rts.items():
         # the first route's ROM_II FRF is run whole; its evaluations price the others
         n_eval0 = next((r["evals"] for (rn, rom), r in rows.items()
-                        if rom == "ROM_II" and r.get("points")), None)
-        r2 = run_route(name, kw, m2, e2, o2, band, n_eval0, ref_kw, a, "ROM_II")
-        print_row(r2)
+                        if rom == "ROM_II" and r.get("points")), a.evals)
+        r2 = dict(skipped, route=name, rom="ROM_II")
+        if "II" in want:
+            r2 = run_route(name, kw, m2, e2, o2, band, n_eval0, ref_kw, a, "ROM_II")
+            print_row(r2)
         n_eval = r2["evals"] if r2.get("points") else n_eval0
-        r1 = run_route(name, kw, m1, e1, o1, band, n_eval, ref_kw, a, "ROM_I")
-        print_row(r1)
+        r1 = dict(skipped, route=name, rom="ROM_I")
+        if "I" in want:
+            r1 = run_route(name, kw, m1, e1, o1, band, n_eval, ref_kw, a, "ROM_I")
+            print_row(r1)
         rows[(name, "ROM_II")], rows[(name, "ROM_I")] = r2, r1
         sys.stdout.flush()
     first = next(iter(rts))
     for rom in ("ROM_II", "ROM_I"):
         r = rows[(first, rom)]
-        if "skip" not in r and r.get("points"):
+        if r.get("points"):
             print(f"  {rom} {first}: peak {r['peak']:.4e} m at {r['f_peak']:.2f} Hz, "
                   f"{'complete' if r['complete'] else 'INCOMPLETE'}")
     print("  extrap.: sampled at a few points; FRF time = s/eval x the evaluations of the "
@@ -342,7 +353,7 @@ def main(a):
         scal = [16, 32]
     if scal:
         kw = rts[first]
-        n_eval = rows[(first, "ROM_II")].get("evals")
+        n_eval = rows[(first, "ROM_II")].get("evals", a.evals)
         print(f"\nscaling, route {first!r}, ROM_I of the same kind (sectors {sectors}, "
               f"{n_modes} modes per stage); FRF s = s/eval x {n_eval} evaluations")
         print(f"  {'pairs':>6} {'ROM DoFs':>8} {'unknowns':>8} {'s/eval':>10} {'FRF s':>10}"
