@@ -1,0 +1,426 @@
+"""Benchmark of large contact interfaces (issue 10): the two-stage flange at the reference
+paper's Table 1 size, ROM_I (1 900 DoFs, 200 normal1d pairs) and ROM_II (712 DoFs).
+
+The model is generated at run time by cases/models/flange.py (CalculiX + frirom's own
+Craig-Bampton and multi-stage reductions) and cached as npz in --work, so reruns skip ccx
+and the reductions. H = 3, 100 AFT samples, EO 2, sweep around the model's EO 2 resonance
+(between its free and stuck frequencies) unless --band is given.
+
+For each route (formulation plus options, see ROUTES and --route) and each ROM it prints:
+unknowns, time per Newton evaluation and its split (AFT, assembly, factorisation, solves,
+receptances: the Fortran timers of frirom.solver), time per FRF, points, and the largest
+difference of the answer (harmonics at the output DoFs) from the reference route at the
+same frequencies (target <= 1e-8, relative to the largest harmonic). A route whose FRF would
+take longer than --budget seconds is *sampled*: solve_point at --samples frequencies gives a
+time per evaluation, and the FRF time is extrapolated as that time x the evaluations the same
+route needed for the ROM_II FRF (marked "extrap."). The reference ("today's dense path",
+--reference) is itself sampled: solve_point from the route's point and contact history at
+--checks frequencies of the route's answer. Today's modal route (every mode of ROM_I, route
+"condensed-modal") differs from the factorisation by 5e-9 (a stuck point, one Newton step,
+the same with tolerances 1e-10 and 1e-12) to 1.4e-8: the round-off of the modal sum sits at
+the 1e-8 target on this model.
+
+Scaling (issue 10 item 5): ROM_I models of the same kind with 100, 200, 400, 800 contact
+pairs (2, 4, 8, 16 segments per sector), time per evaluation and per FRF of the first route
+and the growth exponent of a log-log fit; sizes whose sampled point would exceed --budget
+are predicted from the largest measured one by the route's n^3 LU law (marked "pred.").
+
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python cases/bench/large_interface.py [--quick]
+        [--pairs 200] [--threads 1] [--route "name:key=value,..."] [--budget 600]
+
+Last line: seconds for the ROM_I FRF and for the ROM_II FRF (first route).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+
+SCALING = "100,200,400,800"
+
+
+def _parse(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true",
+                    help="a coarse 8-sector model, a few modes: a smoke run of seconds")
+    ap.add_argument("--pairs", type=int, default=None,
+                    help="contact pairs of the main model (default 200; --quick 16)")
+    ap.add_argument("--threads", type=int, default=None,
+                    help="BLAS threads (default 1: OPENBLAS_NUM_THREADS=1)")
+    ap.add_argument("--work", default=os.environ.get("FRIROM_WORK", "/tmp/frirom_flange"),
+                    help="cache folder of the generated models")
+    ap.add_argument("--route", action="append", default=[],
+                    help="extra route 'name:key=value,...' of SolverOptions fields "
+                         "(numbers, true/false, none or strings)")
+    ap.add_argument("--only", default=None, help="comma list of route names to run")
+    ap.add_argument("--reference", default="condensed",
+                    help="the route the answers are compared with")
+    ap.add_argument("--budget", type=float, default=600.0,
+                    help="seconds above which an FRF (or a scaling point) is sampled")
+    ap.add_argument("--samples", type=int, default=2, help="frequencies of a sampled run")
+    ap.add_argument("--checks", type=int, default=3,
+                    help="frequencies at which a route is compared with the reference")
+    ap.add_argument("--scaling", default=SCALING,
+                    help="contact pairs of the scaling study ('' to skip)")
+    ap.add_argument("--band", default=None, help="sweep 'f1,f2' in Hz")
+    ap.add_argument("--roms", default="II,I",
+                    help="ROMs of the per-route table ('' for the scaling alone)")
+    ap.add_argument("--evals", type=int, default=None,
+                    help="evaluations of an FRF for extrapolations when the table does not "
+                         "run a ROM_II FRF (e.g. 768, today's condensed ROM_II count)")
+    ap.add_argument("--mem-limit", type=float, default=2.0,
+                    help="GB: a route whose estimated matrices exceed it is skipped")
+    return ap.parse_args(argv)
+
+
+ARGS = _parse() if __name__ == "__main__" else None
+if ARGS is not None:
+    _n = str(ARGS.threads or 1)
+    os.environ["OPENBLAS_NUM_THREADS"] = _n     # before numpy is imported
+    os.environ["OMP_NUM_THREADS"] = _n
+
+import dataclasses  # noqa: E402
+import time  # noqa: E402
+import warnings  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from frirom.solver import SolverOptions, frf, solve_point  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "models"))
+import flange  # noqa: E402
+
+H = 3
+SAMPLES = 100
+#: name -> SolverOptions fields ("all": the model's DoF count). "condensed" is today's
+#: dense path (the reference); "condensed-modal" its receptances by superposition of every
+#: mode of the reduced model (exact: the Rayleigh damping is diagonal in the modes).
+ROUTES = {"condensed": {}, "condensed-modal": {"modes": "all"},
+          "banded": {"formulation": "banded"}}
+TOL = dict(tol_residual=1e-10, tol_update=1e-10)
+DIFF_TARGET = 1e-8          # issue 10: the same answers as the dense path to 1e-8
+
+
+def _value(text: str):
+    low = text.strip().lower()
+    if low in ("true", "false"):
+        return low == "true"
+    if low == "none":
+        return None
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text.strip()
+
+
+def routes(extra, only):
+    out = dict(ROUTES)
+    for spec in extra:
+        name, _, body = spec.partition(":")
+        kw = {}
+        for item in filter(None, body.split(",")):
+            k, _, v = item.partition("=")
+            kw[k.strip()] = _value(v)
+        out[name.strip()] = kw
+    fields = {f.name for f in dataclasses.fields(SolverOptions)}
+    for name, kw in out.items():
+        bad = set(kw) - fields
+        if bad:
+            raise SystemExit(f"route {name!r}: SolverOptions has no field(s) {sorted(bad)}")
+    if only:
+        keep = [s.strip() for s in only.split(",")]
+        out = {k: v for k, v in out.items() if k in keep}
+    return out
+
+
+def options(kw, model=None) -> SolverOptions:
+    kw = {k: (model.n_dof if v == "all" else v) for k, v in kw.items()}
+    return SolverOptions(harmonics=H, samples=SAMPLES, **{**TOL, **kw})
+
+
+def estimated_gb(model, kw) -> float:
+    """Memory of the route's linear algebra (GB): dense LU of the condensed unknowns, or
+    the band of the banded formulation (full band for a dense reduced model)."""
+    n_h = 2 * H + 1
+    if kw.get("formulation", "condensed") == "banded":
+        n = model.n_dof * n_h
+        import scipy.sparse as sp
+        from scipy.sparse.csgraph import reverse_cuthill_mckee
+        pat = (abs(model.K) + abs(model.M)).tocsr()
+        for g in model.contacts:
+            pat = pat + abs(g.G.T @ g.G)
+        p = reverse_cuthill_mckee(sp.csr_matrix(pat), symmetric_mode=True)
+        c = pat[p][:, p].tocoo()
+        bw = (int(np.max(np.abs(c.row - c.col))) + 1) * n_h
+        return 8.0 * (3 * bw + 1) * n / 1e9
+    n = model.nonlinear_dofs().size * n_h
+    return 8.0 * 3 * n * n / 1e9
+
+
+def per_eval(t: dict) -> dict:
+    n = max(t.get("evaluations", 0.0), 1.0)
+    return {k: t.get(k, 0.0) / n for k in ("aft", "assembly", "factorization", "solve",
+                                          "receptance", "fortran_total")}
+
+
+def fmt_split(pe: dict) -> str:
+    tot = max(pe["fortran_total"], 1e-300)
+    return " ".join(f"{k[:4]} {100 * pe[k] / tot:4.1f}%" for k in
+                    ("receptance", "factorization", "assembly", "solve", "aft"))
+
+
+def sampled(model, exc, outputs, kw, freqs):
+    """solve_point along `freqs` (each from the previous point): per-evaluation timings."""
+    t, pts, prev = {}, [], None
+    t0 = time.perf_counter()
+    for f in freqs:
+        pt = solve_point(model, exc, 2 * np.pi * f, options(kw, model), outputs=outputs,
+                         start=prev)
+        for k, v in pt.timings.items():
+            t[k] = t.get(k, 0.0) + v
+        pts.append(pt)
+        prev = pt
+    return pts, t, time.perf_counter() - t0
+
+
+def compare(model, exc, outputs, ref_kw, kw, pts):
+    """Largest |X - X_ref| / max|X_ref| over the points: the reference solve_point at the
+    point's frequency, from the point's unknowns (same formulation) or its contact history
+    alone, so both solve the same equations with the same stuck sliders."""
+    same = ref_kw.get("formulation", "condensed") == kw.get("formulation", "condensed")
+    worst, t_ref = 0.0, 0.0
+    for p in pts:
+        start = {"slider": p.slider}
+        if same:
+            start["unknowns"] = p.unknowns
+        t0 = time.perf_counter()
+        r = solve_point(model, exc, p.omega, options(ref_kw, model), outputs=outputs,
+                        start=start)
+        t_ref += time.perf_counter() - t0
+        worst = max(worst, float(np.max(np.abs(p.X - r.X)) / np.max(np.abs(r.X))))
+    return worst, t_ref
+
+
+def pick(pts, n):
+    """n points spread over a run (first, peak, last ...)."""
+    if len(pts) <= n:
+        return list(pts)
+    amp = np.array([np.max(p.amp_max) for p in pts])
+    idx = sorted(set(np.linspace(0, len(pts) - 1, max(n - 1, 2)).round().astype(int))
+                 | {int(np.argmax(amp))})
+    return [pts[i] for i in idx][:max(n, 1)]
+
+
+def run_route(name, kw, model, exc, outputs, band, n_eval_frf, ref_kw, a, label):
+    """One route on one ROM: a dict of the row's numbers (or the reason it was skipped)."""
+    gb = estimated_gb(model, kw)
+    row = dict(route=name, rom=label, gb=gb)
+    if gb > a.mem_limit:
+        row["skip"] = f"estimated {gb:.1f} GB > --mem-limit {a.mem_limit:g}"
+        return row
+    f1, f2 = band
+    # one sampled point first: unknowns and time per evaluation, decides FRF or sample
+    pts, t, wall = sampled(model, exc, outputs, kw, [f1])
+    row["unknowns"] = pts[0].unknowns.size
+    pe = per_eval(t)
+    predicted = pe["fortran_total"] * (n_eval_frf or 0)
+    if n_eval_frf is None or predicted <= a.budget:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            t0 = time.perf_counter()
+            got = []          # every point with its unknowns and history, for the checks
+            res = frf(model, exc, 2 * np.pi * f1, 2 * np.pi * f2, options(kw, model),
+                      outputs=outputs, sink=got.append)
+            row["frf_s"] = time.perf_counter() - t0
+        row.update(points=len(res), evals=int(res.timings.get("evaluations", 0)),
+                   complete=res.complete, pe=per_eval(res.timings), extrap=False,
+                   peak=float(np.max(res.amp_max)),
+                   f_peak=float(res.omega[np.argmax(np.max(res.amp_max, axis=1))]
+                                / 2 / np.pi))
+        check = pick(got, a.checks)
+    else:
+        freqs = np.linspace(f1, f2, a.samples + 2)[1:-1]
+        pts2, t2, _ = sampled(model, exc, outputs, kw, freqs)
+        for k, v in t2.items():
+            t[k] = t.get(k, 0.0) + v
+        pts += pts2
+        row.update(pe=per_eval(t), evals=n_eval_frf, extrap=True, points=None,
+                   sampled_evals=int(t.get("evaluations", 0)))
+        row["frf_s"] = row["pe"]["fortran_total"] * n_eval_frf
+        check = pts[:a.checks]
+    if kw == ref_kw:
+        row["diff"], row["ref_s"] = 0.0, 0.0
+    else:
+        row["diff"], row["ref_s"] = compare(model, exc, outputs, ref_kw, kw, check)
+    row["n_checks"] = len(check)
+    return row
+
+
+def print_row(r):
+    if "skip" in r:
+        print(f"  {r['rom']:<7} {r['route']:<22} skipped: {r['skip']}")
+        return
+    pe = r["pe"]
+    pts = "-" if r["points"] is None else str(r["points"])
+    frf_s = f"{r['frf_s']:9.1f}" + (" extrap." if r["extrap"] else "        ")
+    diff = "reference" if r["diff"] == 0.0 else f"{r['diff']:.1e} ({r['n_checks']} pts)"
+    if r["diff"] > DIFF_TARGET:
+        diff += f" ABOVE {DIFF_TARGET:g}"
+    if r["extrap"]:
+        diff += f"; sampled: {r['sampled_evals']} evaluations"
+    print(f"  {r['rom']:<7} {r['route']:<22} {r['unknowns']:8d} {pe['fortran_total']:10.4f} "
+          f"{fmt_split(pe)}  {frf_s} {pts:>6} {r['evals']:6d}  {diff}")
+
+
+def header():
+    print(f"  {'ROM':<7} {'route':<22} {'unknowns':>8} {'s/eval':>10} split of an evaluation"
+          f"{'':>44}{'FRF s':>9}{'':8} {'points':>6} {'evals':>6}  diff vs reference")
+
+
+def main(a):
+    t_start = time.perf_counter()
+    quick = a.quick
+    pairs = a.pairs or (16 if quick else 200)
+    sectors = 8 if quick else 50
+    if pairs % sectors or pairs // sectors < 2:
+        raise SystemExit(f"--pairs: a multiple of the {sectors} sectors, >= 2 per sector")
+    n_modes = 10 if quick else 200
+
+    def spec_for(p):
+        return flange.FlangeSpec(sectors=sectors, z_per_sector=p // sectors,
+                                 n_modes=n_modes, coarse=quick)
+
+    print(f"large_interface: OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}, "
+          f"H = {H}, {SAMPLES} samples, work folder {a.work}")
+    t0 = time.perf_counter()
+    roms = flange.flange_roms(spec_for(pairs), a.work)
+    s = roms["sizes"]
+    print(f"model: {sectors} sectors x 2 stages, FE DoFs {s['fe_dofs'][0]} + {s['fe_dofs'][1]}"
+          f" = {sum(s['fe_dofs'])}; generation ccx {roms['t_ccx']:.1f} s + reduction "
+          f"{roms['t_reduce']:.1f} s (this run: {time.perf_counter() - t0:.1f} s, "
+          f"{'generated' if roms['generated'] else 'from the cache'})")
+    print(f"ROM_I : {s['interface']} interface + {s['active']} active + {s['modes']} modes = "
+          f"{s['rom1']} DoFs; {s['pairs']} normal1d pairs ({s['contact_rows']} contact rows)")
+    print(f"ROM_II: {s['ms_interface']} interface (MS, indices "
+          f"{roms['spec']['ms_indices']}) + {s['active']} active + {s['modes']} modes = "
+          f"{s['rom2']} DoFs")
+    print(f"EO {roms['spec']['eo']} resonance (linear ROM_I): {roms['f_stuck']:.2f} Hz stuck, "
+          f"{roms['f_free']:.2f} Hz free (bolts only)")
+    if a.band:
+        band = tuple(float(v) for v in a.band.split(","))
+    else:
+        band = (0.97 * roms["f_free"], 1.03 * roms["f_stuck"])
+    print(f"sweep {band[0]:.1f} - {band[1]:.1f} Hz, load {roms['spec']['f0']:g} N per blade")
+    rts = routes(a.route, a.only)
+    ref_kw = routes(a.route, None).get(a.reference)
+    if ref_kw is None:
+        raise SystemExit(f"--reference {a.reference!r}: no such route")
+    m1, e1, o1 = flange.frirom_models(roms, "I")
+    m2, e2, o2 = flange.frirom_models(roms, "II")
+
+    print("\nper route (diff: max |X - X_ref| / max |X_ref| at the output DoFs, reference "
+          f"route {a.reference!r} by solve_point from the route's points)")
+    header()
+    rows = {}
+    want = {v.strip() for v in a.roms.split(",") if v.strip()}
+    skipped = dict(skip="not asked (--roms)")
+    for name, kw in rts.items():
+        # the first route's ROM_II FRF is run whole; its evaluations price the others
+        n_eval0 = next((r["evals"] for (rn, rom), r in rows.items()
+                        if rom == "ROM_II" and r.get("points")), a.evals)
+        r2 = dict(skipped, route=name, rom="ROM_II")
+        if "II" in want:
+            r2 = run_route(name, kw, m2, e2, o2, band, n_eval0, ref_kw, a, "ROM_II")
+            print_row(r2)
+        n_eval = r2["evals"] if r2.get("points") else n_eval0
+        r1 = dict(skipped, route=name, rom="ROM_I")
+        if "I" in want:
+            r1 = run_route(name, kw, m1, e1, o1, band, n_eval, ref_kw, a, "ROM_I")
+            print_row(r1)
+        rows[(name, "ROM_II")], rows[(name, "ROM_I")] = r2, r1
+        sys.stdout.flush()
+    first = next(iter(rts))
+    for rom in ("ROM_II", "ROM_I"):
+        r = rows[(first, rom)]
+        if r.get("points"):
+            print(f"  {rom} {first}: peak {r['peak']:.4e} m at {r['f_peak']:.2f} Hz, "
+                  f"{'complete' if r['complete'] else 'INCOMPLETE'}")
+    print("  extrap.: sampled at a few points; FRF time = s/eval x the evaluations of the "
+          "same route's ROM_II FRF")
+
+    # scaling
+    scal = [int(v) for v in a.scaling.split(",") if v.strip()] if a.scaling else []
+    if quick and a.scaling == SCALING:
+        scal = [16, 32]
+    if scal:
+        kw = rts[first]
+        n_eval = rows[(first, "ROM_II")].get("evals", a.evals)
+        print(f"\nscaling, route {first!r}, ROM_I of the same kind (sectors {sectors}, "
+              f"{n_modes} modes per stage); FRF s = s/eval x {n_eval} evaluations")
+        print(f"  {'pairs':>6} {'ROM DoFs':>8} {'unknowns':>8} {'s/eval':>10} {'FRF s':>10}"
+              f"  {'gen. s':>7}")
+        xs, ys = [], []
+        law = None
+        for p in scal:
+            if p % sectors or p // sectors < 2:
+                print(f"  {p:6d} skipped: not >= 2 per sector of {sectors}")
+                continue
+            if law is not None:
+                # predicted: n^3 from the largest measured size (today's dense LU)
+                n_pred = law[0] * (p / law[1])
+                t_pred = law[2] * (n_pred / law[0]) ** 3
+                if t_pred * 4 > a.budget:
+                    t_frf = t_pred * (n_eval or 0)
+                    print(f"  {p:6d} {'':>8} {n_pred:8.0f} {t_pred:10.2f} {t_frf:10.1f}  "
+                          f"{'':>7} pred. (n^3 from {law[1]} pairs; a sampled point would "
+                          f"exceed --budget)")
+                    xs.append(p)
+                    ys.append(t_frf)
+                    continue
+            main_row = rows[(first, "ROM_I")]
+            if p == pairs and "pe" in main_row:       # measured above: not again
+                pe = main_row["pe"]
+                t_frf = pe["fortran_total"] * (n_eval or 0)
+                print(f"  {p:6d} {m1.n_dof:8d} {main_row['unknowns']:8d} "
+                      f"{pe['fortran_total']:10.4f} {t_frf:10.1f}  {'':>7} (table above)")
+                xs.append(p)
+                ys.append(t_frf)
+                law = (main_row["unknowns"], p, pe["fortran_total"])
+                continue
+            t0 = time.perf_counter()
+            rp = roms if p == pairs else flange.flange_roms(spec_for(p), a.work)
+            t_gen = time.perf_counter() - t0
+            mp, ep, op = flange.frirom_models(rp, "I")
+            if estimated_gb(mp, kw) > a.mem_limit:
+                print(f"  {p:6d} skipped: estimated {estimated_gb(mp, kw):.1f} GB")
+                continue
+            pts, t, _ = sampled(mp, ep, op, kw, [band[0]])
+            pe = per_eval(t)
+            t_frf = pe["fortran_total"] * (n_eval or 0)
+            n_u = pts[0].unknowns.size
+            print(f"  {p:6d} {mp.n_dof:8d} {n_u:8d} {pe['fortran_total']:10.4f} "
+                  f"{t_frf:10.1f}  {t_gen:7.1f}")
+            xs.append(p)
+            ys.append(t_frf)
+            law = (n_u, p, pe["fortran_total"])
+            sys.stdout.flush()
+        if len(xs) >= 2 and min(ys) > 0:
+            slope = np.polyfit(np.log(xs), np.log(ys), 1)[0]
+            print(f"  growth exponent of the FRF time in contact pairs (log-log fit): "
+                  f"{slope:.2f}")
+    print(f"\ntotal benchmark time {time.perf_counter() - t_start:.0f} s")
+    r1, r2 = rows[(first, "ROM_I")], rows[(first, "ROM_II")]
+
+    def sec(r):
+        return "skipped" if "skip" in r else (f"{r['frf_s']:.1f}"
+                                              + (" (extrapolated)" if r["extrap"] else ""))
+    print(f"ROM_I FRF s: {sec(r1)}; ROM_II FRF s: {sec(r2)}")
+
+
+if __name__ == "__main__":
+    main(ARGS)
