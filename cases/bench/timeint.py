@@ -17,7 +17,6 @@ Needs ccx and gmsh. One core (OPENBLAS_NUM_THREADS=1 is set before numpy loads).
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import os
 import sys
 import tempfile
@@ -38,26 +37,16 @@ def main(argv=None):
     ap.add_argument("--out", type=Path, default=None, help="folder for the matrices")
     ap.add_argument("--explicit-periods", type=int, default=3)
     a = ap.parse_args(argv)
-    import make_lap_joint
-    from test_lap_joint_case import small
+    from test_timeint_implicit import LAP_HZ, hbm_point, lap_deck
 
-    from frirom.deck import load_deck
-    from frirom.solver import solve_point
     from frirom.timeint import TimeContact, integrate, state_from_harmonics
     out = a.out or Path(tempfile.mkdtemp(prefix="bench_timeint_"))
     out.mkdir(parents=True, exist_ok=True)
-    make_lap_joint.make(out, size=0.012)
-    (out / "gsi.toml").write_text(small(40))
-    d = load_deck(out / "gsi.toml")
+    d = lap_deck(out)
     m = d.model()
     act = d.outputs[0]
-    w = 2 * np.pi * 877.65
-    start, h0 = None, None
-    for H, ns in ((1, 64), (3, 128), (7, 256)):
-        opts = dataclasses.replace(d.options(), harmonics=H, samples=ns)
-        start = solve_point(m, d.excitation(), w, opts, outputs=np.arange(m.n_dof),
-                            start=start, start_harmonics=h0)
-        h0 = H
+    w = 2 * np.pi * LAP_HZ
+    start = hbm_point(d, w)
     x0, v0 = state_from_harmonics(start.X, w)
     c = d.contacts[0]
     args = (m.M.toarray(), m.C.toarray(), m.K.toarray(),

@@ -46,7 +46,7 @@ import scipy.linalg
 
 from ._errors import ConvergenceError, InputError
 from .contact import LAWS
-from .timeint import _forces  # noqa: E402  (the same return maps)
+from .timeint import _forces, period_change  # the same return maps
 
 
 def hht_coefficients(alpha: float) -> tuple[float, float]:
@@ -266,11 +266,9 @@ def integrate_implicit(M, C, K, contacts, fe_at, omega, *, N: int, alpha: float,
             a = a_new
             x_prev, x = x, x_new
         n_done = period + 1
-        sc = np.maximum(np.abs(last).max(axis=(1, 2)), 1e-300)
-        if prev is not None:
-            drift = np.abs(last - prev).max(axis=(1, 2)) / sc
-            if n_done >= min_periods and np.all(drift < tol):
-                break
+        drift, done = period_change(last, prev, n_done >= min_periods, tol)
+        if done:
+            break
         prev = last.copy()
     return last, drift, n_done, states, x, x_prev, v, w
 
