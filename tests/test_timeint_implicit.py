@@ -253,3 +253,31 @@ def test_lap_joint_hbm_against_implicit_time_integration(lap_gsi):
     assert abs(start.amp_max[act] / ti.amp_max[0, act] - 1) < 1e-2
     np.testing.assert_allclose(ti.state_fractions[0, 0], start.state_fractions[0], atol=0.03)
     assert start.state_fractions[0, 1] > 0.2 and start.state_fractions[0, 2] > 0.0
+
+
+@pytest.mark.parametrize("law", ["jenkins", "normal1d"])
+def test_tangent_of_pattern_matches_finite_differences(law):
+    # The Newton Jacobian of the piecewise-linear laws, built from the stick/slip/lift-off
+    # pattern, against central differences of the return map (exact inside a pattern
+    # region: step 1e-7 of the 1e-1-sized displacements, tolerance 1e-6 relative).
+    from frirom.timeint import _forces
+    from frirom.timeint_implicit import _forces_and_tangent, _tangent_of_pattern
+    rng = np.random.default_rng(3)
+    ne = 40
+    if law == "jenkins":
+        p = [np.full(ne, 2.0), np.full(ne, 0.3), np.full(ne, 0.5)]
+        u = rng.uniform(-0.3, 0.3, (1, ne, 1))
+    else:
+        p = [np.full(ne, 2.0), np.full(ne, 3.0), np.full(ne, 0.3), np.full(ne, 0.2)]
+        u = rng.uniform(-0.3, 0.3, (1, ne, 2))
+    w = rng.uniform(-0.1, 0.1, (1, ne, 1))
+    f, _, state, D = _forces_and_tangent(law, p, u, w)
+    assert {0, 1}.issubset(set(state.ravel()))               # stick and slip both seen
+    pat = state + 3 * (f[..., 0] > 0.0)
+    assert np.array_equal(_tangent_of_pattern(law, p, pat), D)
+    h = 1e-7
+    for d in range(u.shape[-1]):
+        du = np.zeros_like(u)
+        du[..., d] = h
+        fd = (_forces(law, p, u + du, w)[0] - _forces(law, p, u - du, w)[0]) / (2 * h)
+        assert np.allclose(D[..., :, d], fd, rtol=1e-6, atol=1e-6 * 2.0)

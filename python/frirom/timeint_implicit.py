@@ -198,12 +198,19 @@ def integrate_implicit(M, C, K, contacts, fe_at, omega, *, N: int, alpha: float,
             pat.append(st + 3 * (fg[..., 0] > 0.0))
         return f, out_w, out_s, np.concatenate(pat, axis=1) if pat else None
 
-    def jacobian_inverse(z, w):
-        """(I + c1 W D B)^-1 (nb, k, k) at z from the sliders w."""
+    def jacobian_inverse(z, w, pat):
+        """(I + c1 W D B)^-1 (nb, k, k) at z from the sliders w; D from the pattern pat
+        where the laws are piecewise linear."""
         DB = np.empty((nb, m, k))
         u = z @ B.T
+        e0 = 0
         for (law, p, ndir, rows, Be), wg in zip(groups, w):
-            D = _forces_and_tangent(law, p, u[:, rows].reshape(nb, -1, ndir), wg)[3]
+            ne = Be.shape[0]
+            if by_pattern:
+                D = _tangent_of_pattern(law, p, pat[:, e0:e0 + ne])
+            else:
+                D = _forces_and_tangent(law, p, u[:, rows].reshape(nb, -1, ndir), wg)[3]
+            e0 += ne
             DB[:, rows] = np.matmul(D, Be).reshape(nb, -1, k)
         return np.linalg.inv(np.eye(k) + c1 * np.matmul(W, DB))
 
@@ -239,7 +246,7 @@ def integrate_implicit(M, C, K, contacts, fe_at, omega, *, N: int, alpha: float,
                 fn, wn, st, pat = contact(zt, w)
                 for it in range(max_newton):
                     if not by_pattern or pat_J is None or (pat != pat_J).any():
-                        Jinv, pat_J = jacobian_inverse(zt, w), pat
+                        Jinv, pat_J = jacobian_inverse(zt, w, pat), pat
                     R = zt - z_lin + c1 * np.matmul(W, fn[:, :, None])[:, :, 0]
                     dz = np.matmul(Jinv, R[:, :, None])[:, :, 0]
                     zt = zt - dz
@@ -274,3 +281,18 @@ def integrate_implicit(M, C, K, contacts, fe_at, omega, *, N: int, alpha: float,
 
 
 _PIECEWISE_LINEAR = ("jenkins", "normal1d")
+
+
+def _tangent_of_pattern(law: str, p: list, pat: np.ndarray) -> np.ndarray:
+    """d f / d u (nb, ne, ndir, ndir) of a piecewise-linear law from the pattern
+    state + 3 (f_t > 0) (state 0 stick, 1 slip, 2 lift-off): the tangent of
+    :func:`_forces_and_tangent` without evaluating the forces again."""
+    state = pat % 3
+    if law == "jenkins":
+        return np.where(state == 0, p[0], 0.0)[..., None, None]
+    kt, kn, mu, _ = p
+    D = np.zeros(pat.shape + (2, 2))
+    D[..., 0, 0] = np.where(state == 0, kt, 0.0)
+    D[..., 1, 1] = np.where(state != 2, kn, 0.0)
+    D[..., 0, 1] = np.where(state == 1, np.where(pat >= 3, mu * kn, -mu * kn), 0.0)
+    return D
