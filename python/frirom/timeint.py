@@ -19,6 +19,17 @@ error at stick/slip and contact/lift-off transitions is that of locating the kin
 within a step. The step count per period is raised automatically so that omega_max dt
 <= ``max_phase_step``.
 
+``method="implicit"`` (:mod:`frirom.timeint_implicit`) integrates with HHT-alpha instead:
+a fixed number of steps per period whatever the highest mode, Newton on the contact
+coordinates each step, the same return maps. Use it on reduced FE models, whose highest
+mode is hundreds to thousands of times the forcing frequency (the explicit step count
+grows in proportion: 3874 steps per period on the coarse lap joint, 128 implicit ones
+reach 3e-3 in amplitude, cases/bench/timeint.py). On small lumped models the explicit
+scheme is faster per step (one force evaluation, no Newton): ``method="auto"`` (the
+default) takes it unless it needs more than 8 times ``steps_per_period`` steps. Step
+error: both are second order; the frequency of a resolved mode shifts by (2 pi / N)^2 / 24
+(explicit) and about (2 pi / N)^2 / 12 (implicit) relatively, N steps per period.
+
 Many forcing frequencies are integrated at once (the leading batch axis of every array):
 the per-step Python cost is shared, so a sweep of 100 frequencies costs little more than
 one. Only small dense models are meant (lumped test structures, reduced models).
@@ -165,7 +176,8 @@ class TimeResult:
     period at tau_k = 2 pi k / N; drift (nb,) max change between the last two periods
     relative to the amplitude; periods: periods integrated; state_fractions
     (nb, n_groups, 3) stick/slip/lift-off sample fractions over the last period (all
-    elements of a group pooled); x, x_prev, v, w: final state (see :meth:`restart`).
+    elements of a group pooled); x, x_prev, v, w: final state (see :meth:`restart`);
+    method: the scheme used, "explicit" or "implicit".
     """
 
     omega: np.ndarray
@@ -180,6 +192,7 @@ class TimeResult:
     x_prev: np.ndarray = field(repr=False)
     v: np.ndarray = field(repr=False)
     w: list = field(repr=False)
+    method: str = "explicit"
 
     def restart(self) -> dict:
         """Keyword arguments x0, v0, w0 of :func:`integrate` continuing from the end state
@@ -227,7 +240,7 @@ def _as_dense(A, name):
 def integrate(M, C, K, contacts, F, omega, *, H: int = 5, periods: int = 200,
               min_periods: int = 5, steps_per_period: int = 512,
               max_phase_step: float = 0.5, tol: float = 1e-7, x0=None, v0=None,
-              w0=None) -> TimeResult:
+              w0=None, method: str = "auto", alpha: float = -0.05) -> TimeResult:
     """Integrate to a periodic steady state at each forcing frequency of ``omega``.
 
     M, C, K: (n, n); contacts: list of :class:`TimeContact`; F: complex (n, H_F+1) with
@@ -237,7 +250,22 @@ def integrate(M, C, K, contacts, F, omega, *, H: int = 5, periods: int = 200,
     ``min_periods``), or after ``periods`` periods. x0, v0: (n,) or (nb, n) initial
     displacement and velocity (default rest); w0: list (one per group) of (n_elem,
     n_slider) or (nb, n_elem, n_slider) initial sliders (default each group's ``w0``).
+
+    method: ``"explicit"`` (central differences, the step count raised until omega_max dt
+    <= ``max_phase_step``: impractical on reduced FE models whose highest mode is far above
+    the forcing), ``"implicit"`` (HHT-alpha with Newton on the contact coordinates,
+    :mod:`frirom.timeint_implicit`: ``steps_per_period`` steps whatever the model's highest
+    mode; ``max_phase_step`` is not used) or ``"auto"`` (explicit unless it needs more
+    than 8 times ``steps_per_period`` steps: an implicit step costs 4 to 7 times an
+    explicit one, measured on the Jenkins SDOF, the normal1d 3-DoF and the reduced lap
+    joint). alpha: the HHT parameter in [-1/3, 0] (implicit
+    only; 0 is Newmark's average acceleration). Both are second order: the frequency of a
+    resolved mode is shifted by ~(2 pi / N)^2 / 24 (explicit) or ~(2 pi / N)^2 / 12
+    (implicit) relatively, N = steps per period.
     """
+    if method not in ("auto", "explicit", "implicit"):
+        raise InputError(f"timeint: method = {method!r}; expected 'auto', 'explicit' or "
+                         f"'implicit'")
     M, C, K = _as_dense(M, "M"), _as_dense(C, "C"), _as_dense(K, "K")
     n = M.shape[0]
     if C.shape != (n, n) or K.shape != (n, n):
@@ -256,10 +284,18 @@ def integrate(M, C, K, contacts, F, omega, *, H: int = 5, periods: int = 200,
             raise InputError(f"timeint: contact {c.name!r}: G has {c.G.shape[1]} columns, "
                              f"the model {n} DoFs")
 
-    # step count: omega_max dt <= max_phase_step with every contact stuck and closed
-    Kstuck = K + sum((c.stuck_stiffness() for c in contacts), np.zeros((n, n)))
-    wmax = np.sqrt(max(scipy.linalg.eigvalsh(Kstuck, M).max(), 0.0))
-    need = int(np.ceil(2.0 * np.pi * wmax / (omega.min() * max_phase_step)))
+    if method != "implicit":
+        # explicit step count: omega_max dt <= max_phase_step, contacts stuck and closed
+        Kstuck = K + sum((c.stuck_stiffness() for c in contacts), np.zeros((n, n)))
+        wmax = np.sqrt(max(scipy.linalg.eigvalsh(Kstuck, M).max(), 0.0))
+        need = int(np.ceil(2.0 * np.pi * wmax / (omega.min() * max_phase_step)))
+        if method == "auto":
+            method = "implicit" if need > 8 * steps_per_period else "explicit"
+    if method == "implicit":
+        return _run_implicit(M, C, K, contacts, F, omega, H=H, periods=periods,
+                             min_periods=min_periods, steps_per_period=steps_per_period,
+                             tol=tol, x0=x0, v0=v0, w0=w0, alpha=alpha)
+
     N = max(int(steps_per_period), need, 4 * H + 4)
     N += N % 2
     dt = 2.0 * np.pi / (omega * N)                              # (nb,)
@@ -275,20 +311,12 @@ def integrate(M, C, K, contacts, F, omega, *, H: int = 5, periods: int = 200,
     ET = np.ascontiguousarray(np.transpose(E, (0, 2, 1)))       # (nb, 3n, n)
 
     # external force over one period (same in tau for every frequency)
-    tau = 2.0 * np.pi * np.arange(N) / N
-    hF = np.arange(F.shape[1])
-    fe = (np.exp(1j * np.outer(tau, hF)) @ F.T).real             # (N, n)
+    fe = _external(F)(2.0 * np.pi * np.arange(N) / N)           # (N, n)
 
     groups = []
-    for gi, c in enumerate(contacts):
-        ndir, nsl = LAWS[c.law].n_dir, LAWS[c.law].n_slider
+    for c, w in zip(contacts, _start_sliders(contacts, w0, nb)):
         p = [c.params[:, j] for j in range(c.params.shape[1])]
-        if w0 is not None and w0[gi] is not None:
-            w = np.broadcast_to(np.asarray(w0[gi], float),
-                                (nb, c.n_elem, nsl)).copy()
-        else:
-            w = np.broadcast_to(c.w0, (nb, c.n_elem, nsl)).copy()
-        groups.append([c.law, c.G.T.copy(), c.G.copy(), p, ndir, w])
+        groups.append([c.law, c.G.T.copy(), c.G.copy(), p, LAWS[c.law].n_dir, w])
 
     def contact_force(x):
         g = np.zeros_like(x)
@@ -325,16 +353,66 @@ def integrate(M, C, K, contacts, F, omega, *, H: int = 5, periods: int = 200,
             stack[:, sl_p] = x_prev
             x_prev, x = x, np.matmul(stack[:, None, :], ET)[:, 0]
         n_done = period + 1
-        scale = np.maximum(np.abs(last).max(axis=(1, 2)), 1e-300)
-        if prev is not None:
-            drift = np.abs(last - prev).max(axis=(1, 2)) / scale
-            if n_done >= min_periods and np.all(drift < tol):
-                break
+        drift, done = period_change(last, prev, n_done >= min_periods, tol)
+        if done:
+            break
         prev = last.copy()
-    fractions = (np.stack([np.stack([(st == j).mean(axis=(0, 2)) for j in range(3)], -1)
-                           for st in states], axis=1) if contacts else np.zeros((nb, 0, 3)))
     v_end = (x - x_prev) / dt[:, None]
+    return _result(omega, H, last, drift, n_done, N, states, x, x_prev, v_end,
+                   [gr[5] for gr in groups])
+
+
+def period_change(last, prev, may_stop: bool, tol: float):
+    """(drift (nb,), stop): largest change of x between the periods ``prev`` and ``last``
+    (nb, N, n) relative to max |x| (inf without ``prev``), and whether every frequency is
+    below ``tol`` while ``may_stop``."""
+    if prev is None:
+        return np.full(last.shape[0], np.inf), False
+    scale = np.maximum(np.abs(last).max(axis=(1, 2)), 1e-300)
+    drift = np.abs(last - prev).max(axis=(1, 2)) / scale
+    return drift, bool(may_stop and np.all(drift < tol))
+
+
+def _external(F):
+    """f_e at phases tau: tau (k,) -> (k, n), f_e = Re sum_h F[:, h] exp(i h tau)."""
+    hF = np.arange(F.shape[1])
+    return lambda tau: (np.exp(1j * np.outer(tau, hF)) @ F.T).real
+
+
+def _start_sliders(contacts, w0, nb):
+    """Initial sliders per group, (nb, n_elem, n_slider): ``w0[g]`` or the group's own."""
+    out = []
+    for gi, c in enumerate(contacts):
+        shape = (nb, c.n_elem, LAWS[c.law].n_slider)
+        given = w0 is not None and w0[gi] is not None
+        out.append(np.broadcast_to(np.asarray(w0[gi], float) if given else c.w0,
+                                   shape).copy())
+    return out
+
+
+def _result(omega, H, last, drift, n_done, N, states, x, x_prev, v, w,
+            method="explicit") -> TimeResult:
+    """TimeResult of the last period ``last`` (nb, N, n) and the states per group."""
+    nb = omega.size
+    fractions = (np.stack([np.stack([(st == j).mean(axis=(0, 2)) for j in range(3)], -1)
+                           for st in states], axis=1) if states else np.zeros((nb, 0, 3)))
     return TimeResult(omega=omega, harmonics=harmonics_from_samples(last, H),
                       amp_max=np.abs(last).max(axis=1), samples=last, drift=drift,
                       periods=n_done, steps_per_period=N, state_fractions=fractions,
-                      x=x, x_prev=x_prev, v=v_end, w=[gr[5] for gr in groups])
+                      x=x, x_prev=x_prev, v=v, w=w, method=method)
+
+
+def _run_implicit(M, C, K, contacts, F, omega, *, H, periods, min_periods,
+                  steps_per_period, tol, x0, v0, w0, alpha) -> TimeResult:
+    """integrate(..., method="implicit"): see :mod:`frirom.timeint_implicit`."""
+    from .timeint_implicit import integrate_implicit
+    n, nb = M.shape[0], omega.size
+    N = max(int(steps_per_period), 4 * H + 4)
+    N += N % 2
+    x = np.zeros((nb, n)) if x0 is None else np.broadcast_to(x0, (nb, n)).astype(float)
+    v = np.zeros((nb, n)) if v0 is None else np.broadcast_to(v0, (nb, n)).astype(float)
+    last, drift, n_done, states, x, x_prev, v, w = integrate_implicit(
+        M, C, K, contacts, _external(F), omega, N=N, alpha=alpha, periods=periods,
+        min_periods=min_periods, tol=tol, x0=x, v0=v,
+        w_start=_start_sliders(contacts, w0, nb))
+    return _result(omega, H, last, drift, n_done, N, states, x, x_prev, v, w, "implicit")
