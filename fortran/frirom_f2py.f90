@@ -105,7 +105,8 @@ end subroutine hbm_rcm
 !> Harmonic balance solve and pseudo-arc-length continuation (frirom_hbm hbm_run).
 !> formulation: 'condensed' or 'banded'; lam_kind: 'frequency' (lam = omega) or 'load'
 !> (lam scales fe1 at omega_fix). K, M, C: CSR, 1-based, ndof x ndof, symmetric.
-!> perm: RCM order of the DoFs. nl: nonlinear DoFs (condensed). fe0, fe1: real harmonic
+!> perm: RCM order of the DoFs. nl: nonlinear DoFs (condensed); tcontact: condensed
+!> unknowns in contact coordinates (G x) instead. fe0, fe1: real harmonic
 !> excitation (ndof, 2H+1) (frequency: fe0; load: fe0 + lam fe1).
 !> ginfo(3, ngroup): law, n_elem, n_dir; G rows group by group, element, direction (CSR over
 !> the full DoFs); params (npar, ne) and w0 (nslider, ne) per group, concatenated.
@@ -120,7 +121,7 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
                         nmodes, phi, wmodes, zmodes, hmodes, psi, wharm, zharm, ny, y0, lam0, &
                         tan0, start_mode, nropt, ropt, niopt, iopt, stability, history, &
                         maxpts, netot, ntim, ys, lams, tans, iters, xo, states, hill_re, &
-                        sliders, npts, finished, ds_out, timings, info, msg)
+                        sliders, npts, finished, ds_out, timings, info, msg, tcontact)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options, cont_options_from, N_RCONT, N_ICONT, RCONT_DS, &
@@ -135,6 +136,9 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
                               ci(nnzc)
     real(8), intent(in) :: kx(nnzk), mx(nnzm), cx(nnzc)
     integer(4), intent(in) :: perm(ndof), nnl, nl(nnl)
+    !> condensed: 1 = unknowns in contact coordinates u = G x (nrows per harmonic), 0 = the
+    !> nl DoFs (nnl per harmonic)
+    integer(4), intent(in) :: tcontact
     real(8), intent(in) :: fe0(ndof, 2*nh + 1), fe1(ndof, 2*nh + 1)
     real(8), intent(in) :: omega_fix     !! rad/s, the frequency of a load continuation
     integer(4), intent(in) :: ngroup, ginfo(3, ngroup), nrows, nnzg, gp(nrows + 1), gi(nnzg)
@@ -218,7 +222,8 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
         return
     end if
     call hbm_setup(sys, nh, nsamp, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
-                   fe1, mode, omega_fix, ginfo, gp, gi, gx, params, w0, outdofs, linfo, msg)
+                   fe1, mode, omega_fix, ginfo, gp, gi, gx, params, w0, outdofs, linfo, msg, &
+                   contact_coords=tcontact == 1)
     if (linfo == 0 .and. (sys%n /= ny .or. sum(ginfo(2, :)) /= netot)) &
         call set_status(linfo, FRIROM_ERR_SIZE, msg, 'hbm_continue: ny or netot does not '// &
                         'match the model')

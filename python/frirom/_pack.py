@@ -28,6 +28,12 @@ if TYPE_CHECKING:
 
 #: Largest Hill eigenproblem (2 n_dof (2H+1)) computed; above it stability is skipped.
 HILL_MAX = 4000
+#: Largest model whose receptances 'auto' takes from all its modes (a dense eigen-solve).
+MODES_MAX = 4000
+#: Damping counts as diagonal in the modes when every |Phi^T C Phi|_rs is below this
+#: times sqrt(c_rr c_ss) (plus 1e-13 of the largest c_rr): the receptances then differ
+#: from the factorised ones by about this, relative.
+DIAG_TOL = 1e-10
 
 
 def _real_constant(name: str) -> float:
@@ -137,6 +143,52 @@ def _lowest_modes(model: Model, nm: int, H: int) -> _Modes:
     return m
 
 
+def _all_modes(model: Model, H: int, need_diagonal: bool) -> _Modes | str:
+    """All modes of the model (dense eigh of K, M) with the damping ratios that make the
+    modal receptances exact: diag(Phi^T C Phi) / (2 w) when Phi^T C Phi is diagonal
+    (modal, Rayleigh or no damping). Otherwise the reason they do not apply (a str)."""
+    K, M, C = (a.toarray() for a in (model.K, model.M, model.C))
+    w2, phi = sla.eigh(K, M)
+    if np.any(w2 <= 0):
+        return "rigid-body (zero-frequency) modes"
+    cm = phi.T @ C @ phi
+    d = np.diag(cm).copy()
+    off = cm - np.diag(d)
+    scale = np.sqrt(np.outer(np.abs(d), np.abs(d))) + 1e-13 * max(np.abs(d).max(), 1e-300)
+    if need_diagonal and np.any(np.abs(off) > DIAG_TOL * scale):
+        return "damping not diagonal in the modes (a general C)"
+    w = np.sqrt(w2)
+    m = _Modes.none(model.n_dof, H)
+    m.nmodes, m.phi, m.omega, m.zeta = w.size, np.asfortranarray(phi), w, d / (2.0 * w)
+    return m
+
+
+def _receptance_route(model: Model, opts: SolverOptions, H: int) -> tuple[_Modes, str]:
+    """Modes and a description of how the condensed receptances are found (see
+    SolverOptions.receptances)."""
+    n = model.n_dof
+    if opts.modes:
+        return (_lowest_modes(model, int(opts.modes), H),
+                f"receptances from the lowest {opts.modes} modes (truncated)")
+    why = ""
+    if opts.receptances == "modes":
+        m = _all_modes(model, H, True)
+        if isinstance(m, str):
+            raise ParameterError(f"options.receptances: 'modes' not possible: {m}; use "
+                                 "'factorization'")
+        return m, f"receptances from all {n} modes (exact)"
+    if opts.receptances == "auto":
+        dense = model.K.nnz >= 0.1 * n * n
+        if n <= MODES_MAX and dense:
+            m = _all_modes(model, H, True)
+            if not isinstance(m, str):
+                return m, f"receptances from all {n} modes (exact; dense model)"
+            why = f" ({m})"
+        else:
+            why = " (sparse or large model)"
+    return _Modes.none(n, H), f"receptances by banded LU per harmonic{why}"
+
+
 class _Contacts(NamedTuple):
     """The contact groups packed: stacked G (rows, ncol), law/size table, parameters and
     sliders concatenated group by group."""
@@ -226,6 +278,8 @@ class _Packed:
     out_f: np.ndarray         # (n_out,) their rows, 0-based
     stability: bool
     modes: _Modes
+    tcontact: bool = False    # condensed unknowns in contact coordinates G x
+    info: str = ""            # how the system is solved (FRF.solver_info)
 
     @property
     def nc(self) -> int:
@@ -233,8 +287,16 @@ class _Packed:
 
     @property
     def ny(self) -> int:
-        """Unknowns: harmonics of the contact DoFs (condensed) or of all rows (banded)."""
-        return (self.nl.size if self.opts.formulation == "condensed" else self.n_dof) * self.nc
+        """Unknowns: harmonics of the contact DoFs or coordinates (condensed) or of all
+        rows (banded)."""
+        return self.nrow * self.nc
+
+    @property
+    def nrow(self) -> int:
+        """Unknowns per harmonic coefficient."""
+        if self.opts.formulation != "condensed":
+            return self.n_dof
+        return self.G[0].size - 1 if self.tcontact else self.nl.size
 
     @property
     def ne_tot(self) -> int:
@@ -278,7 +340,7 @@ class _Packed:
             y0=y0, lam0=lam0, tan0=tan0, start_mode=start_mode, ropt=ropt, iopt=iopt,
             stability=int(self.stability), history=int(o.history), maxpts=maxpts,
             netot=max(self.ne_tot, 1), ntim=len(_TIMER_SLOTS), nh=self.H, ndof=self.n_dof,
-            nnl=self.nl.size or 1)
+            nnl=self.nl.size or 1, tcontact=int(self.tcontact))
         r = _CallResult(*res[:-1], msg=res[-1].decode(errors="replace"))
         if r.npts > 0 and self.nw and o.history:
             self.w0 = r.sliders[:self.nw, r.npts - 1].copy()
@@ -288,7 +350,7 @@ class _Packed:
         """Unknowns of a solution with H_from harmonics, extended or cut to this H."""
         y = np.asarray(y, dtype=float)
         condensed = self.opts.formulation == "condensed"
-        nrow = self.nl.size if condensed else self.n_dof
+        nrow = self.nrow
         nc_from = 2 * H_from + 1
         if y.size != nrow * nc_from:
             raise SizeError(f"start: {y.size} unknowns do not match H = {H_from} for this "
@@ -376,12 +438,25 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
                       f"size 2 n_dof (2H+1) = {2 * n * (2 * H + 1)} > {HILL_MAX}",
                       RuntimeWarning, stacklevel=4)
         stability = False
-    modes = _lowest_modes(model, int(opts.modes), H) if opts.modes else _Modes.none(n, H)
+    tcontact, info = False, f"banded: {n * (2 * H + 1)} unknowns"
+    modes = _Modes.none(n, H)
+    if opts.formulation == "condensed":
+        nrows = c.G.shape[0]
+        if opts.coordinates == "contact" and opts.stability:
+            raise ParameterError("options.coordinates: 'contact' cannot be used with "
+                                 "stability (Hill's method needs the contact DoFs)")
+        tcontact = opts.coordinates == "contact" or (
+            opts.coordinates == "auto" and nrows < nl.size and not opts.stability)
+        modes, route = _receptance_route(model, opts, H)
+        nu = nrows if tcontact else nl.size
+        info = (f"condensed: {nu * (2 * H + 1)} unknowns, "
+                + (f"{nu} contact coordinates G x" if tcontact else f"{nu} contact DoFs")
+                + f"; {route}")
     return _Packed(opts=opts, H=H, n_dof=n, fe0=fe0, fe1=fe1,
                    K=_csr(model.K), M=_csr(model.M), C=_csr(model.C), perm=perm, nl=nl,
                    G=_csr(c.G), ginfo=c.ginfo, params=c.params, w0=c.w0, nw=c.nw,
                    group_names=c.names, group_sizes=c.sizes, outputs=out, out_f=out,
-                   stability=stability, modes=modes)
+                   stability=stability, modes=modes, tcontact=tcontact, info=info)
 
 
 def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Packed:
@@ -432,4 +507,6 @@ def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Pa
                    K=empty, M=empty, C=empty, perm=np.arange(1, nr + 1, dtype=np.int32),
                    nl=at[cols], G=_csr(G), ginfo=c.ginfo, params=c.params, w0=c.w0,
                    nw=c.nw, group_names=c.names, group_sizes=c.sizes, outputs=out,
-                   out_f=at[out], stability=False, modes=modes)
+                   out_f=at[out], stability=False, modes=modes,
+                   info=f"condensed: {at[cols].size * (2 * H + 1)} unknowns, {at[cols].size} "
+                        "contact DoFs; receptances from each harmonic's nodal-diameter modes")

@@ -26,7 +26,7 @@ from typing import Callable
 import numpy as np
 
 from ._errors import CODES, ParameterError, SizeError, raise_for_status
-from ._pack import HILL_MAX, TIMER_NAMES  # noqa: F401 - public here, defined with the packing
+from ._pack import HILL_MAX, MODES_MAX, TIMER_NAMES  # noqa: F401 - public here
 from ._pack import (START_CONTINUE, START_RESUME, START_SOLVE_ONLY, YSCALE_RELATIVE, _Packed,
                     _split_load, add_timings, pack)
 from .model import CyclicModel, Excitation, Model
@@ -83,6 +83,18 @@ class SolverOptions:
         (truncation: no residual flexibility). None: exact receptances.
     batch : int
         Points per call into Fortran: how often `sink` receives points.
+    coordinates : {'auto', 'dofs', 'contact'}
+        Condensed formulation: unknowns are the harmonics of the contact DoFs ('dofs') or
+        of the contact elements' local relative displacements G x ('contact'); 'auto' takes
+        the shorter ('dofs' when stability is asked: Hill's method needs them).
+    receptances : {'auto', 'modes', 'factorization'}
+        Condensed formulation, without `modes`: how the receptances T D_h^-1 T^T are
+        found at each frequency. 'modes': from all modes of the model, one dense
+        eigen-decomposition (exact; needs damping that the modes diagonalise: modal,
+        Rayleigh, none); 'factorization': a banded LU of the dynamic stiffness per
+        harmonic (any damping). 'auto': 'modes' for a dense model (reduced: at most
+        :data:`MODES_MAX` DoFs, >= 10 % of K's entries non-zero) whose damping the modes
+        diagonalise, else 'factorization'. The choice is in ``FRF.solver_info``.
     """
 
     harmonics: int = 3
@@ -102,6 +114,8 @@ class SolverOptions:
     history: bool = True
     modes: int | None = None
     batch: int = 10
+    coordinates: str = "auto"
+    receptances: str = "auto"
 
     def check(self) -> None:
         """Raise ParameterError naming the first invalid field."""
@@ -127,6 +141,11 @@ class SolverOptions:
         if self.modes is not None and (self.modes < 1 or self.formulation != "condensed"):
             raise ParameterError("options.modes: a positive number of modes, with "
                                  "formulation 'condensed'")
+        for nm, allowed in (("coordinates", ("auto", "dofs", "contact")),
+                            ("receptances", ("auto", "modes", "factorization"))):
+            if getattr(self, nm) not in allowed:
+                raise ParameterError(f"options.{nm}: expected one of {list(allowed)}, got "
+                                     f"{getattr(self, nm)!r}")
         if self.max_iter < 1 or self.max_points < 1 or self.batch < 1:
             raise ParameterError("options.max_iter, max_points and batch must be >= 1")
 
@@ -311,6 +330,7 @@ class _Continuation:
                               complete=complete, message=message,
                               stability_computed=p.stability)
         out.timings = self.timings
+        out.solver_info = p.info
         if keep_unknowns and pts:
             out._last_unknowns = pts[-1].unknowns
             out._last_slider = pts[-1].slider
