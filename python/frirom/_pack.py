@@ -503,10 +503,14 @@ def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Pa
         modes.psi[nb, :r, h] = m.psi[rows[nb] - n] * np.exp(1j * m.k * alpha)
         modes.omega_h[:r, h], modes.zeta_h[:r, h] = m.omega, m.zeta
     empty = _csr(sp.csr_matrix((nr, nr)))
+    tcontact = o.coordinates == "contact" or (o.coordinates == "auto"
+                                              and G.shape[0] < cols.size)
+    nu = G.shape[0] if tcontact else cols.size
     return _Packed(opts=o, H=H, n_dof=nr, fe0=fe0_r, fe1=fe1_r,
                    K=empty, M=empty, C=empty, perm=np.arange(1, nr + 1, dtype=np.int32),
                    nl=at[cols], G=_csr(G), ginfo=c.ginfo, params=c.params, w0=c.w0,
                    nw=c.nw, group_names=c.names, group_sizes=c.sizes, outputs=out,
-                   out_f=at[out], stability=False, modes=modes,
-                   info=f"condensed: {at[cols].size * (2 * H + 1)} unknowns, {at[cols].size} "
-                        "contact DoFs; receptances from each harmonic's nodal-diameter modes")
+                   out_f=at[out], stability=False, modes=modes, tcontact=tcontact,
+                   info=f"condensed: {nu * (2 * H + 1)} unknowns, {nu} "
+                        + ("contact coordinates G x" if tcontact else "contact DoFs")
+                        + "; receptances from each harmonic's nodal-diameter modes")
