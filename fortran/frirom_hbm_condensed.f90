@@ -11,6 +11,11 @@ submodule (frirom_hbm) frirom_hbm_condensed
     use frirom_banded, only: zband_init, zband_zero, zband_add, zband_factor, zband_solve
     implicit none
 
+    !> GMRES (Krylov mode): relative residual, iteration limit before the J is factorised,
+    !> iterations above which the next J is factorised.
+    real(wp), parameter :: GM_TOL = 1.0e-11_wp
+    integer(ip), parameter :: GM_MAXIT = 60, GM_REFRESH = 25
+
 contains
 
     module procedure cond_init
@@ -51,7 +56,14 @@ contains
             end associate
         end do
         sys%ecol = cols(1:nk)
+        sys%lu_any = .false.
     end procedure cond_init
+
+    !> Whether solves go through GMRES on jcur (see hbm_condensed%krylov).
+    pure logical function use_krylov(sys)
+        type(hbm_condensed), intent(in) :: sys
+        use_krylov = sys%krylov == 1 .or. (sys%krylov == -1 .and. sys%n >= 1000)
+    end function use_krylov
 
     module procedure hbm_set_modes
         integer(ip) :: nm
@@ -558,16 +570,31 @@ contains
         type(hbm_condensed), intent(inout) :: sys
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
-        integer(ip) :: nu, nc, n, g, e, ie, m, h, ia, ib, s2, c2, q, col, i, linfo, mnc, nd
-        integer(ip) :: d1, d2, s1, c1, k, r, pos
+        integer(ip) :: nu, nc, n, g, e, ie, m, h, ia, ib, s2, c2, q, col, i, mnc, nd
+        integer(ip) :: d1, d2, s1, c1, k, r, pos, stat
         real(wp), allocatable :: ge(:, :), kt(:, :), ke(:, :), wm(:, :), kab(:, :), out(:, :)
+        real(wp), allocatable :: jt(:, :)
         real(wp) :: t0
+        logical :: krylov
         info = FRIROM_OK
         t0 = wtime()
         nu = sys%nnl
         nc = sys%nc
         n = sys%n
-        sys%jm = 0.0_wp
+        krylov = use_krylov(sys)
+        if (krylov .and. .not. allocated(sys%jcur)) then
+            allocate (sys%jcur(n, n), stat=stat)
+            if (stat /= 0) then
+                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: Krylov Jacobian')
+                return
+            end if
+        end if
+        if (krylov) then
+            call move_alloc(sys%jcur, jt)
+        else
+            call move_alloc(sys%jm, jt)
+        end if
+        jt = 0.0_wp
         ie = 0
         do g = 1, size(sys%cs%grp)
             associate (gr => sys%cs%grp(g), gg => sys%cs%g)
@@ -634,13 +661,12 @@ contains
                                     q = c2 + nc*(s2 - 1)
                                     col = sc(s2) + nu*(c2 - 1)
                                     if (h == 0) then
-                                        sys%jm(1:nu, col) = sys%jm(1:nu, col) + out(:, q)
+                                        jt(1:nu, col) = jt(1:nu, col) + out(:, q)
                                     else
-                                        sys%jm(nu*(ia - 1) + 1:nu*ia, col) = &
-                                            sys%jm(nu*(ia - 1) + 1:nu*ia, col) + out(:, q)
-                                        sys%jm(nu*(ib - 1) + 1:nu*ib, col) = &
-                                            sys%jm(nu*(ib - 1) + 1:nu*ib, col) + &
-                                            out(:, mnc + q)
+                                        jt(nu*(ia - 1) + 1:nu*ia, col) = &
+                                            jt(nu*(ia - 1) + 1:nu*ia, col) + out(:, q)
+                                        jt(nu*(ib - 1) + 1:nu*ib, col) = &
+                                            jt(nu*(ib - 1) + 1:nu*ib, col) + out(:, mnc + q)
                                     end if
                                 end do
                             end do
@@ -651,30 +677,152 @@ contains
             end associate
         end do
         do i = 1, n
-            sys%jm(i, i) = sys%jm(i, i) + 1.0_wp
+            jt(i, i) = jt(i, i) + 1.0_wp
         end do
         sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
+        if (krylov) then
+            call move_alloc(jt, sys%jcur)
+            sys%lu_fresh = .false.
+            ! keep the older LU as GMRES preconditioner unless it served badly
+            if (sys%lu_any .and. .not. sys%refresh) return
+        else
+            call move_alloc(jt, sys%jm)
+        end if
+        call cond_factor(sys, info, errmsg)
+    end subroutine cond_jacobian
+
+    !> LU of J (jm := jcur first in Krylov mode).
+    subroutine cond_factor(sys, info, errmsg)
+        type(hbm_condensed), intent(inout) :: sys
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        integer(ip) :: n, linfo
+        real(wp) :: t0
+        info = FRIROM_OK
+        n = sys%n
         t0 = wtime()
+        if (use_krylov(sys)) sys%jm = sys%jcur
         call dgetrf(n, n, sys%jm, n, sys%ipiv, linfo)
         sys%timers(T_FACT) = sys%timers(T_FACT) + wtime() - t0
         sys%timers(N_FACT) = sys%timers(N_FACT) + 1
+        sys%lu_fresh = linfo == 0
+        sys%lu_any = linfo == 0
+        sys%refresh = .false.
         if (linfo > 0) then
             call set_status(info, FRIROM_ERR_SINGULAR, errmsg, 'condensed Jacobian: dgetrf '// &
                             'zero pivot')
         else if (linfo < 0) then
             call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'dgetrf: illegal argument')
         end if
-    end subroutine cond_jacobian
+    end subroutine cond_factor
 
     module procedure cond_solve
-        integer(ip) :: linfo
+        integer(ip) :: linfo, j, its
         real(wp) :: t0
+        logical :: ok
         info = FRIROM_OK
         t0 = wtime()
-        call dgetrs('N', this%n, size(b, 2), this%jm, this%n, this%ipiv, b, size(b, 1), linfo)
+        if (use_krylov(this) .and. .not. this%lu_fresh) then
+            do j = 1, size(b, 2)
+                call gmres(this, b(:, j), its, ok)
+                ! a preconditioner that needs many iterations is renewed at the next J
+                if (its > GM_REFRESH) this%refresh = .true.
+                if (ok) cycle
+                ! too slow: factorise this J and solve the remaining columns directly
+                this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
+                call cond_factor(this, info, errmsg)
+                if (info /= 0) return
+                t0 = wtime()
+                exit
+            end do
+            if (.not. this%lu_fresh) then
+                this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
+                return
+            end if
+            call dgetrs('N', this%n, size(b, 2) - j + 1, this%jm, this%n, this%ipiv, b(:, j:), &
+                        size(b, 1), linfo)
+        else
+            call dgetrs('N', this%n, size(b, 2), this%jm, this%n, this%ipiv, b, size(b, 1), &
+                        linfo)
+        end if
         this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
         if (linfo /= 0) call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'dgetrs failed')
     end procedure cond_solve
+
+    !> b := J^-1 b by restarted GMRES on jcur, right-preconditioned by the LU in jm (from
+    !> an earlier J), from the preconditioned start x0 = LU^-1 b, to a residual of GM_TOL
+    !> |b|; ok false (b unchanged) when GM_MAXIT iterations do not get there.
+    subroutine gmres(sys, b, its, ok)
+        type(hbm_condensed), intent(inout) :: sys
+        real(wp), intent(inout) :: b(:)
+        integer(ip), intent(out) :: its
+        logical, intent(out) :: ok
+        integer(ip), parameter :: m = 30
+        real(wp), allocatable :: v(:, :), hh(:, :), cs(:), sn(:), gv(:), x(:), r(:), w(:, :)
+        real(wp) :: beta, bn, tmp
+        integer(ip) :: n, j, i, k, linfo
+        n = sys%n
+        allocate (v(n, m + 1), hh(m + 1, m), cs(m), sn(m), gv(m + 1), x(n), r(n), w(n, 1))
+        its = 0
+        ok = .false.
+        bn = norm2(b)
+        if (bn == 0.0_wp) then
+            ok = .true.
+            return
+        end if
+        w(:, 1) = b
+        call dgetrs('N', n, 1, sys%jm, n, sys%ipiv, w, n, linfo)
+        x = w(:, 1)
+        do
+            ! r = b - J x
+            r = b
+            call dgemm('N', 'N', n, 1, n, -1.0_wp, sys%jcur, n, x, n, 1.0_wp, r, n)
+            beta = norm2(r)
+            if (beta <= GM_TOL*bn) exit
+            if (its >= GM_MAXIT) return
+            v(:, 1) = r/beta
+            gv = 0.0_wp
+            gv(1) = beta
+            k = 0
+            do j = 1, m
+                its = its + 1
+                k = j
+                ! w = J LU^-1 v_j, orthogonalised (modified Gram-Schmidt)
+                w(:, 1) = v(:, j)
+                call dgetrs('N', n, 1, sys%jm, n, sys%ipiv, w, n, linfo)
+                call dgemm('N', 'N', n, 1, n, 1.0_wp, sys%jcur, n, w, n, 0.0_wp, v(:, j + 1), n)
+                do i = 1, j
+                    hh(i, j) = dot_product(v(:, i), v(:, j + 1))
+                    v(:, j + 1) = v(:, j + 1) - hh(i, j)*v(:, i)
+                end do
+                hh(j + 1, j) = norm2(v(:, j + 1))
+                if (hh(j + 1, j) > 0.0_wp) v(:, j + 1) = v(:, j + 1)/hh(j + 1, j)
+                do i = 1, j - 1
+                    tmp = cs(i)*hh(i, j) + sn(i)*hh(i + 1, j)
+                    hh(i + 1, j) = -sn(i)*hh(i, j) + cs(i)*hh(i + 1, j)
+                    hh(i, j) = tmp
+                end do
+                tmp = hypot(hh(j, j), hh(j + 1, j))
+                if (tmp == 0.0_wp) exit
+                cs(j) = hh(j, j)/tmp
+                sn(j) = hh(j + 1, j)/tmp
+                hh(j, j) = tmp
+                hh(j + 1, j) = 0.0_wp
+                gv(j + 1) = -sn(j)*gv(j)
+                gv(j) = cs(j)*gv(j)
+                if (abs(gv(j + 1)) <= 0.1_wp*GM_TOL*bn .or. its >= GM_MAXIT) exit
+            end do
+            ! x += LU^-1 V y, H y = g (upper triangular)
+            do i = k, 1, -1
+                gv(i) = (gv(i) - dot_product(hh(i, i + 1:k), gv(i + 1:k)))/hh(i, i)
+            end do
+            call dgemm('N', 'N', n, 1, k, 1.0_wp, v, n, gv, k, 0.0_wp, w, n)
+            call dgetrs('N', n, 1, sys%jm, n, sys%ipiv, w, n, linfo)
+            x = x + w(:, 1)
+        end do
+        b = x
+        ok = .true.
+    end subroutine gmres
 
     module procedure cond_outputs
         real(wp) :: w, s

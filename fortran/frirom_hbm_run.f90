@@ -110,6 +110,7 @@ contains
             end do
             sys%tcontact = .false.
             if (present(contact_coords)) sys%tcontact = contact_coords
+            if (present(krylov)) sys%krylov = krylov
             if (sys%tcontact) then
                 ! u = G x: T = G, and the contacts read u directly (G over u = I)
                 ncol = nrows

@@ -340,7 +340,8 @@ class _Packed:
             y0=y0, lam0=lam0, tan0=tan0, start_mode=start_mode, ropt=ropt, iopt=iopt,
             stability=int(self.stability), history=int(o.history), maxpts=maxpts,
             netot=max(self.ne_tot, 1), ntim=len(_TIMER_SLOTS), nh=self.H, ndof=self.n_dof,
-            nnl=self.nl.size or 1, tcontact=int(self.tcontact))
+            nnl=self.nl.size or 1, tcontact=int(self.tcontact),
+            krylov=-1 if o.krylov is None else int(o.krylov))
         r = _CallResult(*res[:-1], msg=res[-1].decode(errors="replace"))
         if r.npts > 0 and self.nw and o.history:
             self.w0 = r.sliders[:self.nw, r.npts - 1].copy()

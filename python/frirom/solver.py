@@ -95,6 +95,10 @@ class SolverOptions:
         harmonic (any damping). 'auto': 'modes' for a dense model (reduced: at most
         :data:`MODES_MAX` DoFs, >= 10 % of K's entries non-zero) whose damping the modes
         diagonalise, else 'factorization'. The choice is in ``FRF.solver_info``.
+    krylov : bool or None
+        Condensed formulation: solve with each new Jacobian by GMRES preconditioned by
+        the LU of an earlier one, factorising again only when GMRES needs many
+        iterations (same answers, far fewer dense LUs). None: from 1000 unknowns on.
     """
 
     harmonics: int = 3
@@ -116,6 +120,7 @@ class SolverOptions:
     batch: int = 10
     coordinates: str = "auto"
     receptances: str = "auto"
+    krylov: bool | None = None
 
     def check(self) -> None:
         """Raise ParameterError naming the first invalid field."""
