@@ -297,7 +297,7 @@ contains
         end if
     end subroutine modal_project
 
-    !> Modal route: R_h = A_h diag(g_h) A_h^H (ar + i ai) at the cached w. Real modes:
+    !> Modal route: R_h = A_h diag(g_h) A_h^H (ar + i ai) at the Jacobian's w. Real modes:
     !> A diag(Re g) A^T and A diag(Im g) A^T, symmetric, each as the difference of two
     !> rank-k updates over the modes with positive and negative factors (dsyrk).
     subroutine modal_rmat(sys)
@@ -306,7 +306,7 @@ contains
         real(wp), allocatable :: b(:, :), d(:)
         complex(wp), allocatable :: tmp(:, :), rz(:, :)
         real(wp) :: t0
-        if (sys%w_rmat == sys%w_cache) return
+        if (sys%w_rmat == sys%wj) return
         t0 = wtime()
         nu = sys%nnl
         nm = size(sys%g, 1)
@@ -315,9 +315,9 @@ contains
             do h = 0, sys%nh
                 do part = 1, merge(1, 2, h == 0)
                     if (part == 1) then
-                        d = real(sys%g(:, h), wp)
+                        d = real(sys%gj(:, h), wp)
                     else
-                        d = aimag(sys%g(:, h))
+                        d = aimag(sys%gj(:, h))
                     end if
                     if (part == 1) then
                         call sym_scaled(sys%phr, d, b, sys%ar(:, :, h))
@@ -332,7 +332,7 @@ contains
             do h = 0, sys%nh
                 associate (ps => sys%psi(1:nu, :, h))
                     do j = 1, nu
-                        tmp(:, j) = sys%g(:, h)*conjg(ps(j, :))
+                        tmp(:, j) = sys%gj(:, h)*conjg(ps(j, :))
                     end do
                     call zgemm('N', 'N', nu, nu, nm, (1.0_wp, 0.0_wp), sys%psi(1, 1, h), &
                                size(sys%psi, 1), tmp, nm, (0.0_wp, 0.0_wp), rz, nu)
@@ -341,7 +341,7 @@ contains
                 sys%ai(:, :, h) = aimag(rz)
             end do
         end if
-        sys%w_rmat = sys%w_cache
+        sys%w_rmat = sys%wj
         sys%timers(T_REC) = sys%timers(T_REC) + wtime() - t0
 
     contains
@@ -558,7 +558,18 @@ contains
         rlam = reshape(rl2, [n])
         rref = max(sqrt(nxe), nx, sqrt(nhf))
         if (.not. jac) return
-        if (this%modal) call modal_rmat(this)
+        if (this%modal) then
+            this%gj = this%g
+            this%wj = w
+            if (use_krylov(this)) then
+                ! matrix-free J (jmul): R_h is formed only to factorise
+                this%jfree = .true.
+                this%lu_fresh = .false.
+                if (this%lu_any .and. .not. this%refresh) return
+            end if
+            call modal_rmat(this)
+        end if
+        this%jfree = .false.
         call cond_jacobian(this, info, errmsg)
     end procedure cond_eval
 
@@ -573,9 +584,9 @@ contains
         integer(ip) :: nu, nc, n, g, e, ie, m, h, ia, ib, s2, c2, q, col, i, mnc, nd
         integer(ip) :: d1, d2, s1, c1, k, r, pos, stat
         real(wp), allocatable :: ge(:, :), kt(:, :), ke(:, :), wm(:, :), kab(:, :), out(:, :)
-        real(wp), allocatable :: jt(:, :)
+        real(wp), allocatable :: jt(:, :), kc(:, :)
         real(wp) :: t0
-        logical :: krylov
+        logical :: krylov, dense
         info = FRIROM_OK
         t0 = wtime()
         nu = sys%nnl
@@ -596,6 +607,18 @@ contains
         end if
         jt = 0.0_wp
         ie = 0
+        ! elements that each read most coordinates (an interface reduced to a few
+        ! generalised DoFs): sum their blocks into dF_c/dU first, then dense products
+        dense = sum(real(sys%ecp(2:) - sys%ecp(:size(sys%ecp) - 1), wp)**2)*nc**2 > &
+                real(n, wp)**2
+        if (dense) then
+            allocate (kc(n, n), stat=stat)
+            if (stat /= 0) then
+                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: contact Jacobian')
+                return
+            end if
+            kc = 0.0_wp
+        end if
         do g = 1, size(sys%cs%grp)
             associate (gr => sys%cs%grp(g), gg => sys%cs%g)
                 nd = gr%ndir
@@ -623,15 +646,32 @@ contains
                             end do
                         end do
                         ke = 0.0_wp
-                        do s1 = 1, m
-                            do d1 = 1, nd
-                                if (ge(d1, s1) == 0.0_wp) cycle
-                                do c1 = 1, nc
-                                    ke(c1 + nc*(s1 - 1), :) = ke(c1 + nc*(s1 - 1), :) + &
-                                        ge(d1, s1)*kt(c1 + nc*(d1 - 1), :)
+                        do q = 1, mnc
+                            do s1 = 1, m
+                                do d1 = 1, nd
+                                    if (ge(d1, s1) == 0.0_wp) cycle
+                                    ke(1 + nc*(s1 - 1):nc*s1, q) = &
+                                        ke(1 + nc*(s1 - 1):nc*s1, q) + &
+                                        ge(d1, s1)*kt(1 + nc*(d1 - 1):nc*d1, q)
                                 end do
                             end do
                         end do
+                        if (dense) then
+                            do s2 = 1, m
+                                do c2 = 1, nc
+                                    col = sc(s2) + nu*(c2 - 1)
+                                    q = c2 + nc*(s2 - 1)
+                                    do s1 = 1, m
+                                        do c1 = 1, nc
+                                            i = sc(s1) + nu*(c1 - 1)
+                                            kc(i, col) = kc(i, col) + ke(c1 + nc*(s1 - 1), q)
+                                        end do
+                                    end do
+                                end do
+                            end do
+                            deallocate (ge, kt, ke)
+                            cycle
+                        end if
                         allocate (wm(nu, 2*m), kab(2*m, 2*mnc), out(nu, 2*mnc))
                         do h = 0, sys%nh
                             if (h == 0) then
@@ -676,6 +716,7 @@ contains
                 end do
             end associate
         end do
+        if (dense) call jac_dense(sys, n, kc, jt)
         do i = 1, n
             jt(i, i) = jt(i, i) + 1.0_wp
         end do
@@ -690,6 +731,35 @@ contains
         end if
         call cond_factor(sys, info, errmsg)
     end subroutine cond_jacobian
+
+    !> jm = R_h kc for the dense dF_c/dU kc, harmonic block by harmonic block
+    !> (R_h = A + iB).
+    subroutine jac_dense(sys, n, kc, jm)
+        type(hbm_condensed), intent(in) :: sys
+        integer(ip), intent(in) :: n
+        real(wp), intent(in) :: kc(n, n)
+        real(wp), intent(inout) :: jm(n, n)
+        integer(ip) :: nnl, h, ca, cb
+        nnl = sys%nnl
+        do h = 0, sys%nh
+            if (h == 0) then
+                call dgemm('N', 'N', nnl, n, nnl, 1.0_wp, sys%ar(:, :, 0), nnl, kc, n, &
+                           0.0_wp, jm, n)
+            else
+                ca = nnl*(2*h - 1) + 1
+                cb = nnl*(2*h) + 1
+                ! a-rows: A Kc_a + B Kc_b ; b-rows: -B Kc_a + A Kc_b
+                call dgemm('N', 'N', nnl, n, nnl, 1.0_wp, sys%ar(:, :, h), nnl, kc(ca, 1), n, &
+                           0.0_wp, jm(ca, 1), n)
+                call dgemm('N', 'N', nnl, n, nnl, 1.0_wp, sys%ai(:, :, h), nnl, kc(cb, 1), n, &
+                           1.0_wp, jm(ca, 1), n)
+                call dgemm('N', 'N', nnl, n, nnl, -1.0_wp, sys%ai(:, :, h), nnl, kc(ca, 1), &
+                           n, 0.0_wp, jm(cb, 1), n)
+                call dgemm('N', 'N', nnl, n, nnl, 1.0_wp, sys%ar(:, :, h), nnl, kc(cb, 1), n, &
+                           1.0_wp, jm(cb, 1), n)
+            end if
+        end do
+    end subroutine jac_dense
 
     !> LU of J (jm := jcur first in Krylov mode).
     subroutine cond_factor(sys, info, errmsg)
@@ -730,7 +800,14 @@ contains
                 if (ok) cycle
                 ! too slow: factorise this J and solve the remaining columns directly
                 this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
-                call cond_factor(this, info, errmsg)
+                if (this%jfree) then
+                    call modal_rmat(this)
+                    this%jfree = .false.
+                    this%refresh = .true.
+                    call cond_jacobian(this, info, errmsg)
+                else
+                    call cond_factor(this, info, errmsg)
+                end if
                 if (info /= 0) return
                 t0 = wtime()
                 exit
@@ -748,6 +825,58 @@ contains
         this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
         if (linfo /= 0) call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'dgetrs failed')
     end procedure cond_solve
+
+    !> y = J x: the assembled jcur, or matrix-free (jfree: modal route) as
+    !> x + R_h G^T J_loc G x at the Jacobian's frequency, element by element and mode by
+    !> mode (R_h = A diag(g) A^H never formed).
+    subroutine jmul(sys, x, y)
+        type(hbm_condensed), intent(in) :: sys
+        real(wp), intent(in) :: x(:)
+        real(wp), intent(out) :: y(:)
+        real(wp), allocatable :: xv(:, :), f(:, :), xl(:, :), fl(:), y2(:, :)
+        complex(wp), allocatable :: fc(:), v(:, :), b1(:, :)
+        integer(ip) :: n, nu, nc, g, e, d, r, k, h
+        n = sys%n
+        if (.not. sys%jfree) then
+            call dgemm('N', 'N', n, 1, n, 1.0_wp, sys%jcur, n, x, n, 0.0_wp, y, n)
+            return
+        end if
+        nu = sys%nnl
+        nc = sys%nc
+        xv = reshape(x, [nu, nc])
+        allocate (f(nu, nc), y2(nu, nc), fc(nu), v(size(sys%gj, 1), 1), b1(nu, 1))
+        f = 0.0_wp
+        do g = 1, size(sys%cs%grp)
+            associate (gr => sys%cs%grp(g), gg => sys%cs%g)
+                allocate (xl(nc, gr%ndir), fl(nc*gr%ndir))
+                do e = 1, gr%ne
+                    do d = 1, gr%ndir
+                        r = gr%row0 + (e - 1)*gr%ndir + d
+                        xl(:, d) = 0.0_wp
+                        do k = gg%p(r), gg%p(r + 1) - 1
+                            xl(:, d) = xl(:, d) + gg%x(k)*xv(gg%i(k), :)
+                        end do
+                    end do
+                    fl = matmul(gr%jac(:, :, e), reshape(xl, [nc*gr%ndir]))
+                    do d = 1, gr%ndir
+                        r = gr%row0 + (e - 1)*gr%ndir + d
+                        do k = gg%p(r), gg%p(r + 1) - 1
+                            f(gg%i(k), :) = f(gg%i(k), :) + gg%x(k)*fl(1 + nc*(d - 1):nc*d)
+                        end do
+                    end do
+                end do
+                deallocate (xl, fl)
+            end associate
+        end do
+        do h = 0, sys%nh
+            fc = harm_col(f, h)
+            call modal_project(sys, h, fc, v(:, 1))
+            v(:, 1) = sys%gj(:, h)*v(:, 1)
+            call modal_apply(sys, h, 1, nu, v, b1)
+            call harm_set(y2, h, b1(:, 1))
+        end do
+        y = x + reshape(y2, [n])
+    end subroutine jmul
 
     !> b := J^-1 b by restarted GMRES on jcur, right-preconditioned by the LU in jm (from
     !> an earlier J), from the preconditioned start x0 = LU^-1 b, to a residual of GM_TOL
@@ -775,8 +904,8 @@ contains
         x = w(:, 1)
         do
             ! r = b - J x
-            r = b
-            call dgemm('N', 'N', n, 1, n, -1.0_wp, sys%jcur, n, x, n, 1.0_wp, r, n)
+            call jmul(sys, x, r)
+            r = b - r
             beta = norm2(r)
             if (beta <= GM_TOL*bn) exit
             if (its >= GM_MAXIT) return
@@ -790,7 +919,7 @@ contains
                 ! w = J LU^-1 v_j, orthogonalised (modified Gram-Schmidt)
                 w(:, 1) = v(:, j)
                 call dgetrs('N', n, 1, sys%jm, n, sys%ipiv, w, n, linfo)
-                call dgemm('N', 'N', n, 1, n, 1.0_wp, sys%jcur, n, w, n, 0.0_wp, v(:, j + 1), n)
+                call jmul(sys, w(:, 1), v(:, j + 1))
                 do i = 1, j
                     hh(i, j) = dot_product(v(:, i), v(:, j + 1))
                     v(:, j + 1) = v(:, j + 1) - hh(i, j)*v(:, i)
