@@ -114,7 +114,7 @@ end subroutine hbm_rcm
 !> tan0), or solve at lam0 only. ropt, iopt: Newton and continuation settings by slot
 !> (RCONT_*, ICONT_* of frirom_newton; Python reads all of these names with int_constant).
 !> Outputs: npts points; timings(T_*): AFT, assembly, factorisation, solve, receptances (s),
-!> residual evaluations, factorisations; timings(N_TIMERS): total (s).
+!> residual evaluations, factorisations, GMRES iterations; timings(N_TIMERS): total (s).
 subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, &
                         mi, mx, nnzc, cp, ci, cx, perm, nnl, nl, fe0, fe1, omega_fix, ngroup, &
                         ginfo, nrows, nnzg, gp, gi, gx, npart, params, nw0, w0, nout, outdofs, &
@@ -139,8 +139,8 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     !> condensed: 1 = unknowns in contact coordinates u = G x (nrows per harmonic), 0 = the
     !> nl DoFs (nnl per harmonic)
     integer(4), intent(in) :: tcontact
-    !> condensed: 1 = linear solves by GMRES preconditioned by an older LU, 0 = a new LU
-    !> for every Jacobian, -1 = GMRES from 1000 unknowns on
+    !> condensed: 1 = linear solves by GMRES preconditioned by an older LU, 0 or -1 = a
+    !> new LU for every Jacobian
     integer(4), intent(in) :: krylov
     real(8), intent(in) :: fe0(ndof, 2*nh + 1), fe1(ndof, 2*nh + 1)
     real(8), intent(in) :: omega_fix     !! rad/s, the frequency of a load continuation
@@ -264,7 +264,8 @@ end subroutine hbm_continue
 !> Value of a named integer constant of this interface, so that Python reads slots, modes
 !> and codes from Fortran instead of typing their numbers: RCONT_*, N_RCONT, ICONT_*,
 !> N_ICONT (option slots of hbm_continue, frirom_newton), HBM_START_* (start modes),
-!> T_*, N_EVAL, N_FACT, N_TIMERS (timings slots, frirom_hbm) and the FRIROM_* status codes.
+!> T_*, N_EVAL, N_FACT, N_KRYLOV, N_TIMERS (timings slots, frirom_hbm) and the FRIROM_*
+!> status codes.
 !> An unknown name returns info = FRIROM_ERR_PARAM.
 subroutine int_constant(name, value, info, msg)
     use frirom_kinds, only: ip
@@ -272,7 +273,8 @@ subroutine int_constant(name, value, info, msg)
     use frirom_newton, only: RCONT_TOL_R, RCONT_TOL_X, RCONT_TOL_STALL, RCONT_YSCALE, &
                              RCONT_LSCALE, RCONT_DS, RCONT_DS_MIN, RCONT_DS_MAX, RCONT_LAM_END, &
                              RCONT_LAM_LO, N_RCONT, ICONT_MAX_ITER, ICONT_REUSE_JAC, N_ICONT
-    use frirom_hbm, only: T_AFT, T_ASM, T_FACT, T_SOLVE, T_REC, N_EVAL, N_FACT, N_TIMERS, &
+    use frirom_hbm, only: T_AFT, T_ASM, T_FACT, T_SOLVE, T_REC, N_EVAL, N_FACT, N_KRYLOV, &
+                          N_TIMERS, &
                           HBM_START_CONTINUE, HBM_START_RESUME, HBM_START_SOLVE_ONLY
     implicit none
     character(len=*), intent(in) :: name
@@ -331,6 +333,8 @@ subroutine int_constant(name, value, info, msg)
         value = N_EVAL
     case ('N_FACT')
         value = N_FACT
+    case ('N_KRYLOV')
+        value = N_KRYLOV
     case ('N_TIMERS')
         value = N_TIMERS
     case default

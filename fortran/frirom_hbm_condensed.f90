@@ -14,7 +14,7 @@ submodule (frirom_hbm) frirom_hbm_condensed
     !> GMRES (Krylov mode): relative residual, iteration limit before the J is factorised,
     !> iterations above which the next J is factorised.
     real(wp), parameter :: GM_TOL = 1.0e-11_wp
-    integer(ip), parameter :: GM_MAXIT = 60, GM_REFRESH = 25
+    integer(ip), parameter :: GM_MAXIT = 40, GM_REFRESH = 8
 
 contains
 
@@ -62,7 +62,7 @@ contains
     !> Whether solves go through GMRES on jcur (see hbm_condensed%krylov).
     pure logical function use_krylov(sys)
         type(hbm_condensed), intent(in) :: sys
-        use_krylov = sys%krylov == 1 .or. (sys%krylov == -1 .and. sys%n >= 1000)
+        use_krylov = sys%krylov == 1
     end function use_krylov
 
     module procedure hbm_set_modes
@@ -795,6 +795,7 @@ contains
         if (use_krylov(this) .and. .not. this%lu_fresh) then
             do j = 1, size(b, 2)
                 call gmres(this, b(:, j), its, ok)
+                this%timers(N_KRYLOV) = this%timers(N_KRYLOV) + its
                 ! a preconditioner that needs many iterations is renewed at the next J
                 if (its > GM_REFRESH) this%refresh = .true.
                 if (ok) cycle

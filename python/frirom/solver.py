@@ -98,7 +98,10 @@ class SolverOptions:
     krylov : bool or None
         Condensed formulation: solve with each new Jacobian by GMRES preconditioned by
         the LU of an earlier one, factorising again only when GMRES needs many
-        iterations (same answers, far fewer dense LUs). None: from 1000 unknowns on.
+        iterations (same answers, 2-10x fewer dense LUs). None: off. Measured at ROM_I
+        size (2 800 unknowns, cases/bench/condensed.py): GMRES iterations are memory
+        bound (~25 ms each, 2 cores shared) and the stale preconditioner needs ~8-18 per
+        solve, so the FRF takes as long as with a new LU per Jacobian.
     """
 
     harmonics: int = 3
