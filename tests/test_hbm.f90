@@ -11,8 +11,10 @@ program test_hbm
     implicit none
     integer(ip), parameter :: ndof = 4, nh = 3, nc = 2*nh + 1
     type(hbm_condensed) :: sc, scl
-    type(hbm_full) :: sf, sfl, sbad, sfn
-    type(hbm_condensed) :: scn, scm, sch, sct, sctl, sctn, sctm
+    type(hbm_full), target :: sf
+    type(hbm_full) :: sfl, sbad, sfn
+    type(hbm_condensed) :: scn, scm, sch, sct, sctl, sctn, sctm, scd
+    type(hbm_full) :: sfd
     complex(wp) :: psi(ndof, ndof, 0:nh)
     real(wp) :: yr(3*nc), r1(3*nc), r2(3*nc), rl1(3*nc), rl2(3*nc), rr1, rr2
     integer(ip) :: h
@@ -69,6 +71,17 @@ program test_hbm
     call check(info == 0 .and. sct%n == 2*nc, 'setup condensed in G x: '//trim(msg))
     call fd_check(sct, 'condensed G x')
     call agree(sct, 'condensed G x')
+    ! two cubic elements that each read all three nl DoFs (an interface reduced to a few
+    ! generalised DoFs): dF/dU summed densely before the product with R_h
+    call hbm_setup(scd, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
+                   fe1, 1, 0.0_wp, ginfo, [1, 4, 7], [2, 3, 4, 2, 3, 4], &
+                   [1.0_wp, -0.5_wp, 0.3_wp, 0.2_wp, 0.7_wp, -1.0_wp], params, w0, outd, info, msg)
+    call check(info == 0, 'setup condensed, dense dF/dU: '//trim(msg))
+    call fd_check(scd, 'condensed dense dF/dU')
+    call hbm_setup(sfd, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
+                   fe1, 1, 0.0_wp, ginfo, [1, 4, 7], [2, 3, 4, 2, 3, 4], &
+                   [1.0_wp, -0.5_wp, 0.3_wp, 0.2_wp, 0.7_wp, -1.0_wp], params, w0, outd, info, msg)
+    call agree(scd, 'condensed dense dF/dU', sfd)
     ! load mode: same checks with lam = load factor
     call hbm_setup(scl, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
                    fe1, 2, 0.9_wp, ginfo, gp, gi, gx, params, w0, outd, info, msg)
@@ -197,18 +210,22 @@ contains
     end subroutine fd_check
 
     !> Both formulations solved at the same frequency give the same output harmonics.
-    subroutine agree(sc, name)
+    subroutine agree(sc, name, sfo)
         class(hbm_system), intent(inout) :: sc
         character(len=*), intent(in) :: name
+        type(hbm_full), intent(inout), optional, target :: sfo  !! default: sf
         type(cont_options) :: o
+        type(hbm_full), pointer :: pf
         real(wp), allocatable :: yc(:), yf(:), z(:)
         real(wp) :: lc, lf, xc(ndof, nc), xf(ndof, nc)
         integer(ip) :: it
         logical :: hf
+        pf => sf
+        if (present(sfo)) pf => sfo
         o%tol_r = 1.0e-13_wp
         o%tol_x = 1.0e-12_wp
         o%yscale = 1.0e-3_wp
-        allocate (yc(sc%n), yf(sf%n))
+        allocate (yc(sc%n), yf(pf%n))
         yc = 0.0_wp
         yf = 0.0_wp
         lc = 0.9_wp
@@ -219,13 +236,13 @@ contains
         call newton_correct(sc, yc, lc, yc, lc, z, 1.0_wp, o, it, info, msg, hf)
         call check(info == 0, name//' Newton: '//trim(msg))
         deallocate (z)
-        allocate (z(sf%n))
+        allocate (z(pf%n))
         z = 0.0_wp
         hf = .false.
-        call newton_correct(sf, yf, lf, yf, lf, z, 1.0_wp, o, it, info, msg, hf)
+        call newton_correct(pf, yf, lf, yf, lf, z, 1.0_wp, o, it, info, msg, hf)
         call check(info == 0, 'full Newton: '//trim(msg))
         call sc%outputs(yc, lc, xc, info, msg)
-        call sf%outputs(yf, lf, xf, info, msg)
+        call pf%outputs(yf, lf, xf, info, msg)
         err = maxval(abs(xc - xf))/maxval(abs(xf))
         print '(a,a,es10.2,a,es10.2)', name, ' vs full: max rel diff', err, &
             '  |x| =', maxval(abs(xf))
