@@ -121,7 +121,8 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
                         nmodes, phi, wmodes, zmodes, hmodes, psi, wharm, zharm, ny, y0, lam0, &
                         tan0, start_mode, nropt, ropt, niopt, iopt, stability, history, &
                         maxpts, netot, ntim, ys, lams, tans, iters, xo, states, hill_re, &
-                        sliders, npts, finished, ds_out, timings, info, msg, tcontact, krylov)
+                        sliders, npts, finished, ds_out, timings, info, msg, tcontact, krylov, &
+                        sparse)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options, cont_options_from, N_RCONT, N_ICONT, RCONT_DS, &
@@ -142,6 +143,7 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     !> condensed: 1 = linear solves by GMRES preconditioned by an older LU, 0 or -1 = a
     !> new LU for every Jacobian
     integer(4), intent(in) :: krylov
+    integer(4), intent(in) :: sparse   !! condensed: 1 = receptances by sparse LU (MUMPS)
     real(8), intent(in) :: fe0(ndof, 2*nh + 1), fe1(ndof, 2*nh + 1)
     real(8), intent(in) :: omega_fix     !! rad/s, the frequency of a load continuation
     integer(4), intent(in) :: ngroup, ginfo(3, ngroup), nrows, nnzg, gp(nrows + 1), gi(nnzg)
@@ -226,7 +228,7 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     end if
     call hbm_setup(sys, nh, nsamp, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
                    fe1, mode, omega_fix, ginfo, gp, gi, gx, params, w0, outdofs, linfo, msg, &
-                   contact_coords=tcontact == 1, krylov=int(krylov, ip))
+                   contact_coords=tcontact == 1, krylov=int(krylov, ip), sparse_lu=sparse == 1)
     if (linfo == 0 .and. (sys%n /= ny .or. sum(ginfo(2, :)) /= netot)) &
         call set_status(linfo, FRIROM_ERR_SIZE, msg, 'hbm_continue: ny or netot does not '// &
                         'match the model')

@@ -9,6 +9,7 @@ submodule (frirom_hbm) frirom_hbm_condensed
                              FRIROM_ERR_LAPACK, FRIROM_ERR_SINGULAR, FRIROM_ERR_MODEL, &
                              FRIROM_ERR_NONFINITE, set_status
     use frirom_banded, only: zband_init, zband_zero, zband_add, zband_factor, zband_solve
+    use frirom_zsparse, only: zsparse_solve
     implicit none
 
     !> GMRES (Krylov mode): relative residual, iteration limit before the J is factorised,
@@ -425,6 +426,10 @@ contains
         info = FRIROM_OK
         ndof = sys%ndof
         nnl = sys%nnl
+        if (sys%sparse_lu) then
+            call receptance_sparse(sys, w, info, errmsg)
+            return
+        end if
         if (.not. allocated(sys%d%ab)) then
             call zband_init(sys%d, sys%ndof, sys%bw, sys%bw, info, errmsg)
             if (info /= 0) return
@@ -480,6 +485,70 @@ contains
             end do
         end do
     end subroutine receptance_banded
+
+    !> receptance_banded's columns by a sparse LU of D_h per harmonic (MUMPS, one triangle
+    !> of K, M, C in coordinate form; natural DoF order: MUMPS orders itself).
+    subroutine receptance_sparse(sys, w, info, errmsg)
+        type(hbm_condensed), intent(inout) :: sys
+        real(wp), intent(in) :: w
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        integer(ip) :: h, i, k, j, nz, ndof, nnl, stat
+        integer(ip), allocatable :: irn(:), jcn(:)
+        complex(wp), allocatable :: a(:), rhs(:, :)
+        real(wp) :: hw
+        info = FRIROM_OK
+        ndof = sys%ndof
+        nnl = sys%nnl
+        if (.not. allocated(sys%ymat)) then
+            allocate (sys%ymat(ndof, nnl, 0:sys%nh), stat=stat)
+            if (stat /= 0) then
+                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: receptance columns')
+                return
+            end if
+        end if
+        nz = size(sys%k%i) + size(sys%m%i) + size(sys%c%i)
+        allocate (irn(nz), jcn(nz), a(nz), rhs(ndof, nnl + 2))
+        do h = 0, sys%nh
+            hw = h*w
+            nz = 0
+            do i = 1, ndof
+                call add(sys%k, i, (1.0_wp, 0.0_wp))
+                call add(sys%m, i, cmplx(-hw*hw, 0.0_wp, wp))
+                if (h > 0) call add(sys%c, i, cmplx(0.0_wp, hw, wp))
+            end do
+            rhs = (0.0_wp, 0.0_wp)
+            do j = 1, nnl
+                do k = sys%t%p(j), sys%t%p(j + 1) - 1
+                    rhs(sys%t%i(k), j) = rhs(sys%t%i(k), j) + sys%t%x(k)
+                end do
+            end do
+            rhs(:, nnl + 1) = harm_col(sys%fe0, h)
+            rhs(:, nnl + 2) = harm_col(sys%fe1, h)
+            call zsparse_solve(ndof, irn(:nz), jcn(:nz), a(:nz), rhs, info, errmsg)
+            if (info /= 0) return
+            sys%ymat(:, :, h) = rhs(:, 1:nnl)
+            sys%ye0(:, h) = rhs(:, nnl + 1)
+            sys%ye1(:, h) = rhs(:, nnl + 2)
+        end do
+
+    contains
+
+        !> Entries of row i on or right of the diagonal of a, times f.
+        subroutine add(mat, i, f)
+            type(csr_matrix), intent(in) :: mat
+            integer(ip), intent(in) :: i
+            complex(wp), intent(in) :: f
+            integer(ip) :: kk
+            do kk = mat%p(i), mat%p(i + 1) - 1
+                if (mat%i(kk) < i) cycle
+                nz = nz + 1
+                irn(nz) = i
+                jcn(nz) = mat%i(kk)
+                a(nz) = f*mat%x(kk)
+            end do
+        end subroutine add
+    end subroutine receptance_sparse
 
     module procedure cond_eval
         real(wp) :: w, s, nx, nxe, nhf

@@ -111,6 +111,7 @@ contains
             sys%tcontact = .false.
             if (present(contact_coords)) sys%tcontact = contact_coords
             if (present(krylov)) sys%krylov = krylov
+            if (present(sparse_lu)) sys%sparse_lu = sparse_lu
             if (sys%tcontact) then
                 ! u = G x: T = G, and the contacts read u directly (G over u = I)
                 ncol = nrows

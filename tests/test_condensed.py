@@ -3,8 +3,8 @@ the path they replace (issue 10, items 1-3).
 
 Reference: unknowns on the contact DoFs with receptances from a banded LU of the dynamic
 stiffness per harmonic (the route of every earlier release). Against it: unknowns in
-contact coordinates G x, and receptances from all modes of the model (one dense eigh),
-each alone and together, on
+contact coordinates G x, receptances from all modes of the model (one dense eigh) and from
+a sparse LU (MUMPS) per harmonic, each alone and with either coordinates, on
   * a lattice of two blocks touching on a plane (an unreduced, sparse FE-like model,
     tests/_lattices.py), normal1d friction on every node pair along tilted directions so
     that each contact row reads 6 DoFs (72 contact DoFs, 24 contact coordinates), and
@@ -32,7 +32,8 @@ from frirom.solver import SolverOptions, frf, solve_point
 
 TOL = 1e-8
 OPTS = dict(harmonics=2, samples=40, tol_residual=1e-12, tol_update=1e-12, max_iter=60)
-ROUTES = [("contact", "factorization"), ("dofs", "modes"), ("contact", "modes")]
+ROUTES = [("contact", "factorization"), ("dofs", "modes"), ("contact", "modes"),
+          ("dofs", "sparse"), ("contact", "sparse")]
 
 
 def _unit(v):

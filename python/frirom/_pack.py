@@ -164,30 +164,41 @@ def _all_modes(model: Model, H: int, need_diagonal: bool) -> _Modes | str:
     return m
 
 
-def _receptance_route(model: Model, opts: SolverOptions, H: int) -> tuple[_Modes, str]:
-    """Modes and a description of how the condensed receptances are found (see
-    SolverOptions.receptances)."""
+#: 'auto' factorises D_h by sparse LU (MUMPS) instead of a band when the band LU would
+#: take more than this many flops per harmonic (n_dof bw^2, bw the RCM half-bandwidth).
+SPARSE_FLOPS = 5e8
+
+
+def _receptance_route(model: Model, opts: SolverOptions, H: int,
+                      bw: int) -> tuple[_Modes, str, bool]:
+    """Modes, a description of how the condensed receptances are found (see
+    SolverOptions.receptances) and whether D_h is factorised by sparse LU."""
     n = model.n_dof
     if opts.modes:
         return (_lowest_modes(model, int(opts.modes), H),
-                f"receptances from the lowest {opts.modes} modes (truncated)")
+                f"receptances from the lowest {opts.modes} modes (truncated)", False)
     why = ""
     if opts.receptances == "modes":
         m = _all_modes(model, H, True)
         if isinstance(m, str):
             raise ParameterError(f"options.receptances: 'modes' not possible: {m}; use "
                                  "'factorization'")
-        return m, f"receptances from all {n} modes (exact)"
+        return m, f"receptances from all {n} modes (exact)", False
+    if opts.receptances == "sparse":
+        return _Modes.none(n, H), "receptances by sparse LU (MUMPS) per harmonic", True
     if opts.receptances == "auto":
         dense = model.K.nnz >= 0.1 * n * n
         if n <= MODES_MAX and dense:
             m = _all_modes(model, H, True)
             if not isinstance(m, str):
-                return m, f"receptances from all {n} modes (exact; dense model)"
+                return m, f"receptances from all {n} modes (exact; dense model)", False
             why = f" ({m})"
         else:
             why = " (sparse or large model)"
-    return _Modes.none(n, H), f"receptances by banded LU per harmonic{why}"
+        if n * float(bw) ** 2 > SPARSE_FLOPS:
+            return (_Modes.none(n, H), f"receptances by sparse LU (MUMPS) per harmonic "
+                    f"(half-bandwidth {bw} of {n} DoFs{why})", True)
+    return (_Modes.none(n, H), f"receptances by banded LU per harmonic{why}", False)
 
 
 class _Contacts(NamedTuple):
@@ -280,6 +291,7 @@ class _Packed:
     stability: bool
     modes: _Modes
     tcontact: bool = False    # condensed unknowns in contact coordinates G x
+    sparse: bool = False      # condensed receptances by sparse LU (MUMPS)
     info: str = ""            # how the system is solved (FRF.solver_info)
 
     @property
@@ -342,7 +354,7 @@ class _Packed:
             stability=int(self.stability), history=int(o.history), maxpts=maxpts,
             netot=max(self.ne_tot, 1), ntim=len(_TIMER_SLOTS), nh=self.H, ndof=self.n_dof,
             nnl=self.nl.size or 1, tcontact=int(self.tcontact),
-            krylov=-1 if o.krylov is None else int(o.krylov))
+            krylov=-1 if o.krylov is None else int(o.krylov), sparse=int(self.sparse))
         r = _CallResult(*res[:-1], msg=res[-1].decode(errors="replace"))
         if r.npts > 0 and self.nw and o.history:
             self.w0 = r.sliders[:self.nw, r.npts - 1].copy()
@@ -440,7 +452,7 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
                       f"size 2 n_dof (2H+1) = {2 * n * (2 * H + 1)} > {HILL_MAX}",
                       RuntimeWarning, stacklevel=4)
         stability = False
-    tcontact, info = False, f"banded: {n * (2 * H + 1)} unknowns"
+    tcontact, sparse, info = False, False, f"banded: {n * (2 * H + 1)} unknowns"
     modes = _Modes.none(n, H)
     if opts.formulation == "condensed":
         nrows = c.G.shape[0]
@@ -449,7 +461,11 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
                                  "stability (Hill's method needs the contact DoFs)")
         tcontact = opts.coordinates == "contact" or (
             opts.coordinates == "auto" and nrows < nl.size and not opts.stability)
-        modes, route = _receptance_route(model, opts, H)
+        iperm = np.empty(n, dtype=np.int64)
+        iperm[perm - 1] = np.arange(n)
+        pc = pat.tocoo()
+        bw = int(np.abs(iperm[pc.row] - iperm[pc.col]).max())
+        modes, route, sparse = _receptance_route(model, opts, H, bw)
         nu = nrows if tcontact else nl.size
         info = (f"condensed: {nu * (2 * H + 1)} unknowns, "
                 + (f"{nu} contact coordinates G x" if tcontact else f"{nu} contact DoFs")
@@ -458,7 +474,8 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
                    K=_csr(model.K), M=_csr(model.M), C=_csr(model.C), perm=perm, nl=nl,
                    G=_csr(c.G), ginfo=c.ginfo, params=c.params, w0=c.w0, nw=c.nw,
                    group_names=c.names, group_sizes=c.sizes, outputs=out, out_f=out,
-                   stability=stability, modes=modes, tcontact=tcontact, info=info)
+                   stability=stability, modes=modes, tcontact=tcontact, sparse=sparse,
+                   info=info)
 
 
 def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Packed:

@@ -87,14 +87,17 @@ class SolverOptions:
         Condensed formulation: unknowns are the harmonics of the contact DoFs ('dofs') or
         of the contact elements' local relative displacements G x ('contact'); 'auto' takes
         the shorter ('dofs' when stability is asked: Hill's method needs them).
-    receptances : {'auto', 'modes', 'factorization'}
+    receptances : {'auto', 'modes', 'factorization', 'sparse'}
         Condensed formulation, without `modes`: how the receptances T D_h^-1 T^T are
         found at each frequency. 'modes': from all modes of the model, one dense
         eigen-decomposition (exact; needs damping that the modes diagonalise: modal,
         Rayleigh, none); 'factorization': a banded LU of the dynamic stiffness per
-        harmonic (any damping). 'auto': 'modes' for a dense model (reduced: at most
-        :data:`MODES_MAX` DoFs, >= 10 % of K's entries non-zero) whose damping the modes
-        diagonalise, else 'factorization'. The choice is in ``FRF.solver_info``.
+        harmonic (any damping); 'sparse': a sparse LU (MUMPS) per harmonic (any
+        damping; large unreduced FE). 'auto': 'modes' for a dense model (reduced: at
+        most :data:`MODES_MAX` DoFs, >= 10 % of K's entries non-zero) whose damping the
+        modes diagonalise, else 'sparse' when the band LU would cost more than
+        ``_pack.SPARSE_FLOPS`` per harmonic, else 'factorization'. The choice is in
+        ``FRF.solver_info``.
     krylov : bool or None
         Condensed formulation: solve with each new Jacobian by GMRES preconditioned by
         the LU of an earlier one, factorising again only when GMRES needs many
@@ -150,7 +153,7 @@ class SolverOptions:
             raise ParameterError("options.modes: a positive number of modes, with "
                                  "formulation 'condensed'")
         for nm, allowed in (("coordinates", ("auto", "dofs", "contact")),
-                            ("receptances", ("auto", "modes", "factorization"))):
+                            ("receptances", ("auto", "modes", "factorization", "sparse"))):
             if getattr(self, nm) not in allowed:
                 raise ParameterError(f"options.{nm}: expected one of {list(allowed)}, got "
                                      f"{getattr(self, nm)!r}")
