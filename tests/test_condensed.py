@@ -176,3 +176,18 @@ def test_krylov_solves_agree_with_direct_ones(models):
                      receptances="factorization")
         assert np.abs(res[True].X[k] - ref.X).max() / np.abs(ref.X).max() < TOL
     assert res[True].timings["factorizations"] < 0.5 * res[False].timings["factorizations"]
+
+
+def test_start_from_the_other_coordinates_is_explained(models):
+    """A saved point whose unknowns are on the contact DoFs (an earlier release, or
+    coordinates='dofs') does not fit the contact coordinates 'auto' takes: the error says
+    which option makes it fit, and with it the point resumes to the same solution."""
+    model, ex, out = models["red"]
+    w = 1.05 * models["w1"]
+    p = _solve(model, ex, out, w, coordinates="dofs")
+    from frirom import SizeError
+    with pytest.raises(SizeError, match="options.coordinates = 'dofs'"):
+        solve_point(model, ex, w, SolverOptions(**OPTS), outputs=out, start=p)
+    q = solve_point(model, ex, w, SolverOptions(**OPTS, coordinates="dofs"), outputs=out,
+                    start=p)
+    assert np.abs(q.X - p.X).max() / np.abs(p.X).max() < TOL

@@ -367,8 +367,13 @@ class _Packed:
         nrow = self.nrow
         nc_from = 2 * H_from + 1
         if y.size != nrow * nc_from:
+            other = self.nl.size if self.tcontact else self.G[0].size - 1
+            hint = ""
+            if condensed and y.size == other * nc_from:
+                hint = (" (they fit the other condensed unknowns: set options.coordinates = "
+                        f"{'dofs' if self.tcontact else 'contact'!r})")
             raise SizeError(f"start: {y.size} unknowns do not match H = {H_from} for this "
-                            "model and formulation")
+                            f"model and formulation{hint}")
         m = min(nc_from, self.nc)
         out = np.zeros(self.ny)
         if condensed:           # harmonic-major: y[j + nnl c]
