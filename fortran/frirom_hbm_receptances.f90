@@ -373,6 +373,13 @@ contains
         info = FRIROM_OK
         ndof = sys%ndof
         nnl = sys%nnl
+        if (.not. allocated(sys%ymat)) then
+            allocate (sys%ymat(ndof, nnl, 0:sys%nh), stat=stat)
+            if (stat /= 0) then
+                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: receptance columns')
+                return
+            end if
+        end if
         if (sys%sparse_lu) then
             call receptance_sparse(sys, w, info, errmsg)
             return
@@ -380,13 +387,6 @@ contains
         if (.not. allocated(sys%d%ab)) then
             call zband_init(sys%d, sys%ndof, sys%bw, sys%bw, info, errmsg)
             if (info /= 0) return
-        end if
-        if (.not. allocated(sys%ymat)) then
-            allocate (sys%ymat(ndof, nnl, 0:sys%nh), stat=stat)
-            if (stat /= 0) then
-                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: receptance columns')
-                return
-            end if
         end if
         ok = .true.
         allocate (rhs(ndof, nnl + 2))
@@ -433,27 +433,21 @@ contains
         end do
     end subroutine receptance_banded
 
-    !> receptance_banded's columns by a sparse LU of D_h per harmonic (MUMPS, one triangle
-    !> of K, M, C in coordinate form; natural DoF order: MUMPS orders itself).
+    !> receptance_banded's columns (into the allocated ymat) by a sparse LU of D_h per
+    !> harmonic (MUMPS, one triangle of K, M, C in coordinate form, natural DoF order:
+    !> MUMPS orders itself).
     subroutine receptance_sparse(sys, w, info, errmsg)
         type(hbm_condensed), intent(inout) :: sys
         real(wp), intent(in) :: w
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
-        integer(ip) :: h, i, k, j, nz, ndof, nnl, stat
+        integer(ip) :: h, i, k, j, nz, ndof, nnl
         integer(ip), allocatable :: irn(:), jcn(:)
         complex(wp), allocatable :: a(:), rhs(:, :)
         real(wp) :: hw
         info = FRIROM_OK
         ndof = sys%ndof
         nnl = sys%nnl
-        if (.not. allocated(sys%ymat)) then
-            allocate (sys%ymat(ndof, nnl, 0:sys%nh), stat=stat)
-            if (stat /= 0) then
-                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: receptance columns')
-                return
-            end if
-        end if
         nz = size(sys%k%i) + size(sys%m%i) + size(sys%c%i)
         allocate (irn(nz), jcn(nz), a(nz), rhs(ndof, nnl + 2))
         do h = 0, sys%nh

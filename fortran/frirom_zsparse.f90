@@ -7,7 +7,7 @@ module frirom_zsparse
     implicit none
     private
     include 'zmumps_struc.h'
-    public :: zsparse_solve
+    public :: zsparse_solve, mumps_status
 
 contains
 
@@ -31,7 +31,7 @@ contains
         m%job = -1
         call zmumps(m)
         if (m%infog(1) < 0) then
-            call status(m%infog(1), m%infog(2), 'init')
+            call mumps_status('zmumps', m%infog(1), m%infog(2), 'init', info, errmsg)
             return
         end if
         m%icntl(1:4) = [-1, -1, -1, 0]   ! silent
@@ -52,7 +52,8 @@ contains
                 m%icntl(14) = 2*max(m%icntl(14), 20)   ! more working memory, retry
             end do
             if (m%infog(1) < 0) then
-                call status(m%infog(1), m%infog(2), 'factorisation')
+                call mumps_status('zmumps', m%infog(1), m%infog(2), 'factorisation', info, &
+                                  errmsg)
             else
                 m%rhs(1:size(b)) => b
                 m%nrhs = size(b, 2)
@@ -60,7 +61,8 @@ contains
                 m%job = 3
                 call zmumps(m)
                 nullify (m%rhs)
-                if (m%infog(1) < 0) call status(m%infog(1), m%infog(2), 'solve')
+                if (m%infog(1) < 0) call mumps_status('zmumps', m%infog(1), m%infog(2), &
+                                                      'solve', info, errmsg)
             end if
         end if
         if (associated(m%irn)) deallocate (m%irn)
@@ -69,19 +71,22 @@ contains
         m%job = -2
         call zmumps(m)
 
-    contains
-
-        subroutine status(infog1, infog2, stage)
-            integer, intent(in) :: infog1, infog2
-            character(len=*), intent(in) :: stage
-            character(len=200) :: buf
-            write (buf, '(a,a,a,i0,a,i0,a)') 'zmumps (', stage, '): INFOG(1) = ', infog1, &
-                ', INFOG(2) = ', infog2, ' (see the MUMPS user guide, error codes)'
-            if (infog1 == -13) then
-                call set_status(info, FRIROM_ERR_ALLOC, errmsg, trim(buf))
-            else
-                call set_status(info, FRIROM_ERR_FACTOR, errmsg, trim(buf))
-            end if
-        end subroutine status
     end subroutine zsparse_solve
+
+    !> A MUMPS failure (INFOG(1) < 0) of `solver` ('dmumps', 'zmumps') at `stage` as a
+    !> frirom status: out of memory (-13) or a failed factorisation.
+    subroutine mumps_status(solver, infog1, infog2, stage, info, errmsg)
+        character(len=*), intent(in) :: solver, stage
+        integer, intent(in) :: infog1, infog2
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout), optional :: errmsg
+        character(len=200) :: buf
+        write (buf, '(a,a,a,a,a,i0,a,i0,a)') solver, ' (', stage, '): INFOG(1) = ', infog1, &
+            ', INFOG(2) = ', infog2, ' (see the MUMPS user guide, error codes)'
+        if (infog1 == -13) then
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, trim(buf))
+        else
+            call set_status(info, FRIROM_ERR_FACTOR, errmsg, trim(buf))
+        end if
+    end subroutine mumps_status
 end module frirom_zsparse
