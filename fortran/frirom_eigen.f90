@@ -12,6 +12,7 @@
 !! in an `eigen_work` the caller owns.
 module frirom_eigen
     use frirom_kinds, only: wp, ip
+    use frirom_zsparse, only: mumps_status
     use frirom_status, only: set_status, FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, &
                              FRIROM_ERR_NONFINITE, FRIROM_ERR_ALLOC, FRIROM_ERR_ARPACK, &
                              FRIROM_ERR_NOCONV, FRIROM_ERR_SINGULAR, FRIROM_ERR_FACTOR
@@ -119,7 +120,8 @@ contains
         work%mumps%job = -1
         call dmumps(work%mumps)
         if (work%mumps%infog(1) < 0) then
-            call mumps_status(work%mumps%infog(1), work%mumps%infog(2), 'init', info, errmsg)
+            call mumps_status('dmumps', work%mumps%infog(1), work%mumps%infog(2), 'init', &
+                              info, errmsg)
             return
         end if
         work%initialised = .true.
@@ -159,8 +161,8 @@ contains
             call set_status(info, FRIROM_ERR_SINGULAR, errmsg, trim(buf))
             return
         else if (work%mumps%infog(1) < 0) then
-            call mumps_status(work%mumps%infog(1), work%mumps%infog(2), 'factorisation', &
-                              info, errmsg)
+            call mumps_status('dmumps', work%mumps%infog(1), work%mumps%infog(2), &
+                              'factorisation', info, errmsg)
             return
         end if
         work%factored = .true.
@@ -191,7 +193,8 @@ contains
         call dmumps(work%mumps)
         nullify (work%mumps%rhs)
         if (work%mumps%infog(1) < 0) then
-            call mumps_status(work%mumps%infog(1), work%mumps%infog(2), 'solve', info, errmsg)
+            call mumps_status('dmumps', work%mumps%infog(1), work%mumps%infog(2), 'solve', &
+                              info, errmsg)
         end if
     end subroutine eigen_solve
 
@@ -372,21 +375,6 @@ contains
         work%factored = .false.
         work%n = 0
     end subroutine eigen_destroy
-
-    subroutine mumps_status(infog1, infog2, stage, info, errmsg)
-        integer, intent(in) :: infog1, infog2
-        character(len=*), intent(in) :: stage
-        integer(ip), intent(out) :: info
-        character(len=*), intent(inout), optional :: errmsg
-        character(len=200) :: buf
-        write (buf, '(a,a,a,i0,a,i0,a)') 'dmumps (', stage, '): INFOG(1) = ', infog1, &
-            ', INFOG(2) = ', infog2, ' (see the MUMPS user guide, error codes)'
-        if (infog1 == -13) then
-            call set_status(info, FRIROM_ERR_ALLOC, errmsg, trim(buf))
-        else
-            call set_status(info, FRIROM_ERR_FACTOR, errmsg, trim(buf))
-        end if
-    end subroutine mumps_status
 
     !> Insertion sort of an index vector by key (nev is small).
     pure subroutine sort_index(key, idx)

@@ -105,7 +105,8 @@ end subroutine hbm_rcm
 !> Harmonic balance solve and pseudo-arc-length continuation (frirom_hbm hbm_run).
 !> formulation: 'condensed' or 'banded'; lam_kind: 'frequency' (lam = omega) or 'load'
 !> (lam scales fe1 at omega_fix). K, M, C: CSR, 1-based, ndof x ndof, symmetric.
-!> perm: RCM order of the DoFs. nl: nonlinear DoFs (condensed). fe0, fe1: real harmonic
+!> perm: RCM order of the DoFs. nl: nonlinear DoFs (condensed); tcontact: condensed
+!> unknowns in contact coordinates (G x) instead. fe0, fe1: real harmonic
 !> excitation (ndof, 2H+1) (frequency: fe0; load: fe0 + lam fe1).
 !> ginfo(3, ngroup): law, n_elem, n_dir; G rows group by group, element, direction (CSR over
 !> the full DoFs); params (npar, ne) and w0 (nslider, ne) per group, concatenated.
@@ -113,14 +114,15 @@ end subroutine hbm_rcm
 !> tan0), or solve at lam0 only. ropt, iopt: Newton and continuation settings by slot
 !> (RCONT_*, ICONT_* of frirom_newton; Python reads all of these names with int_constant).
 !> Outputs: npts points; timings(T_*): AFT, assembly, factorisation, solve, receptances (s),
-!> residual evaluations, factorisations; timings(N_TIMERS): total (s).
+!> residual evaluations, factorisations, GMRES iterations; timings(N_TIMERS): total (s).
 subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, &
                         mi, mx, nnzc, cp, ci, cx, perm, nnl, nl, fe0, fe1, omega_fix, ngroup, &
                         ginfo, nrows, nnzg, gp, gi, gx, npart, params, nw0, w0, nout, outdofs, &
                         nmodes, phi, wmodes, zmodes, hmodes, psi, wharm, zharm, ny, y0, lam0, &
                         tan0, start_mode, nropt, ropt, niopt, iopt, stability, history, &
                         maxpts, netot, ntim, ys, lams, tans, iters, xo, states, hill_re, &
-                        sliders, npts, finished, ds_out, timings, info, msg)
+                        sliders, npts, finished, ds_out, timings, info, msg, tcontact, krylov, &
+                        sparse)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options, cont_options_from, N_RCONT, N_ICONT, RCONT_DS, &
@@ -135,6 +137,13 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
                               ci(nnzc)
     real(8), intent(in) :: kx(nnzk), mx(nnzm), cx(nnzc)
     integer(4), intent(in) :: perm(ndof), nnl, nl(nnl)
+    !> condensed: 1 = unknowns in contact coordinates u = G x (nrows per harmonic), 0 = the
+    !> nl DoFs (nnl per harmonic)
+    integer(4), intent(in) :: tcontact
+    !> condensed: 1 = linear solves by GMRES preconditioned by an older LU, 0 or -1 = a
+    !> new LU for every Jacobian
+    integer(4), intent(in) :: krylov
+    integer(4), intent(in) :: sparse   !! condensed: 1 = receptances by sparse LU (MUMPS)
     real(8), intent(in) :: fe0(ndof, 2*nh + 1), fe1(ndof, 2*nh + 1)
     real(8), intent(in) :: omega_fix     !! rad/s, the frequency of a load continuation
     integer(4), intent(in) :: ngroup, ginfo(3, ngroup), nrows, nnzg, gp(nrows + 1), gi(nnzg)
@@ -218,7 +227,8 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
         return
     end if
     call hbm_setup(sys, nh, nsamp, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
-                   fe1, mode, omega_fix, ginfo, gp, gi, gx, params, w0, outdofs, linfo, msg)
+                   fe1, mode, omega_fix, ginfo, gp, gi, gx, params, w0, outdofs, linfo, msg, &
+                   contact_coords=tcontact == 1, krylov=int(krylov, ip), sparse_lu=sparse == 1)
     if (linfo == 0 .and. (sys%n /= ny .or. sum(ginfo(2, :)) /= netot)) &
         call set_status(linfo, FRIROM_ERR_SIZE, msg, 'hbm_continue: ny or netot does not '// &
                         'match the model')
@@ -256,7 +266,8 @@ end subroutine hbm_continue
 !> Value of a named integer constant of this interface, so that Python reads slots, modes
 !> and codes from Fortran instead of typing their numbers: RCONT_*, N_RCONT, ICONT_*,
 !> N_ICONT (option slots of hbm_continue, frirom_newton), HBM_START_* (start modes),
-!> T_*, N_EVAL, N_FACT, N_TIMERS (timings slots, frirom_hbm) and the FRIROM_* status codes.
+!> T_*, N_EVAL, N_FACT, N_KRYLOV, N_TIMERS (timings slots, frirom_hbm) and the FRIROM_*
+!> status codes.
 !> An unknown name returns info = FRIROM_ERR_PARAM.
 subroutine int_constant(name, value, info, msg)
     use frirom_kinds, only: ip
@@ -264,7 +275,8 @@ subroutine int_constant(name, value, info, msg)
     use frirom_newton, only: RCONT_TOL_R, RCONT_TOL_X, RCONT_TOL_STALL, RCONT_YSCALE, &
                              RCONT_LSCALE, RCONT_DS, RCONT_DS_MIN, RCONT_DS_MAX, RCONT_LAM_END, &
                              RCONT_LAM_LO, N_RCONT, ICONT_MAX_ITER, ICONT_REUSE_JAC, N_ICONT
-    use frirom_hbm, only: T_AFT, T_ASM, T_FACT, T_SOLVE, T_REC, N_EVAL, N_FACT, N_TIMERS, &
+    use frirom_hbm, only: T_AFT, T_ASM, T_FACT, T_SOLVE, T_REC, N_EVAL, N_FACT, N_KRYLOV, &
+                          N_TIMERS, &
                           HBM_START_CONTINUE, HBM_START_RESUME, HBM_START_SOLVE_ONLY
     implicit none
     character(len=*), intent(in) :: name
@@ -323,6 +335,8 @@ subroutine int_constant(name, value, info, msg)
         value = N_EVAL
     case ('N_FACT')
         value = N_FACT
+    case ('N_KRYLOV')
+        value = N_KRYLOV
     case ('N_TIMERS')
         value = N_TIMERS
     case default

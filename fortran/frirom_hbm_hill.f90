@@ -2,7 +2,7 @@
 !> linearised harmonic balance equations over all DoFs x harmonics.
 submodule (frirom_hbm) frirom_hbm_hill
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_ALLOC, FRIROM_ERR_LAPACK, &
-                             FRIROM_ERR_SINGULAR, set_status
+                             FRIROM_ERR_SINGULAR, FRIROM_ERR_PARAM, set_status
     implicit none
 
 contains
@@ -39,6 +39,11 @@ contains
         if (info /= 0) return
         select type (sys)
         type is (hbm_condensed)
+            if (sys%tcontact) then
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'Hill stability needs '// &
+                                'the condensed unknowns on the nonlinear DoFs (T = P)')
+                return
+            end if
             colmap = sys%nl
         class default
             colmap = [(i, i = 1, nd)]

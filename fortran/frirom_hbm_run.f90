@@ -108,8 +108,25 @@ contains
                     return
                 end if
             end do
-            ncol = nnl
-            call csr_set(sys%cs%g, nrows, ncol, gp, gi2, gx, 'G', info, errmsg)
+            sys%tcontact = .false.
+            if (present(contact_coords)) sys%tcontact = contact_coords
+            if (present(krylov)) sys%krylov = krylov
+            if (present(sparse_lu)) sys%sparse_lu = sparse_lu
+            if (sys%tcontact) then
+                ! u = G x: T = G, and the contacts read u directly (G over u = I)
+                ncol = nrows
+                call csr_set(sys%t, nrows, ndof, gp, gi, gx, 'G', info, errmsg)
+                if (info /= 0) return
+                call csr_set(sys%cs%g, nrows, ncol, [(i, i=1, nrows + 1)], [(i, i=1, nrows)], &
+                             [(1.0_wp, i=1, nrows)], 'G', info, errmsg)
+            else
+                ! u = P x: T selects the nl DoFs, G's columns renumbered to them
+                ncol = nnl
+                call csr_set(sys%t, nnl, ndof, [(i, i=1, nnl + 1)], nl, [(1.0_wp, i=1, nnl)], &
+                             'T', info, errmsg)
+                if (info /= 0) return
+                call csr_set(sys%cs%g, nrows, ncol, gp, gi2, gx, 'G', info, errmsg)
+            end if
         class default
             ncol = ndof
             call csr_set(sys%cs%g, nrows, ncol, gp, gi, gx, 'G', info, errmsg)

@@ -11,8 +11,10 @@ program test_hbm
     implicit none
     integer(ip), parameter :: ndof = 4, nh = 3, nc = 2*nh + 1
     type(hbm_condensed) :: sc, scl
-    type(hbm_full) :: sf, sfl, sbad, sfn
-    type(hbm_condensed) :: scn, scm, sch
+    type(hbm_full), target :: sf
+    type(hbm_full) :: sfl, sbad, sfn
+    type(hbm_condensed) :: scn, scm, sch, sct, sctl, sctn, sctm, scd
+    type(hbm_full) :: sfd
     complex(wp) :: psi(ndof, ndof, 0:nh)
     real(wp) :: yr(3*nc), r1(3*nc), r2(3*nc), rl1(3*nc), rl2(3*nc), rr1, rr2
     integer(ip) :: h
@@ -61,12 +63,34 @@ program test_hbm
     call check(info == 0, 'setup full: '//trim(msg))
     call fd_check(sc, 'condensed')
     call fd_check(sf, 'full')
-    call agree()
+    call agree(sc, 'condensed')
+    ! unknowns in contact coordinates u = G x (2 per harmonic instead of 3 DoFs)
+    call hbm_setup(sct, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
+                   fe1, 1, 0.0_wp, ginfo, gp, gi, gx, params, w0, outd, info, msg, &
+                   contact_coords=.true.)
+    call check(info == 0 .and. sct%n == 2*nc, 'setup condensed in G x: '//trim(msg))
+    call fd_check(sct, 'condensed G x')
+    call agree(sct, 'condensed G x')
+    ! two cubic elements that each read all three nl DoFs (an interface reduced to a few
+    ! generalised DoFs): dF/dU summed densely before the product with R_h
+    call hbm_setup(scd, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
+                   fe1, 1, 0.0_wp, ginfo, [1, 4, 7], [2, 3, 4, 2, 3, 4], &
+                   [1.0_wp, -0.5_wp, 0.3_wp, 0.2_wp, 0.7_wp, -1.0_wp], params, w0, outd, info, msg)
+    call check(info == 0, 'setup condensed, dense dF/dU: '//trim(msg))
+    call fd_check(scd, 'condensed dense dF/dU')
+    call hbm_setup(sfd, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
+                   fe1, 1, 0.0_wp, ginfo, [1, 4, 7], [2, 3, 4, 2, 3, 4], &
+                   [1.0_wp, -0.5_wp, 0.3_wp, 0.2_wp, 0.7_wp, -1.0_wp], params, w0, outd, info, msg)
+    call agree(scd, 'condensed dense dF/dU', sfd)
     ! load mode: same checks with lam = load factor
     call hbm_setup(scl, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
                    fe1, 2, 0.9_wp, ginfo, gp, gi, gx, params, w0, outd, info, msg)
     call check(info == 0, 'setup condensed load')
     call fd_check(scl, 'condensed load')
+    call hbm_setup(sctl, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
+                   fe1, 2, 0.9_wp, ginfo, gp, gi, gx, params, w0, outd, info, msg, &
+                   contact_coords=.true.)
+    call fd_check(sctl, 'condensed G x load')
     call hbm_setup(sfl, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
                    fe1, 2, 0.9_wp, ginfo, gp, gi, gx, params, w0, outd, info, msg)
     call fd_check(sfl, 'full load')
@@ -78,6 +102,11 @@ program test_hbm
                    [1.0_wp, 1.0_wp], [0.5_wp, 1.0_wp, 0.3_wp, 0.2_wp], [0.0_wp], outd, info, msg)
     call check(info == 0, 'setup normal1d: '//trim(msg))
     call fd_check(scn, 'condensed normal1d')
+    call hbm_setup(sctn, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
+                   fe1, 1, 0.0_wp, reshape([2, 1, 2], [3, 1]), [1, 2, 3], [3, 4], &
+                   [1.0_wp, 1.0_wp], [0.5_wp, 1.0_wp, 0.3_wp, 0.2_wp], [0.0_wp], outd, info, &
+                   msg, contact_coords=.true.)
+    call fd_check(sctn, 'condensed G x normal1d')
     call hbm_setup(sfn, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
                    fe1, 1, 0.0_wp, reshape([2, 1, 2], [3, 1]), [1, 2, 3], [3, 4], &
                    [1.0_wp, 1.0_wp], [0.5_wp, 1.0_wp, 0.3_wp, 0.2_wp], [0.0_wp], outd, info, msg)
@@ -98,6 +127,13 @@ program test_hbm
     call hbm_set_modes(scm, kd, sqrt(wev), [(0.02_wp, i = 1, ndof)], info, msg)
     call check(info == 0, 'set modes: '//trim(msg))
     call fd_check(scm, 'condensed modal')
+    ! all modes, contact coordinates: the modal route's J, dR/dw and outputs
+    call hbm_setup(sctm, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
+                   fe1, 1, 0.0_wp, ginfo, gp, gi, gx, params, w0, outd, info, msg, &
+                   contact_coords=.true.)
+    call hbm_set_modes(sctm, kd, sqrt(wev), [(0.02_wp, i = 1, ndof)], info, msg)
+    call check(info == 0, 'set modes G x: '//trim(msg))
+    call fd_check(sctm, 'condensed G x modal')
     ! modes per harmonic (hbm_set_modes_harmonic, the cyclic-sector path): the real shapes
     ! times a phase of their own for every mode and harmonic give the same receptances
     ! Psi g Psi^H, hence the same residual and dR/dw as the real modes to rounding
@@ -174,16 +210,22 @@ contains
     end subroutine fd_check
 
     !> Both formulations solved at the same frequency give the same output harmonics.
-    subroutine agree()
+    subroutine agree(sc, name, sfo)
+        class(hbm_system), intent(inout) :: sc
+        character(len=*), intent(in) :: name
+        type(hbm_full), intent(inout), optional, target :: sfo  !! default: sf
         type(cont_options) :: o
+        type(hbm_full), pointer :: pf
         real(wp), allocatable :: yc(:), yf(:), z(:)
         real(wp) :: lc, lf, xc(ndof, nc), xf(ndof, nc)
         integer(ip) :: it
         logical :: hf
+        pf => sf
+        if (present(sfo)) pf => sfo
         o%tol_r = 1.0e-13_wp
         o%tol_x = 1.0e-12_wp
         o%yscale = 1.0e-3_wp
-        allocate (yc(sc%n), yf(sf%n))
+        allocate (yc(sc%n), yf(pf%n))
         yc = 0.0_wp
         yf = 0.0_wp
         lc = 0.9_wp
@@ -192,18 +234,18 @@ contains
         z = 0.0_wp
         hf = .false.
         call newton_correct(sc, yc, lc, yc, lc, z, 1.0_wp, o, it, info, msg, hf)
-        call check(info == 0, 'condensed Newton: '//trim(msg))
+        call check(info == 0, name//' Newton: '//trim(msg))
         deallocate (z)
-        allocate (z(sf%n))
+        allocate (z(pf%n))
         z = 0.0_wp
         hf = .false.
-        call newton_correct(sf, yf, lf, yf, lf, z, 1.0_wp, o, it, info, msg, hf)
+        call newton_correct(pf, yf, lf, yf, lf, z, 1.0_wp, o, it, info, msg, hf)
         call check(info == 0, 'full Newton: '//trim(msg))
         call sc%outputs(yc, lc, xc, info, msg)
-        call sf%outputs(yf, lf, xf, info, msg)
+        call pf%outputs(yf, lf, xf, info, msg)
         err = maxval(abs(xc - xf))/maxval(abs(xf))
-        print '(a,es10.2,a,es10.2)', 'condensed vs full: max rel diff', err, &
+        print '(a,a,es10.2,a,es10.2)', name, ' vs full: max rel diff', err, &
             '  |x| =', maxval(abs(xf))
-        call check(err < 1.0e-10_wp, 'condensed and full formulations agree')
+        call check(err < 1.0e-10_wp, name//' and full formulations agree')
     end subroutine agree
 end program test_hbm

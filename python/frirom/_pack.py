@@ -28,6 +28,12 @@ if TYPE_CHECKING:
 
 #: Largest Hill eigenproblem (2 n_dof (2H+1)) computed; above it stability is skipped.
 HILL_MAX = 4000
+#: Largest model whose receptances 'auto' takes from all its modes (a dense eigen-solve).
+MODES_MAX = 4000
+#: Damping counts as diagonal in the modes when every |Phi^T C Phi|_rs is below this
+#: times sqrt(c_rr c_ss) (plus 1e-13 of the largest c_rr): the receptances then differ
+#: from the factorised ones by about this, relative.
+DIAG_TOL = 1e-10
 
 
 def _real_constant(name: str) -> float:
@@ -60,7 +66,8 @@ _ICONT_AT = np.array(list(_ICONT.values()))
 _TIMER_SLOTS = {name: int_constant(slot) - 1 for name, slot in (
     ("aft", "T_AFT"), ("assembly", "T_ASM"), ("factorization", "T_FACT"),
     ("solve", "T_SOLVE"), ("receptance", "T_REC"), ("evaluations", "N_EVAL"),
-    ("factorizations", "N_FACT"), ("fortran_total", "N_TIMERS"))}
+    ("factorizations", "N_FACT"), ("krylov_iterations", "N_KRYLOV"),
+    ("fortran_total", "N_TIMERS"))}
 TIMER_NAMES = tuple(sorted(_TIMER_SLOTS, key=_TIMER_SLOTS.get))
 
 
@@ -135,6 +142,63 @@ def _lowest_modes(model: Model, nm: int, H: int) -> _Modes:
     m = _Modes.none(n, H)
     m.nmodes, m.phi, m.omega, m.zeta = w.size, np.asfortranarray(phi), w, z
     return m
+
+
+def _all_modes(model: Model, H: int, need_diagonal: bool) -> _Modes | str:
+    """All modes of the model (dense eigh of K, M) with the damping ratios that make the
+    modal receptances exact: diag(Phi^T C Phi) / (2 w) when Phi^T C Phi is diagonal
+    (modal, Rayleigh or no damping). Otherwise the reason they do not apply (a str)."""
+    K, M, C = (a.toarray() for a in (model.K, model.M, model.C))
+    w2, phi = sla.eigh(K, M)
+    if np.any(w2 <= 0):
+        return "rigid-body (zero-frequency) modes"
+    cm = phi.T @ C @ phi
+    d = np.diag(cm).copy()
+    off = cm - np.diag(d)
+    scale = np.sqrt(np.outer(np.abs(d), np.abs(d))) + 1e-13 * max(np.abs(d).max(), 1e-300)
+    if need_diagonal and np.any(np.abs(off) > DIAG_TOL * scale):
+        return "damping not diagonal in the modes (a general C)"
+    w = np.sqrt(w2)
+    m = _Modes.none(model.n_dof, H)
+    m.nmodes, m.phi, m.omega, m.zeta = w.size, np.asfortranarray(phi), w, d / (2.0 * w)
+    return m
+
+
+#: 'auto' factorises D_h by sparse LU (MUMPS) instead of a band when the band LU would
+#: take more than this many flops per harmonic (n_dof bw^2, bw the RCM half-bandwidth).
+SPARSE_FLOPS = 5e8
+
+
+def _receptance_route(model: Model, opts: SolverOptions, H: int,
+                      bw: int) -> tuple[_Modes, str, bool]:
+    """Modes, a description of how the condensed receptances are found (see
+    SolverOptions.receptances) and whether D_h is factorised by sparse LU."""
+    n = model.n_dof
+    if opts.modes:
+        return (_lowest_modes(model, int(opts.modes), H),
+                f"receptances from the lowest {opts.modes} modes (truncated)", False)
+    why = ""
+    if opts.receptances == "modes":
+        m = _all_modes(model, H, True)
+        if isinstance(m, str):
+            raise ParameterError(f"options.receptances: 'modes' not possible: {m}; use "
+                                 "'factorization'")
+        return m, f"receptances from all {n} modes (exact)", False
+    if opts.receptances == "sparse":
+        return _Modes.none(n, H), "receptances by sparse LU (MUMPS) per harmonic", True
+    if opts.receptances == "auto":
+        dense = model.K.nnz >= 0.1 * n * n
+        if n <= MODES_MAX and dense:
+            m = _all_modes(model, H, True)
+            if not isinstance(m, str):
+                return m, f"receptances from all {n} modes (exact; dense model)", False
+            why = f" ({m})"
+        else:
+            why = " (sparse or large model)"
+        if n * float(bw) ** 2 > SPARSE_FLOPS:
+            return (_Modes.none(n, H), f"receptances by sparse LU (MUMPS) per harmonic "
+                    f"(half-bandwidth {bw} of {n} DoFs{why})", True)
+    return (_Modes.none(n, H), f"receptances by banded LU per harmonic{why}", False)
 
 
 class _Contacts(NamedTuple):
@@ -226,6 +290,9 @@ class _Packed:
     out_f: np.ndarray         # (n_out,) their rows, 0-based
     stability: bool
     modes: _Modes
+    tcontact: bool = False    # condensed unknowns in contact coordinates G x
+    sparse: bool = False      # condensed receptances by sparse LU (MUMPS)
+    info: str = ""            # how the system is solved (FRF.solver_info)
 
     @property
     def nc(self) -> int:
@@ -233,8 +300,16 @@ class _Packed:
 
     @property
     def ny(self) -> int:
-        """Unknowns: harmonics of the contact DoFs (condensed) or of all rows (banded)."""
-        return (self.nl.size if self.opts.formulation == "condensed" else self.n_dof) * self.nc
+        """Unknowns: harmonics of the contact DoFs or coordinates (condensed) or of all
+        rows (banded)."""
+        return self.nrow * self.nc
+
+    @property
+    def nrow(self) -> int:
+        """Unknowns per harmonic coefficient."""
+        if self.opts.formulation != "condensed":
+            return self.n_dof
+        return self.G[0].size - 1 if self.tcontact else self.nl.size
 
     @property
     def ne_tot(self) -> int:
@@ -278,7 +353,8 @@ class _Packed:
             y0=y0, lam0=lam0, tan0=tan0, start_mode=start_mode, ropt=ropt, iopt=iopt,
             stability=int(self.stability), history=int(o.history), maxpts=maxpts,
             netot=max(self.ne_tot, 1), ntim=len(_TIMER_SLOTS), nh=self.H, ndof=self.n_dof,
-            nnl=self.nl.size or 1)
+            nnl=self.nl.size or 1, tcontact=int(self.tcontact),
+            krylov=-1 if o.krylov is None else int(o.krylov), sparse=int(self.sparse))
         r = _CallResult(*res[:-1], msg=res[-1].decode(errors="replace"))
         if r.npts > 0 and self.nw and o.history:
             self.w0 = r.sliders[:self.nw, r.npts - 1].copy()
@@ -288,11 +364,16 @@ class _Packed:
         """Unknowns of a solution with H_from harmonics, extended or cut to this H."""
         y = np.asarray(y, dtype=float)
         condensed = self.opts.formulation == "condensed"
-        nrow = self.nl.size if condensed else self.n_dof
+        nrow = self.nrow
         nc_from = 2 * H_from + 1
         if y.size != nrow * nc_from:
+            other = self.nl.size if self.tcontact else self.G[0].size - 1
+            hint = ""
+            if condensed and y.size == other * nc_from:
+                hint = (" (they fit the other condensed unknowns: set options.coordinates = "
+                        f"{'dofs' if self.tcontact else 'contact'!r})")
             raise SizeError(f"start: {y.size} unknowns do not match H = {H_from} for this "
-                            "model and formulation")
+                            f"model and formulation{hint}")
         m = min(nc_from, self.nc)
         out = np.zeros(self.ny)
         if condensed:           # harmonic-major: y[j + nnl c]
@@ -378,12 +459,30 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
                       f"size 2 n_dof (2H+1) = {2 * n * (2 * H + 1)} > {HILL_MAX}",
                       RuntimeWarning, stacklevel=4)
         stability = False
-    modes = _lowest_modes(model, int(opts.modes), H) if opts.modes else _Modes.none(n, H)
+    tcontact, sparse, info = False, False, f"banded: {n * (2 * H + 1)} unknowns"
+    modes = _Modes.none(n, H)
+    if opts.formulation == "condensed":
+        nrows = c.G.shape[0]
+        if opts.coordinates == "contact" and opts.stability:
+            raise ParameterError("options.coordinates: 'contact' cannot be used with "
+                                 "stability (Hill's method needs the contact DoFs)")
+        tcontact = opts.coordinates == "contact" or (
+            opts.coordinates == "auto" and nrows < nl.size and not opts.stability)
+        iperm = np.empty(n, dtype=np.int64)
+        iperm[perm - 1] = np.arange(n)
+        pc = pat.tocoo()
+        bw = int(np.abs(iperm[pc.row] - iperm[pc.col]).max())
+        modes, route, sparse = _receptance_route(model, opts, H, bw)
+        nu = nrows if tcontact else nl.size
+        info = (f"condensed: {nu * (2 * H + 1)} unknowns, "
+                + (f"{nu} contact coordinates G x" if tcontact else f"{nu} contact DoFs")
+                + f"; {route}")
     return _Packed(opts=opts, H=H, n_dof=n, fe0=fe0, fe1=fe1,
                    K=_csr(model.K), M=_csr(model.M), C=_csr(model.C), perm=perm, nl=nl,
                    G=_csr(c.G), ginfo=c.ginfo, params=c.params, w0=c.w0, nw=c.nw,
                    group_names=c.names, group_sizes=c.sizes, outputs=out, out_f=out,
-                   stability=stability, modes=modes)
+                   stability=stability, modes=modes, tcontact=tcontact, sparse=sparse,
+                   info=info)
 
 
 def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Packed:
@@ -430,8 +529,14 @@ def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Pa
         modes.psi[nb, :r, h] = m.psi[rows[nb] - n] * np.exp(1j * m.k * alpha)
         modes.omega_h[:r, h], modes.zeta_h[:r, h] = m.omega, m.zeta
     empty = _csr(sp.csr_matrix((nr, nr)))
+    tcontact = o.coordinates == "contact" or (o.coordinates == "auto"
+                                              and G.shape[0] < cols.size)
+    nu = G.shape[0] if tcontact else cols.size
     return _Packed(opts=o, H=H, n_dof=nr, fe0=fe0_r, fe1=fe1_r,
                    K=empty, M=empty, C=empty, perm=np.arange(1, nr + 1, dtype=np.int32),
                    nl=at[cols], G=_csr(G), ginfo=c.ginfo, params=c.params, w0=c.w0,
                    nw=c.nw, group_names=c.names, group_sizes=c.sizes, outputs=out,
-                   out_f=at[out], stability=False, modes=modes)
+                   out_f=at[out], stability=False, modes=modes, tcontact=tcontact,
+                   info=f"condensed: {nu * (2 * H + 1)} unknowns, {nu} "
+                        + ("contact coordinates G x" if tcontact else "contact DoFs")
+                        + "; receptances from each harmonic's nodal-diameter modes")

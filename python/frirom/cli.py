@@ -140,6 +140,7 @@ def cmd_run(args) -> int:
         progress.close()
         writer.close(complete=result.complete, message=result.message)
         elapsed = time.perf_counter() - t0
+        print(f"frirom: {result.solver_info}")
         if not result.complete:
             print(f"frirom: the run stopped early: {result.message}; the points computed "
                   f"are in {h5}", file=sys.stderr)

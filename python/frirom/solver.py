@@ -27,7 +27,7 @@ from typing import Callable
 import numpy as np
 
 from ._errors import CODES, ParameterError, SizeError, raise_for_status
-from ._pack import HILL_MAX, TIMER_NAMES  # noqa: F401 - public here, defined with the packing
+from ._pack import HILL_MAX, MODES_MAX, TIMER_NAMES  # noqa: F401 - public here
 from ._pack import (START_CONTINUE, START_RESUME, START_SOLVE_ONLY, YSCALE_RELATIVE, _Packed,
                     _split_load, add_timings, pack)
 from .harmonics import default_samples
@@ -90,6 +90,28 @@ class SolverOptions:
     refine_peak : bool
         Frequency runs: solve each output's peak on the curve between the points around
         the largest one (FRF.peaks, FRF.peak; about ten corrector solves per output).
+    coordinates : {'auto', 'dofs', 'contact'}
+        Condensed formulation: unknowns are the harmonics of the contact DoFs ('dofs') or
+        of the contact elements' local relative displacements G x ('contact'); 'auto' takes
+        the shorter ('dofs' when stability is asked: Hill's method needs them).
+    receptances : {'auto', 'modes', 'factorization', 'sparse'}
+        Condensed formulation, without `modes`: how the receptances T D_h^-1 T^T are
+        found at each frequency. 'modes': from all modes of the model, one dense
+        eigen-decomposition (exact; needs damping that the modes diagonalise: modal,
+        Rayleigh, none); 'factorization': a banded LU of the dynamic stiffness per
+        harmonic (any damping); 'sparse': a sparse LU (MUMPS) per harmonic (any
+        damping; large unreduced FE). 'auto': 'modes' for a dense model (reduced: at
+        most :data:`MODES_MAX` DoFs, >= 10 % of K's entries non-zero) whose damping the
+        modes diagonalise, else 'sparse' when the band LU would cost more than
+        ``_pack.SPARSE_FLOPS`` per harmonic, else 'factorization'. The choice is in
+        ``FRF.solver_info``.
+    krylov : bool or None
+        Condensed formulation: solve with each new Jacobian by GMRES preconditioned by
+        the LU of an earlier one, factorising again only when GMRES needs many
+        iterations (same answers, 2-10x fewer dense LUs). None: off. Measured at ROM_I
+        size (2 800 unknowns, cases/bench/condensed.py): GMRES iterations are memory
+        bound (~25 ms each, 2 cores shared) and the stale preconditioner needs ~8-18 per
+        solve, so the FRF takes as long as with a new LU per Jacobian.
     """
 
     harmonics: int = 3
@@ -110,6 +132,9 @@ class SolverOptions:
     modes: int | None = None
     batch: int = 10
     refine_peak: bool = True
+    coordinates: str = "auto"
+    receptances: str = "auto"
+    krylov: bool | None = None
 
     def check(self) -> None:
         """Raise ParameterError naming the first invalid field."""
@@ -135,6 +160,11 @@ class SolverOptions:
         if self.modes is not None and (self.modes < 1 or self.formulation != "condensed"):
             raise ParameterError("options.modes: a positive number of modes, with "
                                  "formulation 'condensed'")
+        for nm, allowed in (("coordinates", ("auto", "dofs", "contact")),
+                            ("receptances", ("auto", "modes", "factorization", "sparse"))):
+            if getattr(self, nm) not in allowed:
+                raise ParameterError(f"options.{nm}: expected one of {list(allowed)}, got "
+                                     f"{getattr(self, nm)!r}")
         if self.max_iter < 1 or self.max_points < 1 or self.batch < 1:
             raise ParameterError("options.max_iter, max_points and batch must be >= 1")
 
@@ -317,6 +347,7 @@ class _Continuation:
                               complete=complete, message=message,
                               stability_computed=p.stability)
         out.timings = self.timings
+        out.solver_info = p.info
         if keep_unknowns and pts:
             out._last_unknowns = pts[-1].unknowns
             out._last_slider = pts[-1].slider

@@ -1,0 +1,193 @@
+"""The condensed formulation's unknown coordinates and receptance routes give the answers of
+the path they replace (issue 10, items 1-3).
+
+Reference: unknowns on the contact DoFs with receptances from a banded LU of the dynamic
+stiffness per harmonic (the route of every earlier release). Against it: unknowns in
+contact coordinates G x, receptances from all modes of the model (one dense eigh) and from
+a sparse LU (MUMPS) per harmonic, each alone and with either coordinates, on
+  * a lattice of two blocks touching on a plane (an unreduced, sparse FE-like model,
+    tests/_lattices.py), normal1d friction on every node pair along tilted directions so
+    that each contact row reads 6 DoFs (72 contact DoFs, 24 contact coordinates), and
+  * its Craig-Bampton reduction (dense: the route 'auto' takes the modes).
+The preload and force make the contacts stick, slip and lift off at the frequencies used.
+The Jacobians of the new routes are checked against finite differences in
+tests/test_hbm.f90; the cyclic sector (modes per harmonic, contact coordinates chosen
+automatically) against the full rotor in tests/test_cyclic_solver.py.
+
+Tolerance 1e-8 on the output harmonics, relative to their largest: every solve converges
+to a residual of 1e-12 (relative), and J has condition ~1e3 here.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from _lattices import two_blocks
+from frirom import ParameterError
+from frirom.model import ContactGroup, Damping, Excitation, Model
+from frirom.reduction.cb import craig_bampton
+from frirom.solver import SolverOptions, frf, solve_point
+
+TOL = 1e-8
+OPTS = dict(harmonics=2, samples=40, tol_residual=1e-12, tol_update=1e-12, max_iter=60)
+ROUTES = [("contact", "factorization"), ("dofs", "modes"), ("contact", "modes"),
+          ("dofs", "sparse"), ("contact", "sparse")]
+
+
+def _unit(v):
+    v = np.asarray(v, float)
+    return v / np.linalg.norm(v)
+
+
+def _contact_G(m, n):
+    """Two rows per node pair (tangential, normal), tilted: each reads 6 DoFs."""
+    t, nn = _unit([1.0, 0.3, 0.2]), _unit([0.1, -0.2, 1.0])
+    pairs = len(m["dofs_a"])
+    G = sp.lil_matrix((2 * pairs, n))
+    for e, (a, b) in enumerate(zip(m["dofs_a"], m["dofs_b"])):
+        for d, v in enumerate((t, nn)):
+            G[2 * e + d, a] = v
+            G[2 * e + d, b] = -v
+    return G.tocsr()
+
+
+@pytest.fixture(scope="module")
+def models():
+    m = two_blocks(nx=4, ny=3, nz=3, seed=2)
+    K, M = m["K"], m["M"]
+    n = K.shape[0]
+    G = _contact_G(m, n)
+    params = (3e5, 3e5, 0.3, 2.0)                   # kt, kn (N/m), mu, n0 (N)
+    damp = Damping.rayleigh(5.0, 2e-6)
+    full = Model(M, K, damp, [ContactGroup("normal1d", G, params, name="plane")])
+    masters = np.unique(np.concatenate([G.indices, m["active"]]))
+    cb = craig_bampton((K, M), 12, masters=masters)
+    at = -np.ones(n, dtype=np.int64)
+    at[cb.master_index] = np.arange(cb.master_index.size)
+    Gr = sp.csr_matrix((G.data, at[G.indices], G.indptr), shape=(G.shape[0], cb.K.shape[0]))
+    red = Model(cb.M, cb.K, damp, [ContactGroup("normal1d", Gr, params, name="plane")])
+    # stuck-contact first resonance of the full model, force on the active node
+    Ks = (K + G.T @ sp.diags(np.full(G.shape[0], 3e5)) @ G).toarray()
+    import scipy.linalg as sla
+    w1 = float(np.sqrt(sla.eigh(Ks, M.toarray(), eigvals_only=True, subset_by_index=[0, 0])[0]))
+    F = np.zeros((n, 2), complex)
+    F[m["active"], 1] = [15.0, 5.0, 10.0]
+    Fr = np.zeros((cb.K.shape[0], 2), complex)
+    Fr[at[m["active"]], 1] = F[m["active"], 1]
+    out_f, out_r = m["active"], at[m["active"]]
+    return dict(full=(full, Excitation(F), out_f), red=(red, Excitation(Fr), out_r), w1=w1)
+
+
+def _solve(model, ex, out, w, **kw):
+    p = solve_point(model, ex, w, SolverOptions(**OPTS, **kw), outputs=out)
+    return p
+
+
+@pytest.mark.parametrize("which", ["full", "red"])
+def test_routes_agree_with_the_banded_dof_route(models, which):
+    """Output harmonics of each route against the reference at three frequencies around
+    the stuck resonance; the contacts are in mixed states there (asserted)."""
+    model, ex, out = models[which]
+    mixed = 0
+    for w in (0.9 * models["w1"], 1.05 * models["w1"], 1.2 * models["w1"]):
+        ref = _solve(model, ex, out, w, coordinates="dofs", receptances="factorization")
+        st = ref.state_fractions[0]
+        mixed += st[1] > 0.01 or st[2] > 0.01          # slip or lift-off somewhere
+        scale = np.abs(ref.X).max()
+        for coords, rec in ROUTES:
+            p = _solve(model, ex, out, w, coordinates=coords, receptances=rec)
+            err = np.abs(p.X - ref.X).max() / scale
+            assert err < TOL, (which, w, coords, rec, err)
+            assert p.unknowns.size == (24 if coords == "contact" else 72) * 5
+    assert mixed >= 2
+
+
+def test_auto_choice_and_its_log(models):
+    """'auto' takes the contact coordinates when they are fewer, the modes for the dense
+    reduced model and the banded LU for the sparse one; FRF.solver_info says so. An FRF
+    along the new route passes through the reference's solutions at its own points."""
+    model, ex, out = models["red"]
+    w1 = models["w1"]
+    r = frf(model, ex, 1.17 * w1, 1.2 * w1, SolverOptions(**OPTS), outputs=out)
+    assert r.complete
+    assert "24 contact coordinates" in r.solver_info and "all" in r.solver_info
+    assert "modes (exact" in r.solver_info
+    for k in (1, len(r.omega) // 2, len(r.omega) - 1):
+        ref = _solve(model, ex, out, r.omega[k], coordinates="dofs",
+                     receptances="factorization")
+        assert np.abs(r.X[k] - ref.X).max() / np.abs(ref.X).max() < TOL
+    # a lumped chain (tridiagonal K: sparse) keeps the banded LU; one contact element
+    # reading one DoF: the contact DoFs are as few as the coordinates, and are kept
+    n = 60
+    K = sp.diags([np.full(n - 1, -1e6), np.full(n, 2e6), np.full(n - 1, -1e6)], [-1, 0, 1])
+    chain = Model(sp.identity(n) * 0.1, K, Damping.rayleigh(1.0, 1e-6),
+                  [ContactGroup("jenkins", sp.csr_matrix(([1.0], ([0], [n - 1])), (1, n)),
+                                (1e6, 0.3, 1.0))])
+    F = np.zeros((n, 2), complex)
+    F[n // 2, 1] = 1.0
+    r2 = frf(chain, Excitation(F), 100.0, 101.0, SolverOptions(**OPTS, max_points=2))
+    assert "banded LU" in r2.solver_info and "sparse" in r2.solver_info
+    assert "1 contact DoFs" in r2.solver_info
+
+
+def test_general_damping_keeps_the_factorisation(models):
+    """A damper between two DoFs is not diagonal in the modes: 'auto' factorises (and
+    says why), 'modes' is refused with a message naming the option; stability forces the
+    contact DoFs as unknowns, and asking for contact coordinates with it is refused."""
+    model, ex, out = models["red"]
+    n = model.n_dof
+    C = model.C.toarray()
+    C[0, 0] += 5.0
+    C[1, 1] += 5.0
+    C[0, 1] -= 5.0
+    C[1, 0] -= 5.0
+    m2 = Model(model.M, model.K, Damping.matrix(C), model.contacts)
+    w = 0.95 * models["w1"]
+    p_auto = solve_point(m2, ex, w, SolverOptions(**OPTS, max_points=2), outputs=out)
+    r = frf(m2, ex, w, 1.001 * w, SolverOptions(**OPTS, max_points=2), outputs=out)
+    assert "not diagonal" in r.solver_info
+    ref = _solve(m2, ex, out, w, coordinates="dofs", receptances="factorization")
+    assert np.abs(p_auto.X - ref.X).max() / np.abs(ref.X).max() < TOL
+    with pytest.raises(ParameterError, match="options.receptances"):
+        _solve(m2, ex, out, w, receptances="modes")
+    with pytest.raises(ParameterError, match="options.coordinates"):
+        _solve(model, ex, out, w, coordinates="contact", stability=True)
+    with pytest.raises(ParameterError, match="options.coordinates"):
+        SolverOptions(coordinates="nodes").check()
+    assert n == model.n_dof
+
+
+def test_krylov_solves_agree_with_direct_ones(models):
+    """GMRES on the current J preconditioned by an older LU (forced on here; by default
+    from 1000 unknowns): the same points to TOL, along an FRF through slip, with fewer
+    factorisations than Jacobians."""
+    model, ex, out = models["red"]
+    w1 = models["w1"]
+    res = {}
+    for kr in (False, True):
+        o = SolverOptions(**OPTS, krylov=kr)
+        r = frf(model, ex, 1.17 * w1, 1.2 * w1, o, outputs=out)
+        assert r.complete
+        res[kr] = r
+    for k in (1, len(res[True].omega) // 2, len(res[True].omega) - 1):
+        ref = _solve(model, ex, out, res[True].omega[k], coordinates="dofs",
+                     receptances="factorization")
+        assert np.abs(res[True].X[k] - ref.X).max() / np.abs(ref.X).max() < TOL
+    assert res[True].timings["factorizations"] < 0.5 * res[False].timings["factorizations"]
+
+
+def test_start_from_the_other_coordinates_is_explained(models):
+    """A saved point whose unknowns are on the contact DoFs (an earlier release, or
+    coordinates='dofs') does not fit the contact coordinates 'auto' takes: the error says
+    which option makes it fit, and with it the point resumes to the same solution."""
+    model, ex, out = models["red"]
+    w = 1.05 * models["w1"]
+    p = _solve(model, ex, out, w, coordinates="dofs")
+    from frirom import SizeError
+    with pytest.raises(SizeError, match="options.coordinates = 'dofs'"):
+        solve_point(model, ex, w, SolverOptions(**OPTS), outputs=out, start=p)
+    q = solve_point(model, ex, w, SolverOptions(**OPTS, coordinates="dofs"), outputs=out,
+                    start=p)
+    assert np.abs(q.X - p.X).max() / np.abs(p.X).max() < TOL
