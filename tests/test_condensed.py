@@ -165,16 +165,20 @@ def test_krylov_solves_agree_with_direct_ones(models):
     factorisations than Jacobians."""
     model, ex, out = models["red"]
     w1 = models["w1"]
-    res = {}
+    res, kept = {}, []
     for kr in (False, True):
         o = SolverOptions(**OPTS, krylov=kr)
-        r = frf(model, ex, 1.17 * w1, 1.2 * w1, o, outputs=out)
+        r = frf(model, ex, 1.17 * w1, 1.2 * w1, o, outputs=out,
+                sink=kept.append if kr else None)
         assert r.complete
         res[kr] = r
-    for k in (1, len(res[True].omega) // 2, len(res[True].omega) - 1):
-        ref = _solve(model, ex, out, res[True].omega[k], coordinates="dofs",
-                     receptances="factorization")
-        assert np.abs(res[True].X[k] - ref.X).max() / np.abs(ref.X).max() < TOL
+    # each point re-solved by direct LUs from its own unknowns and contact history (a
+    # fresh start from the linear solution may find another stuck state: friction is
+    # history dependent)
+    for k in (1, len(kept) // 2, len(kept) - 1):
+        ref = solve_point(model, ex, kept[k].omega, SolverOptions(**OPTS, krylov=False),
+                          outputs=out, start=kept[k])
+        assert np.abs(kept[k].X - ref.X).max() / np.abs(ref.X).max() < TOL
     assert res[True].timings["factorizations"] < 0.5 * res[False].timings["factorizations"]
 
 
