@@ -11,7 +11,8 @@ contains
         integer(ip), parameter :: NMAX = 4000
         real(wp), allocatable :: jm(:, :), d1(:, :), md(:, :), a(:, :), wr(:), wi(:), &
                                  work(:), key(:)
-        real(wp) :: w, s, hw, vl(1, 1), vr(1, 1), wq(1)
+        real(wp), allocatable :: vr(:, :)
+        real(wp) :: w, s, hw, vl(1, 1), wq(1)
         integer(ip), allocatable :: colmap(:), idx(:)
         integer(ip) :: nd, nc, n, i, k, j, h, c, linfo, lwork, stat, m, t
         info = FRIROM_OK
@@ -84,16 +85,23 @@ contains
         a(n + 1:2*n, 1:n) = -jm
         a(n + 1:2*n, n + 1:2*n) = -d1
         deallocate (jm, d1)
-        call dgeev('N', 'N', 2*n, a, 2*n, wr, wi, vl, 1, vr, 1, wq, -1, linfo)
+        allocate (vr(2*n, 2*n), stat=stat)
+        if (stat /= 0) then
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'Hill eigenvectors')
+            return
+        end if
+        call dgeev('N', 'V', 2*n, a, 2*n, wr, wi, vl, 1, vr, 2*n, wq, -1, linfo)
         lwork = int(wq(1))
         allocate (work(lwork))
-        call dgeev('N', 'N', 2*n, a, 2*n, wr, wi, vl, 1, vr, 1, work, lwork, linfo)
+        call dgeev('N', 'V', 2*n, a, 2*n, wr, wi, vl, 1, vr, 2*n, work, lwork, linfo)
         if (linfo /= 0) then
             call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'Hill: dgeev did not converge')
             return
         end if
-        ! the 2 ndof exponents with the smallest |Im s| (selection sort, m is small)
-        key = abs(wi)
+        ! each exponent repeats 2H+1 times shifted by i h w, its eigenvector shifted by h
+        ! harmonics: keep the 2 ndof whose eigenvectors are centred on harmonic 0
+        call harmonic_centroids(vr, wi, nd, sys%nh, key)
+        key = abs(key)
         idx = [(i, i = 1, 2*n)]
         m = 2*nd
         do i = 1, m
@@ -108,6 +116,42 @@ contains
         end do
         maxre = maxval(real(expo, wp))
     end procedure hbm_hill
+
+    !> Harmonic centroid of each eigenvector of the Hill matrix: sum_k k |p_k|^2 / sum_k
+    !> |p_k|^2 over the complex harmonics k = -H..H of its displacement part p (rows
+    !> 1..nd(2H+1) of vr, slot 1 constant, 2h cos, 2h+1 sin). dgeev's storage: a complex
+    !> pair j, j+1 (wi(j) > 0) has eigenvectors vr(:, j) +- i vr(:, j+1); a real
+    !> eigenvector has centroid 0.
+    pure subroutine harmonic_centroids(vr, wi, nd, nh, cen)
+        real(wp), intent(in) :: vr(:, :)  !! (2n, 2n) right eigenvectors from dgeev
+        real(wp), intent(in) :: wi(:)     !! (2n) imaginary parts of the eigenvalues
+        integer(ip), intent(in) :: nd, nh
+        real(wp), intent(out) :: cen(:)   !! (2n) centroids, harmonic index
+        integer(ip) :: j, h, ic, is
+        real(wp) :: tot, mom
+        cen = 0.0_wp
+        j = 1
+        do while (j <= size(wi))
+            if (wi(j) == 0.0_wp) then
+                j = j + 1
+                cycle
+            end if
+            ! |p_h|^2 - |p_-h|^2 = xr_c . xi_s - xi_c . xr_s for p = xr + i xi
+            tot = sum(vr(1:nd, j)**2) + sum(vr(1:nd, j + 1)**2)
+            mom = 0.0_wp
+            do h = 1, nh
+                ic = nd*(2*h - 1)
+                is = nd*(2*h)
+                tot = tot + 0.5_wp*(sum(vr(ic + 1:ic + nd, j:j + 1)**2) + &
+                                    sum(vr(is + 1:is + nd, j:j + 1)**2))
+                mom = mom + h*(dot_product(vr(ic + 1:ic + nd, j), vr(is + 1:is + nd, j + 1)) &
+                               - dot_product(vr(ic + 1:ic + nd, j + 1), vr(is + 1:is + nd, j)))
+            end do
+            cen(j) = mom/max(tot, tiny(1.0_wp))
+            cen(j + 1) = -cen(j)
+            j = j + 2
+        end do
+    end subroutine harmonic_centroids
 
     !> a(slot r of DoF i, slot c of DoF j) += alpha s(i, j) over the entries of row i of s,
     !> for a dense a whose slot c of DoF j is index j + nd (c - 1).
