@@ -8,7 +8,6 @@ number of the boundary is typed here.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -26,8 +25,9 @@ from .results import FRFPoint, amplitude_max
 if TYPE_CHECKING:
     from .solver import SolverOptions
 
-#: Largest Hill eigenproblem (2 n_dof (2H+1)) computed; above it stability is skipped.
-HILL_MAX = 4000
+#: Largest Hill eigenproblem (2 n_dof (2H+1)) solved densely (all exponents, dgeev);
+#: above it the exponents near the imaginary axis come from shift-invert Arnoldi.
+HILL_MAX = int_constant("HILL_DENSE_MAX")
 
 
 def _real_constant(name: str) -> float:
@@ -371,11 +371,6 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
     raise_for_status(info, msg.decode(errors="replace"))
     out = _check_outputs((np.arange(n) if n <= 100 else nl) if outputs is None else outputs, n)
     stability = bool(opts.stability)
-    if stability and 2 * n * (2 * H + 1) > HILL_MAX:
-        warnings.warn(f"frirom: Hill stability skipped: its dense eigenproblem would have "
-                      f"size 2 n_dof (2H+1) = {2 * n * (2 * H + 1)} > {HILL_MAX}",
-                      RuntimeWarning, stacklevel=4)
-        stability = False
     modes = _lowest_modes(model, int(opts.modes), H) if opts.modes else _Modes.none(n, H)
     return _Packed(opts=opts, H=H, n_dof=n, fe0=fe0, fe1=fe1,
                    K=_csr(model.K), M=_csr(model.M), C=_csr(model.C), perm=perm, nl=nl,
