@@ -67,7 +67,8 @@ contains
         end if
     end procedure hbm_hill
 
-    !> All 2n exponents (dgeev with eigenvectors); keeps the 2 ndof most centred ones.
+    !> All 2n exponents (dgeev with eigenvectors), then those `kept`; expo: the kept ones,
+    !> then (-huge, 0).
     subroutine hill_dense(sys, w, expo, maxre, info, errmsg)
         class(hbm_system), intent(inout) :: sys
         real(wp), intent(in) :: w
@@ -76,17 +77,17 @@ contains
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
         real(wp), allocatable :: jm(:, :), d1(:, :), md(:, :), a(:, :), wr(:), wi(:), &
-                                 work(:), key(:), vr(:, :)
+                                 work(:), vr(:, :)
         complex(wp), allocatable :: p(:, :)
         real(wp) :: hw, vl(1, 1), wq(1)
-        integer(ip), allocatable :: colmap(:), idx(:)
+        integer(ip), allocatable :: colmap(:)
         integer(ip) :: nd, nc, n, i, k, j, h, c, linfo, lwork, stat, t
         info = FRIROM_OK
         nd = sys%ndof
         nc = sys%nc
         n = nd*nc
-        allocate (jm(n, n), d1(n, n), md(nd, nd), a(2*n, 2*n), wr(2*n), wi(2*n), key(2*n), &
-                  idx(2*n), p(nc, nd), stat=stat)
+        allocate (jm(n, n), d1(n, n), md(nd, nd), a(2*n, 2*n), wr(2*n), wi(2*n), p(nc, nd), &
+                  stat=stat)
         if (stat /= 0) then
             call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'Hill matrices')
             return
@@ -153,43 +154,36 @@ contains
             return
         end if
         ! dgeev: a complex pair j, j+1 (wi(j) > 0) has eigenvectors vr(:, j) +- i vr(:, j+1)
+        expo = cmplx(-huge(1.0_wp), 0.0_wp, wp)
+        maxre = -huge(1.0_wp)
+        k = 0
         j = 1
         do while (j <= 2*n)
-            if (wi(j) == 0.0_wp) then
+            t = merge(1, 2, wi(j) == 0.0_wp)
+            if (t == 1) then
                 p = transpose(reshape(cmplx(vr(1:n, j), 0.0_wp, wp), [nd, nc]))
-                key(j) = abs(centroid(p))
-                j = j + 1
             else
                 p = transpose(reshape(cmplx(vr(1:n, j), vr(1:n, j + 1), wp), [nd, nc]))
-                key(j) = abs(centroid(p))
-                key(j + 1) = key(j)
-                j = j + 2
             end if
+            if (kept(cmplx(wr(j), wi(j), wp), centroid(p), w, sys%nh)) then
+                ! the pair's two members (conjugates, centroids of opposite sign) alike
+                do i = j, j + t - 1
+                    k = k + 1
+                    if (k <= size(expo)) expo(k) = cmplx(wr(i), wi(i), wp)
+                end do
+                maxre = max(maxre, wr(j))
+            end if
+            j = j + t
         end do
-        ! the 2 ndof most centred (selection sort, 2 ndof is small)
-        idx = [(i, i = 1, 2*n)]
-        do i = 1, 2*nd
-            k = i
-            do j = i + 1, 2*n
-                if (key(idx(j)) < key(idx(k))) k = j
-            end do
-            t = idx(i)
-            idx(i) = idx(k)
-            idx(k) = t
-            expo(i) = cmplx(wr(idx(i)), wi(idx(i)), wp)
-        end do
-        maxre = maxval(real(expo, wp))
     end subroutine hill_dense
 
-    !> The exponents near s = i m w, m = 0..H, by shift-invert Arnoldi on the linearised
-    !> problem A = [0 I; -M^-1 J, -M^-1 D1], whose (A - sigma)^-1 needs one solve with the
-    !> banded Q(sigma) = J + sigma D1 + sigma^2 M (RCM order, as the full formulation). Kept:
-    !> the centred exponents (|centroid| <= 1/2) within w/2 of the shift in Im. Parametric
-    !> and sum-combination resonances with harmonics <= H involve an exponent with
-    !> |Im s| <= (H + 1/2) w, so these decide stability. Each shift covers the disc
-    !> |s - sigma| <= w/sqrt(2) (NEV_MAX exponents at most): an exponent with |Re s| > w/2
-    !> may be missed. expo: the kept exponents, then (-huge, 0) for the entries not
-    !> computed.
+    !> The exponents near s = 0 by shift-invert Arnoldi on the linearised problem
+    !> A = [0 I; -M^-1 J, -M^-1 D1], whose (A - sigma)^-1 needs one solve with the banded
+    !> Q(sigma) = J + sigma D1 + sigma^2 M (RCM order, as the full formulation); kept: those
+    !> in the strip |Im s| <= w/2. The disc |s| <= w/sqrt(2) is covered (NEV_MAX exponents
+    !> at most): an exponent with |Re s| > w/2 may be missed, and so are the exponents of
+    !> modes above (H + 1/2) w (no copy in the strip; the dense path keeps their centred
+    !> copy). expo: the kept exponents, then (-huge, 0).
     subroutine hill_arnoldi(sys, w, expo, maxre, info, errmsg)
         class(hbm_system), intent(inout) :: sys
         real(wp), intent(in) :: w
@@ -202,8 +196,8 @@ contains
         complex(wp), allocatable :: ev(:), vec(:, :)
         integer(ip), allocatable :: ipc(:)
         complex(wp) :: sg
-        real(wp) :: hw, cen, best
-        integer(ip) :: nd, nc, n, kl, i, h, c, m, k, nev, nconv, nk
+        real(wp) :: hw
+        integer(ip) :: nd, nc, n, kl, i, h, c, k, nev, nconv, nk, t
         logical :: ok
         info = FRIROM_OK
         nd = sys%ndof
@@ -245,45 +239,35 @@ contains
         call contact_assemble(sys%cs, kb=jr, iperm=ipc, info=info, errmsg=errmsg)
         if (info /= 0) return
         expo = cmplx(-huge(1.0_wp), 0.0_wp, wp)
-        nk = 0
         maxre = -huge(1.0_wp)
-        best = huge(1.0_wp)
-        nev = 0
-        do m = 0, sys%nh
-            sg = cmplx(0.0_wp, m*w, wp)
+        sg = (0.0_wp, 0.0_wp)
+        do t = 1, 2
             q%ab = jr%ab + sg*dr%ab + sg*sg*mr%ab
             q%factored = .false.
             call band_factor(q, info, errmsg)
+            if (info == 0) exit
+            ! an exponent exactly on the shift (a fold): move the shift off the axis
+            if (t == 2) return
+            info = FRIROM_OK
+            sg = cmplx(1.0e-3_wp*w, 0.0_wp, wp)
+        end do
+        nev = min(NEV0, 2*n - 2)
+        do
+            call shift_invert(q, dr, mr, sg, nev, ev, vec, nconv, info, errmsg)
             if (info /= 0) return
-            ! start from the count the previous window needed (nev = 0 before the first)
-            nev = min(max(NEV0, nev), 2*n - 2)
-            do
-                call shift_invert(q, dr, mr, sg, nev, ev, vec, nconv, info, errmsg)
-                if (info /= 0) return
-                ! enough when the disc reached covers the square |Im s - m w| <= w/2,
-                ! |Re s| <= w/2 (period doubling sits at the window's edge, Im s = w/2)
-                if (nconv == 0) exit
-                if (maxval(abs(ev(1:nconv) - sg)) >= w/sqrt(2.0_wp) .or. &
-                    nev >= min(NEV_MAX, 2*n - 2)) exit
-                nev = min(2*nev, NEV_MAX, 2*n - 2)
-            end do
-            do k = 1, nconv
-                cen = centroid(reshape(vec(1:n, k), [nc, nd]))
-                if (abs(aimag(ev(k)) - m*w) > 0.5_wp*w) cycle
-                if (abs(cen) > 0.5_wp) then
-                    ! no centred exponent at all: report the most centred one found
-                    if (nk == 0 .and. abs(cen) < best) then
-                        best = abs(cen)
-                        maxre = real(ev(k), wp)
-                    end if
-                    cycle
-                end if
-                if (nk == 0) maxre = -huge(1.0_wp)
-                best = 0.0_wp
-                nk = nk + 1
-                if (nk <= size(expo)) expo(nk) = ev(k)
-                maxre = max(maxre, real(ev(k), wp))
-            end do
+            ! enough when the disc reached covers the square |Im s|, |Re s| <= w/2
+            ! (period doubling sits at its edge, Im s = w/2)
+            if (nconv == 0) exit
+            if (maxval(abs(ev(1:nconv))) >= w/sqrt(2.0_wp) .or. &
+                nev >= min(NEV_MAX, 2*n - 2)) exit
+            nev = min(2*nev, NEV_MAX, 2*n - 2)
+        end do
+        nk = 0
+        do k = 1, nconv
+            if (.not. kept(ev(k), 0.0_wp, w, sys%nh)) cycle
+            nk = nk + 1
+            if (nk <= size(expo)) expo(nk) = ev(k)
+            maxre = max(maxre, real(ev(k), wp))
         end do
     end subroutine hill_arnoldi
 
@@ -374,6 +358,22 @@ contains
             end do
         end do
     end subroutine band_matvec
+
+    !> Whether an exponent s of the truncated Hill matrix is kept: every exponent appears
+    !> 2H+1 times, shifted by i h w. The AFT Jacobian of a hysteretic law linearises the
+    !> slider's memory as if s were 0 (a perturbation p(t) e^(s t) recalled from the last
+    !> stick onset t_s is off by e^(-s (t - t_s))), so the copy with the smallest |s|, in
+    !> the strip |Im s| <= w/2, is the accurate one (the off-strip copies of a friction
+    !> model can have Re s of either sign, time integration siding with the strip). A mode
+    !> above (H + 1/2) w has no copy in the strip: its copy centred on harmonic 0 is kept.
+    pure logical function kept(s, cen, w, nh)
+        complex(wp), intent(in) :: s   !! exponent, 1/s
+        real(wp), intent(in) :: cen    !! harmonic centroid of its eigenvector
+        real(wp), intent(in) :: w      !! excitation frequency, rad/s
+        integer(ip), intent(in) :: nh
+        kept = abs(aimag(s)) <= 0.5_wp*w*(1.0_wp + 1.0e-10_wp) .or. &
+               (abs(cen) <= 0.5_wp .and. abs(aimag(s)) > (nh + 0.5_wp)*w)
+    end function kept
 
     !> Harmonic centroid sum_k k |p_k|^2 / sum_k |p_k|^2 of a Hill eigenvector over the
     !> complex harmonics k = -H..H: p(slot, DoF) with slot 1 constant, 2h cos h, 2h+1 sin h,

@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from .solver import SolverOptions
 
 #: Largest Hill eigenproblem (2 n_dof (2H+1)) solved densely (all exponents, dgeev);
-#: above it the exponents near the imaginary axis come from shift-invert Arnoldi.
+#: above it the exponents of the strip |Im s| <= omega/2 come from shift-invert Arnoldi.
 HILL_MAX = int_constant("HILL_DENSE_MAX")
 
 
