@@ -24,9 +24,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from ccx import (STEEL, matrix_storage_steps, nset, run_ccx,  # noqa: E402
-                 solid_material)
-from lap_joint import GMSH_TO_C3D10  # noqa: E402
+from ccx import STEEL, run_ccx, write_tet10_deck  # noqa: E402
+from lap_joint import generate_tet10  # noqa: E402
 
 GEOMETRY = dict(L=0.2, W=0.02, T=0.02, x0=0.08, x1=0.12)   # m
 
@@ -43,17 +42,7 @@ def cantilever_pad_mesh(size=0.006, L=0.2, W=0.02, T=0.02, x0=0.08, x1=0.12):
         boxes = [occ.addBox(a, 0, 0, b - a, W, T) for a, b in ((0, x0), (x0, x1), (x1, L))]
         occ.fragment([(3, boxes[0])], [(3, b) for b in boxes[1:]])
         occ.synchronize()
-        gmsh.option.setNumber("Mesh.MeshSizeMax", size)
-        gmsh.option.setNumber("Mesh.MeshSizeMin", size / 4)
-        gmsh.option.setNumber("Mesh.ElementOrder", 2)
-        gmsh.option.setNumber("Mesh.SecondOrderLinear", 1)
-        gmsh.model.mesh.generate(3)
-        tags, xyz, _ = gmsh.model.mesh.getNodes()
-        xyz = xyz.reshape(-1, 3)
-        etypes, _, enodes = gmsh.model.mesh.getElements(dim=3)
-        if list(etypes) != [11]:
-            raise RuntimeError(f"gmsh made element types {list(etypes)}, expected 11 (tet10)")
-        elems = enodes[0].reshape(-1, 10)[:, GMSH_TO_C3D10].astype(np.int64)
+        tags, xyz, elems = generate_tet10(gmsh, size)
     finally:
         gmsh.finalize()
     ids = tags.astype(np.int64)
@@ -69,21 +58,9 @@ def cantilever_pad_mesh(size=0.006, L=0.2, W=0.02, T=0.02, x0=0.08, x1=0.12):
 
 def write_cantilever_pad_deck(path, size=0.006, n_ref_modes=0, material=STEEL):
     """Mesh the beam and write its CalculiX deck (matrix storage); returns the path."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     ids, xyz, elems, sets = cantilever_pad_mesh(size=size, **GEOMETRY)
-    with open(path, "w") as fh:
-        fh.write(f"** cantilever with a side pad, gmsh C3D10, size {size} m\n*NODE, NSET=ALL\n")
-        for i, (x, y, z) in zip(ids, xyz):
-            fh.write(f"{i}, {x:.12g}, {y:.12g}, {z:.12g}\n")
-        fh.write("*ELEMENT, TYPE=C3D10, ELSET=EALL\n")
-        for e, conn in enumerate(elems, start=1):
-            fh.write(f"{e}, " + ", ".join(str(c) for c in conn) + "\n")
-        for name, nodes in sets.items():
-            fh.write(nset(name, nodes))
-        fh.write(solid_material(material) + "*BOUNDARY\nFIX, 1, 3\n"
-                 + matrix_storage_steps(n_ref_modes))
-    return path
+    return write_tet10_deck(path, f"cantilever with a side pad, gmsh C3D10, size {size} m",
+                            ids, xyz, elems, sets, n_ref_modes, material)
 
 
 def make(out, size=0.006) -> Path:
