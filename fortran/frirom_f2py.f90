@@ -276,7 +276,7 @@ subroutine int_constant(name, value, info, msg)
                              RCONT_LSCALE, RCONT_DS, RCONT_DS_MIN, RCONT_DS_MAX, RCONT_LAM_END, &
                              RCONT_LAM_LO, N_RCONT, ICONT_MAX_ITER, ICONT_REUSE_JAC, N_ICONT
     use frirom_hbm, only: T_AFT, T_ASM, T_FACT, T_SOLVE, T_REC, N_EVAL, N_FACT, N_KRYLOV, &
-                          N_TIMERS, &
+                          N_TIMERS, HILL_DENSE_MAX, &
                           HBM_START_CONTINUE, HBM_START_RESUME, HBM_START_SOLVE_ONLY
     implicit none
     character(len=*), intent(in) :: name
@@ -321,6 +321,8 @@ subroutine int_constant(name, value, info, msg)
         value = HBM_START_RESUME
     case ('HBM_START_SOLVE_ONLY')
         value = HBM_START_SOLVE_ONLY
+    case ('HILL_DENSE_MAX')
+        value = HILL_DENSE_MAX
     case ('T_AFT')
         value = T_AFT
     case ('T_ASM')

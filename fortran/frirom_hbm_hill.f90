@@ -1,42 +1,61 @@
 !> Hill stability of frirom_hbm's periodic solutions: Floquet exponents from the
-!> linearised harmonic balance equations over all DoFs x harmonics.
+!> linearised harmonic balance equations over all DoFs x harmonics, dense (dgeev) up to
+!> 2n = HILL_DENSE_MAX unknowns, shift-invert Arnoldi (ARPACK znaupd) on the banded
+!> matrices above.
 submodule (frirom_hbm) frirom_hbm_hill
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_ALLOC, FRIROM_ERR_LAPACK, &
-                             FRIROM_ERR_SINGULAR, FRIROM_ERR_PARAM, set_status
+                             FRIROM_ERR_SINGULAR, FRIROM_ERR_ARPACK, FRIROM_ERR_MODEL, &
+                             FRIROM_ERR_PARAM, set_status
+    use frirom_banded, only: band_init, band_add, band_factor, band_solve
     implicit none
+
+    !> Arnoldi: eigenvalues wanted per shift at first, at most.
+    integer(ip), parameter :: NEV0 = 16, NEV_MAX = 256
+
+    interface
+        subroutine znaupd(ido, bmat, n, which, nev, tol, resid, ncv, v, ldv, iparam, ipntr, &
+                          workd, workl, lworkl, rwork, info)
+            import :: wp
+            integer, intent(inout) :: ido
+            character(len=1), intent(in) :: bmat
+            integer, intent(in) :: n, nev, ncv, ldv, lworkl
+            character(len=2), intent(in) :: which
+            real(wp), intent(inout) :: tol
+            complex(wp), intent(inout) :: resid(n), v(ldv, ncv), workd(3*n), workl(lworkl)
+            real(wp), intent(inout) :: rwork(ncv)
+            integer, intent(inout) :: iparam(11), ipntr(14), info
+        end subroutine znaupd
+        subroutine zneupd(rvec, howmny, sel, d, z, ldz, sigma, workev, bmat, n, which, nev, &
+                          tol, resid, ncv, v, ldv, iparam, ipntr, workd, workl, lworkl, &
+                          rwork, info)
+            import :: wp
+            integer, intent(in) :: ldz, n, nev, ncv, ldv, lworkl
+            logical, intent(in) :: rvec
+            character(len=1), intent(in) :: howmny, bmat
+            logical, intent(inout) :: sel(ncv)
+            complex(wp), intent(out) :: d(nev + 1), z(ldz, *)
+            complex(wp), intent(in) :: sigma
+            complex(wp), intent(inout) :: workev(2*ncv)
+            character(len=2), intent(in) :: which
+            real(wp), intent(inout) :: tol
+            complex(wp), intent(inout) :: resid(n), v(ldv, ncv), workd(3*n), workl(lworkl)
+            real(wp), intent(inout) :: rwork(ncv)
+            integer, intent(inout) :: iparam(11), ipntr(14), info
+        end subroutine zneupd
+    end interface
 
 contains
 
     module procedure hbm_hill
-        integer(ip), parameter :: NMAX = 4000
-        real(wp), allocatable :: jm(:, :), d1(:, :), md(:, :), a(:, :), wr(:), wi(:), &
-                                 work(:), key(:)
-        real(wp) :: w, s, hw, vl(1, 1), vr(1, 1), wq(1)
-        integer(ip), allocatable :: colmap(:), idx(:)
-        integer(ip) :: nd, nc, n, i, k, j, h, c, linfo, lwork, stat, m, t
+        real(wp) :: w, s
+        integer(ip) :: nd, n
         info = FRIROM_OK
         nd = sys%ndof
-        nc = sys%nc
-        n = nd*nc
+        n = nd*sys%nc
         if (size(expo) /= 2*nd) then
             call set_status(info, FRIROM_ERR_SIZE, errmsg, 'hbm_hill: expo needs 2 ndof')
             return
         end if
-        if (2*n > NMAX) then
-            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'Hill stability: 2 ndof (2H+1) '// &
-                            'exceeds 4000 (dense eigen-solve); reduce the model or H')
-            return
-        end if
-        call freq_load(sys, lam, w, s)
-        allocate (jm(n, n), d1(n, n), md(nd, nd), a(2*n, 2*n), wr(2*n), wi(2*n), key(2*n), &
-                  idx(2*n), stat=stat)
-        if (stat /= 0) then
-            call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'Hill matrices')
-            return
-        end if
-        ! contact Jacobians at the solution (a condensed system's G has the nl DoFs as columns)
-        call hbm_contact_forces(sys, y, .true., info, errmsg)
-        if (info /= 0) return
         select type (sys)
         type is (hbm_condensed)
             if (sys%tcontact) then
@@ -44,6 +63,46 @@ contains
                                 'the condensed unknowns on the nonlinear DoFs (T = P)')
                 return
             end if
+        end select
+        call freq_load(sys, lam, w, s)
+        ! contact Jacobians at the solution
+        call hbm_contact_forces(sys, y, .true., info, errmsg)
+        if (info /= 0) return
+        if (2*n <= HILL_DENSE_MAX) then
+            call hill_dense(sys, w, expo, maxre, info, errmsg)
+        else
+            call hill_arnoldi(sys, w, expo, maxre, info, errmsg)
+        end if
+    end procedure hbm_hill
+
+    !> All 2n exponents (dgeev with eigenvectors), then those `kept`; expo: the kept ones,
+    !> then (-huge, 0).
+    subroutine hill_dense(sys, w, expo, maxre, info, errmsg)
+        class(hbm_system), intent(inout) :: sys
+        real(wp), intent(in) :: w
+        complex(wp), intent(out) :: expo(:)
+        real(wp), intent(out) :: maxre
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        real(wp), allocatable :: jm(:, :), d1(:, :), md(:, :), a(:, :), wr(:), wi(:), &
+                                 work(:), vr(:, :)
+        complex(wp), allocatable :: p(:, :)
+        real(wp) :: hw, vl(1, 1), wq(1)
+        integer(ip), allocatable :: colmap(:)
+        integer(ip) :: nd, nc, n, i, k, j, h, c, linfo, lwork, stat, t
+        info = FRIROM_OK
+        nd = sys%ndof
+        nc = sys%nc
+        n = nd*nc
+        allocate (jm(n, n), d1(n, n), md(nd, nd), a(2*n, 2*n), wr(2*n), wi(2*n), p(nc, nd), &
+                  stat=stat)
+        if (stat /= 0) then
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'Hill matrices')
+            return
+        end if
+        ! a condensed system's G has the nl DoFs as columns
+        select type (sys)
+        type is (hbm_condensed)
             colmap = sys%nl
         class default
             colmap = [(i, i = 1, nd)]
@@ -89,30 +148,260 @@ contains
         a(n + 1:2*n, 1:n) = -jm
         a(n + 1:2*n, n + 1:2*n) = -d1
         deallocate (jm, d1)
-        call dgeev('N', 'N', 2*n, a, 2*n, wr, wi, vl, 1, vr, 1, wq, -1, linfo)
+        allocate (vr(2*n, 2*n), stat=stat)
+        if (stat /= 0) then
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'Hill eigenvectors')
+            return
+        end if
+        call dgeev('N', 'V', 2*n, a, 2*n, wr, wi, vl, 1, vr, 2*n, wq, -1, linfo)
         lwork = int(wq(1))
         allocate (work(lwork))
-        call dgeev('N', 'N', 2*n, a, 2*n, wr, wi, vl, 1, vr, 1, work, lwork, linfo)
+        call dgeev('N', 'V', 2*n, a, 2*n, wr, wi, vl, 1, vr, 2*n, work, lwork, linfo)
         if (linfo /= 0) then
             call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'Hill: dgeev did not converge')
             return
         end if
-        ! the 2 ndof exponents with the smallest |Im s| (selection sort, m is small)
-        key = abs(wi)
-        idx = [(i, i = 1, 2*n)]
-        m = 2*nd
-        do i = 1, m
-            k = i
-            do j = i + 1, 2*n
-                if (key(idx(j)) < key(idx(k))) k = j
-            end do
-            t = idx(i)
-            idx(i) = idx(k)
-            idx(k) = t
-            expo(i) = cmplx(wr(idx(i)), wi(idx(i)), wp)
+        ! dgeev: a complex pair j, j+1 (wi(j) > 0) has eigenvectors vr(:, j) +- i vr(:, j+1)
+        expo = cmplx(-huge(1.0_wp), 0.0_wp, wp)
+        maxre = -huge(1.0_wp)
+        k = 0
+        j = 1
+        do while (j <= 2*n)
+            t = merge(1, 2, wi(j) == 0.0_wp)
+            if (t == 1) then
+                p = transpose(reshape(cmplx(vr(1:n, j), 0.0_wp, wp), [nd, nc]))
+            else
+                p = transpose(reshape(cmplx(vr(1:n, j), vr(1:n, j + 1), wp), [nd, nc]))
+            end if
+            if (kept(cmplx(wr(j), wi(j), wp), centroid(p), w, sys%nh)) then
+                ! the pair's two members (conjugates, centroids of opposite sign) alike
+                do i = j, j + t - 1
+                    k = k + 1
+                    if (k <= size(expo)) expo(k) = cmplx(wr(i), wi(i), wp)
+                end do
+                maxre = max(maxre, wr(j))
+            end if
+            j = j + t
         end do
-        maxre = maxval(real(expo, wp))
-    end procedure hbm_hill
+    end subroutine hill_dense
+
+    !> The exponents near s = 0 by shift-invert Arnoldi on the linearised problem
+    !> A = [0 I; -M^-1 J, -M^-1 D1], whose (A - sigma)^-1 needs one solve with the banded
+    !> Q(sigma) = J + sigma D1 + sigma^2 M (RCM order, as the full formulation); kept: those
+    !> in the strip |Im s| <= w/2. The disc |s| <= w/sqrt(2) is covered (NEV_MAX exponents
+    !> at most): an exponent with |Re s| > w/2 may be missed, and so are the exponents of
+    !> modes above (H + 1/2) w (no copy in the strip; the dense path keeps their centred
+    !> copy). expo: the kept exponents, then (-huge, 0).
+    subroutine hill_arnoldi(sys, w, expo, maxre, info, errmsg)
+        class(hbm_system), intent(inout) :: sys
+        real(wp), intent(in) :: w
+        complex(wp), intent(out) :: expo(:)
+        real(wp), intent(out) :: maxre
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        type(band_matrix) :: jr, dr, mr
+        type(zband_matrix) :: q
+        complex(wp), allocatable :: ev(:), vec(:, :)
+        integer(ip), allocatable :: ipc(:)
+        complex(wp) :: sg
+        real(wp) :: hw
+        integer(ip) :: nd, nc, n, kl, i, h, c, k, nev, nconv, nk, t
+        logical :: ok
+        info = FRIROM_OK
+        nd = sys%ndof
+        nc = sys%nc
+        n = nd*nc
+        kl = min(nc*(sys%bw + 1) - 1, n - 1)
+        call band_init(jr, n, kl, kl, info, errmsg)
+        if (info == 0) call band_init(dr, n, kl, kl, info, errmsg)
+        if (info == 0) call band_init(mr, n, kl, kl, info, errmsg)
+        if (info == 0) call band_init(q, n, kl, kl, info, errmsg)
+        if (info /= 0) return
+        ok = .true.
+        do i = 1, nd
+            do c = 1, nc
+                call band_row(jr, sys%k, sys%iperm, nc, i, c, c, 1.0_wp, ok)
+                call band_row(dr, sys%c, sys%iperm, nc, i, c, c, 1.0_wp, ok)
+                call band_row(mr, sys%m, sys%iperm, nc, i, c, c, 1.0_wp, ok)
+            end do
+            do h = 1, sys%nh
+                hw = h*w
+                call band_row(jr, sys%m, sys%iperm, nc, i, 2*h, 2*h, -hw*hw, ok)
+                call band_row(jr, sys%m, sys%iperm, nc, i, 2*h + 1, 2*h + 1, -hw*hw, ok)
+                call band_row(jr, sys%c, sys%iperm, nc, i, 2*h, 2*h + 1, hw, ok)
+                call band_row(jr, sys%c, sys%iperm, nc, i, 2*h + 1, 2*h, -hw, ok)
+                call band_row(dr, sys%m, sys%iperm, nc, i, 2*h, 2*h + 1, 2*hw, ok)
+                call band_row(dr, sys%m, sys%iperm, nc, i, 2*h + 1, 2*h, -2*hw, ok)
+            end do
+        end do
+        if (.not. ok) then
+            call set_status(info, FRIROM_ERR_MODEL, errmsg, 'Hill: entry outside the band')
+            return
+        end if
+        select type (sys)
+        type is (hbm_condensed)
+            ipc = sys%iperm(sys%nl)
+        class default
+            ipc = sys%iperm
+        end select
+        call contact_assemble(sys%cs, kb=jr, iperm=ipc, info=info, errmsg=errmsg)
+        if (info /= 0) return
+        expo = cmplx(-huge(1.0_wp), 0.0_wp, wp)
+        maxre = -huge(1.0_wp)
+        sg = (0.0_wp, 0.0_wp)
+        do t = 1, 2
+            q%ab = jr%ab + sg*dr%ab + sg*sg*mr%ab
+            q%factored = .false.
+            call band_factor(q, info, errmsg)
+            if (info == 0) exit
+            ! an exponent exactly on the shift (a fold): move the shift off the axis
+            if (t == 2) return
+            info = FRIROM_OK
+            sg = cmplx(1.0e-3_wp*w, 0.0_wp, wp)
+        end do
+        nev = min(NEV0, 2*n - 2)
+        do
+            call shift_invert(q, dr, mr, sg, nev, ev, vec, nconv, info, errmsg)
+            if (info /= 0) return
+            ! enough when the disc reached covers the square |Im s|, |Re s| <= w/2
+            ! (period doubling sits at its edge, Im s = w/2)
+            if (nconv == 0) exit
+            if (maxval(abs(ev(1:nconv))) >= w/sqrt(2.0_wp) .or. &
+                nev >= min(NEV_MAX, 2*n - 2)) exit
+            nev = min(2*nev, NEV_MAX, 2*n - 2)
+        end do
+        nk = 0
+        do k = 1, nconv
+            if (.not. kept(ev(k), 0.0_wp, w, sys%nh)) cycle
+            nk = nk + 1
+            if (nk <= size(expo)) expo(nk) = ev(k)
+            maxre = max(maxre, real(ev(k), wp))
+        end do
+    end subroutine hill_arnoldi
+
+    !> nev eigenpairs of A nearest sigma (ev, vec(2n, nconv), converged first) by ARPACK
+    !> on (A - sigma)^-1 [u; v] = [x; u + sigma x], Q(sigma) x = -M (v + sigma u) - D1 u.
+    subroutine shift_invert(q, dr, mr, sg, nev, ev, vec, nconv, info, errmsg)
+        type(zband_matrix), intent(in) :: q           !! Q(sigma), factored
+        type(band_matrix), intent(in) :: dr, mr       !! D1 and M over harmonics, banded
+        complex(wp), intent(in) :: sg                 !! shift sigma, 1/s
+        integer(ip), intent(in) :: nev
+        complex(wp), allocatable, intent(out) :: ev(:)      !! (nconv) eigenvalues, 1/s
+        complex(wp), allocatable, intent(out) :: vec(:, :)  !! (2n, nconv) eigenvectors
+        integer(ip), intent(out) :: nconv, info
+        character(len=*), intent(inout) :: errmsg
+        complex(wp), allocatable :: resid(:), v(:, :), workd(:), workl(:), workev(:), d(:), &
+                                    x(:, :)
+        real(wp), allocatable :: rwork(:)
+        logical, allocatable :: sel(:)
+        integer :: ido, iparam(11), ipntr(14), ainfo, n2, ncv, lworkl, nv
+        integer(ip) :: n, k
+        real(wp) :: tol
+        character(len=24) :: buf
+        info = FRIROM_OK
+        n = q%n
+        n2 = int(2*n)
+        nv = int(nev)
+        ncv = int(min(2*n, max(2*nev + 1, nev + 20)))
+        lworkl = 3*ncv*ncv + 5*ncv
+        allocate (resid(n2), v(n2, ncv), workd(3*n2), workl(lworkl), workev(2*ncv), &
+                  d(nv + 1), rwork(ncv), sel(ncv), x(n, 1))
+        iparam = 0
+        iparam(1) = 1           ! exact shifts
+        iparam(3) = 500         ! iterations
+        iparam(7) = 1           ! we apply (A - sigma)^-1 ourselves
+        ipntr = 0
+        ido = 0
+        ainfo = 0
+        tol = 1.0e-10_wp
+        do
+            call znaupd(ido, 'I', n2, 'LM', nv, tol, resid, ncv, v, n2, iparam, ipntr, &
+                        workd, workl, lworkl, rwork, ainfo)
+            if (ido /= -1 .and. ido /= 1) exit
+            associate (u => workd(ipntr(1):ipntr(1) + n - 1), &
+                       vv => workd(ipntr(1) + n:ipntr(1) + 2*n - 1), &
+                       ox => workd(ipntr(2):ipntr(2) + n - 1), &
+                       oy => workd(ipntr(2) + n:ipntr(2) + 2*n - 1))
+                x(:, 1) = 0.0_wp
+                call band_matvec(mr, vv + sg*u, x(:, 1))
+                call band_matvec(dr, u, x(:, 1))
+                x = -x
+                call band_solve(q, x, info, errmsg)
+                if (info /= 0) return
+                ox = x(:, 1)
+                oy = u + sg*x(:, 1)
+            end associate
+        end do
+        if (ainfo < 0 .or. ainfo > 1) then
+            write (buf, '(i0)') ainfo
+            call set_status(info, FRIROM_ERR_ARPACK, errmsg, 'Hill: znaupd info = '//trim(buf))
+            return
+        end if
+        nconv = iparam(5)
+        allocate (ev(nconv), vec(n2, max(nconv, 1)))
+        if (nconv == 0) return
+        call zneupd(.true., 'A', sel, d, v, n2, (0.0_wp, 0.0_wp), workev, 'I', n2, 'LM', nv, &
+                    tol, resid, ncv, v, n2, iparam, ipntr, workd, workl, lworkl, rwork, ainfo)
+        if (ainfo /= 0) then
+            write (buf, '(i0)') ainfo
+            call set_status(info, FRIROM_ERR_ARPACK, errmsg, 'Hill: zneupd info = '//trim(buf))
+            return
+        end if
+        do k = 1, nconv
+            ev(k) = sg + 1.0_wp/d(k)
+            vec(:, k) = v(:, k)
+        end do
+    end subroutine shift_invert
+
+    !> y += A x for a real banded A and a complex x.
+    subroutine band_matvec(a, x, y)
+        type(band_matrix), intent(in) :: a
+        complex(wp), intent(in) :: x(:)
+        complex(wp), intent(inout) :: y(:)
+        integer(ip) :: i, j, d
+        d = a%kl + a%ku + 1
+        do j = 1, a%n
+            do i = max(1_ip, j - a%ku), min(a%n, j + a%kl)
+                y(i) = y(i) + a%ab(d + i - j, j)*x(j)
+            end do
+        end do
+    end subroutine band_matvec
+
+    !> Whether an exponent s of the truncated Hill matrix is kept: every exponent appears
+    !> 2H+1 times, shifted by i h w. The AFT Jacobian of a hysteretic law linearises the
+    !> slider's memory as if s were 0 (a perturbation p(t) e^(s t) recalled from the last
+    !> stick onset t_s is off by e^(-s (t - t_s))), so the copy with the smallest |s|, in
+    !> the strip |Im s| <= w/2, is the accurate one (the off-strip copies of a friction
+    !> model can have Re s of either sign, time integration siding with the strip). A mode
+    !> above (H + 1/2) w has no copy in the strip: its copy centred on harmonic 0 is kept.
+    pure logical function kept(s, cen, w, nh)
+        complex(wp), intent(in) :: s   !! exponent, 1/s
+        real(wp), intent(in) :: cen    !! harmonic centroid of its eigenvector
+        real(wp), intent(in) :: w      !! excitation frequency, rad/s
+        integer(ip), intent(in) :: nh
+        kept = abs(aimag(s)) <= 0.5_wp*w*(1.0_wp + 1.0e-10_wp) .or. &
+               (abs(cen) <= 0.5_wp .and. abs(aimag(s)) > (nh + 0.5_wp)*w)
+    end function kept
+
+    !> Harmonic centroid sum_k k |p_k|^2 / sum_k |p_k|^2 of a Hill eigenvector over the
+    !> complex harmonics k = -H..H: p(slot, DoF) with slot 1 constant, 2h cos h, 2h+1 sin h,
+    !> so p_h = (p(2h) - i p(2h+1))/2 and p_-h = (p(2h) + i p(2h+1))/2.
+    pure function centroid(p) result(cen)
+        complex(wp), intent(in) :: p(:, :)   !! (2H+1, ndof)
+        real(wp) :: cen
+        real(wp) :: tot, mom, wp_, wm_
+        integer(ip) :: h
+        complex(wp), parameter :: im = (0.0_wp, 1.0_wp)
+        tot = sum(abs(p(1, :))**2)
+        mom = 0.0_wp
+        do h = 1, (size(p, 1) - 1)/2
+            wp_ = 0.25_wp*sum(abs(p(2*h, :) - im*p(2*h + 1, :))**2)
+            wm_ = 0.25_wp*sum(abs(p(2*h, :) + im*p(2*h + 1, :))**2)
+            tot = tot + wp_ + wm_
+            mom = mom + h*(wp_ - wm_)
+        end do
+        cen = mom/max(tot, tiny(1.0_wp))
+    end function centroid
 
     !> a(slot r of DoF i, slot c of DoF j) += alpha s(i, j) over the entries of row i of s,
     !> for a dense a whose slot c of DoF j is index j + nd (c - 1).
@@ -128,4 +417,18 @@ contains
             a(ia, ja) = a(ia, ja) + alpha*s%x(k)
         end do
     end subroutine add_row
+
+    !> The same for a banded a in RCM order: slot c of DoF j is index c + nc (iperm(j) - 1).
+    pure subroutine band_row(a, s, iperm, nc, i, r, c, alpha, ok)
+        type(band_matrix), intent(inout) :: a
+        type(csr_matrix), intent(in) :: s
+        integer(ip), intent(in) :: iperm(:), nc, i, r, c
+        real(wp), intent(in) :: alpha
+        logical, intent(inout) :: ok   !! set to .false. when an entry falls outside the band
+        integer(ip) :: k
+        do k = s%p(i), s%p(i + 1) - 1
+            call band_add(a, r + nc*(iperm(i) - 1), c + nc*(iperm(s%i(k)) - 1), &
+                          alpha*s%x(k), ok)
+        end do
+    end subroutine band_row
 end submodule frirom_hbm_hill

@@ -20,12 +20,27 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from ccx import (STEEL, matrix_storage_steps, nset, run_ccx,  # noqa: E402
-                 solid_material)
+from ccx import STEEL, run_ccx, write_tet10_deck  # noqa: E402
 
 # gmsh's 10-node tetrahedron numbers its last two edge nodes (2-3, 1-3) the other way
 # round from Abaqus/CalculiX C3D10 (1-3, 2-3 in 0-based vertices).
 GMSH_TO_C3D10 = [0, 1, 2, 3, 4, 5, 6, 7, 9, 8]
+
+
+def generate_tet10(gmsh, size):
+    """Mesh gmsh's current (synchronised) model with straight-sided 10-node tetrahedra of
+    size <= `size` [m]: node tags (n,), coordinates (n, 3), C3D10 connectivity (ne, 10)."""
+    gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+    gmsh.option.setNumber("Mesh.MeshSizeMin", size / 4)
+    gmsh.option.setNumber("Mesh.ElementOrder", 2)
+    gmsh.option.setNumber("Mesh.SecondOrderLinear", 1)     # straight edges: flat faces
+    gmsh.model.mesh.generate(3)
+    tags, xyz, _ = gmsh.model.mesh.getNodes()
+    etypes, _, enodes = gmsh.model.mesh.getElements(dim=3)
+    if list(etypes) != [11]:
+        raise RuntimeError(f"gmsh made element types {list(etypes)}, expected 11 (tet10)")
+    elems = enodes[0].reshape(-1, 10)[:, GMSH_TO_C3D10].astype(np.int64)
+    return tags, xyz.reshape(-1, 3), elems
 
 
 def lap_joint_mesh(L=0.1, W=0.03, t=0.005, a=0.03, size=0.006):
@@ -43,17 +58,7 @@ def lap_joint_mesh(L=0.1, W=0.03, t=0.005, a=0.03, size=0.006):
         occ.fragment([(3, a1)], [(3, a2)])
         occ.fragment([(3, b1)], [(3, b2)])
         occ.synchronize()
-        gmsh.option.setNumber("Mesh.MeshSizeMax", size)
-        gmsh.option.setNumber("Mesh.MeshSizeMin", size / 4)
-        gmsh.option.setNumber("Mesh.ElementOrder", 2)
-        gmsh.option.setNumber("Mesh.SecondOrderLinear", 1)     # straight edges: flat faces
-        gmsh.model.mesh.generate(3)
-        tags, xyz, _ = gmsh.model.mesh.getNodes()
-        xyz = xyz.reshape(-1, 3)
-        etypes, _, enodes = gmsh.model.mesh.getElements(dim=3)
-        if list(etypes) != [11]:
-            raise RuntimeError(f"gmsh made element types {list(etypes)}, expected 11 (tet10)")
-        elems = enodes[0].reshape(-1, 10)[:, GMSH_TO_C3D10].astype(np.int64)
+        tags, xyz, elems = generate_tet10(gmsh, size)
         eps = 1e-3 * t          # above the OCC bounding-box tolerance, far below t
 
         def nodes_in_box(x0, y0, z0, x1, y1, z1):
@@ -89,21 +94,9 @@ def lap_joint_mesh(L=0.1, W=0.03, t=0.005, a=0.03, size=0.006):
 
 def write_lap_joint_deck(path, size=0.006, n_ref_modes=20, material=STEEL, **geom):
     """Mesh the lap joint and write the CalculiX deck; returns the deck path."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     ids, xyz, elems, sets = lap_joint_mesh(size=size, **geom)
-    with open(path, "w") as fh:
-        fh.write(f"** lap joint, gmsh C3D10, size {size} m\n*NODE, NSET=ALL\n")
-        for i, (x, y, z) in zip(ids, xyz):
-            fh.write(f"{i}, {x:.12g}, {y:.12g}, {z:.12g}\n")
-        fh.write("*ELEMENT, TYPE=C3D10, ELSET=EALL\n")
-        for e, conn in enumerate(elems, start=1):
-            fh.write(f"{e}, " + ", ".join(str(c) for c in conn) + "\n")
-        for name, nodes in sets.items():
-            fh.write(nset(name, nodes))
-        fh.write(solid_material(material) + "*BOUNDARY\nFIX, 1, 3\n"
-                 + matrix_storage_steps(n_ref_modes))
-    return path
+    return write_tet10_deck(path, f"lap joint, gmsh C3D10, size {size} m", ids, xyz, elems,
+                            sets, n_ref_modes, material)
 
 
 def main(argv=None):

@@ -8,7 +8,6 @@ number of the boundary is typed here.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -26,8 +25,9 @@ from .results import FRFPoint, amplitude_max
 if TYPE_CHECKING:
     from .solver import SolverOptions
 
-#: Largest Hill eigenproblem (2 n_dof (2H+1)) computed; above it stability is skipped.
-HILL_MAX = 4000
+#: Largest Hill eigenproblem (2 n_dof (2H+1)) solved densely (all exponents, dgeev);
+#: above it the exponents of the strip |Im s| <= omega/2 come from shift-invert Arnoldi.
+HILL_MAX = int_constant("HILL_DENSE_MAX")
 #: Largest model whose receptances 'auto' takes from all its modes (a dense eigen-solve).
 MODES_MAX = 4000
 #: Damping counts as diagonal in the modes when every |Phi^T C Phi|_rs is below this
@@ -454,11 +454,6 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
     raise_for_status(info, msg.decode(errors="replace"))
     out = _check_outputs((np.arange(n) if n <= 100 else nl) if outputs is None else outputs, n)
     stability = bool(opts.stability)
-    if stability and 2 * n * (2 * H + 1) > HILL_MAX:
-        warnings.warn(f"frirom: Hill stability skipped: its dense eigenproblem would have "
-                      f"size 2 n_dof (2H+1) = {2 * n * (2 * H + 1)} > {HILL_MAX}",
-                      RuntimeWarning, stacklevel=4)
-        stability = False
     tcontact, sparse, info = False, False, f"banded: {n * (2 * H + 1)} unknowns"
     modes = _Modes.none(n, H)
     if opts.formulation == "condensed":

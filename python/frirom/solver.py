@@ -74,8 +74,10 @@ class SolverOptions:
         Keep a factorisation while Newton contracts by a factor 10 per iteration (a
         corrector that fails with reuse is retried with a fresh Jacobian every iteration).
     stability : bool
-        Hill's method at every point: a dense eigen-solve of size 2 n_dof (2H+1), skipped
-        with a warning above :data:`HILL_MAX`.
+        Hill's method at every point: the Floquet exponents in the strip |Im s| <= omega/2
+        (and the centred copies of modes above (H + 1/2) omega); a dense eigen-solve of
+        size 2 n_dof (2H+1) up to :data:`HILL_MAX`, shift-invert Arnoldi about s = 0 above
+        (strip only).
     history : bool
         Carry the contact history along the curve: each point starts its sliders where the
         previous point's closed cycles left them. False restarts every point from the
