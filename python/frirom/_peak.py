@@ -1,6 +1,8 @@
 """The peak of a continuation run solved on the curve: for each output, the largest
 max-over-the-period amplitude between the points around the largest one, found by a
-bounded Brent search along the curve whose every evaluation is one corrector solve.
+bounded Brent search along the curve whose every evaluation is one corrector solve (one
+search per resonance, for the first output that peaks there; the other outputs take the
+largest of its solves).
 
 The curve near the largest point i is parameterised by the arc length s along the tangent
 of point i - 1 (pseudo-arc-length: the corrector solves R = 0 on the hyperplane at distance
@@ -64,19 +66,32 @@ def refine_peaks(packed: _Packed, points: list, lam_end: float, lam_lo: float,
         return cache[key]
 
     amp = np.array([p.amp_max for p in points])
-    peaks = []
+    # candidates per output: every interior local maximum of the points close to the
+    # largest (two resonances of about the same height may swap once solved)
+    cands = []
     for j in range(amp.shape[1]):
         a = amp[:, j]
         i = int(np.argmax(a))
-        best = Peak(points[i].omega, float(a[i]), i)
-        # every local maximum of the points close to the largest: two resonances of about
-        # the same height may swap once solved between the points
         inner = np.flatnonzero((a[1:-1] >= a[:-2]) & (a[1:-1] >= a[2:])) + 1
         inner = inner[a[inner] >= (1.0 - NEAR) * a[i]]
-        for k in inner[np.argsort(-a[inner], kind="stable")][:MAX_CANDIDATES]:
-            p = _solve_peak(solve, points, int(k), j, lscale)
-            if p is not None and p.amp_max[j] > best.amplitude:
-                best = Peak(p.omega, float(p.amp_max[j]), int(k), "solve")
+        cands.append((i, inner[np.argsort(-a[inner], kind="stable")][:MAX_CANDIDATES]))
+    # one Brent search per candidate point, for the first output (in the caller's order)
+    # that has it; the other outputs sharing the candidate take the largest of the same
+    # solves (the corrector gives every output at once: a structure with 300 outputs costs
+    # what one output does, and their peaks are found to the spacing of those solves)
+    lead = {}
+    for j, (_, inner) in enumerate(cands):
+        for k in inner:
+            lead.setdefault(int(k), []).append(j)
+    for k, js in lead.items():
+        _solve_peak(solve, points, k, js[0], lscale)
+    peaks = []
+    for j, (i, inner) in enumerate(cands):
+        best = Peak(points[i].omega, float(amp[i, j]), i)
+        for k in inner:
+            for (b, _), p in cache.items():
+                if b == int(k) - 1 and p.amp_max[j] > best.amplitude:
+                    best = Peak(p.omega, float(p.amp_max[j]), int(k), "solve")
         peaks.append(best)
     return peaks
 
