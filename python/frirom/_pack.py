@@ -30,6 +30,9 @@ if TYPE_CHECKING:
 HILL_MAX = int_constant("HILL_DENSE_MAX")
 #: Largest model whose receptances 'auto' takes from all its modes (a dense eigen-solve).
 MODES_MAX = 4000
+#: Evaluations of an FRF that 'auto' weighs one eigen-decomposition against (a 100-point
+#: curve takes some 500 to 1 500)
+EIG_EVALS = 500
 #: Damping counts as diagonal in the modes when every |Phi^T C Phi|_rs is below this
 #: times sqrt(c_rr c_ss) (plus 1e-13 of the largest c_rr): the receptances then differ
 #: from the factorised ones by about this, relative.
@@ -187,11 +190,15 @@ def _receptance_route(model: Model, opts: SolverOptions, H: int,
     if opts.receptances == "sparse":
         return _Modes.none(n, H), "receptances by sparse LU (MUMPS) per harmonic", True
     if opts.receptances == "auto":
-        dense = model.K.nnz >= 0.1 * n * n
+        # one dense eigen-decomposition (~10 n^3 flops) against the band LUs it saves
+        # (n bw^2 per harmonic, some EIG_EVALS evaluations of an FRF): a Craig-Bampton
+        # model (a dense interface block beside a diagonal modal block) takes the modes,
+        # a lumped chain or an FE mesh keeps its narrow band
+        dense = 10.0 * n ** 3 <= EIG_EVALS * (H + 1) * n * float(bw) ** 2
         if n <= MODES_MAX and dense:
             m = _all_modes(model, H, True)
             if not isinstance(m, str):
-                return m, f"receptances from all {n} modes (exact; dense model)", False
+                return m, f"receptances from all {n} modes (exact; reduced model)", False
             why = f" ({m})"
         else:
             why = " (sparse or large model)"

@@ -102,9 +102,10 @@ class SolverOptions:
         eigen-decomposition (exact; needs damping that the modes diagonalise: modal,
         Rayleigh, none); 'factorization': a banded LU of the dynamic stiffness per
         harmonic (any damping); 'sparse': a sparse LU (MUMPS) per harmonic (any
-        damping; large unreduced FE). 'auto': 'modes' for a dense model (reduced: at
-        most :data:`MODES_MAX` DoFs, >= 10 % of K's entries non-zero) whose damping the
-        modes diagonalise, else 'sparse' when the band LU would cost more than
+        damping; large unreduced FE). 'auto': 'modes' for a model of at most
+        :data:`MODES_MAX` DoFs whose band LUs over an FRF (``_pack.EIG_EVALS``
+        evaluations) would cost more than one dense eigen-solve (a reduced model) and
+        whose damping the modes diagonalise, else 'sparse' when the band LU would cost more than
         ``_pack.SPARSE_FLOPS`` per harmonic, else 'factorization'. The choice is in
         ``FRF.solver_info``.
     krylov : bool or None
