@@ -155,12 +155,18 @@ def _all_modes(model: Model, H: int, need_diagonal: bool) -> _Modes | str:
     w2, phi = sla.eigh(K, M)
     if np.any(w2 <= 0):
         return "rigid-body (zero-frequency) modes"
-    cm = phi.T @ C @ phi
-    d = np.diag(cm).copy()
-    off = cm - np.diag(d)
-    scale = np.sqrt(np.outer(np.abs(d), np.abs(d))) + 1e-13 * max(np.abs(d).max(), 1e-300)
-    if need_diagonal and np.any(np.abs(off) > DIAG_TOL * scale):
-        return "damping not diagonal in the modes (a general C)"
+    if model.damping.kind == "rayleigh":
+        # Phi^T (alpha M + beta K) Phi = alpha + beta w^2 exactly: no test of round-off
+        # (a cyclic rotor's mode pairs are degenerate, and their computed Phi^T K Phi
+        # couples them at ~1e-10 of their eigenvalue)
+        d = model.damping.alpha + model.damping.beta * w2
+    else:
+        cm = phi.T @ C @ phi
+        d = np.diag(cm).copy()
+        off = cm - np.diag(d)
+        scale = np.sqrt(np.outer(np.abs(d), np.abs(d))) + 1e-13 * max(np.abs(d).max(), 1e-300)
+        if need_diagonal and np.any(np.abs(off) > DIAG_TOL * scale):
+            return "damping not diagonal in the modes (a general C)"
     w = np.sqrt(w2)
     m = _Modes.none(model.n_dof, H)
     m.nmodes, m.phi, m.omega, m.zeta = w.size, np.asfortranarray(phi), w, d / (2.0 * w)
