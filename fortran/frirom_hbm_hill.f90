@@ -87,9 +87,10 @@ contains
         real(wp), allocatable :: jm(:, :), d1(:, :), md(:, :), a(:, :), wr(:), wi(:), &
                                  work(:), vr(:, :)
         complex(wp), allocatable :: p(:, :)
-        real(wp) :: hw, vl(1, 1), wq(1)
+        real(wp) :: vl(1, 1), wq(1)
+        logical :: ok
         integer(ip), allocatable :: colmap(:)
-        integer(ip) :: nd, nc, n, i, k, j, h, c, linfo, lwork, stat, t
+        integer(ip) :: nd, nc, n, i, k, j, c, linfo, lwork, stat, t
         info = FRIROM_OK
         nd = sys%ndof
         nc = sys%nc
@@ -116,19 +117,7 @@ contains
             do k = sys%m%p(i), sys%m%p(i + 1) - 1
                 md(i, sys%m%i(k)) = md(i, sys%m%i(k)) + sys%m%x(k)
             end do
-            do c = 1, nc
-                call add_row(jm, sys%k, nd, i, c, c, 1.0_wp)
-                call add_row(d1, sys%c, nd, i, c, c, 1.0_wp)
-            end do
-            do h = 1, sys%nh
-                hw = h*w
-                call add_row(jm, sys%m, nd, i, 2*h, 2*h, -hw*hw)
-                call add_row(jm, sys%m, nd, i, 2*h + 1, 2*h + 1, -hw*hw)
-                call add_row(jm, sys%c, nd, i, 2*h, 2*h + 1, hw)
-                call add_row(jm, sys%c, nd, i, 2*h + 1, 2*h, -hw)
-                call add_row(d1, sys%m, nd, i, 2*h, 2*h + 1, 2*hw)
-                call add_row(d1, sys%m, nd, i, 2*h + 1, 2*h, -2*hw)
-            end do
+            call hill_linear_row(sys, i, w, ok, jm=jm, d1=d1)
         end do
         ! M^-1 applied to every harmonic row block of J and D1 (Cholesky of M)
         call dpotrf('L', nd, md, nd, linfo)
@@ -204,8 +193,7 @@ contains
         complex(wp), allocatable :: ev(:), vec(:, :)
         integer(ip), allocatable :: ipc(:)
         complex(wp) :: sg
-        real(wp) :: hw
-        integer(ip) :: nd, nc, n, kl, i, h, c, k, nev, nconv, nk, t
+        integer(ip) :: nd, nc, n, kl, i, k, nev, nconv, nk, t
         logical :: ok
         info = FRIROM_OK
         nd = sys%ndof
@@ -219,20 +207,7 @@ contains
         if (info /= 0) return
         ok = .true.
         do i = 1, nd
-            do c = 1, nc
-                call band_row(jr, sys%k, sys%iperm, nc, i, c, c, 1.0_wp, ok)
-                call band_row(dr, sys%c, sys%iperm, nc, i, c, c, 1.0_wp, ok)
-                call band_row(mr, sys%m, sys%iperm, nc, i, c, c, 1.0_wp, ok)
-            end do
-            do h = 1, sys%nh
-                hw = h*w
-                call band_row(jr, sys%m, sys%iperm, nc, i, 2*h, 2*h, -hw*hw, ok)
-                call band_row(jr, sys%m, sys%iperm, nc, i, 2*h + 1, 2*h + 1, -hw*hw, ok)
-                call band_row(jr, sys%c, sys%iperm, nc, i, 2*h, 2*h + 1, hw, ok)
-                call band_row(jr, sys%c, sys%iperm, nc, i, 2*h + 1, 2*h, -hw, ok)
-                call band_row(dr, sys%m, sys%iperm, nc, i, 2*h, 2*h + 1, 2*hw, ok)
-                call band_row(dr, sys%m, sys%iperm, nc, i, 2*h + 1, 2*h, -2*hw, ok)
-            end do
+            call hill_linear_row(sys, i, w, ok, jr=jr, dr=dr, mr=mr)
         end do
         if (.not. ok) then
             call set_status(info, FRIROM_ERR_MODEL, errmsg, 'Hill: entry outside the band')
@@ -405,6 +380,52 @@ contains
 
     !> a(slot r of DoF i, slot c of DoF j) += alpha s(i, j) over the entries of row i of s,
     !> for a dense a whose slot c of DoF j is index j + nd (c - 1).
+    !> Row i (every harmonic slot of DoF i) of the linear part of the Hill problem
+    !> Q(s) = J + s D1 + s^2 M: J = K per slot, -(h w)^2 M and the +-h w C couplings of
+    !> the cos/sin slots of harmonic h; D1 = C per slot and the +-2 h w M couplings; M per
+    !> slot (banded only: the dense path factorises M once, apart). Into dense jm, d1
+    !> (slot c of DoF j at j + ndof (c - 1)) or banded jr, dr, mr (RCM order).
+    subroutine hill_linear_row(sys, i, w, ok, jm, d1, jr, dr, mr)
+        class(hbm_system), intent(in) :: sys
+        integer(ip), intent(in) :: i
+        real(wp), intent(in) :: w
+        logical, intent(inout) :: ok   !! set to .false. when an entry falls outside a band
+        real(wp), intent(inout), optional :: jm(:, :), d1(:, :)
+        type(band_matrix), intent(inout), optional :: jr, dr, mr
+        integer(ip), parameter :: TJ = 1, TD = 2, TM = 3
+        integer(ip) :: c, h
+        real(wp) :: hw
+        do c = 1, sys%nc
+            call put(TJ, sys%k, c, c, 1.0_wp)
+            call put(TD, sys%c, c, c, 1.0_wp)
+            call put(TM, sys%m, c, c, 1.0_wp)
+        end do
+        do h = 1, sys%nh
+            hw = h*w
+            call put(TJ, sys%m, 2*h, 2*h, -hw*hw)
+            call put(TJ, sys%m, 2*h + 1, 2*h + 1, -hw*hw)
+            call put(TJ, sys%c, 2*h, 2*h + 1, hw)
+            call put(TJ, sys%c, 2*h + 1, 2*h, -hw)
+            call put(TD, sys%m, 2*h, 2*h + 1, 2*hw)
+            call put(TD, sys%m, 2*h + 1, 2*h, -2*hw)
+        end do
+    contains
+        !> target tgt (slot r of DoF i, slot c of DoF j) += alpha s(i, j), row i of s
+        subroutine put(tgt, s, r, c, alpha)
+            integer(ip), intent(in) :: tgt, r, c
+            type(csr_matrix), intent(in) :: s
+            real(wp), intent(in) :: alpha
+            if (present(jm)) then
+                if (tgt == TJ) call add_row(jm, s, sys%ndof, i, r, c, alpha)
+                if (tgt == TD) call add_row(d1, s, sys%ndof, i, r, c, alpha)
+            else
+                if (tgt == TJ) call band_row(jr, s, sys%iperm, sys%nc, i, r, c, alpha, ok)
+                if (tgt == TD) call band_row(dr, s, sys%iperm, sys%nc, i, r, c, alpha, ok)
+                if (tgt == TM) call band_row(mr, s, sys%iperm, sys%nc, i, r, c, alpha, ok)
+            end if
+        end subroutine put
+    end subroutine hill_linear_row
+
     pure subroutine add_row(a, s, nd, i, r, c, alpha)
         real(wp), intent(inout) :: a(:, :)
         type(csr_matrix), intent(in) :: s
