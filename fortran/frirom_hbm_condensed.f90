@@ -164,7 +164,7 @@ contains
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
         integer(ip) :: nu, nc, n, g, e, ie, m, h, ia, ib, s2, c2, q, col, i, mnc, nd
-        integer(ip) :: d1, d2, s1, c1, k, r, pos, stat
+        integer(ip) :: d1, d2, s1, k, r, pos, stat
         real(wp), allocatable :: ge(:, :), kt(:, :), ke(:, :), wm(:, :), kab(:, :), out(:, :)
         real(wp), allocatable :: jt(:, :), kc(:, :)
         real(wp) :: t0
@@ -175,12 +175,27 @@ contains
         nc = sys%nc
         n = sys%n
         krylov = use_krylov(sys)
-        if (krylov .and. .not. allocated(sys%jcur)) then
+        ! elements that each read most coordinates (an interface reduced to a few
+        ! generalised DoFs): dF_c/dU = G^T J_loc G assembled whole, then dense products
+        dense = sum(real(sys%ecp(2:) - sys%ecp(:size(sys%ecp) - 1), wp)**2)*nc**2 > &
+                real(n, wp)**2
+        if (dense) then
+            allocate (kc(n, n), stat=stat)
+            if (stat == 0 .and. krylov .and. .not. allocated(sys%jcur)) &
+                allocate (sys%jcur(n, n), stat=stat)
+        else if (krylov .and. .not. allocated(sys%jcur)) then
             allocate (sys%jcur(n, n), stat=stat)
-            if (stat /= 0) then
-                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: Krylov Jacobian')
-                return
-            end if
+        else
+            stat = 0
+        end if
+        if (stat /= 0) then
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: Jacobian')
+            return
+        end if
+        if (dense) then
+            kc = 0.0_wp
+            call contact_assemble(sys%cs, kd=kc, info=info, errmsg=errmsg)
+            if (info /= 0) return
         end if
         if (krylov) then
             call move_alloc(sys%jcur, jt)
@@ -188,20 +203,9 @@ contains
             call move_alloc(sys%jm, jt)
         end if
         jt = 0.0_wp
+        if (dense) call jac_dense(sys, n, kc, jt)
         ie = 0
-        ! elements that each read most coordinates (an interface reduced to a few
-        ! generalised DoFs): sum their blocks into dF_c/dU first, then dense products
-        dense = sum(real(sys%ecp(2:) - sys%ecp(:size(sys%ecp) - 1), wp)**2)*nc**2 > &
-                real(n, wp)**2
-        if (dense) then
-            allocate (kc(n, n), stat=stat)
-            if (stat /= 0) then
-                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: contact Jacobian')
-                return
-            end if
-            kc = 0.0_wp
-        end if
-        do g = 1, size(sys%cs%grp)
+        do g = 1, merge(0, size(sys%cs%grp), dense)   ! element by element unless dense
             associate (gr => sys%cs%grp(g), gg => sys%cs%g)
                 nd = gr%ndir
                 do e = 1, gr%ne
@@ -238,22 +242,6 @@ contains
                                 end do
                             end do
                         end do
-                        if (dense) then
-                            do s2 = 1, m
-                                do c2 = 1, nc
-                                    col = sc(s2) + nu*(c2 - 1)
-                                    q = c2 + nc*(s2 - 1)
-                                    do s1 = 1, m
-                                        do c1 = 1, nc
-                                            i = sc(s1) + nu*(c1 - 1)
-                                            kc(i, col) = kc(i, col) + ke(c1 + nc*(s1 - 1), q)
-                                        end do
-                                    end do
-                                end do
-                            end do
-                            deallocate (ge, kt, ke)
-                            cycle
-                        end if
                         allocate (wm(nu, 2*m), kab(2*m, 2*mnc), out(nu, 2*mnc))
                         do h = 0, sys%nh
                             if (h == 0) then
@@ -298,7 +286,6 @@ contains
                 end do
             end associate
         end do
-        if (dense) call jac_dense(sys, n, kc, jt)
         do i = 1, n
             jt(i, i) = jt(i, i) + 1.0_wp
         end do
@@ -515,7 +502,11 @@ contains
                     hh(i, j) = tmp
                 end do
                 tmp = hypot(hh(j, j), hh(j + 1, j))
-                if (tmp == 0.0_wp) exit
+                if (tmp == 0.0_wp) then
+                    ! breakdown: column j adds nothing; solve with the first j - 1
+                    k = j - 1
+                    exit
+                end if
                 cs(j) = hh(j, j)/tmp
                 sn(j) = hh(j + 1, j)/tmp
                 hh(j, j) = tmp

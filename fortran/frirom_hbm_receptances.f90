@@ -62,6 +62,13 @@ contains
         integer(ip) :: h, r, nr, nu, stat
         real(wp), allocatable :: fr(:, :), q(:, :)
         info = FRIROM_OK
+        ! checked before the system's current modes are given up
+        if (any(wm <= 0.0_wp) .or. any(zm < 0.0_wp) .or. &
+            .not. all(abs(wm) + abs(zm) <= huge(1.0_wp))) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'modes: need omega > 0 and '// &
+                            'zeta >= 0, finite')
+            return
+        end if
         select type (sys => sysc)
         type is (hbm_condensed)
             nu = sys%nnl
@@ -88,7 +95,10 @@ contains
             sys%zm = zm
             if (present(phi)) then
                 ! rows T phi and phi(outdofs); q = phi^T [fe0_h, fe1_h] (Re, Im) in one product
-                call csr_rows(sys%t, phi, sys%phr(1:nu, :))
+                sys%phr(1:nu, :) = 0.0_wp
+                do r = 1, nm
+                    call csr_matvec_add(sys%t, phi(:, r), sys%phr(1:nu, r), 1.0_wp)
+                end do
                 sys%phr(nu + 1:, :) = phi(sys%outdofs, :)
                 do h = 0, sys%nh
                     fr(:, 4*h + 1) = real(harm_col(sys%fe0, h), wp)
@@ -105,18 +115,14 @@ contains
             else
                 do h = 0, sys%nh
                     do r = 1, nm
-                        sys%psi(1:nu, r, h) = csr_rows_z(sys%t, psi(:, r, h))
+                        sys%psi(1:nu, r, h) = (0.0_wp, 0.0_wp)
+                        call csr_matvec_add(sys%t, psi(:, r, h), sys%psi(1:nu, r, h), &
+                                            (1.0_wp, 0.0_wp))
                         sys%psi(nu + 1:, r, h) = psi(sys%outdofs, r, h)
                         sys%qf(r, h) = sum(conjg(psi(:, r, h))*harm_col(sys%fe0, h))
                         sys%qf1(r, h) = sum(conjg(psi(:, r, h))*harm_col(sys%fe1, h))
                     end do
                 end do
-            end if
-            if (any(sys%wm <= 0.0_wp) .or. any(sys%zm < 0.0_wp) .or. &
-                .not. all(abs(sys%wm) + abs(sys%zm) <= huge(1.0_wp))) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'modes: need omega > 0 and '// &
-                                'zeta >= 0, finite')
-                return
             end if
             sys%modal = .true.
             sys%w_cache = -1.0_wp
@@ -126,34 +132,6 @@ contains
                             'condensed formulation')
         end select
     end subroutine modal_store
-
-    !> b = A x for a real CSR A and the columns of a dense x (rows of x = columns of A).
-    subroutine csr_rows(a, x, b)
-        type(csr_matrix), intent(in) :: a
-        real(wp), intent(in) :: x(:, :)
-        real(wp), intent(out) :: b(:, :)
-        integer(ip) :: i, k
-        do i = 1, a%nrow
-            b(i, :) = 0.0_wp
-            do k = a%p(i), a%p(i + 1) - 1
-                b(i, :) = b(i, :) + a%x(k)*x(a%i(k), :)
-            end do
-        end do
-    end subroutine csr_rows
-
-    !> A z for a real CSR A and a complex vector z.
-    pure function csr_rows_z(a, z) result(b)
-        type(csr_matrix), intent(in) :: a
-        complex(wp), intent(in) :: z(:)
-        complex(wp) :: b(a%nrow)
-        integer(ip) :: i, k
-        do i = 1, a%nrow
-            b(i) = (0.0_wp, 0.0_wp)
-            do k = a%p(i), a%p(i + 1) - 1
-                b(i) = b(i) + a%x(k)*z(a%i(k))
-            end do
-        end do
-    end function csr_rows_z
 
     !> Complex amplitudes of harmonic h of every row of a real-harmonic array a(:, 2H+1).
     pure module function harm_col(a, h) result(z)

@@ -150,13 +150,14 @@ def test_banded_turns_the_corner_at_398_78():
     """The corner itself, in small steps: the banded run used to stall there (the
     corrector's hyperplane across the old tangent never meets the branch beyond)."""
     model, exc, dof, tip = nlvib_friction_beam()
-    for form in ("banded", "condensed"):
-        opts = SolverOptions(harmonics=7, samples=512, formulation=form, ds_max=0.02)
-        r = frf(model, exc, 398.9, 398.6, opts)
-        assert r.complete, f"{form}: {r.message}"
+    runs = _both_runs(model, exc, 398.9, 398.6,
+                      SolverOptions(harmonics=7, samples=512, ds_max=0.02))
+    for _, pts in runs.values():
         # the stick fraction steps up by 2 samples (one per half cycle) on the way
-        stick = r.state_fractions[:, 0, 0]
+        stick = np.array([p.state_fractions[0, 0] for p in pts])
         assert stick.min() < 0.809 and stick.max() > 0.812
+    # every point on either side of the corner solves the other formulation's equations
+    _cross_check(model, exc, runs, 1, "corner")
 
 
 def _curve_gap(a, b):

@@ -367,7 +367,7 @@ class _Packed:
             stability=int(self.stability), history=int(o.history), maxpts=maxpts,
             netot=max(self.ne_tot, 1), ntim=len(_TIMER_SLOTS), nh=self.H, ndof=self.n_dof,
             nnl=self.nl.size or 1, tcontact=int(self.tcontact),
-            krylov=-1 if o.krylov is None else int(o.krylov), sparse=int(self.sparse))
+            krylov=int(o.krylov), sparse=int(self.sparse))
         r = _CallResult(*res[:-1], msg=res[-1].decode(errors="replace"))
         if r.npts > 0 and self.nw and o.history:
             self.w0 = r.sliders[:self.nw, r.npts - 1].copy()
@@ -471,9 +471,6 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
     modes = _Modes.none(n, H)
     if opts.formulation == "condensed":
         nrows = c.G.shape[0]
-        if opts.coordinates == "contact" and opts.stability:
-            raise ParameterError("options.coordinates: 'contact' cannot be used with "
-                                 "stability (Hill's method needs the contact DoFs)")
         tcontact = opts.coordinates == "contact" or (
             opts.coordinates == "auto" and nrows < nl.size and not opts.stability)
         iperm = np.empty(n, dtype=np.int64)

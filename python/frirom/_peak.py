@@ -79,37 +79,39 @@ def refine_peaks(packed: _Packed, points: list, lam_end: float, lam_lo: float,
     # that has it; the other outputs sharing the candidate take the largest of the same
     # solves (the corrector gives every output at once: a structure with 300 outputs costs
     # what one output does, and their peaks are found to the spacing of those solves)
-    lead = {}
+    first = {}
     for j, (_, inner) in enumerate(cands):
         for k in inner:
-            lead.setdefault(int(k), []).append(j)
-    for k, js in lead.items():
-        _solve_peak(solve, points, k, js[0], lscale)
+            first.setdefault(int(k), j)
+    for k, j in first.items():
+        _search_peak(solve, points, k, j, lscale)
+    solved = {}   # candidate k -> the points solved between its neighbours
+    for (b, _), p in cache.items():
+        solved.setdefault(b + 1, []).append(p)
     peaks = []
     for j, (i, inner) in enumerate(cands):
         best = Peak(points[i].omega, float(amp[i, j]), i)
         for k in inner:
-            for (b, _), p in cache.items():
-                if b == int(k) - 1 and p.amp_max[j] > best.amplitude:
+            for p in solved.get(int(k), []):
+                if p.amp_max[j] > best.amplitude:
                     best = Peak(p.omega, float(p.amp_max[j]), int(k), "solve")
         peaks.append(best)
     return peaks
 
 
-def _solve_peak(solve, points: list, i: int, j: int, lscale: float) -> FRFPoint | None:
-    """The point of largest amplitude of output j between points i - 1 and i + 1 (Brent's
-    method along the tangent of i - 1, started from the bracket the three points make);
-    None when a solve fails or the curve turns too much between them for that
-    parameterisation."""
+def _search_peak(solve, points: list, i: int, j: int, lscale: float) -> None:
+    """Brent's method for the largest amplitude of output j between points i - 1 and
+    i + 1, along the tangent of i - 1 from the bracket the three points make; every point
+    it solves stays in `solve`'s cache. Nothing is solved when the curve turns too much
+    between the points for that parameterisation; a failed solve ends the search."""
     base = points[i - 1]
     s_i, s_hi = (_offset(base, points[k], lscale) for k in (i, i + 1))
     if not 0 < s_i < s_hi or not points[i].amp_max[j] > 0:
-        return None
+        return
     known = {0.0: base, s_i: points[i], s_hi: points[i + 1]}
     try:
-        r = scipy.optimize.minimize_scalar(
+        scipy.optimize.minimize_scalar(
             lambda s: -(known[s] if s in known else solve(i - 1, s)).amp_max[j],
             bracket=(0.0, s_i, s_hi), method="brent", tol=XTOL * s_hi / s_i)
-        return known[r.x] if r.x in known else solve(i - 1, float(r.x))
     except (RuntimeError, ValueError):
-        return None
+        pass

@@ -147,7 +147,8 @@ class Peak:
 
     omega: float        #: rad/s
     amplitude: float    #: max over the period of |x(t)|, the unit of X
-    index: int          #: the point of largest amp_max
+    index: int          #: the point it was found at or next to (method 'solve': the
+                        #: candidate point whose neighbours bracket it)
     #: how it was found: 'point' (the largest point itself), 'parabola' (through it and its
     #: neighbours, in chord length), 'solve' (solved on the curve between its neighbours)
     method: str = "point"
@@ -185,6 +186,9 @@ class FRF:
     timings: dict = field(default_factory=dict)
     #: (n_out,) Peak per output solved on the curve by the solver (None: not computed)
     peaks: list | None = None
+    #: how the system was solved: formulation, unknowns, receptance route (the solver's
+    #: choice, printed by ``frirom run``)
+    solver_info: str = ""
 
     @property
     def harmonics(self) -> int:
@@ -281,6 +285,7 @@ class FRF:
             f.attrs["complete"] = self.complete
             f.attrs["message"] = self.message
             f.attrs["stability_computed"] = self.stability_computed
+            f.attrs["solver_info"] = self.solver_info
 
     def save_csv(self, path) -> None:
         """One row per point: omega, parameter, stable, fold, iterations, time, max amplitude
@@ -330,7 +335,8 @@ class FRF:
                        parameter_name=str(f.attrs.get("parameter_name", "omega")),
                        complete=bool(f.attrs.get("complete", True)),
                        message=str(f.attrs.get("message", "")),
-                       stability_computed=bool(f.attrs.get("stability_computed", False)))
+                       stability_computed=bool(f.attrs.get("stability_computed", False)),
+                       solver_info=str(f.attrs.get("solver_info", "")))
 
 
 class FRFWriter:

@@ -105,13 +105,13 @@ class SolverOptions:
         damping; large unreduced FE). 'auto': 'modes' for a model of at most
         :data:`MODES_MAX` DoFs whose band LUs over an FRF (``_pack.EIG_EVALS``
         evaluations) would cost more than one dense eigen-solve (a reduced model) and
-        whose damping the modes diagonalise, else 'sparse' when the band LU would cost more than
-        ``_pack.SPARSE_FLOPS`` per harmonic, else 'factorization'. The choice is in
+        whose damping the modes diagonalise, else 'sparse' when the band LU would cost
+        more than ``_pack.SPARSE_FLOPS`` per harmonic, else 'factorization'. The choice is in
         ``FRF.solver_info``.
-    krylov : bool or None
+    krylov : bool
         Condensed formulation: solve with each new Jacobian by GMRES preconditioned by
         the LU of an earlier one, factorising again only when GMRES needs many
-        iterations (same answers, 2-10x fewer dense LUs). None: off. Measured at ROM_I
+        iterations (same answers, 2-10x fewer dense LUs). Off by default. Measured at ROM_I
         size (2 800 unknowns, cases/bench/condensed.py): GMRES iterations are memory
         bound (~25 ms each, 2 cores shared) and the stale preconditioner needs ~8-18 per
         solve, so the FRF takes as long as with a new LU per Jacobian.
@@ -137,7 +137,7 @@ class SolverOptions:
     refine_peak: bool = True
     coordinates: str = "auto"
     receptances: str = "auto"
-    krylov: bool | None = None
+    krylov: bool = False
 
     def check(self) -> None:
         """Raise ParameterError naming the first invalid field."""
@@ -163,6 +163,13 @@ class SolverOptions:
         if self.modes is not None and (self.modes < 1 or self.formulation != "condensed"):
             raise ParameterError("options.modes: a positive number of modes, with "
                                  "formulation 'condensed'")
+        for nm in ("refine_peak", "krylov", "stability", "history", "reuse_jacobian"):
+            if not isinstance(getattr(self, nm), (bool, np.bool_)):
+                raise ParameterError(f"options.{nm}: expected true or false, got "
+                                     f"{getattr(self, nm)!r}")
+        if self.coordinates == "contact" and self.stability:
+            raise ParameterError("options.coordinates: 'contact' cannot be used with "
+                                 "stability (Hill's method needs the contact DoFs)")
         for nm, allowed in (("coordinates", ("auto", "dofs", "contact")),
                             ("receptances", ("auto", "modes", "factorization", "sparse"))):
             if getattr(self, nm) not in allowed:
