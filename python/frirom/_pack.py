@@ -466,7 +466,6 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
                                        pat.indices.astype(np.int32) + 1)
     raise_for_status(info, msg.decode(errors="replace"))
     out = _check_outputs((np.arange(n) if n <= 100 else nl) if outputs is None else outputs, n)
-    stability = bool(opts.stability)
     tcontact, sparse, info = False, False, f"banded: {n * (2 * H + 1)} unknowns"
     modes = _Modes.none(n, H)
     if opts.formulation == "condensed":
@@ -486,7 +485,7 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
                    K=_csr(model.K), M=_csr(model.M), C=_csr(model.C), perm=perm, nl=nl,
                    G=_csr(c.G), ginfo=c.ginfo, params=c.params, w0=c.w0, nw=c.nw,
                    group_names=c.names, group_sizes=c.sizes, outputs=out, out_f=out,
-                   stability=stability, modes=modes, tcontact=tcontact, sparse=sparse,
+                   stability=bool(opts.stability), modes=modes, tcontact=tcontact, sparse=sparse,
                    info=info)
 
 
