@@ -244,6 +244,25 @@ def _pack_contacts(groups, ncol: int) -> _Contacts:
                      names, sizes)
 
 
+def _output_map(outputs, n: int):
+    """(columns, map) of outputs given as an (n_out, n) matrix (physical DoFs recovered
+    through a reduction basis: x_out = map @ x[columns]); (outputs, None) otherwise."""
+    if outputs is None or np.ndim(outputs) != 2:
+        return outputs, None
+    P = np.asarray(outputs.toarray() if sp.issparse(outputs) else outputs, dtype=float)
+    if P.shape[1] != n or P.shape[0] == 0 or not np.all(np.isfinite(P)):
+        raise SizeError(f"outputs: an output matrix must be finite, (n_out, {n}); got "
+                        f"shape {P.shape}")
+    cols = np.flatnonzero(np.any(P != 0, axis=0))
+    return (cols if cols.size else np.zeros(1, dtype=int)), P[:, cols if cols.size else [0]]
+
+
+def _map_dofs(P: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """(n_out,) the DoF each output row of P selects (a unit row), -1 for a combination."""
+    unit = (np.count_nonzero(P, axis=1) == 1) & (P.max(axis=1) == 1.0)
+    return np.where(unit, cols[np.argmax(P != 0, axis=1)], -1)
+
+
 def _check_outputs(outputs, n: int) -> np.ndarray:
     out = np.asarray(outputs, dtype=int).ravel()
     if out.size == 0:
@@ -306,6 +325,9 @@ class _Packed:
     tcontact: bool = False    # condensed unknowns in contact coordinates G x
     sparse: bool = False      # condensed receptances by sparse LU (MUMPS)
     info: str = ""            # how the system is solved (FRF.solver_info)
+    #: (n_out, len(out_f)) physical outputs from the rows read (outputs given as a
+    #: matrix): X = out_map @ x[out_f]; None: X = x[out_f]
+    out_map: np.ndarray | None = None
 
     @property
     def nc(self) -> int:
@@ -399,7 +421,10 @@ class _Packed:
         """The converged points of one call; t_call (s) is shared out among them."""
         pts = []
         # every point's maxima in one batch: (n_out, 2H+1, npts) -> (npts, n_out)
-        amps = amplitude_max(np.moveaxis(res.xo[:, :, :res.npts], 2, 0))
+        xo = res.xo[:, :, :res.npts]
+        if self.out_map is not None:
+            xo = np.einsum("oj,jcp->ocp", self.out_map, xo)
+        amps = amplitude_max(np.moveaxis(xo, 2, 0))
         for k in range(res.npts):
             st = np.zeros((len(self.group_sizes), 3))
             e0 = 0
@@ -407,6 +432,8 @@ class _Packed:
                 st[g] = res.states[:, e0:e0 + ne, k].mean(axis=1)
                 e0 += ne
             X = np.array(res.xo[:, :, k])
+            if self.out_map is not None:
+                X = self.out_map @ X
             om = res.lams[k] if self.opts.parameter == "frequency" else omega_fix
             pts.append(FRFPoint(omega=float(om), parameter=float(res.lams[k]),
                                 unknowns=res.ys[:, k].copy(), tangent=res.tans[:, k].copy(),
@@ -429,8 +456,10 @@ def _split_load(fe: np.ndarray, part: str) -> tuple[np.ndarray, np.ndarray]:
 
 def pack(model: Model | CyclicModel, excitation: Excitation, opts: SolverOptions, outputs,
          load_part: str = "dynamic") -> _Packed:
-    """Check the inputs and pack them for hbm_continue; outputs: DoF indices (0-based) or
-    None for the default (all DoFs up to 100, else the contact DoFs)."""
+    """Check the inputs and pack them for hbm_continue; outputs: DoF indices (0-based),
+    an (n_out, n_dof) matrix (each output a combination of the DoFs: physical DoFs through
+    a reduction basis) or None for the default (all DoFs up to 100, else the contact
+    DoFs)."""
     if not isinstance(model, (Model, CyclicModel)):
         raise ParameterError("model: expected a frirom.model.Model or CyclicModel")
     if not isinstance(excitation, Excitation):
@@ -443,9 +472,14 @@ def pack(model: Model | CyclicModel, excitation: Excitation, opts: SolverOptions
         fe0, fe1 = fe, np.zeros_like(fe)
     else:
         fe0, fe1 = _split_load(fe, load_part)
+    outputs, P = _output_map(outputs, model.n_dof)
     if isinstance(model, CyclicModel):
-        return _pack_sector(model, opts, fe0, fe1, outputs)
-    return _pack_model(model, opts, fe0, fe1, outputs)
+        packed = _pack_sector(model, opts, fe0, fe1, outputs)
+    else:
+        packed = _pack_model(model, opts, fe0, fe1, outputs)
+    if P is not None:
+        packed.out_map, packed.outputs = P, _map_dofs(P, packed.outputs)
+    return packed
 
 
 def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed:

@@ -2,6 +2,9 @@
 
     frirom run DECK [--out DIR] [--resume]    forced response of a deck (docs/deck.md)
     frirom demo [--out DIR]                   contact hysteresis loops and harmonics
+    frirom show OUT --at 470Hz | --point K | --peak
+                                              one point of a run: time histories,
+                                              hysteresis loops, energy, interface maps
 """
 
 from __future__ import annotations
@@ -45,6 +48,50 @@ def _demo(args) -> int:
     return 0
 
 
+def _add_show(sub) -> None:
+    p = sub.add_parser(
+        "show", help="one point of a run: outputs over a period, hysteresis loops, "
+                     "dissipated energy, interface maps, VTK",
+        description="Solve one point of a finished (or stopped) run again from what "
+        "OUT/frf.h5 stores and write, in OUT/show_<f>Hz: time.csv/png (outputs over one "
+        "period), hysteresis.csv/png (tangential force against relative displacement and "
+        "normal force of the chosen or most dissipative contacts), contacts.csv and "
+        "energy.png (per contact element: dissipated energy, stick/slip/lift-off fractions, "
+        "peak normal force, slip amplitude); with an FE deck also maps.png (the fields on "
+        "the contact face) and with --vtk point.vtu for ParaView.")
+    p.add_argument("out", type=Path, help="the run's output folder (or its frf.h5)")
+    which = p.add_mutually_exclusive_group()
+    which.add_argument("--at", metavar="FREQ",
+                       help="frequency, e.g. 470Hz, 2950rad/s, or a number in the deck's unit")
+    which.add_argument("--point", type=int, metavar="K", help="stored point K (from 0; "
+                       "negative from the end)")
+    which.add_argument("--peak", action="store_true",
+                       help="the peak of the first output (the default)")
+    p.add_argument("--contact", action="append", metavar="GROUP:E", default=None,
+                   help="a contact element to draw (repeatable); default the most "
+                   "dissipative ones")
+    p.add_argument("--top", type=int, default=4, help="how many of the most dissipative "
+                   "contacts to draw (default 4)")
+    p.add_argument("--along", type=int, default=0, metavar="N",
+                   help="also map the contact pairs along the curve at N points (FE decks)")
+    p.add_argument("--vtk", action="store_true", help="write point.vtu (meshio) for "
+                   "ParaView (FE decks)")
+    p.add_argument("--frames", type=int, default=0, metavar="N",
+                   help="with --vtk: also N frames over the period")
+    p.add_argument("--phase", action="store_true",
+                   help="also write OUT/frf_phase.png (amplitude and phase of h1)")
+    p.add_argument("--deck", type=Path, default=None,
+                   help="the deck (default: the one recorded in frf.h5)")
+    p.add_argument("--dir", type=Path, default=None,
+                   help="folder for the files (default OUT/show_<f>Hz)")
+    p.set_defaults(func=cmd_show)
+
+
+def cmd_show(args) -> int:
+    from .show import cmd_show as run
+    return run(args)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="frirom", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -52,6 +99,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     _add_run(sub)
     _add_demo(sub)
+    _add_show(sub)
     return parser
 
 
@@ -116,7 +164,8 @@ def cmd_run(args) -> int:
     print(f"frirom: {model.n_dof} coordinates, {len(model.nonlinear_dofs())} in contact, "
           f"{sum(g.n_elem for g in model.contacts)} contact elements, H = {deck.harmonics}")
     if start is not None or not args.resume:
-        writer = FRFWriter(h5, deck.outputs, names, deck.harmonics, append=args.resume)
+        writer = FRFWriter(h5, deck.outputs, names, deck.harmonics, append=args.resume,
+                           output_labels=deck.output_names, meta=deck.result_meta())
         progress = _Progress(deck, args.quiet)
 
         def sink(point):
@@ -126,7 +175,7 @@ def cmd_run(args) -> int:
         t0 = time.perf_counter()
         try:
             result = frf(model, excitation, deck.omega_start, deck.omega_end, options,
-                         outputs=deck.outputs, sink=sink, start=start)
+                         outputs=deck.solver_outputs, sink=sink, start=start)
         except KeyboardInterrupt:
             progress.close()
             writer.close(complete=False, message="interrupted")

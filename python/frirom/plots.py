@@ -14,7 +14,7 @@ import matplotlib as mpl
 import numpy as np
 from matplotlib.figure import Figure
 
-__all__ = ["plot_frf", "plot_states", "frequency_axis"]
+__all__ = ["plot_frf", "plot_states", "frequency_axis", "fold_marks", "relevant_outputs"]
 
 _UNITS = {"hz": (1.0 / (2.0 * np.pi), "frequency [Hz]"),
           "rad/s": (1.0, "frequency [rad/s]")}
@@ -37,19 +37,52 @@ def _runs(mask):
     return [(int(a), int(b), bool(mask[a])) for a, b in zip(starts, ends)]
 
 
+def relevant_outputs(amp, share: float = 1e-3) -> np.ndarray:
+    """(n_out,) bool: outputs whose largest amplitude reaches `share` of the largest one's.
+
+    A DoF that stays near round-off (a stuck or symmetric direction) is drawn but does not
+    set the amplitude axis."""
+    amp = np.asarray(amp, float).reshape(len(amp), -1)
+    top = np.nanmax(np.abs(amp), axis=0) if amp.size else np.zeros(amp.shape[1])
+    return top >= share * max(float(np.max(top, initial=0.0)), 1e-300)
+
+
+def fold_marks(f, amp, fold, max_marks: int = 4, share: float = 0.005) -> np.ndarray:
+    """Indices of the folds worth marking: those that turn the curve back over more than
+    `share` of the frequency span (to the next fold or the end), at most `max_marks` of the
+    largest. Round-off wiggles of a stepping continuation (folds in pairs a few
+    millihertz apart) are left unmarked."""
+    idx = np.flatnonzero(np.asarray(fold, bool))
+    f = np.asarray(f, float)
+    span = float(np.ptp(f)) if f.size else 0.0
+    if idx.size == 0 or span == 0.0:
+        return idx[:0]
+    ends = np.r_[idx[1:], f.size - 1]
+    # frequency extent of the stretch between this fold and the next turn (or the end)
+    extent = np.array([np.ptp(f[a:b + 1]) for a, b in zip(idx, ends)])
+    keep = idx[extent > share * span]
+    ext = extent[extent > share * span]
+    keep = keep[np.argsort(-ext)[:max_marks]]
+    return np.sort(keep)
+
+
 def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = None,
-             amplitude_unit: str = "m", log: bool | None = None, ax=None) -> Figure:
+             amplitude_unit: str = "m", log: bool | None = None, ax=None,
+             phase: bool = False) -> Figure:
     """Max amplitude over a period against frequency, one curve per output.
 
-    Stable stretches are solid, unstable dashed (Hill's method, ``frf.stable``); folds
-    (``frf.fold``) are marked with a black diamond.
+    The curve is drawn in the order of the continuation, so it stays a line against
+    frequency through folds. Stable stretches are solid, unstable dashed (Hill's method,
+    ``frf.stable``); the folds that turn the curve back noticeably are marked with open
+    circles on the largest output (:func:`fold_marks`). The amplitude axis is set by the
+    outputs that matter (:func:`relevant_outputs`): a DoF near round-off does not drag it.
 
     Parameters
     ----------
     frf : FRF-like
         See the module docstring; ``amp_max`` may also be (n_pts,).
     output_names : list of str, optional
-        Legend entry per output (n_out,); default ``output j``.
+        Legend entry per output (n_out,); default ``frf.output_labels`` or ``output j``.
     unit : {"hz", "rad/s"}
         Frequency axis unit.
     title : str, optional
@@ -57,9 +90,13 @@ def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = No
     amplitude_unit : str
         Unit shown on the amplitude axis.
     log : bool, optional
-        Logarithmic amplitude axis; default when the amplitudes span more than 30x.
+        Logarithmic amplitude axis; default when the relevant amplitudes span more than
+        30x.
     ax : matplotlib.axes.Axes, optional
         Draw on these axes; default a new 7.5 x 4.6 in Figure at 130 dpi.
+    phase : bool
+        Add a panel below with the phase of the first harmonic of each relevant output
+        (x_1 = A cos(omega t + phase), deg; needs ``frf.X``); not with `ax`.
 
     Returns
     -------
@@ -74,41 +111,59 @@ def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = No
               else np.asarray(frf.stable, bool))
     fold = (np.zeros(f.size, bool) if getattr(frf, "fold", None) is None
             else np.asarray(frf.fold, bool))
-    names = output_names or [f"output {j}" for j in range(amp.shape[1])]
+    names = (output_names or list(getattr(frf, "output_labels", None) or [])
+             or [f"output {j}" for j in range(amp.shape[1])])
     own = ax is None
     if own:
-        fig = Figure(figsize=(7.5, 4.6), dpi=130)
-        ax = fig.add_subplot()
+        fig = Figure(figsize=(7.5, 6.4 if phase else 4.6), dpi=130)
+        if phase:
+            ax, pax = fig.subplots(2, 1, sharex=True, height_ratios=(2.2, 1.0))
+        else:
+            ax = fig.add_subplot()
     fig = ax.figure
+    rel = relevant_outputs(amp) if amp.size else np.ones(amp.shape[1], bool)
     colors = mpl.rcParams["axes.prop_cycle"].by_key()["color"]
     for j in range(amp.shape[1]):
         col = colors[j % len(colors)]
+        label = names[j] if rel[j] else f"{names[j]} (< 1e-3 of the largest)"
         for a, b, st in _runs(stable):
             # join each stretch to the next point so the curve has no gaps
             sl = slice(a, min(b + 1, f.size))
             ax.plot(f[sl], amp[sl, j], color=col, lw=1.6 if st else 1.2,
-                    ls="-" if st else "--",
-                    label=names[j] if a == 0 else None)
-        if fold.any():
-            ax.plot(f[fold], amp[fold, j], "D", color="k", ms=4.5, zorder=5,
-                    label="fold" if j == 0 else None)
+                    ls="-" if st else "--", label=label if a == 0 else None)
+    if f.size and amp.size:
+        top = int(np.argmax(np.nanmax(amp, axis=0)))
+        marks = fold_marks(f, amp[:, top], fold)
+        if marks.size:
+            ax.plot(f[marks], amp[marks, top], "o", mfc="none", mec="k", ms=6, mew=1.0,
+                    zorder=5, label="fold")
+    pos = amp[:, rel][amp[:, rel] > 0]
     if log is None:
-        pos = amp[amp > 0]
         log = pos.size > 0 and pos.max() / pos.min() > 30.0
-    if log:
-        ax.set_yscale("log")
-        # a DoF that stays at round-off (a stuck or symmetric direction) would stretch
-        # the axis over twenty decades: show six below the largest amplitude
-        pos = amp[amp > 0]
-        if pos.size:
-            ax.set_ylim(bottom=max(pos.min(), 1e-6 * pos.max()) / 2)
+    if pos.size:
+        lo, hi = pos.min(), pos.max()
+        if log:
+            ax.set_yscale("log")
+            # six decades below the largest amplitude at most
+            ax.set_ylim(max(lo, 1e-6 * hi) / 1.5, hi * 1.5)
+        else:
+            ax.set_ylim(0.0, hi * 1.08)
     if not stable.all():
         ax.plot([], [], color="0.3", ls="--", label="unstable (Hill)")
-    ax.set_xlabel(xlabel)
     ax.set_ylabel(f"max amplitude over a period [{amplitude_unit}]")
     ax.set_title(title or "Forced response")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(loc="best", fontsize=8)
+    if own and phase:
+        X = np.asarray(frf.X, float)
+        for j in np.flatnonzero(rel):
+            ph = np.degrees(np.unwrap(np.arctan2(-X[:, j, 2], X[:, j, 1])))
+            pax.plot(f, ph, color=colors[j % len(colors)], lw=1.2)
+        pax.set_ylabel("phase of h1 [deg]")
+        pax.grid(True, alpha=0.3)
+        pax.set_xlabel(xlabel)
+    else:
+        ax.set_xlabel(xlabel)
     if own:
         fig.tight_layout()
     return fig
@@ -126,8 +181,9 @@ def plot_states(frf, *, contact_names=None, unit: str = "hz",
     contact_names : list of str, optional
         Panel title per contact group (n_groups,); default ``contact g``.
     unit : {"hz", "rad/s"}
-        Frequency axis unit (used when the frequency is monotone along the path; else
-        the panels are drawn against the point index).
+        Frequency axis unit. Stacked areas while the frequency is monotone along the
+        path; where the curve folds, three lines (stick, slip, lift-off) in the path's
+        order, still against frequency.
     title : str, optional
         Figure title; default "Contact states".
 
@@ -144,23 +200,27 @@ def plot_states(frf, *, contact_names=None, unit: str = "hz",
     names = contact_names or [f"contact {g}" for g in range(ng)]
     fig = Figure(figsize=(7.5, 1.2 + 2.0 * max(ng, 1)), dpi=130)
     axes = fig.subplots(max(ng, 1), 1, sharex=True, squeeze=False)
-    # along a continuation path the frequency can turn back: plot against the point order
-    # mapped to frequency only when it is monotone
+    # along a continuation path the frequency can turn back: a stacked area needs a
+    # monotone x, lines in the path's order do not
     mono = np.all(np.diff(f) > 0) or np.all(np.diff(f) < 0)
-    xs = f if mono else np.arange(f.size)
-    order = np.argsort(xs) if mono else slice(None)
+    order = np.argsort(f)
     colors = ("#2b8cbe", "#f39c12", "#c0392b")
+    labels = ("stick", "slip", "lift-off")
     for g in range(ng):
         ax = axes[g, 0]
-        ax.stackplot(xs[order], *(sf[order, g, k] for k in range(3)), colors=colors,
-                     labels=("stick", "slip", "lift-off"), alpha=0.85)
+        if mono:
+            ax.stackplot(f[order], *(sf[order, g, k] for k in range(3)), colors=colors,
+                         labels=labels, alpha=0.85)
+        else:
+            for k in range(3):
+                ax.plot(f, sf[:, g, k], color=colors[k], lw=1.4, label=labels[k])
         ax.set_ylim(0.0, 1.0)
         ax.set_ylabel("fraction of period")
         ax.set_title(names[g], fontsize=9, loc="left")
         ax.grid(True, alpha=0.3)
     axes[0, 0].legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8, ncol=3,
                       frameon=False, borderaxespad=0.2)
-    axes[-1, 0].set_xlabel(xlabel if mono else "point along the continuation path")
+    axes[-1, 0].set_xlabel(xlabel)
     fig.suptitle(title or "Contact states", fontsize=11)
     fig.tight_layout()
     return fig

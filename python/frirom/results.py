@@ -117,6 +117,53 @@ def amplitude_max(X: np.ndarray, return_time: bool = False):
     return amp
 
 
+def harmonic_table(X: np.ndarray) -> tuple:
+    """Amplitude and phase of each harmonic of real coefficients X (..., 2H+1).
+
+    x(t) = a0 + sum_h A_h cos(h omega t + phi_h): A_h = hypot(a_h, b_h),
+    phi_h = atan2(-b_h, a_h) (rad), the angle of the complex amplitude a_h - i b_h.
+
+    Returns
+    -------
+    amplitude : ndarray (..., H+1)
+        [a0 (the mean, signed), A_1, ..., A_H], the unit of X.
+    phase : ndarray (..., H+1)
+        [0, phi_1, ..., phi_H], rad in (-pi, pi].
+    """
+    X = np.asarray(X, float)
+    amp = np.concatenate([X[..., :1], np.hypot(X[..., 1::2], X[..., 2::2])], axis=-1)
+    ph = np.concatenate([np.zeros_like(X[..., :1]), np.arctan2(-X[..., 2::2], X[..., 1::2])],
+                        axis=-1)
+    return amp, ph
+
+
+def output_columns(labels: list, H: int) -> list:
+    """CSV column names of the outputs: per output its true peak over the period, its mean
+    and the amplitude and phase (deg) of each harmonic."""
+    head = []
+    for lab in labels:
+        head += [f"{lab} amp_max", f"{lab} h0"]
+        for h in range(1, H + 1):
+            head += [f"{lab} h{h} amp", f"{lab} h{h} phase_deg"]
+    return head
+
+
+def output_values(X: np.ndarray, amp_max: np.ndarray) -> list:
+    """One CSV row's output values (X (n_out, 2H+1), amp_max (n_out,)), as output_columns."""
+    amp, ph = harmonic_table(X)
+    row = []
+    for j in range(X.shape[0]):
+        row += [repr(float(amp_max[j])), repr(float(amp[j, 0]))]
+        for h in range(1, amp.shape[1]):
+            row += [repr(float(amp[j, h])), f"{np.degrees(ph[j, h]):.6f}"]
+    return row
+
+
+#: attributes of a result file saying how it was made (FRF.meta)
+META_KEYS = ("deck_path", "deck_text", "solver_settings", "model_fingerprint",
+             "frirom_version")
+
+
 @dataclass
 class FRFPoint:
     """One converged point of a continuation run (what `sink` receives)."""
@@ -189,6 +236,28 @@ class FRF:
     #: how the system was solved: formulation, unknowns, receptance route (the solver's
     #: choice, printed by ``frirom run``)
     solver_info: str = ""
+    #: (n_out,) the outputs as the deck names them ("ACTIVE:z", "1234:UX"); default
+    #: "dof<j>" from output_dofs
+    output_labels: list = field(default_factory=list)
+    #: (n_pts, n_unknowns) the solver unknowns of each point (what ``frirom show``
+    #: restarts from; None when not kept)
+    unknowns: np.ndarray | None = None
+    #: how the result was made: META_KEYS (deck text, solver settings as JSON, reduced
+    #: model's fingerprint, frirom version), strings
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def labels(self) -> list:
+        """(n_out,) output names: output_labels, or dof<j> (j = -1: a recovered DoF)."""
+        if len(self.output_labels) == self.X.shape[1]:
+            return list(self.output_labels)
+        return [f"dof{d}" for d in self.output_dofs][:self.X.shape[1]] or \
+            [f"output {j}" for j in range(self.X.shape[1])]
+
+    @property
+    def frequency_hz(self) -> np.ndarray:
+        """(n_pts,) excitation frequency, Hz."""
+        return np.asarray(self.omega, float) / (2.0 * np.pi)
 
     @property
     def harmonics(self) -> int:
@@ -259,6 +328,8 @@ class FRF:
                    iterations=stack("iterations", (), int), time_s=stack("time_s", ()),
                    slider=(np.array([p.slider for p in points], dtype=float) if points
                            else np.zeros((0, 0))),
+                   unknowns=(np.array([p.unknowns for p in points], dtype=float)
+                             if points else None),
                    output_dofs=np.asarray(output_dofs, dtype=int),
                    group_names=list(group_names), parameter_name=parameter_name, **kw)
 
@@ -275,6 +346,7 @@ class FRF:
                 f.create_dataset(name, data=np.asarray(v if v is not None else self.omega))
             if self.slider is not None:
                 f.create_dataset("slider", data=np.asarray(self.slider, dtype=float))
+            _save_readable(f, self)
             if self.peaks is not None:
                 f.create_dataset("peak_omega", data=[p.omega for p in self.peaks])
                 f.create_dataset("peak_amplitude", data=[p.amplitude for p in self.peaks])
@@ -288,21 +360,27 @@ class FRF:
             f.attrs["solver_info"] = self.solver_info
 
     def save_csv(self, path) -> None:
-        """One row per point: omega, parameter, stable, fold, iterations, time, max amplitude
-        per output DoF, state fractions per group."""
+        """One row per point: frequency (Hz, rad/s), the load parameter of a load curve,
+        stable, fold, iterations, time, then per output (named as in the deck) the true
+        peak over the period, the mean and each harmonic's amplitude and phase
+        (x_h = A cos(h omega t + phase), deg), then the state fractions per group."""
+        load = self.parameter_name != "omega"
         with open(path, "w", newline="") as fh:
             w = csv.writer(fh)
-            head = ["omega_rad_s", self.parameter_name, "stable", "fold", "iterations",
-                    "time_s"]
-            head += [f"amp_max_dof{d}" for d in self.output_dofs]
+            head = ["f_hz", "omega_rad_s"] + ([self.parameter_name] if load else [])
+            head += ["stable", "fold", "iterations", "time_s"]
+            head += output_columns(self.labels, self.harmonics)
             for g in self.group_names:
                 head += [f"{g}_stick", f"{g}_slip", f"{g}_liftoff"]
             w.writerow(head)
             par = self.parameter if self.parameter is not None else self.omega
+            fhz = self.frequency_hz
             for i in range(len(self)):
-                row = [repr(float(self.omega[i])), repr(float(par[i])), int(self.stable[i]),
-                       int(self.fold[i]), int(self.iterations[i]), f"{self.time_s[i]:.6g}"]
-                row += [repr(float(a)) for a in self.amp_max[i]]
+                row = [repr(float(fhz[i])), repr(float(self.omega[i]))]
+                row += [repr(float(par[i]))] if load else []
+                row += [int(self.stable[i]), int(self.fold[i]), int(self.iterations[i]),
+                        f"{self.time_s[i]:.6g}"]
+                row += output_values(self.X[i], self.amp_max[i])
                 row += [f"{s:.6g}" for s in self.state_fractions[i].ravel()]
                 w.writerow(row)
 
@@ -330,6 +408,10 @@ class FRF:
                 kw["peaks"] = [Peak(float(w), float(a), int(i), m.decode()) for w, a, i, m in
                                zip(f["peak_omega"], f["peak_amplitude"], f["peak_index"],
                                    f.attrs["peak_method"])]
+            if "unknowns" in f and f["unknowns"].shape[0] == kw["omega"].shape[0]:
+                kw["unknowns"] = f["unknowns"][...]
+            kw["output_labels"] = [s.decode() for s in f.attrs.get("output_labels", [])]
+            kw["meta"] = {k: str(f.attrs[k]) for k in META_KEYS if k in f.attrs}
             return cls(**kw,
                        group_names=[s.decode() for s in f.attrs.get("group_names", [])],
                        parameter_name=str(f.attrs.get("parameter_name", "omega")),
@@ -348,7 +430,8 @@ class FRFWriter:
     """
 
     def __init__(self, path, output_dofs, group_names, harmonics: int,
-                 parameter_name: str = "omega", append: bool = False):
+                 parameter_name: str = "omega", append: bool = False,
+                 output_labels=None, meta: dict | None = None):
         import h5py
         self.path = path
         mode = "a" if append else "w"
@@ -374,6 +457,7 @@ class FRFWriter:
             self.f.attrs["parameter_name"] = parameter_name
             self.f.attrs["complete"] = False
             self.f.attrs["message"] = "running"
+            _write_labels_meta(self.f, output_labels, meta)
         elif self.f["X"].shape[1:] != (n_out, nc):
             raise InputError(f"{path}: existing file has X of shape {self.f['X'].shape[1:]}"
                              f", this run makes {(n_out, nc)}")
@@ -402,6 +486,7 @@ class FRFWriter:
             if name in f:
                 del f[name]
             f.create_dataset(name, data=v)
+        _append_readable(f, n, p)
         f.attrs["last_parameter"] = p.parameter
         f.attrs["last_omega"] = p.omega
         f.attrs["last_yscale"] = p.yscale
@@ -441,3 +526,51 @@ class FRFWriter:
                     "tangent": f["last_tangent"][...],
                     "yscale": float(f.attrs.get("last_yscale", 0.0)),
                     "slider": slider}
+
+
+# ---- the readable datasets of a result file (frequency in Hz, harmonics' amplitude and
+# phase, output labels, how it was made) and the unknowns per point (`frirom show`) -------
+
+def _write_labels_meta(f, labels, meta) -> None:
+    """Output labels and META_KEYS attributes of an HDF5 file (h5py.File)."""
+    if labels is not None and len(labels):
+        f.attrs["output_labels"] = np.array([str(x) for x in labels], dtype="S")
+    for k, v in (meta or {}).items():
+        if k in META_KEYS and v is not None:
+            f.attrs[k] = str(v)
+
+
+def _save_readable(f, frf: FRF) -> None:
+    """FRF.save_h5's readable part: frequency_hz, harmonic_amplitude and harmonic_phase
+    (n_pts, n_out, H+1), unknowns per point, output labels and META_KEYS."""
+    amp, ph = harmonic_table(frf.X)
+    f.create_dataset("frequency_hz", data=frf.frequency_hz)
+    f.create_dataset("harmonic_amplitude", data=amp)
+    f.create_dataset("harmonic_phase", data=ph)
+    if frf.unknowns is not None:
+        f.create_dataset("unknowns", data=np.asarray(frf.unknowns, float))
+    _write_labels_meta(f, frf.labels, frf.meta)
+
+
+def _append_row(f, name: str, n: int, row) -> None:
+    """Write row n of a resizable dataset, made on first use (rows of points already in
+    the file before it existed are NaN)."""
+    row = np.asarray(row, dtype=float)
+    if name not in f:
+        f.create_dataset(name, data=np.full((n,) + row.shape, np.nan),
+                         maxshape=(None,) + row.shape,
+                         chunks=(64,) + row.shape if row.size else True)
+    elif f[name].shape[1:] != row.shape:
+        raise InputError(f"{f.filename}: existing file has {name} rows of shape "
+                         f"{f[name].shape[1:]}, this run makes {row.shape}")
+    f[name].resize(n + 1, axis=0)
+    f[name][n] = row
+
+
+def _append_readable(f, n: int, p: FRFPoint) -> None:
+    """FRFWriter.append's readable part for point n (see _save_readable)."""
+    amp, ph = harmonic_table(p.X)
+    _append_row(f, "frequency_hz", n, p.omega / (2.0 * np.pi))
+    _append_row(f, "harmonic_amplitude", n, amp)
+    _append_row(f, "harmonic_phase", n, ph)
+    _append_row(f, "unknowns", n, p.unknowns)

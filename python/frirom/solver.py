@@ -457,9 +457,10 @@ def frf(model: Model | CyclicModel, excitation: Excitation, omega_start: float,
         Frequency range, rad/s (either direction).
     options : SolverOptions, optional
         Its ``parameter`` is set to 'frequency'.
-    outputs : array_like of int, optional
-        DoF indices (0-based) whose harmonics are kept; default all DoFs up to 100, else
-        the contact DoFs.
+    outputs : array_like of int, or (n_out, n_dof) array, optional
+        DoF indices (0-based) whose harmonics are kept, or a matrix P whose rows give each
+        output as P x (physical DoFs through a reduction basis); default all DoFs up to
+        100, else the contact DoFs.
     sink : callable, optional
         ``sink(point)`` receives every converged FRFPoint as it comes.
     start : FRFPoint or dict, optional

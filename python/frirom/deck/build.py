@@ -10,6 +10,7 @@ modes (:mod:`frirom.deck.build_cyclic`). :meth:`Deck.model`, :meth:`Deck.excitat
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -69,8 +70,8 @@ class Deck:
     frequency_unit: str
     continuation: dict        # the [continuation] keys given
     solver: dict              # the [solver] tolerances given, and 'stability'
-    outputs: list             # DoF indices
-    output_names: list
+    outputs: list             # DoF indices (-1: an FE DoF recovered through output_map)
+    output_names: list        # as the deck names them ("ACTIVE:z", "1234:UX", "tip:x")
     dof_labels: list | None = None
     plot: bool = True
     csv: bool = True
@@ -81,10 +82,45 @@ class Deck:
     #: 'engine_order', 'single_index' (None or k*), 'sign', 'seconds'}
     cyclic: dict | None = None
     settings: DeckSettings | None = field(default=None, repr=False)
+    #: (n_out, n_dof) with [fe_model]: x_out = output_map @ x, the rows of the reduction
+    #: basis T of the FE DoFs named in [outputs] (sector 0's with [reduction.cyclic])
+    output_map: np.ndarray | None = None
 
     @property
     def n_dof(self) -> int:
         return self.M.shape[0]
+
+    def fingerprint(self) -> str:
+        """sha256 naming the model: the reduced model's cache key with [fe_model], else a
+        hash of the M, K (and damping matrix) arrays."""
+        if self.reduced is not None and getattr(self.reduced, "fingerprint", ""):
+            return self.reduced.fingerprint
+        h = hashlib.sha256()
+        for A in (self.M, self.K, self.damping.get("C")):
+            if A is not None:
+                A = sp.csr_matrix(A)
+                for part in (A.indptr, A.indices, A.data):
+                    h.update(np.ascontiguousarray(part).tobytes())
+        return h.hexdigest()
+
+    def result_meta(self) -> dict:
+        """What a result file keeps of how it was made (frirom.results.META_KEYS)."""
+        import dataclasses
+        import json
+
+        from .. import __version__
+        opts = dataclasses.asdict(self.options())
+        return {"deck_path": str(self.path.resolve()), "deck_text": self.path.read_text(),
+                "solver_settings": json.dumps(opts, sort_keys=True, default=str),
+                "model_fingerprint": self.fingerprint(), "frirom_version": __version__}
+
+    @property
+    def solver_outputs(self):
+        """The solver's ``outputs``: the DoF indices, or output_map when an output is an FE
+        DoF the reduction does not keep as a coordinate."""
+        if self.output_map is not None and min(self.outputs, default=0) < 0:
+            return self.output_map
+        return list(self.outputs)
 
     def damping_object(self) -> Damping:
         """The model's :class:`frirom.model.Damping` from the [damping] table."""
@@ -197,6 +233,8 @@ class _Builder:
             raise ctx.error("excitation", "at least one load on a harmonic >= 1 "
                             "([[excitation.load]] or [[excitation.engine_order]])")
         outputs = [self.coordinate(ref) for ref in s.outputs.dofs]
+        omap = (np.array([self.output_row(ref) for ref in s.outputs.dofs]) if s.fe
+                else None)
         labels = self.labels
         onames = [ref.value.text if s.fe else (labels[j] if labels else f"dof{j}")
                   for ref, j in zip(s.outputs.dofs, outputs)]
@@ -214,7 +252,7 @@ class _Builder:
                     continuation=cont, solver=solver, outputs=outputs, output_names=onames,
                     dof_labels=labels if not s.fe else list(rom.labels),
                     plot=s.outputs.plot, csv=s.outputs.csv, raw=s.raw, reduced=rom, log=log,
-                    cyclic=cyclic, settings=s)
+                    cyclic=cyclic, settings=s, output_map=omap)
 
     # ---- [model]: matrices used as they are ----
     def matrices(self):
@@ -319,20 +357,27 @@ class _Builder:
             raise InputError(f"{self.s.path}: {key}: {exc}") from None
 
     def coordinate(self, ref: DofRef) -> int:
-        """Model coordinate of an output DoF (a kept physical DoF of a reduced model)."""
+        """Model coordinate of an output DoF: a [model] DoF, or a physical DoF the
+        reduction keeps; -1 for another FE DoF (recovered by :meth:`output_row`)."""
         if not self.s.fe:
             return self.index(ref)
+        lab = f"N{self.output_node(ref)}:{DIRECTION_NAMES[ref.value.direction]}"
+        return self.rom.labels.index(lab) if lab in self.rom.labels else -1
+
+    def output_node(self, ref: DofRef) -> int:
+        """The one FE node of an output reference ("1234:UX", or a set of one node)."""
         nodes = self.fe_nodes(ref)
-        nd = ref.value
         if len(nodes) != 1:
-            raise self.ctx.error(ref.key, f"one node (set {nd.node} has {len(nodes)})",
-                                 nd.text)
-        lab = f"N{nodes[0]}:{DIRECTION_NAMES[nd.direction]}"
-        if lab not in self.rom.labels:
-            raise self.ctx.error(ref.key, "a DoF kept by the reduction (a node of "
-                                 "reduction.active, or of reduction.interface without "
-                                 "interface modes)", nd.text)
-        return self.rom.labels.index(lab)
+            raise self.ctx.error(ref.key, f"one node (set {ref.value.node} has "
+                                 f"{len(nodes)})", ref.value.text)
+        return nodes[0]
+
+    def output_row(self, ref: DofRef) -> np.ndarray:
+        """(n_r,) the row of the reduction basis T of an output FE DoF: x = row @ q."""
+        try:
+            return self.rom.load_row(self.output_node(ref), ref.value.direction)
+        except InputError as exc:
+            raise InputError(f"{self.s.path}: {ref.key}: {exc}") from None
 
     def fe_nodes(self, ref: DofRef) -> list:
         """Node ids of a "NODE:DIR" reference (a node, or every node of a set)."""

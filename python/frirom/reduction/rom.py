@@ -250,6 +250,8 @@ class ReducedModel:
     node_ids: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     node_xyz: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     b_rotation: dict = field(default_factory=dict)
+    #: sha256 of the inputs it was built from (the cache key), kept in result files
+    fingerprint: str = ""
 
     @property
     def n_fe(self) -> int:
@@ -372,7 +374,7 @@ class ReducedModel:
                            fe_dofs=h["fe_dofs"][()], node_sets=sets, from_cache=True,
                            build_seconds=float(h.attrs.get("build_seconds", 0.0)),
                            node_ids=h["node_ids"][()], node_xyz=h["node_xyz"][()],
-                           b_rotation=rot)
+                           b_rotation=rot, fingerprint=fingerprint)
         except (OSError, KeyError):
             return None
 
@@ -578,7 +580,8 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
                        node_sets={k: np.asarray(v, np.int64)
                                   for k, v in model.node_sets.items()},
                        build_seconds=time.perf_counter() - t0,
-                       node_ids=kept_nodes, node_xyz=kept_xyz, b_rotation=rot)
+                       node_ids=kept_nodes, node_xyz=kept_xyz, b_rotation=rot,
+                       fingerprint=fp)
     try:
         out.save(cache, fp)
     except OSError as exc:
