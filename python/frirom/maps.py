@@ -19,7 +19,8 @@ from matplotlib.figure import Figure
 from ._errors import InputError
 from .results import _series
 
-__all__ = ["pair_nodes", "face_axes", "figure_maps", "figure_curve_maps", "write_vtk"]
+__all__ = ["pair_nodes", "face_axes", "figure_maps", "figure_curve_maps", "curve_indices",
+           "write_vtk"]
 
 #: (field, title, colour map) of the map panels
 _FIELDS = (("stick", "stick fraction", "Blues"), ("slip", "slip fraction", "Oranges"),
@@ -50,10 +51,16 @@ def pair_nodes(deck, name: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 def face_axes(xyz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(2-D coordinates (n, 2), axes (2, 3)) of points on a face: their projection on the
-    two principal directions of the point cloud (the face's plane)."""
+    """(2-D coordinates (n, 2), axes (2, 3)) of points on a face: the two global axes in
+    its plane when its normal (least principal direction of the points) is a global axis,
+    else its projection on its two principal directions (centred)."""
     c = xyz - xyz.mean(axis=0)
-    _, _, vt = np.linalg.svd(c, full_matrices=False)
+    _, _, vt = np.linalg.svd(c, full_matrices=False) if len(xyz) > 2 else (0, 0, np.eye(3))
+    normal = vt[-1] if len(vt) == 3 else np.cross(vt[0], vt[1])
+    k = int(np.argmax(np.abs(normal)))
+    if abs(normal[k]) > 0.99:
+        ax = np.delete(np.eye(3), k, axis=0)
+        return xyz @ ax.T, ax
     ax = vt[:2]
     for i in range(2):          # the largest component positive: stable orientation
         if ax[i, np.argmax(np.abs(ax[i]))] < 0:
@@ -62,7 +69,21 @@ def face_axes(xyz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _axis_label(v: np.ndarray) -> str:
-    return "[" + ", ".join(f"{a:.2g}" for a in v) + "] [mm]"
+    names = {(1.0, 0.0, 0.0): "x", (0.0, 1.0, 0.0): "y", (0.0, 0.0, 1.0): "z"}
+    name = names.get(tuple(float(a) for a in v))
+    return (f"{name} [mm]" if name else
+            "along [" + ", ".join(f"{a:.2g}" for a in v) + "] [mm]")
+
+
+def _marker_size(uv: np.ndarray, inches: float = 2.6) -> float:
+    """Scatter size (points^2) of squares that about tile points spaced as uv's nearest
+    neighbours on an axes `inches` wide."""
+    if len(uv) < 2:
+        return 40.0
+    from scipy.spatial import cKDTree
+    d = cKDTree(uv).query(uv, k=2)[0][:, 1]
+    span = max(float(np.ptp(uv, axis=0).max()), 1e-300)
+    return float((0.7 * np.median(d) / span * inches * 72.0) ** 2)
 
 
 def figure_maps(state, deck) -> Figure:
@@ -77,7 +98,7 @@ def figure_maps(state, deck) -> Figure:
     for gi, c in enumerate(groups):
         _, xyz = pair_nodes(deck, c.name)
         uv, ax2 = face_axes(xyz)
-        size = max(8.0, 9000.0 / max(c.n_elem, 1))
+        size = _marker_size(uv)
         for k, (name, title, cmap) in enumerate(_FIELDS):
             ax = axes[2 * gi + k // 3, k % 3]
             v = _values(c, name)
@@ -95,10 +116,35 @@ def figure_maps(state, deck) -> Figure:
     return fig
 
 
+def _bins(y: np.ndarray, n_max: int = 30) -> tuple[np.ndarray, np.ndarray]:
+    """(bin of each value (n,), bin edges) of positions y: one bin per distinct position
+    (to 1e-6 of their range), or n_max equal bins when there are more."""
+    span = float(np.ptp(y)) or 1.0
+    u = np.unique(np.round(y / (1e-6 * span)))
+    if u.size <= n_max:
+        centres = u * 1e-6 * span
+        mid = (centres[1:] + centres[:-1]) / 2
+        half = (np.diff(centres).min() / 2) if centres.size > 1 else 0.5 * span
+        edges = np.r_[centres[0] - half, mid, centres[-1] + half]
+    else:
+        edges = np.linspace(y.min(), y.max(), n_max + 1)
+    idx = np.clip(np.searchsorted(edges, y, side="right") - 1, 0, edges.size - 2)
+    return idx, edges
+
+
+def curve_indices(frf, n: int) -> np.ndarray:
+    """About n stored points evenly spread in frequency over the curve (the nearest to n
+    equally spaced frequencies, and the largest first output's point)."""
+    w = np.asarray(frf.omega, float)
+    target = np.linspace(w.min(), w.max(), max(n, 2))
+    idx = np.abs(w[None, :] - target[:, None]).argmin(axis=1)
+    return np.unique(np.r_[idx, int(np.argmax(frf.amp_max[:, 0]))])
+
+
 def figure_curve_maps(states, deck, unit_scale: float = 1.0 / (2 * np.pi)) -> Figure:
-    """Slip fraction, lift-off fraction and dissipated energy of every pair along the
-    curve: x the frequency of each point (Hz; points on a folded stretch overlap), y the
-    pair's coordinate along the face's first principal direction."""
+    """Slip fraction, lift-off fraction and dissipated energy of the pairs along the
+    curve: x the frequency of each point (Hz, a column per point), y the position along
+    the face's first axis (pairs at one position averaged)."""
     if not states:
         raise InputError("no point to draw along the curve")
     names = [c.name for c in states[0].contacts
@@ -107,27 +153,36 @@ def figure_curve_maps(states, deck, unit_scale: float = 1.0 / (2 * np.pi)) -> Fi
         raise InputError("interface maps need an FE deck ([fe_model]) with node-set contacts")
     fields = (("slip", "slip fraction", "Oranges"), ("liftoff", "lift-off fraction", "Reds"),
               ("energy", "energy / period [J]", "magma_r"))
+    f = np.array([s.omega * unit_scale for s in states])
+    order = np.argsort(f, kind="stable")
+    fs = f[order]
+    mid = (fs[1:] + fs[:-1]) / 2
+    lo = np.r_[fs[0] - (mid[0] - fs[0] if fs.size > 1 else 0.5), mid]
+    hi = np.r_[mid, fs[-1] + (fs[-1] - mid[-1] if fs.size > 1 else 0.5)]
     fig = Figure(figsize=(10.5, 0.8 + 3.0 * len(names)), dpi=110)
     axes = fig.subplots(len(names), 3, squeeze=False)
     for gi, name in enumerate(names):
         _, xyz = pair_nodes(deck, name)
         uv, ax2 = face_axes(xyz)
-        y = uv[:, 0] * 1e3
+        b, edges = _bins(uv[:, 0])
+        count = np.bincount(b, minlength=edges.size - 1)
         for k, (fld, title, cmap) in enumerate(fields):
             ax = axes[gi, k]
-            xs = np.concatenate([np.full(y.size, s.omega * unit_scale) for s in states])
-            ys = np.tile(y, len(states))
-            v = np.concatenate([_values(next(c for c in s.contacts if c.name == name), fld)
-                                for s in states])
-            lim = (0.0, 1.0) if k < 2 else (None, None)
-            sc = ax.scatter(xs, ys, c=v, s=10, marker="s", cmap=cmap, vmin=lim[0],
-                            vmax=lim[1], edgecolors="none")
-            fig.colorbar(sc, ax=ax, shrink=0.85)
+            vals = np.array([np.bincount(b, _values(next(c for c in s.contacts
+                                                          if c.name == name), fld),
+                                         minlength=edges.size - 1) / np.maximum(count, 1)
+                             for s in states])[order]
+            lim = (0.0, 1.0) if k < 2 else (0.0, max(float(vals.max()), 1e-300))
+            for j in range(fs.size):
+                qm = ax.pcolormesh([lo[j], hi[j]], edges * 1e3, vals[j][:, None],
+                                   cmap=cmap, vmin=lim[0], vmax=lim[1], shading="flat")
+            fig.colorbar(qm, ax=ax, shrink=0.85)
             ax.set_title(f"{name}: {title}", fontsize=9)
             ax.set_xlabel("frequency [Hz]", fontsize=8)
             ax.set_ylabel("position " + _axis_label(ax2[0]), fontsize=7)
             ax.tick_params(labelsize=7)
-    fig.suptitle("Contact pairs along the curve", fontsize=11)
+    fig.suptitle("Contact pairs along the curve (mean over the pairs at a position)",
+                 fontsize=11)
     fig.tight_layout()
     return fig
 

@@ -48,22 +48,25 @@ def relevant_outputs(amp, share: float = 1e-3) -> np.ndarray:
 
 
 def fold_marks(f, amp, fold, max_marks: int = 4, share: float = 0.005) -> np.ndarray:
-    """Indices of the folds worth marking: those that turn the curve back over more than
-    `share` of the frequency span (to the next fold or the end), at most `max_marks` of the
-    largest. Round-off wiggles of a stepping continuation (folds in pairs a few
+    """Indices of the folds worth marking: those whose turned-back stretch spans more than
+    `share` of the frequency range, at most `max_marks` (the widest stretches).
+
+    Folds come in pairs along a sweep: one turns the curve back, the next turns it
+    forward again; the stretch between them (to the end for an unpaired last fold) is
+    what the pair measures. Round-off wiggles of a stepping continuation (pairs a few
     millihertz apart) are left unmarked."""
     idx = np.flatnonzero(np.asarray(fold, bool))
     f = np.asarray(f, float)
     span = float(np.ptp(f)) if f.size else 0.0
     if idx.size == 0 or span == 0.0:
         return idx[:0]
-    ends = np.r_[idx[1:], f.size - 1]
-    # frequency extent of the stretch between this fold and the next turn (or the end)
-    extent = np.array([np.ptp(f[a:b + 1]) for a, b in zip(idx, ends)])
-    keep = idx[extent > share * span]
-    ext = extent[extent > share * span]
-    keep = keep[np.argsort(-ext)[:max_marks]]
-    return np.sort(keep)
+    first = idx[0::2]
+    second = np.r_[idx[1::2], [f.size - 1] * (first.size - idx[1::2].size)].astype(int)
+    extent = np.array([np.ptp(f[a:b + 1]) for a, b in zip(first, second)])
+    big = np.argsort(-extent)[:max(max_marks // 2, 1)]
+    big = big[extent[big] > share * span]
+    keep = np.r_[first[big], idx[1::2][big[big < idx[1::2].size]]]
+    return np.sort(keep).astype(int)
 
 
 def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = None,
@@ -91,7 +94,8 @@ def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = No
         Unit shown on the amplitude axis.
     log : bool, optional
         Logarithmic amplitude axis; default when the relevant amplitudes span more than
-        30x.
+        30x. Its bottom is the 5th percentile of the relevant outputs' amplitudes, at most
+        four decades below the largest.
     ax : matplotlib.axes.Axes, optional
         Draw on these axes; default a new 7.5 x 4.6 in Figure at 130 dpi.
     phase : bool
@@ -141,11 +145,14 @@ def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = No
     if log is None:
         log = pos.size > 0 and pos.max() / pos.min() > 30.0
     if pos.size:
-        lo, hi = pos.min(), pos.max()
+        hi = pos.max()
         if log:
             ax.set_yscale("log")
-            # six decades below the largest amplitude at most
-            ax.set_ylim(max(lo, 1e-6 * hi) / 1.5, hi * 1.5)
+            # the bottom: where the relevant outputs spend all but 5 % of the curve (a
+            # direction that passes through zero at a few points dips below it), four
+            # decades below the largest amplitude at most
+            lows = [np.percentile(a[a > 0], 5) for a in amp[:, rel].T if np.any(a > 0)]
+            ax.set_ylim(max(min(lows), 1e-4 * hi) / 1.5, hi * 1.5)
         else:
             ax.set_ylim(0.0, hi * 1.08)
     if not stable.all():
@@ -214,7 +221,8 @@ def plot_states(frf, *, contact_names=None, unit: str = "hz",
         else:
             for k in range(3):
                 ax.plot(f, sf[:, g, k], color=colors[k], lw=1.4, label=labels[k])
-        ax.set_ylim(0.0, 1.0)
+        # lines at 0 or 1 must not hide under the frame
+        ax.set_ylim((0.0, 1.0) if mono else (-0.03, 1.03))
         ax.set_ylabel("fraction of period")
         ax.set_title(names[g], fontsize=9, loc="left")
         ax.grid(True, alpha=0.3)

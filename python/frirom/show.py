@@ -287,7 +287,8 @@ def figure_hysteresis(state: PointState, pick: list) -> Figure:
         u0, f0 = np.r_[c.u[e, 0], c.u[e, 0, :1]], np.r_[c.f[e, 0], c.f[e, 0, :1]]
         ax.plot(u0 * 1e6, f0, lw=1.3, label=lab)
         if bx is not None and "v" in c.directions:
-            bx.plot(np.degrees(c.tau), c.f[e, -1], lw=1.3, label=lab)
+            bx.plot(np.degrees(np.r_[c.tau, 2 * np.pi]), np.r_[c.f[e, -1], c.f[e, -1, :1]],
+                    lw=1.3, label=lab)
     ax.set_xlabel(f"relative displacement {state.contacts[pick[0][0]].directions[0]} "
                   "[um]" if pick else "relative displacement [um]")
     ax.set_ylabel("tangential force [N]")
@@ -393,7 +394,7 @@ def cmd_show(args) -> int:
         if not fe:
             raise InputError("--along: interface maps need an FE deck ([fe_model]) with "
                              "node-set contacts")
-        idx = np.unique(np.linspace(0, len(frf) - 1, max(args.along, 2)).round().astype(int))
+        idx = maps.curve_indices(frf, args.along)
         states = [point_state(frf, deck, int(i), float(frf.omega[i])) for i in idx]
         fig = maps.figure_curve_maps(states, deck)
         fig.savefig(folder / "maps_along.png")
