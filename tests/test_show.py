@@ -173,3 +173,30 @@ def test_plots_keep_frequency_mark_few_folds_and_ignore_tiny_dofs():
     # folded: lines against frequency (in path order), not a stacked area
     assert len(sax.lines) == 3 and not sax.collections
     np.testing.assert_allclose(sax.lines[0].get_xdata(), f)
+
+
+def test_power_balance_of_a_cyclic_sector(tmp_path_factory):
+    """The same balance on a cyclic sector (the bladed sector of tests/test_cyclic_deck.py
+    with friction on the flange, EO 2, H = 3): the viscous work comes from the modes of
+    each harmonic's nodal diameter and the generalised forces (frirom.show), the contact
+    work from the AFT march, the excitation's from the loads; 1e-6 of the excitation's
+    work (tol_residual 1e-8)."""
+    if shutil.which("ccx") is None:
+        pytest.skip("ccx (calculix-ccx) not installed")
+    import test_cyclic_deck as tc
+    out = tmp_path_factory.mktemp("cyclic_show")
+    _, sec = tc.bladed_sector.write_sector_decks(out / "inner", tc.N_SEC, n_modes=4,
+                                                 sector_clamp="inner")
+    tc.bladed_sector.run_ccx(sec, expect=(".sti", ".mas", ".dof"))
+    deck = tc.write(out, kp="1.0e9", h=3, solver_extra="samples = 64")
+    deck.write_text(deck.read_text().replace("mu = 1.0e3", "mu = 0.3")
+                    .replace("n0 = 1.0e6", "n0 = 0.5"))
+    d = load_deck(deck)
+    o = dataclasses.replace(d.options(), max_points=40)
+    r = frf(d.model(), d.excitation(), 2 * np.pi * 600.0, 2 * np.pi * 720.0, o,
+            outputs=d.solver_outputs)
+    k = int(np.argmax(r.amp_max[:, 0]))
+    s = point_state(r, d, k, float(r.omega[k]))
+    b = s.balance
+    assert b["contacts"] > 1e-3 * b["excitation"] and b["viscous"] > 0, b
+    assert abs(b["residual"]) <= 1e-6 * b["excitation"], b

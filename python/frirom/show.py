@@ -71,8 +71,8 @@ class PointState:
     omega rad/s; index: the stored point it was solved from; x (n_dof, 2H+1) harmonics of
     every model coordinate; outputs (n_out, 2H+1) of the deck's outputs; labels (n_out,);
     contacts: ContactField per group; balance: {'excitation', 'contacts', 'viscous'} work
-    per period [J] ('viscous' NaN for a cyclic sector, whose damping is modal per nodal
-    diameter) and 'residual' = excitation - contacts - viscous.
+    per period [J] (for a cyclic sector per sector, the viscous part from the modes of
+    each harmonic's nodal diameter) and 'residual' = excitation - contacts - viscous.
     """
 
     omega: float
@@ -204,6 +204,33 @@ def contact_fields(model, x: np.ndarray, slider: np.ndarray, n_samples: int) -> 
     return out
 
 
+def _sector_viscous_work(model: CyclicModel, fe: np.ndarray, contacts: list, omega: float,
+                         H: int) -> float:
+    """Viscous work per period of a cyclic sector from its modes: harmonic h on nodal
+    diameter k_h, modal amplitudes q = psi_ext^H (f_e - G^T f) / (w_m^2 - W^2 + 2 i z_m w_m W)
+    (W = h omega; psi_ext: sector 0's rows, then the next sector's times exp(i k alpha);
+    f the contact forces' harmonics from the AFT samples), work h pi W sum 2 z_m w_m |q_m|^2
+    (modes normalised to unit modal mass over the sector)."""
+    from .harmonics import to_harmonics
+    n = model.n_dof
+    alpha = 2.0 * np.pi / model.n_sectors
+    gf = np.zeros((2 * n, 2 * H + 1))
+    for g, c in zip(model.contacts, contacts):
+        fh = to_harmonics(c.f, H).reshape(-1, 2 * H + 1)
+        gf[:g.G.shape[1]] += np.asarray(g.G.T @ fh)
+    work = 0.0
+    for h in range(1, H + 1):
+        m = model.modes_of(model.harmonic_index(h))
+        W = h * omega
+        f = np.zeros(2 * n, complex)
+        f[:n] = fe[:, 2 * h - 1] - 1j * fe[:, 2 * h]
+        f -= gf[:, 2 * h - 1] - 1j * gf[:, 2 * h]
+        psi = np.vstack([m.psi, m.psi * np.exp(1j * m.k * alpha)])
+        q = (psi.conj().T @ f) / (m.omega**2 - W**2 + 2j * m.zeta * m.omega * W)
+        work += h * np.pi * W * float(np.sum(2.0 * m.zeta * m.omega * np.abs(q) ** 2))
+    return work
+
+
 def point_state(frf: FRF, deck, index: int, omega: float) -> PointState:
     """Solve the point again at omega from stored point `index` with every coordinate kept
     and compute its outputs, contact fields and power balance."""
@@ -223,7 +250,8 @@ def point_state(frf: FRF, deck, index: int, omega: float) -> PointState:
     contacts = contact_fields(model, x, np.asarray(pt.slider, float), opts.n_samples)
     ext = _velocity_work(x, exc.real_harmonic(n, opts.harmonics))
     if isinstance(model, CyclicModel):
-        visc = float("nan")
+        visc = _sector_viscous_work(model, exc.real_harmonic(n, opts.harmonics), contacts,
+                                    omega, opts.harmonics)
     else:
         h = np.arange(1, opts.harmonics + 1)
         a, b = x[:, 1::2], x[:, 2::2]
@@ -232,7 +260,7 @@ def point_state(frf: FRF, deck, index: int, omega: float) -> PointState:
                                                     + np.einsum("ih,ih->h", b, C @ b))))
     dis = float(sum(c.energy.sum() for c in contacts))
     bal = {"excitation": ext, "contacts": dis, "viscous": visc,
-           "residual": ext - dis - (0.0 if np.isnan(visc) else visc)}
+           "residual": ext - dis - visc}
     return PointState(omega=float(omega), index=int(index), x=x, outputs=P @ x,
                       labels=list(deck.output_names), contacts=contacts, balance=bal)
 
@@ -313,7 +341,7 @@ def figure_energy(state: PointState) -> Figure:
     for ax, c in zip(axes, state.contacts):
         ax.bar(np.arange(c.n_elem), c.energy, width=0.9, color="#c0392b")
         ax.set_ylabel("energy / period [J]")
-        ax.set_title(f"{c.name}: {c.energy.sum():.4g} J per period", fontsize=9, loc="left")
+        ax.set_title(f"{c.name}: {c.energy.sum():.4g} J per period", fontsize=9, loc="right")
         ax.grid(True, axis="y", alpha=0.3)
     axes[-1].set_xlabel("contact element (pair)")
     b = state.balance
