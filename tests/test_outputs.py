@@ -25,55 +25,15 @@ from frirom.solver import frf, solve_point
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "models"))
 import block  # noqa: E402
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from test_reduction_deck import GSI_DECK  # noqa: E402
+
 #: the block of tests/test_reduction_deck.py (CB + GSI: the interface DoFs are not
-#: coordinates), one harmonic, few samples: a few seconds per run
-DECK = """
-title = "block"
-[fe_model]
-format = "calculix"
-job = "block"
-
-[reduction]
-interface = "IFACE"
-active = ["ACTIVE"]
-fixed_interface_modes = 30
-
-[reduction.interface_modes]
-method = "gsi"
-free = 6
-stick = 6
-
-[[contacts]]
-name = "end"
-law = "normal2d"
-a = "IFACE"
-b = "ground"
-normal = [1.0, 0.0, 0.0]
-kt = 2.0e8
-kn = 8.0e8
-mu = 0.5
-n0 = 100.0
-
-[damping]
-type = "modal"
-zeta = 0.01
-
-[[excitation.load]]
-dof = "ACTIVE:z"
-amplitude = 1.0
-
-[solver]
-harmonics = 2
-samples = 64
-
-[frequency]
-start = 140.0
-end = 160.0
-
-[outputs]
-plot = false
-dofs = {outputs}
-"""
+#: coordinates), two harmonics, few samples, 140..160 Hz: a few seconds per run
+DECK = (GSI_DECK.format(kt="2.0e8", h=2, mu=0.5)
+        .replace("harmonics = 2", "harmonics = 2\nsamples = 64")
+        .replace("start = 100.0\nend = 200.0", "start = 140.0\nend = 160.0")
+        .replace('dofs = ["ACTIVE:z", "ACTIVE:x"]', "plot = false\ndofs = {outputs}"))
 
 
 @pytest.fixture(scope="module")
