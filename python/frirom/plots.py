@@ -100,7 +100,8 @@ def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = No
         Draw on these axes; default a new 7.5 x 4.6 in Figure at 130 dpi.
     phase : bool
         Add a panel below with the phase of the first harmonic of each relevant output
-        (x_1 = A cos(omega t + phase), deg; needs ``frf.X``); not with `ax`.
+        (x_1 = A cos(omega t + phase), deg in (-270, 90]; needs ``frf.X``); not with
+        `ax`.
 
     Returns
     -------
@@ -164,9 +165,15 @@ def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = No
     if own and phase:
         X = np.asarray(frf.X, float)
         for j in np.flatnonzero(rel):
-            ph = np.degrees(np.unwrap(np.arctan2(-X[:, j, 2], X[:, j, 1])))
+            a1 = np.hypot(X[:, j, 1], X[:, j, 2])
+            # in (-270, 90]: a lag from 0 through -180 stays continuous; no phase where
+            # the first harmonic is below 1e-3 of its largest (a stuck direction's
+            # round-off has no phase)
+            ph = (np.degrees(np.arctan2(-X[:, j, 2], X[:, j, 1])) + 270.0) % 360.0 - 270.0
+            ph[a1 < 1e-3 * max(a1.max(), 1e-300)] = np.nan
             pax.plot(f, ph, color=colors[j % len(colors)], lw=1.2)
         pax.set_ylabel("phase of h1 [deg]")
+        pax.set_yticks([-270, -180, -90, 0, 90])
         pax.grid(True, alpha=0.3)
         pax.set_xlabel(xlabel)
     else:
