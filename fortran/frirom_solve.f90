@@ -319,7 +319,10 @@ contains
         nc = 2*nh + 1
         nout = size(outdofs)
         call check_input(info, msg)
-        if (info /= 0) return
+        if (info /= 0) then
+            call fail(info, msg)
+            return
+        end if
         ! K, M, C as CSR (C: matrix + Rayleigh + modal)
         call coo_csr(n, n, kr, kc, kv, 'K', kp, ki, kx, info, msg)
         if (info == 0) call coo_csr(n, n, mr, mc, mv, 'M', mp, mi, mx, info, msg)
@@ -339,9 +342,15 @@ contains
         end if
         nrows = sum(ginfo(2, :)*ginfo(3, :))
         if (info == 0) call coo_csr(nrows, n, gr, gc, gv, 'G', gp, gi, gx, info, msg)
-        if (info /= 0) return
+        if (info /= 0) then
+            call fail(info, msg)
+            return
+        end if
         call rcm_pattern(info, msg)
-        if (info /= 0) return
+        if (info /= 0) then
+            call fail(info, msg)
+            return
+        end if
         ! the contact DoFs: G's columns, sorted
         block
             logical :: used(n)
@@ -458,6 +467,9 @@ contains
                 call set_status(st, FRIROM_ERR_SIZE, m, 'frf_solve: fe must be (n, 2H+1)')
             else if (size(ginfo, 1) /= 3) then
                 call set_status(st, FRIROM_ERR_SIZE, m, 'frf_solve: ginfo must be (3, ngroup)')
+            else if (any(ginfo(2:3, :) < 1)) then
+                call set_status(st, FRIROM_ERR_PARAM, m, 'frf_solve: ginfo: every group needs '// &
+                                '>= 1 element and direction')
             else if (nout < 1 .or. any(outdofs < 1) .or. any(outdofs > n)) then
                 call set_status(st, FRIROM_ERR_PARAM, m, 'frf_solve: outdofs must name '// &
                                 'DoFs 1..n (at least one)')

@@ -1,5 +1,6 @@
-"""meson test: the whole-solve programs (tests/frf_joint.f90 through frirom_solve,
-tests/frf_joint.c through frirom_frf) reproduce frirom.solver.frf on the joint deck.
+"""meson test and tests/test_install.py: the README's whole-solve programs (frf_joint.f90
+through frirom_solve, frf_joint.c through frirom_frf) reproduce frirom.solver.frf on the
+joint deck.
 
 Usage: python capi_compare.py PROGRAM [PROGRAM ...]. Each program prints
 "omega amp(tip:x) amp(platform:x) amp(platform:y)" per point, then "complete FLAG NPTS".
