@@ -5,11 +5,10 @@
                                               one go; --out is then their parent folder
     frirom demo [--out DIR]                   contact hysteresis loops and harmonics
 
-Exit codes of `frirom run`: 0 every run reached the end of its frequency range; 2 a deck
-is wrong (the message names the field); 3 a run stopped before the end of its range (its
-points are kept: see --resume); 130 interrupted (Ctrl-C). With several decks the code is
-that of the first deck that did not reach 0, after all of them have run (Ctrl-C stops the
-batch at once).
+Exit codes of `frirom run` on several decks: 0 every run reached the end of its frequency
+range; 2 a deck is wrong (the message names the field); 3 a run stopped before the end of
+its range (its points are kept: see --resume); 130 interrupted (Ctrl-C stops the batch at
+once); the code of the first deck that did not end with 0, after all of them have run.
 """
 
 from __future__ import annotations
