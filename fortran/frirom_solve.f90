@@ -377,15 +377,9 @@ contains
             return
         end if
         res%ny = sys%n
-        cap = s%max_points
-        allocate (res%omega(cap), res%xo(nout, nc, cap), res%amp(nout, cap), &
-                  res%y(sys%n, cap), res%states(3, max(ne, 1), cap), res%iters(cap), &
-                  stat=info)
-        if (info /= 0) then
-            call set_status(info, FRIROM_ERR_ALLOC, msg, 'frf_solve: result arrays')
-            call fail(info, msg)
-            return
-        end if
+        cap = 0                 ! the result arrays grow as points come (keep)
+        allocate (res%omega(0), res%xo(nout, nc, 0), res%amp(nout, 0), res%y(sys%n, 0), &
+                  res%states(3, max(ne, 1), 0), res%iters(0))
         lscale = abs(omega_end - omega_start)
         if (lscale == 0.0_wp) lscale = 1.0_wp
         lam_lo = omega_start - 0.02_wp*(omega_end - omega_start)
@@ -401,12 +395,17 @@ contains
             return
         end if
         call keep(1_ip)
+        if (info /= 0) then
+            call fail(info, msg)
+            return
+        end if
         y0 = ys(:, 1)
         yscale = norm2(y0)
         if (yscale == 0.0_wp) yscale = 1.0_wp
         pending = .true.
         start = HBM_START_CONTINUE
         res%complete = .false.
+        fin = .false.
         do while (res%npts < s%max_points)
             maxpts = min(s%batch, s%max_points - res%npts) + merge(1, 0, pending)
             call run_call(start, yscale, maxpts)
@@ -601,10 +600,13 @@ contains
             ds = dsl
         end subroutine run_call
 
-        !> Keep point k of the last call.
+        !> Keep point k of the last call (info = FRIROM_ERR_ALLOC if there is no room).
         subroutine keep(kk)
             integer(ip), intent(in) :: kk
             integer(ip) :: o
+            if (res%npts == cap) then
+                if (.not. grown(min(max(2*cap, 16_ip), int(s%max_points, ip)))) return
+            end if
             res%npts = res%npts + 1
             j = res%npts
             res%omega(j) = lams(kk)
@@ -617,5 +619,35 @@ contains
             res%iters(j) = itb(kk)
             tan_last = tans(:, kk)
         end subroutine keep
+        !> Room for nn points in the result arrays (the npts kept are copied); false, with
+        !> info = FRIROM_ERR_ALLOC and the message, when memory runs out.
+        logical function grown(nn)
+            integer(ip), intent(in) :: nn
+            real(wp), allocatable :: a1(:), a2(:, :), a3(:, :, :), b2(:, :), b3(:, :, :)
+            integer(ip), allocatable :: i1(:)
+            integer(ip) :: m, stat
+            m = res%npts
+            allocate (a1(nn), a2(nout, nn), a3(nout, nc, nn), b2(res%ny, nn), &
+                      b3(size(res%states, 1), size(res%states, 2), nn), i1(nn), stat=stat)
+            grown = stat == 0
+            if (.not. grown) then
+                call set_status(info, FRIROM_ERR_ALLOC, msg, 'frf_solve: no memory for '// &
+                                'more points')
+                return
+            end if
+            a1(1:m) = res%omega(1:m)
+            a2(:, 1:m) = res%amp(:, 1:m)
+            a3(:, :, 1:m) = res%xo(:, :, 1:m)
+            b2(:, 1:m) = res%y(:, 1:m)
+            b3(:, :, 1:m) = res%states(:, :, 1:m)
+            i1(1:m) = res%iters(1:m)
+            call move_alloc(a1, res%omega)
+            call move_alloc(a2, res%amp)
+            call move_alloc(a3, res%xo)
+            call move_alloc(b2, res%y)
+            call move_alloc(b3, res%states)
+            call move_alloc(i1, res%iters)
+            cap = nn
+        end function grown
     end subroutine frf_solve
 end module frirom_solve

@@ -94,14 +94,15 @@ def test_legacy_fortran_program_links_installed_library(tmp_path):
     build, prefix = tmp_path / "build", tmp_path / "prefix"
     env = dict(os.environ)
     subprocess.run([_tool("meson"), "setup", str(build), str(ROOT), "-Dpython=false",
-                    f"--prefix={prefix}"], check=True, env=env,
+                    f"--prefix={prefix}", "--libdir=lib"], check=True, env=env,
                    capture_output=True)
     subprocess.run([_tool("meson"), "install", "-C", str(build)], check=True, env=env,
                    capture_output=True)
     pcs = list(prefix.rglob("frirom.pc"))
-    assert len(pcs) == 1, pcs
+    assert pcs == [prefix / "lib" / "pkgconfig" / "frirom.pc"], pcs   # README's path
     assert (prefix / "include" / "frirom" / "frirom_aft.mod").exists()
     assert (prefix / "include" / "frirom" / "frirom.h").exists()
+    assert (prefix / "include" / "frirom" / "frirom_solve.mod").exists()
     env["PKG_CONFIG_PATH"] = str(pcs[0].parent)
     flags = subprocess.run(["pkg-config", "--cflags", "--libs", "frirom"], check=True,
                            env=env, capture_output=True, text=True).stdout.split()
