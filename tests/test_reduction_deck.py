@@ -18,6 +18,7 @@ from frirom._errors import InputError
 from frirom.io import read_calculix, write_calculix_matrices
 from frirom.deck import load_deck
 from frirom.reduction.interface import contact_matrix, stick_stiffness
+from frirom.reduction import rom as rom_module
 from frirom.reduction.multistage import harmonic_indices
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "models"))
@@ -237,7 +238,7 @@ dofs = ["TIP0:x"]
 def test_cache_is_keyed_by_content_not_by_deck_name(block_dir, tmp_path, monkeypatch):
     """Two decks (other names, other excitation) share one cache entry, read back
     unchanged; an edit of an FE file's content (a CalculiX comment line: same matrices)
-    builds a new entry. The entry sits beside the FE files, whatever the decks' names."""
+    or another reduction code version builds a new entry. The entry sits beside the FE files, whatever the decks' names."""
     monkeypatch.delenv("FRIROM_CACHE", raising=False)
     fe = tmp_path / "fe"
     fe.mkdir()
@@ -259,6 +260,9 @@ def test_cache_is_keyed_by_content_not_by_deck_name(block_dir, tmp_path, monkeyp
     c = load_deck(tmp_path / "variant_a.toml")
     assert not c.reduced.from_cache and "built" in c.log[0]
     assert len(list((fe / ".frirom_cache").glob("rom-*.h5"))) == 2
+    # another version of the reduction code: not reused
+    monkeypatch.setattr(rom_module, "_code_version", lambda: "another")
+    assert not load_deck(tmp_path / "variant_a.toml").reduced.from_cache
     # an explicit folder is a shared cache too; an explicit *.h5 file is used as before
     d = load_deck(_write(tmp_path / "in_folder.toml", text.replace(
         "fixed_interface_modes = 30", 'fixed_interface_modes = 30\ncache = "store"')))

@@ -401,9 +401,10 @@ def _label(model, i):
 
 @functools.lru_cache(maxsize=1)
 def _code_version() -> str:
-    """sha256 of frirom's reduction code (the sources of frirom.reduction and of the FE
-    readers frirom.io): any change to them invalidates every cached reduced model."""
-    h = hashlib.sha256(f"frirom-rom-{CACHE_VERSION}".encode())
+    """sha256 of frirom's version and reduction code (the sources of frirom.reduction and
+    of the FE readers frirom.io): any change to them invalidates every cached model."""
+    from .. import __version__
+    h = hashlib.sha256(f"frirom-{__version__}-rom-{CACHE_VERSION}".encode())
     here = Path(__file__).resolve().parent
     for folder in (here, here.parent / "io"):
         for f in sorted(folder.glob("*.py")):
