@@ -70,8 +70,9 @@ void frirom_settings_default(struct frirom_settings *s);
  * 2H+1, npts) output harmonics, amp (nout, npts) max over a period of |x(t)|, y (nycap,
  * npts) unknowns when y is not NULL and nycap >= ny (ny: unknowns per point); complete = 1
  * when the curve reached omega_end. Returns 0 when every solve converged (complete = 0
- * then means max_points was reached; msg says so); non-zero with npts > 0: the curve
- * stopped there, msg says why; non-zero with npts = 0: bad input or no first point. */
+ * then means max_points was reached or the curve turned back out of the range; msg says
+ * which); non-zero with npts > 0: the curve stopped there, msg says why; non-zero with
+ * npts = 0: bad input (msg names the argument) or no first point. */
 int frirom_frf(int n, int nk, const int *kr, const int *kc, const double *kv,
                int nm, const int *mr, const int *mc, const double *mv,
                int ncd, const int *cr, const int *cc, const double *cv,
