@@ -6,9 +6,10 @@ module frirom_capi
     use frirom_kinds, only: wp, ip
     use frirom_status
     use frirom_aft
+    use frirom_solve, only: frf_settings, frf_result, frf_solve
     implicit none
     private
-    public :: frirom_aft_eval_c, frirom_status_message_c
+    public :: frirom_aft_eval_c, frirom_status_message_c, frirom_settings_default_c, frirom_frf_c
 
 contains
 
@@ -98,4 +99,87 @@ contains
         call to_c_string(text, msg, msglen)
         info = int(st, c_int)
     end function frirom_aft_eval_c
+
+    !> void frirom_settings_default(struct frirom_settings *s)
+    subroutine frirom_settings_default_c(s) bind(c, name='frirom_settings_default')
+        type(frf_settings), intent(out) :: s
+        s = frf_settings()
+    end subroutine frirom_settings_default_c
+
+    !> int frirom_frf(...): the whole forced-response solve of frirom_solve frf_solve for C
+    !> (see frirom.h); indices 0-based, arrays column-major, results in caller memory.
+    function frirom_frf_c(n, nk, kr, kc, kv, nm, mr, mc, mv, ncd, cr, cc, cv, alpha, beta, &
+                          nzeta, zeta, ngroup, ginfo, ng, gr, gc, gv, npar, params, nw, w0, &
+                          fe, omega_start, omega_end, nout, outdofs, s, maxpts, npts, &
+                          complete, omega, xo, amp, nycap, ny, y, msg, msglen) result(info) &
+        bind(c, name='frirom_frf')
+        integer(c_int), value :: n, nk, nm, ncd, nzeta, ngroup, ng, npar, nw, nout, maxpts, &
+                                 nycap, msglen
+        real(c_double), value :: alpha, beta, omega_start, omega_end
+        integer(c_int), intent(in) :: kr(*), kc(*), mr(*), mc(*), cr(*), cc(*), ginfo(*), &
+                                      gr(*), gc(*), outdofs(*)
+        real(c_double), intent(in) :: kv(*), mv(*), cv(*), zeta(*), gv(*), params(*), w0(*), &
+                                      fe(*)
+        type(frf_settings), intent(in) :: s
+        integer(c_int), intent(out) :: npts, complete, ny
+        real(c_double), intent(out) :: omega(*), xo(*), amp(*)
+        type(c_ptr), value :: y, msg
+        integer(c_int) :: info
+        type(frf_result) :: res
+        real(c_double), pointer :: yp(:, :)
+        integer(ip) :: nc, k, st
+        character(len=512) :: text
+
+        npts = 0
+        complete = 0
+        ny = 0
+        nc = 2*s%harmonics + 1
+        text = ''
+        st = FRIROM_OK
+        if (min(n, nk, nm, ncd, nzeta, ngroup, ng, npar, nw, nout, maxpts, nycap) < 0 .or. &
+            s%harmonics < 0) then
+            call set_status(st, FRIROM_ERR_SIZE, text, 'frirom_frf: negative count')
+        else if (maxpts < s%max_points) then
+            call set_status(st, FRIROM_ERR_SIZE, text, 'frirom_frf: maxpts (the room in '// &
+                            'omega, xo, amp, y) must be >= settings.max_points')
+        end if
+        if (st == FRIROM_OK) then
+            if (nw > 0) then
+                call frf_solve(n, kr(:nk) + 1, kc(:nk) + 1, kv(:nk), mr(:nm) + 1, mc(:nm) + 1, &
+                               mv(:nm), cr(:ncd) + 1, cc(:ncd) + 1, cv(:ncd), alpha, beta, &
+                               zeta(:nzeta), reshape(ginfo(:3*ngroup), [3, ngroup]), &
+                               gr(:ng) + 1, gc(:ng) + 1, gv(:ng), params(:npar), &
+                               reshape(fe(:n*nc), [n, nc]), omega_start, omega_end, &
+                               outdofs(:nout) + 1, s, res, w0=w0(:nw))
+            else
+                call frf_solve(n, kr(:nk) + 1, kc(:nk) + 1, kv(:nk), mr(:nm) + 1, mc(:nm) + 1, &
+                               mv(:nm), cr(:ncd) + 1, cc(:ncd) + 1, cv(:ncd), alpha, beta, &
+                               zeta(:nzeta), reshape(ginfo(:3*ngroup), [3, ngroup]), &
+                               gr(:ng) + 1, gc(:ng) + 1, gv(:ng), params(:npar), &
+                               reshape(fe(:n*nc), [n, nc]), omega_start, omega_end, &
+                               outdofs(:nout) + 1, s, res)
+            end if
+            st = res%info
+            text = res%message
+            npts = res%npts
+            complete = merge(1, 0, res%complete)
+            ny = res%ny
+            omega(:npts) = res%omega
+            xo(:nout*nc*npts) = reshape(res%xo, [nout*nc*npts])
+            amp(:nout*npts) = reshape(res%amp, [nout*npts])
+            if (c_associated(y)) then
+                if (nycap < res%ny) then
+                    if (st == FRIROM_OK) call set_status(st, FRIROM_ERR_SIZE, text, &
+                                                         'frirom_frf: nycap < ny, y not filled')
+                else
+                    call c_f_pointer(y, yp, [int(nycap, ip), int(maxpts, ip)])
+                    do k = 1, npts
+                        yp(:res%ny, k) = res%y(:, k)
+                    end do
+                end if
+            end if
+        end if
+        call to_c_string(text, msg, msglen)
+        info = int(st, c_int)
+    end function frirom_frf_c
 end module frirom_capi

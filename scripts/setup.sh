@@ -23,7 +23,8 @@ python3 -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip
 .venv/bin/python -m pip install -q -r requirements-dev.txt
 # Editable install: meson-python rebuilds the Fortran core on import when sources change.
-.venv/bin/python -m pip install -q --no-build-isolation -Cbuild-dir=build/py -e .
+.venv/bin/python -m pip install -q --no-build-isolation -Cbuild-dir=build/py \
+    -Csetup-args=-Dnative=true -e .
 
 # The main job: the forced response of a blade with a platform friction damper (bundled
 # deck), written to results/joint/; then the contact-element demo into results/demo/.

@@ -1,6 +1,7 @@
 /* The C interface: a Jenkins element stuck all cycle is the spring kt (f = kt x, exact),
  * one that slips dissipates 4 mu N (A - mu N / kt) per cycle (to 10/N^2), and bad input
- * returns a status code with a message. */
+ * returns a status code with a message (frirom_frf: naming the argument). The whole solve
+ * is checked against Python by the frf_joint test (tests/capi_compare.py). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -40,6 +41,24 @@ int main(void) {
     info = frirom_aft_eval(9, H, N, 1, x, params, NULL, f, NULL, NULL, msg, 256);
     if (info != 11 || strstr(msg, "law 9 (expected 1 jenkins, 2 normal1d") == NULL) {
         fprintf(stderr, "bad law: info %d msg %s\n", info, msg); return 1;
+    }
+    {   /* frirom_frf: an output DoF out of range, no point computed */
+        const int kr[] = {0}, md[] = {0}, ginfo[] = {FRIROM_LAW_JENKINS, 1, 1}, gr[] = {0};
+        const int out[] = {3};
+        const double kv[] = {1e4}, mv[] = {1.0}, gv[] = {1.0}, fe[3] = {0, 1, 0};
+        double om[1], xo[3], amp[1];
+        int npts = -1, complete = -1, ny = -1;
+        struct frirom_settings s;
+        frirom_settings_default(&s);
+        s.harmonics = 1;
+        s.max_points = 1;
+        info = frirom_frf(1, 1, kr, kr, kv, 1, md, md, mv, 0, NULL, NULL, NULL, 0.0, 0.0, 0,
+                          NULL, 1, ginfo, 1, gr, gr, gv, 3, params, 0, NULL, fe, 50.0, 150.0,
+                          1, out, &s, 1, &npts, &complete, om, xo, amp, 0, &ny, NULL, msg, 256);
+        if (info != 2 || npts != 0 || complete != 0 || strstr(msg, "outdofs") == NULL) {
+            fprintf(stderr, "frirom_frf bad output: info %d npts %d msg %s\n", info, npts, msg);
+            return 1;
+        }
     }
     puts("test_capi: ok");
     return 0;

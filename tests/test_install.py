@@ -4,7 +4,11 @@ Builds the library alone (-Dpython=false) into a temporary prefix, then compiles
 Fortran programs that `use` frirom_aft and frirom_eigen and link with `pkg-config
 --cflags --libs frirom`, as a legacy code's makefile would. They check a stuck Jenkins
 element against the linear spring (exact) and the first eigenvalue of a spring chain
-against its closed form (1e-10; ARPACK + MUMPS through the static library).
+against its closed form (1e-10; ARPACK + MUMPS through the static library). The README's
+whole-solve programs (frf_joint.f90 through frirom_solve, frf_joint.c through frirom.h,
+taken from the README's code blocks) are built the same way and must reproduce the Python
+FRF of the joint deck (tests/capi_compare.py: same points, 1e-9); no test program is built
+or installed by a plain build.
 """
 
 import os
@@ -90,14 +94,15 @@ def test_legacy_fortran_program_links_installed_library(tmp_path):
     build, prefix = tmp_path / "build", tmp_path / "prefix"
     env = dict(os.environ)
     subprocess.run([_tool("meson"), "setup", str(build), str(ROOT), "-Dpython=false",
-                    "-Dtests=false", f"--prefix={prefix}"], check=True, env=env,
+                    f"--prefix={prefix}", "--libdir=lib"], check=True, env=env,
                    capture_output=True)
     subprocess.run([_tool("meson"), "install", "-C", str(build)], check=True, env=env,
                    capture_output=True)
     pcs = list(prefix.rglob("frirom.pc"))
-    assert len(pcs) == 1, pcs
+    assert pcs == [prefix / "lib" / "pkgconfig" / "frirom.pc"], pcs   # README's path
     assert (prefix / "include" / "frirom" / "frirom_aft.mod").exists()
     assert (prefix / "include" / "frirom" / "frirom.h").exists()
+    assert (prefix / "include" / "frirom" / "frirom_solve.mod").exists()
     env["PKG_CONFIG_PATH"] = str(pcs[0].parent)
     flags = subprocess.run(["pkg-config", "--cflags", "--libs", "frirom"], check=True,
                            env=env, capture_output=True, text=True).stdout.split()
@@ -109,3 +114,18 @@ def test_legacy_fortran_program_links_installed_library(tmp_path):
         subprocess.run(["gfortran", str(src), "-o", str(exe)] + flags, check=True, env=env)
         out = subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout
         assert expect in out
+    # no test program is installed or built by `meson install`
+    assert not list(prefix.rglob("test_*")) and not list(build.rglob("test_aft"))
+    sys.path.insert(0, str(ROOT / "tests"))
+    try:
+        import capi_compare
+        import readme_program
+    finally:
+        sys.path.pop(0)
+    exe_f, exe_c = tmp_path / "frf_joint", tmp_path / "frf_joint_c"
+    for exe, cmd in ((exe_f, ["gfortran"]), (exe_c, ["cc"])):
+        src = tmp_path / f"{exe.name.removesuffix('_c')}.{'c' if cmd == ['cc'] else 'f90'}"
+        src.write_text(readme_program.extract(ROOT / "README.md", src.name))
+        extra = ["-lgfortran", "-lm"] if cmd == ["cc"] else []
+        subprocess.run(cmd + [str(src), "-o", str(exe)] + flags + extra, check=True, env=env)
+    assert capi_compare.main([str(exe_f), str(exe_c)]) == 0

@@ -18,6 +18,7 @@ from frirom._errors import InputError
 from frirom.io import read_calculix, write_calculix_matrices
 from frirom.deck import load_deck
 from frirom.reduction.interface import contact_matrix, stick_stiffness
+from frirom.reduction import rom as rom_module
 from frirom.reduction.multistage import harmonic_indices
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "models"))
@@ -233,3 +234,37 @@ dofs = ["TIP0:x"]
     x = np.linalg.solve(K * (1 + 0.01j) - om**2 * M, f)
     y = np.linalg.solve(rom.K * (1 + 0.01j) - om**2 * rom.M, rom.T.T @ f)
     assert np.linalg.norm(rom.expand(y) - x) < 1e-10 * np.linalg.norm(x)
+
+
+def test_cache_is_keyed_by_content_not_by_deck_name(block_dir, tmp_path, monkeypatch):
+    """Two decks (other names, other excitation) share one cache entry, read back
+    unchanged; an edit of an FE file's content (a CalculiX comment line: same matrices)
+    or another reduction code version builds a new entry. The entry sits beside the FE files, whatever the decks' names."""
+    monkeypatch.delenv("FRIROM_CACHE", raising=False)
+    fe = tmp_path / "fe"
+    fe.mkdir()
+    for f in block_dir.glob("block.*"):
+        shutil.copy(f, fe / f.name)
+    text = GSI_DECK.format(kt="2.0e8", h=3, mu=0.5).replace('job = "block"',
+                                                          'job = "fe/block"')
+    a = load_deck(_write(tmp_path / "variant_a.toml", text))
+    b = load_deck(_write(tmp_path / "other_name.toml",
+                         text.replace("amplitude = 1.0", "amplitude = 5.0")))
+    entries = sorted((fe / ".frirom_cache").glob("rom-*.h5"))
+    assert len(entries) == 1 and not a.reduced.from_cache and b.reduced.from_cache
+    assert f"reused from {entries[0]}" in b.log[0]
+    assert np.array_equal(a.reduced.K, b.reduced.K) and np.array_equal(a.reduced.T, b.reduced.T)
+    assert np.allclose(b.F, 5.0 * a.F, rtol=0, atol=0)
+    assert not list(tmp_path.glob("*.rom.h5"))
+    inp = fe / "block.inp"
+    inp.write_text(inp.read_text() + "** edited\n")
+    c = load_deck(tmp_path / "variant_a.toml")
+    assert not c.reduced.from_cache and "built" in c.log[0]
+    assert len(list((fe / ".frirom_cache").glob("rom-*.h5"))) == 2
+    # another version of the reduction code: not reused
+    monkeypatch.setattr(rom_module, "_code_version", lambda: "another")
+    assert not load_deck(tmp_path / "variant_a.toml").reduced.from_cache
+    # an explicit folder is a shared cache too; an explicit *.h5 file is used as before
+    d = load_deck(_write(tmp_path / "in_folder.toml", text.replace(
+        "fixed_interface_modes = 30", 'fixed_interface_modes = 30\ncache = "store"')))
+    assert len(list((tmp_path / "store").glob("rom-*.h5"))) == 1 and not d.reduced.from_cache

@@ -1,10 +1,17 @@
 """frirom: nonlinear forced response of frictionally damped structures.
 
     frirom run DECK [--out DIR] [--resume]    forced response of a deck (docs/deck.md)
+    frirom run A.toml B.toml DIR/ ...         several decks (and every *.toml of DIR) in
+                                              one go; --out is then their parent folder
     frirom demo [--out DIR]                   contact hysteresis loops and harmonics
     frirom show OUT --at 470Hz | --point K | --peak
                                               one point of a run: time histories,
                                               hysteresis loops, energy, interface maps
+
+Exit codes of `frirom run` on several decks: 0 every run reached the end of its frequency
+range; 2 a deck is wrong (the message names the field); 3 a run stopped before the end of
+its range (its points are kept: see --resume); 130 interrupted (Ctrl-C stops the batch at
+once); the code of the first deck that did not end with 0, after all of them have run.
 """
 
 from __future__ import annotations
@@ -25,13 +32,17 @@ def _add_run(sub) -> None:
         description="Compute the forced response (FRF) described by a TOML deck. Points are "
         "appended to OUT/frf.h5 as they converge (an interrupted run continues with "
         "--resume); at the end OUT/frf.csv, OUT/frf.png and OUT/states.png are written.")
-    p.add_argument("deck", type=Path, help="the TOML deck (see docs/deck.md)")
+    p.add_argument("decks", type=Path, nargs="+", metavar="DECK",
+                   help="the TOML deck (see docs/deck.md); several decks, or folders whose "
+                   "*.toml decks all run, in one go")
     p.add_argument("--out", type=Path, default=None,
-                   help="output folder (default: results/<deck name>)")
+                   help="output folder (default: results/<deck name>); with several decks "
+                   "the parent folder of one subfolder per deck (OUT/<deck name>)")
     p.add_argument("--resume", action="store_true",
-                   help="continue the run stored in OUT/frf.h5 from its last point")
+                   help="continue the run stored in OUT/frf.h5 from its last point (each "
+                   "deck's own folder with several decks)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.set_defaults(func=cmd_run)
+    p.set_defaults(func=cmd_run_decks)
 
 
 def _add_demo(sub) -> None:
@@ -215,6 +226,81 @@ def cmd_run(args) -> int:
     # a resumed run's own peaks cover only its part: the whole file's then (between points)
     _print_peaks(full if args.resume else result, deck)
     return 0
+
+
+#: Exit code of a run that stopped before the end of its frequency range.
+EXIT_INCOMPLETE = 3
+#: Exit code of a deck that cannot be read (a FriromError; the message names the field).
+EXIT_BAD_DECK = 2
+#: Exit code of an interrupted run (Ctrl-C).
+EXIT_INTERRUPTED = 130
+
+
+def _deck_files(paths) -> list[Path]:
+    """The decks named on the command line: files as given, folders as their *.toml files
+    (sorted by name). Raises InputError for a missing path, an empty folder, a deck named
+    twice or two decks with the same name (their results would share a folder)."""
+    decks = []
+    for p in paths:
+        if p.is_dir():
+            found = sorted(p.glob("*.toml"))
+            if not found:
+                raise InputError(f"{p}: a folder with no *.toml deck in it")
+            decks += found
+        elif p.is_file():
+            decks.append(p)
+        else:
+            raise InputError(f"{p}: no such deck file or folder")
+    seen = {}
+    for d in decks:
+        if d.stem in seen:
+            same = "is named twice" if d.resolve() == seen[d.stem].resolve() else \
+                f"and {seen[d.stem]} have the same name: their results would share a folder"
+            raise InputError(f"{d} {same}")
+        seen[d.stem] = d
+    return decks
+
+
+def _run_one(args, deck: Path, out: Path | None) -> int:
+    """cmd_run on one deck of a batch: its exit code, EXIT_BAD_DECK for a deck it could not
+    read, EXIT_INCOMPLETE for a run that returned 0 but whose frf.h5 does not reach the end
+    of the range."""
+    from .results import FRF
+    one = argparse.Namespace(**{**vars(args), "deck": deck, "out": out})
+    try:
+        code = cmd_run(one)
+    except FriromError as exc:
+        print(f"frirom: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_DECK
+    h5 = (out if out is not None else Path("results") / deck.stem) / "frf.h5"
+    if code == 0 and h5.is_file() and not FRF.load(h5).complete:
+        return EXIT_INCOMPLETE
+    return code
+
+
+def cmd_run_decks(args) -> int:
+    """`frirom run` on one deck (cmd_run) or on several in one go: each with the same
+    resume rules, in its own folder (OUT/<deck name>, or results/<deck name>); a summary
+    line per deck; the exit code of the first deck that did not end with 0 (module doc)."""
+    decks = _deck_files(args.decks)
+    if len(decks) == 1 and not args.decks[0].is_dir():
+        args.deck = decks[0]
+        return cmd_run(args)
+    codes = []
+    for i, deck in enumerate(decks):
+        out = args.out / deck.stem if args.out is not None else None
+        print(f"frirom: [{i + 1}/{len(decks)}] {deck}")
+        codes.append(_run_one(args, deck, out))
+        if codes[-1] == EXIT_INTERRUPTED:
+            print(f"frirom: interrupted; {len(decks) - i - 1} decks not run", file=sys.stderr)
+            break
+    what = {0: "complete", EXIT_BAD_DECK: "error in the deck", EXIT_INCOMPLETE:
+            "stopped before the end of its range", EXIT_INTERRUPTED: "interrupted"}
+    for deck, code in zip(decks, codes):
+        print(f"frirom: {deck}: {what.get(code, f'exit code {code}')}")
+    bad = [c for c in codes if c != 0]
+    print(f"frirom: {codes.count(0)} of {len(decks)} runs complete")
+    return bad[0] if bad else 0
 
 
 def _print_peaks(result, deck) -> None:

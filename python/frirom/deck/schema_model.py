@@ -116,8 +116,8 @@ def parse_reduction(ctx: Context, red: dict) -> tuple[ReductionSpec, CyclicSetti
     active = names(ctx, red, "active", "reduction.active", required=False)
     n_cb = number(ctx, red, "fixed_interface_modes", "reduction.fixed_interface_modes",
                   integer=True, minimum=0)
-    cache = file(ctx, red, "cache", "reduction.cache") if "cache" in red else \
-        ctx.path.with_suffix(".rom.h5")
+    # a *.h5 file, or a folder of the shared cache; default the shared cache (rom_key)
+    cache = file(ctx, red, "cache", "reduction.cache") if "cache" in red else None
     pre = "reduction.interface_modes"
     im = table(ctx, red, pre, required=False)
     method = string(ctx, im, "method", f"{pre}.method", default="none",

@@ -3,12 +3,13 @@
 The deck (frirom.deck, docs/deck.md) parses ``[fe_model]``, ``[reduction]`` and the
 node-set contacts into a :class:`FESource`, a :class:`ReductionSpec` and
 :class:`PairSpec` s; :func:`build_reduced_model` turns them into a :class:`ReducedModel`
-(K, M, the map T back to the FE DoFs, the physical contact pairs). The model is saved to
-the cache file with a fingerprint of the matrix files' bytes and of the reduction
-settings, and read back (without even parsing the FE files) while neither changes:
-friction coefficients, preloads, excitation, damping, harmonics or frequencies can be
-edited without recomputing it. Contact stiffnesses enter the fingerprint only when
-full-stick interface modes are asked for.
+(K, M, the map T back to the FE DoFs, the physical contact pairs). The model is saved under a
+key made of its content: the matrix files' bytes, the reduction settings, the contact
+geometry and the version of frirom's reduction code (:func:`rom_key`), in a cache shared
+by every deck (:func:`cache_file`), and read back (without even parsing the FE files) while
+none of them changes: decks that differ in friction coefficients, preloads, excitation,
+damping, harmonics or frequencies share one reduced model, whatever their names. Contact
+stiffnesses enter the key only when full-stick interface modes are asked for.
 
 A cyclic sector (``ReductionSpec.cyclic``: the left and right boundary node sets) keeps
 its boundary DoFs as Craig-Bampton masters (physical coordinates of the reduced model,
@@ -21,8 +22,10 @@ joins sector 0's set ``a`` to set ``b`` of the next sector (matched after rotati
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
+import os
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -41,7 +44,7 @@ from .interface import ContactPairs, contact_matrix, gsi_basis, local_frames, re
 from .multistage import harmonic_indices, ms_basis, radial_line_segments
 
 __all__ = ["FESource", "PairSpec", "ReductionSpec", "ReducedModel", "build_reduced_model",
-           "read_fe_model", "pairs_from_node_sets", "FORMATS"]
+           "read_fe_model", "pairs_from_node_sets", "rom_key", "cache_file", "FORMATS"]
 
 #: format -> (file roles, required roles); see docs/deck.md, [fe_model]
 FORMATS = {
@@ -52,6 +55,9 @@ FORMATS = {
     "op4": (("file", "dofs"), ("file",)),
 }
 CACHE_VERSION = 3
+#: Environment variable naming the folder of the shared reduced-model cache (default: a
+#: folder .frirom_cache beside the FE files).
+CACHE_ENV = "FRIROM_CACHE"
 
 
 @dataclass(frozen=True)
@@ -325,6 +331,17 @@ class ReducedModel:
         return self.T @ np.asarray(q)
 
     def save(self, path, fingerprint: str) -> None:
+        """Write to a temporary file, then rename it: decks run in parallel that build the
+        same model never leave a half-written entry."""
+        path = Path(path)
+        tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
+        try:
+            self._write(tmp, fingerprint)
+            os.replace(tmp, path)
+        finally:
+            tmp.unlink(missing_ok=True)
+
+    def _write(self, path, fingerprint: str) -> None:
         with h5py.File(path, "w") as h:
             h.attrs["fingerprint"] = fingerprint
             h.attrs["version"] = CACHE_VERSION
@@ -384,15 +401,30 @@ def _label(model, i):
     return f"N{nd}:{DIRECTION_NAMES.get(int(d), d)}"
 
 
-def _fingerprint(source: FESource, spec: ReductionSpec, pairs: list) -> str:
-    """sha256 of the FE files' bytes, the reduction settings and the pair geometry (plus
-    the stick stiffness when full-stick modes are asked for)."""
-    h = hashlib.sha256()
-    h.update(f"frirom-rom-{CACHE_VERSION}-{source.format}".encode())
-    for f in source.paths():
+@functools.lru_cache(maxsize=1)
+def _code_version() -> str:
+    """sha256 of frirom's version and reduction code (the sources of frirom.reduction and
+    of the FE readers frirom.io): any change to them invalidates every cached model."""
+    from .. import __version__
+    h = hashlib.sha256(f"frirom-{__version__}-rom-{CACHE_VERSION}".encode())
+    here = Path(__file__).resolve().parent
+    for folder in (here, here.parent / "io"):
+        for f in sorted(folder.glob("*.py")):
+            h.update(f.name.encode())
+            h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def rom_key(source: FESource, spec: ReductionSpec, pairs: list) -> str:
+    """The content key of a reduced model: sha256 of the FE files' bytes (by role, not by
+    name), the reduction settings, the pair geometry (plus the stick stiffness when
+    full-stick modes are asked for) and the reduction code's version. The deck's name and
+    the cache location do not enter."""
+    h = hashlib.sha256(f"{_code_version()}-{source.format}".encode())
+    for i, f in enumerate(source.paths()):
         if not f.is_file():
             continue
-        h.update(f.name.encode())
+        h.update(f"file {i} {f.suffix}".encode())
         with open(f, "rb") as fh:
             for chunk in iter(lambda: fh.read(1 << 22), b""):
                 h.update(chunk)
@@ -404,6 +436,23 @@ def _fingerprint(source: FESource, spec: ReductionSpec, pairs: list) -> str:
     return h.hexdigest()
 
 
+def cache_file(source: FESource, spec: ReductionSpec, key: str) -> Path:
+    """Where the reduced model of this key is kept: ``spec.cache`` when it names a file
+    (``*.h5``: that file, checked against the key); else the entry ``rom-<key>.h5`` of the
+    shared cache folder: ``spec.cache`` when it names a folder, else $FRIROM_CACHE, else
+    ``.frirom_cache`` beside the first FE file."""
+    if spec.cache is not None and Path(spec.cache).suffix == ".h5":
+        return Path(spec.cache)
+    if spec.cache is not None:
+        folder = Path(spec.cache)
+    elif os.environ.get(CACHE_ENV):
+        folder = Path(os.environ[CACHE_ENV])
+    else:
+        paths = source.paths()
+        folder = (paths[0].parent if paths else Path.cwd()) / ".frirom_cache"
+    return folder / f"rom-{key[:32]}.h5"
+
+
 def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_path="deck",
                         log=None) -> ReducedModel:
     """Build the reduced model, or read it back from ``spec.cache`` when its fingerprint
@@ -413,8 +462,8 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
     ``contacts[i]``, ...).
     """
     where = f"{deck_path}: "
-    cache = spec.cache or Path(deck_path).with_suffix(".rom.h5")
-    fp = _fingerprint(source, spec, list(pairs))
+    fp = rom_key(source, spec, list(pairs))
+    cache = cache_file(source, spec, fp)
     cached = ReducedModel.load(cache, fp)
     if cached is not None:
         if log:
@@ -583,6 +632,7 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
                        node_ids=kept_nodes, node_xyz=kept_xyz, b_rotation=rot,
                        fingerprint=fp)
     try:
+        cache.parent.mkdir(parents=True, exist_ok=True)
         out.save(cache, fp)
     except OSError as exc:
         raise InputError(f"{where}reduction.cache: cannot write {cache} ({exc})") from None
