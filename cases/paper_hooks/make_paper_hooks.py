@@ -30,7 +30,7 @@ KT_TOTAL, KN_TOTAL = 2.0e9, 4.0e9
 #: per size: CB modes, Tran boundary modes, harmonics, frequency range [Hz], load [N]
 SETTINGS = {
     "coarse": dict(CB=30, TRAN=40, H=1, F0=165.0, F1=195.0, F=5.0),
-    "paper": dict(CB=100, TRAN=100, H=1, F0=165.0, F1=195.0, F=5.0),
+    "paper": dict(CB=100, TRAN=100, H=1, F0=120.0, F1=145.0, F=5.0),
 }
 GSI = "method = \"gsi\"\nfree = {free}\nstick = {stick}"
 NONE = "method = \"none\""
