@@ -14,6 +14,7 @@ cyclic boundary by Tran's interface modes (``boundary_modes``).
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 from pathlib import Path
 
@@ -57,8 +58,9 @@ def deck_text(rom: str, size: str, n_pairs: int, f0: float, n_gsi: int = 40,
         if old not in text:
             raise ValueError(f"hooks.toml has no {old!r}")
         text = text.replace(old, new)
-    if "@" in text.split("\n", 12)[-1].replace("@...@", ""):
-        raise ValueError("hooks.toml: a placeholder was left unfilled")
+    left = re.search(r"@[A-Z0-9]+@", text)
+    if left:
+        raise ValueError(f"hooks.toml: placeholder {left.group()} was left unfilled")
     return text
 
 
