@@ -17,7 +17,9 @@ ROM_II markers) in WORK.
 ROM_I only at a few frequencies around ROM_II's peak, following them from the linear
 solution, finds its peak from a parabola through the three highest, and extrapolates the
 FRF time from the time per point times the number of points of ROM_II's FRF; the rows say
-so (``rom1_extrapolated``).
+so (``rom1_extrapolated``). Where a continuation stops before the end of the range, the
+row is flagged; ROM_II's peak is then found by 13 solve_point calls marching across the
+2 % above the stop (red squares in the figure).
 """
 
 from __future__ import annotations
@@ -152,6 +154,16 @@ def run_family(work: Path, size: str = "coarse", f0s=F0_FAMILY, n_gsi: int = 40,
         r2.set_preload(f0)
         res2, t2 = r2.frf()
         f2, a2 = _peak(res2)
+        pointwise = None
+        if not res2.complete:
+            # the continuation stopped: march solve_point across the window above the
+            # stop (1 % of the frequency each side, 13 points) and take the peak there
+            f_stop = res2.omega[-1] / (2 * np.pi)
+            f2, a2, ts, _, fs2, amps2 = r2.sampled_peak(f_stop * 1.005, f_stop * 0.01, 13)
+            t2 += ts
+            pointwise = (fs2, amps2)
+            log(f"f0 = {f0:g} N: ROM_II's continuation stopped at {f_stop:.3f} Hz; its peak "
+                f"from 13 pointwise solves above: {a2:.4e} m at {f2:.3f} Hz")
         r1.set_preload(f0)
         if rom1 == "full":
             res1, t1 = r1.frf()
@@ -165,7 +177,7 @@ def run_family(work: Path, size: str = "coarse", f0s=F0_FAMILY, n_gsi: int = 40,
             curve1 = (fs, amps)
             extrap, done1 = True, True
         row = dict(f0=f0, f1=f1, a1=a1, f2=f2, a2=a2, t1=t1, t2=t2, extrap=extrap,
-                   complete=done1 and res2.complete,
+                   complete=done1 and res2.complete, rom2_pointwise=pointwise,
                    pts1=None if extrap else len(curve1[0]), pts2=len(res2),
                    amp_err=a2 / a1 - 1.0, freq_err=f2 / f1 - 1.0,
                    slip=float(res2.state_fractions[res2.peak(0).index, 0, 1]),
@@ -212,10 +224,14 @@ def family_table(res) -> str:
                      f"{r['a2']:10.4e} {r['amp_err']:+9.2e} {r['freq_err']:+9.2e} "
                      f"{r['slip']:5.2f} {r['t1']:8.1f}{'*' if r['extrap'] else ' '}"
                      f"{r['t2']:7.1f} {r['t1'] / r['t2']:8.1f}"
-                     + ("" if r["complete"] else "  ! a run stopped early"))
+                     + ("" if r["complete"] else "  ! a run stopped early"
+                        + (" (ROM_II's peak: pointwise)" if r["rom2_pointwise"] is not None
+                           else "")))
     if not all(r["complete"] for r in res["rows"]):
         lines.append("! the continuation of ROM_I or ROM_II stopped before the end of the "
-                     "range (printed above): the peak is the largest point reached")
+                     "range (printed above): ROM_I's peak is the largest point reached, "
+                     "ROM_II's from 13 solve_point calls marching across the 2 % above its "
+                     "stop (red squares in the figure)")
     if any(r["extrap"] for r in res["rows"]):
         lines.append("* ROM_I sampled at a few frequencies around ROM_II's peak; its FRF "
                      "time extrapolated (time per point x ROM_II's points)")
@@ -232,12 +248,17 @@ def plot_family(res, path: Path):
         line, = ax.plot(x1, y1, "k-" if not r["extrap"] else "k.", lw=1.2)
         step = max(1, len(x2) // 40)
         ax.plot(x2[::step], y2[::step], "o", mfc="none", color="tab:blue", ms=5)
+        if r["rom2_pointwise"] is not None:
+            ax.plot(*r["rom2_pointwise"], "s", mfc="none", color="tab:red", ms=5)
         j = int(np.argmax(y2))
         ax.annotate(f"f0 = {r['f0']:g} N", (x2[j], y2[j]), textcoords="offset points",
                     xytext=(4, 4), fontsize=8)
     ax.plot([], [], "k-", label="ROM_I (every hook DoF)")
     ax.plot([], [], "o", mfc="none", color="tab:blue",
             label=f"ROM_II ({res['n_gsi']} GSI modes)")
+    if any(r["rom2_pointwise"] is not None for r in res["rows"]):
+        ax.plot([], [], "s", mfc="none", color="tab:red",
+                label="ROM_II by solve_point (its continuation stopped)")
     peaks = [r["f2"] for r in res["rows"]] + [r["f1"] for r in res["rows"]]
     ax.set_xlim(min(peaks) - 3.0, max(peaks) + 3.0)       # the resonances, not the flanks
     ax.set_xlabel("frequency [Hz]")
