@@ -1,0 +1,129 @@
+"""Make the vane-with-hooks case: the sector's CalculiX matrices and its two decks.
+
+    python cases/paper_hooks/make_paper_hooks.py [--size coarse|paper] [--out DIR]
+    frirom run results/paper_hooks/coarse/rom2.toml      # ROM_II: 40 GSI modes
+    frirom run results/paper_hooks/coarse/rom1.toml      # ROM_I: every hook DoF
+
+Writes DIR (default results/paper_hooks/<size>) with the ccx model of
+cases/models/hooks.py (job ``hooks``, not committed) and ``rom1.toml`` / ``rom2.toml``
+filled from the template hooks.toml: ROM_I keeps every hook DoF nonlinear (Craig-Bampton
+only), ROM_II reduces the hooks by 20 free + 20 full-stick GSI modes. Both reduce the
+cyclic boundary by Tran's interface modes (``boundary_modes``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "models"))
+from hooks import make_hooks  # noqa: E402
+
+#: total tangential and normal contact stiffness of the two hooks [N/m], split over the
+#: node pairs (so the coarse and the paper-size meshes model the same joint)
+KT_TOTAL, KN_TOTAL = 2.0e9, 4.0e9
+
+#: per size: CB modes, Tran boundary modes, harmonics, frequency range [Hz], load [N]
+SETTINGS = {
+    "coarse": dict(CB=30, TRAN=40, H=1, F0=165.0, F1=195.0, F=5.0),
+    "paper": dict(CB=100, TRAN=100, H=1, F0=120.0, F1=145.0, F=5.0),
+}
+GSI = "method = \"gsi\"\nfree = {free}\nstick = {stick}"
+NONE = "method = \"none\""
+
+
+def deck_text(rom: str, size: str, n_pairs: int, f0: float, n_gsi: int = 40,
+              changes=(), pairs=None) -> str:
+    """The deck of ``rom`` ('rom1' or 'rom2') for a mesh of n_pairs hook pairs, hook
+    preload f0 [N, the total over all pairs: n0 = f0 / n_pairs], n_gsi GSI modes (half free,
+    half stick); pairs: :func:`hook_geometry` of the model (the preload's loads; None: no
+    preload loads, the faces pushed apart by n0)."""
+    s = dict(SETTINGS[size])
+    text = (HERE / "hooks.toml").read_text()
+    im = NONE if rom == "rom1" else GSI.format(free=n_gsi // 2, stick=n_gsi - n_gsi // 2)
+    title = ("ROM_I (every hook DoF)" if rom == "rom1" else
+             f"ROM_II ({n_gsi} GSI modes)")
+    n0 = f0 / n_pairs
+    s.update(ROM=title, IM=im, KT=f"{KT_TOTAL / n_pairs:.6g}",
+             KN=f"{KN_TOTAL / n_pairs:.6g}", N0=f"{n0:.6g}",
+             PRELOAD=preload_loads(pairs, n0) if pairs is not None else "")
+    for k, v in s.items():
+        text = text.replace(f"@{k}@", str(v))
+    for old, new in changes:
+        if old not in text:
+            raise ValueError(f"hooks.toml has no {old!r}")
+        text = text.replace(old, new)
+    left = re.search(r"@[A-Z0-9]+@", text)
+    if left:
+        raise ValueError(f"hooks.toml: placeholder {left.group()} was left unfilled")
+    return text
+
+
+def _nset(text: str, name: str) -> np.ndarray:
+    block = text.split(f"*NSET, NSET={name}\n", 1)[1].split("*", 1)[0]
+    return np.array([int(v) for v in block.replace("\n", ",").split(",") if v.strip()])
+
+
+def hook_geometry(job: Path):
+    """The hook pairs of job.inp: (vane nodes (n,), casing nodes (n,), radial unit normals
+    (n, 3)); HOOK_V and HOOK_C list the pairs in the same order."""
+    text = job.with_suffix(".inp").read_text()
+    v, c = _nset(text, "HOOK_V"), _nset(text, "HOOK_C")
+    block = text.split("*NODE, NSET=ALL\n", 1)[1].split("*", 1)[0]
+    xyz = np.loadtxt(block.splitlines(), delimiter=",")
+    pos = xyz[np.searchsorted(xyz[:, 0], v), 1:]
+    n = pos * [1.0, 1.0, 0.0]
+    return v, c, n / np.linalg.norm(n, axis=1)[:, None]
+
+
+def hook_pairs(job: Path) -> int:
+    """Number of node pairs of the hooks (the HOOK_V set of job.inp)."""
+    return len(_nset(job.with_suffix(".inp").read_text(), "HOOK_V"))
+
+
+def preload_loads(pairs, n0: float) -> str:
+    """[[excitation.load]] tables of the hook preload: +n0 n on each vane node, -n0 n on
+    its casing node (harmonic 0, x and y components of the radial normal n)."""
+    out = []
+    for va, ca, n in zip(*pairs):
+        for node, sign in ((va, 1.0), (ca, -1.0)):
+            for comp, d in ((n[0], "x"), (n[1], "y")):
+                if abs(comp) > 1e-14:
+                    out.append(f'[[excitation.load]]\ndof = "{node}:{d}"\nharmonic = 0\n'
+                               f"amplitude = {sign * n0 * comp:.9g}\n")
+    return "\n".join(out)
+
+
+#: the default hook preload (total over both hooks, N): the case's middle member
+F0_DEFAULT = 2000.0
+
+
+def make(out: Path, size: str = "coarse", f0: float = F0_DEFAULT) -> Path:
+    """Generate the model in ``out`` and write rom1.toml, rom2.toml; returns ``out``."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    job = make_hooks(out, size)
+    pairs = hook_geometry(job)
+    for rom in ("rom1", "rom2"):
+        (out / f"{rom}.toml").write_text(deck_text(rom, size, len(pairs[0]), f0,
+                                                   pairs=pairs))
+    return out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--size", default="coarse", choices=sorted(SETTINGS))
+    ap.add_argument("--out", type=Path, default=None,
+                    help="folder (default results/paper_hooks/<size>)")
+    a = ap.parse_args(argv)
+    out = make(a.out or Path("results/paper_hooks") / a.size, a.size)
+    print(f"wrote {out}/hooks.* (ccx) and {out}/rom1.toml, {out}/rom2.toml")
+
+
+if __name__ == "__main__":
+    main()
