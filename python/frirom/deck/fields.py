@@ -64,9 +64,15 @@ def unknown(ctx: Context, d: dict, allowed, prefix: str) -> None:
                             + " (unknown key)")
 
 
+#: The largest integer a deck field may hold: the Fortran interface's 32-bit integers.
+MAX_INT = 2**31 - 1
+
+
 def number(ctx: Context, d, name, key, *, default=None, required=False, positive=False,
-           nonneg=False, integer=False, minimum=None):
-    """A finite int or float (``integer``: an int), optionally > 0, >= 0 or >= minimum."""
+           nonneg=False, integer=False, minimum=None, maximum=None):
+    """A finite int or float (``integer``: an int), optionally > 0, >= 0, >= minimum or
+    <= maximum. Integers are at most :data:`MAX_INT`; other numbers come back as float
+    (a TOML integer too big for a float is refused as not finite)."""
     if name not in d:
         if required:
             raise ctx.error(key, "a number (missing)")
@@ -76,8 +82,20 @@ def number(ctx: Context, d, name, key, *, default=None, required=False, positive
         raise ctx.error(key, "an integer" if integer else "a number", v)
     if integer and not isinstance(v, int):
         raise ctx.error(key, "an integer", v)
-    if not math.isfinite(v):
-        raise ctx.error(key, "a finite number", v)
+    if integer:
+        top = MAX_INT if maximum is None else maximum
+        if v > top or v < -MAX_INT:
+            raise ctx.error(key, f"an integer at most {top}" if v > 0 else
+                            f"an integer >= {-MAX_INT}", v)
+    else:
+        try:
+            v = float(v)
+        except OverflowError:
+            v = math.inf
+        if not math.isfinite(v):
+            raise ctx.error(key, "a finite number", d[name])
+        if maximum is not None and v > maximum:
+            raise ctx.error(key, f"a number at most {maximum:g}", v)
     if positive and v <= 0:
         raise ctx.error(key, "a positive number", v)
     if nonneg and v < 0:
