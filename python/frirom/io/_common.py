@@ -71,6 +71,17 @@ class FEModel:
             raise InputError(f"no coordinates for node(s) {missing[:10].tolist()}")
         return self.coords[order[pos]]
 
+    def node_set(self, name: str) -> np.ndarray:
+        """The node ids of a node set (case-insensitive); InputError naming the sets the
+        model has (and where node sets come from when it has none)."""
+        ids = self.node_sets.get(name.upper())
+        if ids is None:
+            raise InputError(f"unknown node set {name!r}; the model has "
+                             f"{sorted(self.node_sets)}" + ("" if self.node_sets else
+                             " (matrix files carry no node sets: give [fe_model] inp, "
+                             "a file of *NODE and *NSET blocks, see docs/deck.md)"))
+        return ids
+
     def dof_indices(self, node_set=None, nodes=None, directions=(1, 2, 3),
                     missing: str = "error") -> np.ndarray:
         """Matrix indices of the DoFs of some nodes in some directions.
@@ -85,11 +96,7 @@ class FEModel:
         names = [] if node_set is None else ([node_set] if isinstance(node_set, str)
                                              else list(node_set))
         for name in names:
-            key = name.upper()
-            if key not in self.node_sets:
-                raise InputError(f"unknown node set {name!r}; the model has "
-                                 f"{sorted(self.node_sets)}")
-            ids.append(self.node_sets[key])
+            ids.append(self.node_set(name))
         want = np.unique(np.concatenate(ids)) if ids else np.zeros(0, np.int64)
         sel = np.isin(self.dofs[:, 0], want) & np.isin(self.dofs[:, 1], list(directions))
         idx = np.nonzero(sel)[0]
