@@ -99,7 +99,7 @@ contains
         if (.not. (c_associated(plan%m_rin) .and. c_associated(plan%m_cin) .and. &
                    c_associated(plan%m_rout) .and. c_associated(plan%m_cout))) then
             call fourier_plan_destroy(plan)
-            write (buf, '(a,i0,a,i0,a)') 'fftw_alloc: no memory for the buffers of N = ', &
+            write (buf, '(a,i0,a,i0,a)') 'fftw_alloc failed: no memory, N = ', &
                 nsamp, ' samples x ', nbatch, ' signals'
             call set_status(info, FRIROM_ERR_ALLOC, errmsg, trim(buf))
             return
@@ -137,7 +137,7 @@ contains
                   stat=stat)
         if (stat /= 0) then
             call fourier_plan_destroy(plan)
-            write (buf, '(a,i0,a,i0)') 'allocate: no memory for the tables of N = ', nsamp, &
+            write (buf, '(a,i0,a,i0)') 'allocate failed: no memory, N = ', nsamp, &
                 ' samples, H = ', nharm
             call set_status(info, FRIROM_ERR_ALLOC, errmsg, trim(buf))
             return
