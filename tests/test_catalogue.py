@@ -120,41 +120,24 @@ def _labels_short(d):
     return _deck(d, BASE)
 
 
-def _m_nan(d):
-    (d / "M.mtx").write_text("%%MatrixMarket matrix coordinate real symmetric\n5 5 5\n"
-                             "1 1 nan\n2 2 1\n3 3 1\n4 4 1\n5 5 1\n")
-    return _deck(d, BASE)
+def _matrix(name, field, size, entries):
+    """A deck whose matrix file ``name`` is replaced: MatrixMarket ``field`` (real or
+    complex) symmetric of ``size``, with these ``row col value`` entries."""
+    def make(d):
+        (d / name).write_text(f"%%MatrixMarket matrix coordinate {field} symmetric\n"
+                              f"{size} {size} {len(entries)}\n" + "\n".join(entries) + "\n")
+        return _deck(d, BASE)
+    return make
 
 
-def _m_complex(d):
-    (d / "M.mtx").write_text("%%MatrixMarket matrix coordinate complex symmetric\n5 5 5\n"
-                             "1 1 1 1\n2 2 1 0\n3 3 1 0\n4 4 1 0\n5 5 1 0\n")
-    return _deck(d, BASE)
-
-
-def _k_indefinite(d):
-    (d / "K.mtx").write_text("%%MatrixMarket matrix coordinate real symmetric\n5 5 5\n"
-                             "1 1 -1e6\n2 2 1e6\n3 3 1e6\n4 4 1e6\n5 5 1e6\n")
-    return _deck(d, BASE)
-
-
-def _m_indefinite(d):
-    (d / "M.mtx").write_text("%%MatrixMarket matrix coordinate real symmetric\n5 5 6\n"
-                             "1 1 1\n2 2 1\n2 1 3\n3 3 1\n4 4 1\n5 5 1\n")
-    return _deck(d, BASE)
-
-
-def _k_size(d):
-    (d / "K.mtx").write_text("%%MatrixMarket matrix coordinate real symmetric\n4 4 4\n"
-                             "1 1 1\n2 2 1\n3 3 1\n4 4 1\n")
-    return _deck(d, BASE)
-
-
-def _k_singular(d):
-    # K = 0 on DoF 5 (the tip): a free body; the static harmonic cannot be solved
-    (d / "K.mtx").write_text("%%MatrixMarket matrix coordinate real symmetric\n5 5 4\n"
-                             "1 1 5.5e6\n2 2 8e6\n3 3 2.5e6\n4 4 1.6e6\n")
-    return _deck(d, BASE)
+_DIAG = ["2 2 1", "3 3 1", "4 4 1", "5 5 1"]
+_m_nan = _matrix("M.mtx", "real", 5, ["1 1 nan"] + _DIAG)
+_m_complex = _matrix("M.mtx", "complex", 5, ["1 1 1 1"] + [e + " 0" for e in _DIAG])
+_k_indefinite = _matrix("K.mtx", "real", 5, ["1 1 -1e6"] + _DIAG)
+_m_indefinite = _matrix("M.mtx", "real", 5, ["1 1 1", "2 1 3"] + _DIAG)
+_k_size = _matrix("K.mtx", "real", 4, ["1 1 1"] + _DIAG[:3])
+# K = 0 on DoF 5 (the tip): a free body; the static harmonic cannot be solved
+_k_singular = _matrix("K.mtx", "real", 5, ["1 1 5.5e6", "2 2 8e6", "3 3 2.5e6", "4 4 1.6e6"])
 
 
 def _not_a_deck(d):

@@ -4,13 +4,13 @@ loader and the readers; counts the inputs tried, accepted, refused with a frirom
 The target is 0 crashes and 0 hangs in 10 000 decks.
 
 Decks: the bundled [model] decks (cases/joint/joint.toml, cases/bladed_disk) and, with
---lap, the lap-joint [fe_model] deck (its CalculiX matrices are made once with gmsh + ccx
-into --work). Each mutated deck is loaded and its solver objects built as `frirom run` does
-before the sweep (tests/_mutate.py: load_and_check); each mutated file is read by its
-reader. Mutations come from a seeded random.Random: a run is reproducible.
+--lap N, N mutations of the lap-joint [fe_model] deck (its CalculiX matrices are made
+once with gmsh + ccx into --work). Each mutated deck is loaded and its solver objects
+built as `frirom run` does before the sweep (tests/_mutate.py: load_and_check); each
+mutated file is read by its reader. Mutations come from a seeded random.Random: a run is reproducible.
 
     OPENBLAS_NUM_THREADS=1 python cases/bench/fuzz.py [--decks 10000] [--files 2000]
-        [--seed 13] [--lap] [--work results/fuzz]
+        [--seed 13] [--lap 100] [--work results/fuzz]
 
 Prints a table per input kind, then each crash (the first 10) with its input.
 """
@@ -33,6 +33,9 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 from _mutate import (load_and_check, mutate_bytes, mutate_deck, reader_cases,  # noqa: E402
                      try_input)
+
+
+OUTCOMES = ("ok", "error", "crash", "hang")
 
 
 class _Hang(Exception):
@@ -84,18 +87,20 @@ def main(argv=None):
     ap.add_argument("--files", type=int, default=2000, help="mutated matrix files to try")
     ap.add_argument("--seed", type=int, default=13)
     ap.add_argument("--hang", type=float, default=60.0, help="seconds that make a hang")
-    ap.add_argument("--lap", action="store_true", help="also the lap-joint [fe_model] deck")
+    ap.add_argument("--lap", type=int, default=0,
+                    help="mutated lap-joint [fe_model] decks to try (a changed reduction is "
+                    "rebuilt: seconds to a minute each)")
     ap.add_argument("--work", type=Path, default=ROOT / "results" / "fuzz")
     a = ap.parse_args(argv)
     rnd = random.Random(a.seed)
-    sources = deck_sources(a.work, a.lap)
+    sources = deck_sources(a.work, a.lap > 0)
     texts = {k: p.read_text() for k, p in sources.items()}
     counts = {k: Counter() for k in list(sources) + [c[0] for c in reader_cases()]}
     crashes, slowest = [], (0.0, "")
     t_start = time.perf_counter()
-    names = sorted(sources)
-    for i in range(a.decks):
-        name = names[i % len(names)]
+    names = ["bladed_disk", "joint"]
+    plan = [names[i % 2] for i in range(a.decks)] + ["lap_joint"] * a.lap
+    for i, name in enumerate(plan):
         data = mutate_deck(texts[name], rnd)
         path = sources[name].with_name("fuzzed.toml")
         path.write_bytes(data)
@@ -104,6 +109,7 @@ def main(argv=None):
         dt = time.perf_counter() - t0
         slowest = max(slowest, (dt, f"{name} deck {i}"))
         counts[name][outcome] += 1
+        counts[name]["named"] += outcome == "error" and path.name in str(exc)
         if outcome in ("crash", "hang"):
             crashes.append((name, outcome, exc, data))
     readers = reader_cases()
@@ -120,20 +126,22 @@ def main(argv=None):
             (folder / f).write_bytes(b)
         outcome, exc = timed(lambda: read(folder), a.hang)
         counts[name][outcome] += 1
+        counts[name]["named"] += outcome == "error" and str(folder) in str(exc)
         if outcome in ("crash", "hang"):
             crashes.append((f"{name}/{victim}", outcome, exc, data))
     total = time.perf_counter() - t_start
 
-    print(f"fuzz: seed {a.seed}, {a.decks} decks, {a.files} files, {total:.0f} s")
-    print(f"{'input':<16}{'tried':>8}{'accepted':>10}{'refused':>10}{'crashed':>9}"
-          f"{'hung':>6}")
+    print(f"fuzz: seed {a.seed}, {a.decks + a.lap} decks, {a.files} files, {total:.0f} s")
+    print(f"{'input':<16}{'tried':>8}{'accepted':>10}{'refused':>10}{'named':>8}"
+          f"{'crashed':>9}{'hung':>6}")
     tot = Counter()
     for k, c in counts.items():
         tot.update(c)
-        print(f"{k:<16}{sum(c.values()):>8}{c['ok']:>10}{c['error']:>10}{c['crash']:>9}"
-              f"{c['hang']:>6}")
-    print(f"{'all':<16}{sum(tot.values()):>8}{tot['ok']:>10}{tot['error']:>10}"
-          f"{tot['crash']:>9}{tot['hang']:>6}")
+        print(f"{k:<16}{sum(c[o] for o in OUTCOMES):>8}{c['ok']:>10}{c['error']:>10}"
+              f"{c['named']:>8}{c['crash']:>9}{c['hang']:>6}")
+    print(f"{'all':<16}{sum(tot[o] for o in OUTCOMES):>8}{tot['ok']:>10}{tot['error']:>10}"
+          f"{tot['named']:>8}{tot['crash']:>9}{tot['hang']:>6}")
+    print("named: refusals whose message names the deck or file given")
     print(f"slowest input: {slowest[1]}, {slowest[0]:.2f} s")
     for name, outcome, exc, data in crashes[:10]:
         print(f"\n{outcome} on {name}: {type(exc).__name__}: {exc}\n{data[:1500]!r}")
