@@ -378,7 +378,7 @@ API = [
     ("aft-kt-text", lambda: _aft(params=["abc", 0.3, 1.0]), ParameterError,
      ["params", "numbers"]),
     ("aft-x-nan", lambda: _aft(x=np.full((1, 1, 3), np.nan)), frirom.NonFiniteError,
-     ["x", "NaN"]),
+     ["element 0", "not finite"]),
     ("excitation-nan", lambda: frirom.model.Excitation(np.array([0.0, np.nan])),
      frirom.NonFiniteError, ["excitation.F"]),
 ]

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _kernels
-from ._errors import (NonFiniteError, ParameterError, SamplesError, SizeError, check_integer,
+from ._errors import (ParameterError, SamplesError, SizeError, check_integer,
                       check_number, raise_for_status, samples_problem)
 from .harmonics import default_samples, n_harmonics
 
@@ -179,8 +179,6 @@ def _prepare(law, x, params, n_samples, w0, tol, max_periods):
     check_number("tol", tol, positive=True)
     check_integer("max_periods", max_periods, minimum=1, maximum=2**31 - 1)
     x = _as_floats("x", x)
-    if not np.all(np.isfinite(x)):
-        raise NonFiniteError(f"{law.name}: x contains NaN or Inf")
     if x.ndim == 2 and law.n_dir == 1:
         x = x[:, None, :]
     if x.ndim != 3 or x.shape[1] != law.n_dir:

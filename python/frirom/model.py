@@ -415,7 +415,6 @@ class CyclicModel:
                 raise SizeError(f"contact {g.name!r}: G has {g.G.shape[1]} columns; a cyclic "
                                 f"sector of {n} DoFs needs {n} (sector 0) or {2 * n} (sector "
                                 "0, then the next sector)")
-        check_definite(self.K, self.M, contacts=[g.G for g in self.contacts])
         if self.dof_labels is not None and len(self.dof_labels) != n:
             raise SizeError(f"dof_labels: {len(self.dof_labels)} labels for {n} DoFs")
         self.n_dof, self.n_sectors = n, N

@@ -160,9 +160,11 @@ class SolverOptions:
             v = getattr(self, nm)
             if not (np.isfinite(v) and v > 0):
                 raise ParameterError(f"options.{nm}: expected a positive number, got {v}")
-        if not self.ds_min <= self.ds <= self.ds_max:
-            raise ParameterError(f"options.ds: expected ds_min <= ds <= ds_max, got "
-                                 f"{self.ds_min:g}, {self.ds:g}, {self.ds_max:g}")
+        if self.ds_min > self.ds_max:
+            raise ParameterError("options.ds_min must not exceed options.ds_max")
+        if self.ds > self.ds_max:
+            raise ParameterError(f"options.ds: expected a first step at most ds_max = "
+                                 f"{self.ds_max:g}, got {self.ds:g}")
         if self.modes is not None and (self.modes < 1 or self.formulation != "condensed"):
             raise ParameterError("options.modes: a positive number of modes, with "
                                  "formulation 'condensed'")
