@@ -8,6 +8,7 @@ issue 13 asks for (>= 80 rows)."""
 
 from __future__ import annotations
 
+import re
 import shutil
 from pathlib import Path
 
@@ -67,6 +68,11 @@ DECK = [
      "solver.tol_residual", "positive"),
     ('format = "condensed"', 'format = "condensed"\nmax_iterations = 0',
      "solver.max_iterations", ">= 1"),
+    ("directions = [ [0.8660254037844386, 0.5] ]", "directions = [ [1" + "0" * 400 + ", 0.5] ]",
+     "contacts[0].directions[0]", "2 numbers"),
+    ("kt = 1.0e7", "kt = 1" + "0" * 400, "contacts[0].kt", "finite"),
+    ("max_points = 1000", "max_points = -" + "9" * 20, "continuation.max_points",
+     "integer"),
     ("title = ", "titel = ", "titel", "unknown key"),
     ("[[contacts]]", "[[contact]]", "contact", "unknown key"),
     ('[frequency]\nstart = 400.0\nend = 520.0\nunit = "Hz"', "", "frequency", "table"),
@@ -146,7 +152,15 @@ def _not_a_deck(d):
     return p
 
 
+def _cubic(d):
+    """The damper as a cubic spring with k1 < 0 (docs/deck.md: k1 >= 0)."""
+    text = re.sub(r'law = "jenkins".*\n', 'law = "cubic"\n', BASE)
+    text = re.sub(r"kt = 1.0e7.*\nmu = .*\nfn0 = .*\n", "k1 = -1.0\nk3 = 1.0\n", text)
+    return _deck(d, text)
+
+
 FILES = [
+    ("cubic-k1", _cubic, ["case.toml", "contacts[0].k1", ">= 0"]),
     ("deck-latin1", _bytes_deck, ["latin.toml", "UTF-8", "line 5"]),
     ("labels-latin1", _labels_latin1, ["dofs.txt", "UTF-8", "line 5"]),
     ("labels-count", _labels_short, ["model.dof_labels", "5 labels"]),

@@ -41,6 +41,14 @@ class Context:
         return InputError(msg)
 
 
+def finite(x) -> bool:
+    """True for a finite number (a TOML integer too large for a float is not)."""
+    try:
+        return math.isfinite(x)
+    except OverflowError:
+        return False
+
+
 def table(ctx: Context, d, key: str, required: bool = True) -> dict:
     """The sub-table at ``key`` (its last dotted part is looked up in ``d``); {} if absent
     and not required."""
@@ -157,7 +165,8 @@ def integers(ctx: Context, d, name, key, required=False, minimum=None) -> tuple:
     if v is None and not required:
         return ()
     if (not isinstance(v, list) or not v
-            or any(isinstance(x, bool) or not isinstance(x, int) for x in v)
+            or any(isinstance(x, bool) or not isinstance(x, int) or abs(x) > MAX_INT
+                   for x in v)
             or (minimum is not None and min(v) < minimum)):
         what = "integers" if minimum is None else f"integers >= {minimum}"
         raise ctx.error(key, f"a non-empty list of {what}", v)
@@ -169,7 +178,7 @@ def vector(ctx: Context, d, name, key, default=None, nonzero=True) -> tuple:
     v = d.get(name, default)
     if (not isinstance(v, (list, tuple)) or len(v) != 3
             or any(isinstance(x, bool) or not isinstance(x, (int, float))
-                   or not math.isfinite(x) for x in v)
+                   or not finite(x) for x in v)
             or (nonzero and not any(v))):
         raise ctx.error(key, "a list of 3 finite numbers"
                         + (", not all zero" if nonzero else ""), v)
@@ -190,7 +199,7 @@ def per_element(ctx: Context, c, p, key, ne, required=False, nonneg=False) -> np
     out = np.empty(ne)
     for i, x in enumerate(vals):
         k = f"{key}[{i}]" if isinstance(v, list) else key
-        if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+        if isinstance(x, bool) or not isinstance(x, (int, float)) or not finite(x):
             raise ctx.error(k, "a finite number", x)
         if nonneg and x < 0:
             raise ctx.error(k, "a number >= 0", x)
