@@ -275,10 +275,21 @@ def _cli_cases(d):
         (["run", str(_deck(d, BASE.replace("samples = 64", "samples = 1e8"), "b.toml"))],
          ["b.toml", "solver.samples"]),
         (["run", str(_bytes_deck(d))], ["latin.toml", "UTF-8"]),
+        (["run", str(deck), "--out", str(_garbage_h5(d)), "--resume"], ["frf.h5", "HDF5"]),
     ]
 
 
-@pytest.mark.parametrize("i", range(6), ids=[f"cli:{i}" for i in range(6)])
+def _garbage_h5(d):
+    """A results folder whose frf.h5 is not HDF5 (a resume must refuse it by name)."""
+    (d / "bad").mkdir(exist_ok=True)
+    (d / "bad" / "frf.h5").write_text("not hdf5")
+    return d / "bad"
+
+
+N_CLI = 7
+
+
+@pytest.mark.parametrize("i", range(N_CLI), ids=[f"cli:{i}" for i in range(N_CLI)])
 def test_cli(deckdir, capsys, i):
     from frirom.cli import main
     argv, words = _cli_cases(deckdir)[i]
@@ -408,5 +419,5 @@ def test_api(name, call, cls, words):
 
 def test_catalogue_size():
     """Issue 13 asks for at least 80 malformed inputs."""
-    n = len(DECK) + len(FILES) + len(READERS) + 3 + 6 + 1 + len(API)
+    n = len(DECK) + len(FILES) + len(READERS) + 3 + N_CLI + 1 + len(API)
     assert n >= 80, n
