@@ -134,6 +134,16 @@ def check_number(name: str, v, *, positive: bool = False, nonneg: bool = False,
     return x
 
 
+def as_floats(name: str, v, cls=None):
+    """``v`` as a float ndarray; ``cls`` (default ParameterError) naming ``name`` if it
+    holds anything but real numbers (text, None, an integer too big for a float)."""
+    import numpy as np
+    try:
+        return np.asarray(v, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise (cls or ParameterError)(f"{name}: expected numbers, got {_shown(v)}") from None
+
+
 def check_integer(name: str, v, *, minimum: int | None = None, maximum: int | None = None,
                   cls=None) -> int:
     """``v`` as an int (an integral Python or numpy integer, not a float or bool) within

@@ -11,7 +11,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from ._errors import NonFiniteError, ParameterError, SingularMatrixError, SizeError
+from ._errors import (NonFiniteError, ParameterError, SingularMatrixError, SizeError,
+                      as_floats)
 from .contact import LAWS
 from .reduction.damping import modal_damping
 
@@ -190,11 +191,7 @@ class ContactGroup:
             raise SizeError(f"contact {self.name!r}: no element (G has no rows)")
         if not np.all(np.isfinite(self.G.data)):
             raise NonFiniteError(f"contact {self.name!r}: G contains NaN or Inf")
-        try:
-            p = np.asarray(self.params, dtype=float)
-        except (TypeError, ValueError, OverflowError):
-            raise ParameterError(f"contact {self.name!r}: params: expected numbers "
-                                 f"{names}, got {self.params!r:.80}") from None
+        p = as_floats(f"contact {self.name!r}: params {names}", self.params)
         if p.ndim == 1 and p.size == len(names):
             p = np.tile(p, (ne, 1))
         if p.shape != (ne, len(names)):
@@ -216,10 +213,7 @@ class ContactGroup:
         if self.w0 is None:
             self.w0 = np.zeros((ne, nsl))
         else:
-            try:
-                w0 = np.asarray(self.w0, dtype=float)
-            except (TypeError, ValueError, OverflowError):
-                raise ParameterError(f"contact {self.name!r}: w0: expected numbers") from None
+            w0 = as_floats(f"contact {self.name!r}: w0", self.w0)
             if w0.shape != (ne, nsl):
                 raise SizeError(f"contact {self.name!r}: w0 must have shape ({ne}, {nsl}), "
                                 f"got {w0.shape}")
