@@ -175,7 +175,7 @@ def samples_problem(n_harm: int, n_samples, n_signals: int = 1) -> str | None:
     if isinstance(n_samples, (bool, np.bool_)) or not isinstance(n_samples, (int, np.integer)):
         return f"an integer in {lo}..{MAX_SAMPLES}"
     if n_samples < lo:
-        return f"an integer >= 2H+1 = {lo} (2*harmonics+1)"
+        return f"an integer >= 2*harmonics+1 (2H+1 = {lo})"
     need = aft_bytes(n_harm, n_samples, n_signals)
     if n_samples > MAX_SAMPLES:
         return (f"at most {MAX_SAMPLES} samples (N = {n_samples} would need "
