@@ -369,6 +369,8 @@ API = [
     ("M-indefinite", lambda: _model(M=np.array([[1.0, 2.0], [2.0, 1.0]])), ParameterError,
      ["M", "positive definite"]),
     ("K-size", lambda: _model(K=np.eye(3)), frirom.SizeError, ["K", "(2, 2)"]),
+    ("K-singular", lambda: _model(K=np.diag([1.0, 0.0])), frirom.SingularMatrixError,
+     ["K", "singular", "contact"]),
     ("K-nan", lambda: _model(K=np.diag([1.0, np.nan])), frirom.NonFiniteError, ["K", "NaN"]),
     ("K-text", lambda: _model(K="abc"), ParameterError, ["K", "matrix"]),
     ("kt-text", lambda: _group(law="jenkins", params=["abc", 0.3, 1.0]), ParameterError,
@@ -421,3 +423,34 @@ def test_catalogue_size():
     """Issue 13 asks for at least 80 malformed inputs."""
     n = len(DECK) + len(FILES) + len(READERS) + 3 + N_CLI + 1 + len(API)
     assert n >= 80, n
+
+
+@pytest.mark.parametrize("dense_limit", [2000, 0], ids=["dense", "sparse-lu"])
+def test_definiteness_check_against_eigenvalues(monkeypatch, dense_limit):
+    """model._positive_definite (dense Cholesky, or the sparse LU with diagonal pivots
+    used above DENSE_CHECK) against numpy's eigenvalues on random sparse symmetric
+    matrices with a clear margin (smallest eigenvalue beyond +-1e-3 of a spectrum of
+    order 1-10: far from round-off, so the verdicts must agree exactly)."""
+    import frirom.model as fm
+    monkeypatch.setattr(fm, "DENSE_CHECK", dense_limit)
+    rng = np.random.default_rng(13)
+    verdicts = []
+    for _ in range(40):
+        n = int(rng.integers(5, 40))
+        B = sp.random(n, n, density=0.2, random_state=rng).toarray()
+        A = B + B.T
+        lam = np.linalg.eigvalsh(A)
+        A += np.eye(n) * (rng.uniform(-1.0, 1.0) - lam[0] + rng.choice([-1, 1]) * 0.05)
+        lam_min = np.linalg.eigvalsh(A)[0]
+        if abs(lam_min) < 1e-3:
+            continue
+        verdicts.append(lam_min > 0)
+        assert fm._positive_definite(sp.csr_matrix(A)) == (lam_min > 0), lam_min
+    assert 5 < sum(verdicts) < len(verdicts) - 5      # both kinds were tried
+
+
+def test_singular_stiffness_held_by_a_contact_is_accepted():
+    """A DoF free in K but tied by a contact (the contact's stick stiffness holds it) is
+    a valid model: only a rigid motion no contact holds is refused (API row K-singular)."""
+    m = _model(K=np.diag([0.0, 1.0]))
+    assert m.n_dof == 2
