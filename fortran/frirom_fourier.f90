@@ -13,7 +13,7 @@ module frirom_fourier
     use, intrinsic :: iso_c_binding
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_SAMPLES, FRIROM_ERR_PARAM, &
-                             FRIROM_ERR_FFTW, set_status
+                             FRIROM_ERR_FFTW, FRIROM_ERR_ALLOC, set_status
     implicit none
     private
     include 'fftw3.f03'
@@ -62,7 +62,7 @@ contains
         character(len=*), intent(inout), optional :: errmsg
         integer(c_int) :: n(1), nembed_c(1), flags, nb
         logical :: aligned
-        integer(ip) :: k, h, nc, nhalf
+        integer(ip) :: k, h, nc, nhalf, stat
         real(wp) :: tau
         character(len=80) :: buf
 
@@ -96,6 +96,14 @@ contains
         plan%m_cin = fftw_alloc_complex(int(nhalf, c_size_t)*plan%nbatch*nslot_in)
         plan%m_rout = fftw_alloc_real(int(nsamp, c_size_t)*plan%nbatch*nslot_out)
         plan%m_cout = fftw_alloc_complex(int(nhalf, c_size_t)*plan%nbatch*nslot_out)
+        if (.not. (c_associated(plan%m_rin) .and. c_associated(plan%m_cin) .and. &
+                   c_associated(plan%m_rout) .and. c_associated(plan%m_cout))) then
+            call fourier_plan_destroy(plan)
+            write (buf, '(a,i0,a,i0,a)') 'fftw_alloc failed: no memory, N = ', &
+                nsamp, ' samples x ', nbatch, ' signals'
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, trim(buf))
+            return
+        end if
         call c_f_pointer(plan%m_rin, plan%rin, [plan%nbatch, nsamp, nslot_in])
         call c_f_pointer(plan%m_cin, plan%cin, [plan%nbatch, nhalf, nslot_in])
         call c_f_pointer(plan%m_rout, plan%rout, [plan%nbatch, nsamp, nslot_out])
@@ -125,7 +133,15 @@ contains
         plan%cin = (0.0_wp, 0.0_wp)
         plan%cout = (0.0_wp, 0.0_wp)
 
-        allocate (plan%basis(nsamp, nc), plan%weight(nc), plan%prefix(4*nharm + 1, 0:nsamp))
+        allocate (plan%basis(nsamp, nc), plan%weight(nc), plan%prefix(4*nharm + 1, 0:nsamp), &
+                  stat=stat)
+        if (stat /= 0) then
+            call fourier_plan_destroy(plan)
+            write (buf, '(a,i0,a,i0)') 'allocate failed: no memory, N = ', nsamp, &
+                ' samples, H = ', nharm
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, trim(buf))
+            return
+        end if
         do k = 1, nsamp
             tau = 2.0_wp*acos(-1.0_wp)*real(k - 1, wp)/real(nsamp, wp)
             plan%basis(k, 1) = 1.0_wp

@@ -15,6 +15,10 @@ program test_fourier
     call fourier_plan_create(plan, 3_ip, 6_ip, 4_ip, 1_ip, 1_ip, .false., info, msg)
     if (info /= FRIROM_ERR_SAMPLES) error stop 'N < 2H+1 must be rejected'
     if (index(msg, '2H+1') == 0) error stop 'the message must say N >= 2H+1'
+    ! buffers of 2^30 samples x 2^20 signals (8 PiB): a status code, not a crash
+    call fourier_plan_create(plan, 1_ip, 2_ip**30, 2_ip**20, 1_ip, 1_ip, .false., info, msg)
+    if (info /= FRIROM_ERR_ALLOC) error stop 'a failed fftw_alloc must give FRIROM_ERR_ALLOC'
+    if (index(msg, 'fftw_alloc') == 0) error stop 'the message must name fftw_alloc'
 
     call fourier_plan_create(plan, nh, ns, 3_ip, 2_ip, 2_ip, .false., info, msg)
     if (info /= FRIROM_OK) error stop 'plan creation failed'

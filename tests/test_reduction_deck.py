@@ -268,3 +268,26 @@ def test_cache_is_keyed_by_content_not_by_deck_name(block_dir, tmp_path, monkeyp
     d = load_deck(_write(tmp_path / "in_folder.toml", text.replace(
         "fixed_interface_modes = 30", 'fixed_interface_modes = 30\ncache = "store"')))
     assert len(list((tmp_path / "store").glob("rom-*.h5"))) == 1 and not d.reduced.from_cache
+
+
+def test_mtx_fe_model_with_node_set_file(block_dir, tmp_path):
+    """[fe_model] format = "mtx" takes its nodes and node sets from `inp` (the matrix
+    files carry none): the same block as the calculix deck gives the same reduced model
+    (the MatrixMarket copies hold the matrices to 17 digits: to round-off)."""
+    from frirom.io import write_dof_table, write_mtx
+    fe = read_calculix(block_dir / "block")
+    write_mtx(tmp_path / "K.mtx", fe.K)
+    write_mtx(tmp_path / "M.mtx", fe.M)
+    write_dof_table(tmp_path / "dofs.txt", fe.dofs)
+    shutil.copy(block_dir / "block.inp", tmp_path / "nodes.inp")
+    fe_mtx = ('format = "mtx"\nstiffness = "K.mtx"\nmass = "M.mtx"\ndofs = "dofs.txt"\n'
+              'inp = "nodes.inp"')
+    text = GSI_DECK.format(kt="2.0e8", h=3, mu=0.5)
+    ref = load_deck(_write(block_dir / "ref.toml", text)).reduced
+    rom = load_deck(_write(tmp_path / "mtx.toml", text.replace(
+        'format = "calculix"\njob = "block"', fe_mtx))).reduced
+    assert abs(rom.K - ref.K).max() <= 1e-9 * abs(ref.K).max()
+    # without inp the deck's node sets are unknown, and the message says where they go
+    with pytest.raises(InputError, match="inp"):
+        load_deck(_write(tmp_path / "bare.toml", text.replace(
+            'format = "calculix"\njob = "block"', fe_mtx.replace('\ninp = "nodes.inp"', ""))))

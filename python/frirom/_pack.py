@@ -264,7 +264,12 @@ def _map_dofs(P: np.ndarray, cols: np.ndarray) -> np.ndarray:
 
 
 def _check_outputs(outputs, n: int) -> np.ndarray:
-    out = np.asarray(outputs, dtype=int).ravel()
+    raw = np.asarray(outputs).ravel()
+    if raw.size and (raw.dtype.kind not in "iu" and not (
+            raw.dtype.kind == "O" and all(isinstance(v, (int, np.integer))
+                                          and not isinstance(v, bool) for v in raw))):
+        raise SizeError(f"outputs: expected integer DoF indices, got {raw[:5].tolist()}")
+    out = raw.astype(int)
     if out.size == 0:
         out = np.zeros(1, dtype=int)
     if np.any(out < 0) or np.any(out >= n):

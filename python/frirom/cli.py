@@ -17,6 +17,7 @@ once); the code of the first deck that did not end with 0, after all of them hav
 from __future__ import annotations
 
 import argparse
+import os
 import shutil
 import sys
 import time
@@ -107,6 +108,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="frirom", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"frirom {__version__}")
+    parser.add_argument("--debug", action="store_true",
+                        help="show the traceback of an error (also FRIROM_DEBUG=1)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     _add_run(sub)
     _add_demo(sub)
@@ -323,10 +326,24 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         parser.print_help()
         return 0
+    debug = getattr(args, "debug", False) or os.environ.get("FRIROM_DEBUG", "") not in ("",
+                                                                                       "0")
     try:
+        out = getattr(args, "out", None)
+        if out is not None and out.exists() and not out.is_dir():
+            raise InputError(f"--out {out}: expected a folder, got an existing file")
         return args.func(args)
     except FriromError as exc:
-        print(f"frirom: error: {exc}", file=sys.stderr)
+        if debug:
+            raise
+        print(f"frirom: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 2
+    except Exception as exc:            # a bug or an unforeseen input: one line, no traceback
+        if debug:
+            raise
+        print(f"frirom: error: {type(exc).__name__}: {' '.join(str(exc).split())} (this is "
+              "a frirom bug or an input it does not check: rerun with FRIROM_DEBUG=1 or "
+              "--debug for the traceback)", file=sys.stderr)
         return 2
 
 

@@ -35,7 +35,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _kernels
-from ._errors import ParameterError, SizeError, raise_for_status
+from ._errors import (ParameterError, SamplesError, SizeError, as_floats, check_integer,
+                      check_number, raise_for_status, samples_problem)
 from .harmonics import default_samples, n_harmonics
 
 
@@ -149,14 +150,14 @@ def _params_array(law: Law, params, n_elem: int) -> np.ndarray:
             raise ParameterError(f"{law.name}: missing parameter(s) {missing}")
         cols = []
         for p in law.parameters:
-            v = np.asarray(params[p], dtype=float)
+            v = as_floats(f"{law.name}: params[{p!r}]", params[p])
             if v.ndim > 1 or (v.ndim == 1 and v.shape[0] != n_elem):
                 raise SizeError(f"{law.name}: parameter {p!r} has shape {v.shape}; expected a "
                                 f"scalar or ({n_elem},)")
             cols.append(np.broadcast_to(v, (n_elem,)))
         arr = np.stack(cols, axis=1)
     else:
-        arr = np.asarray(params, dtype=float)
+        arr = as_floats(f"{law.name}: params", params)
         if arr.ndim == 1:
             arr = np.broadcast_to(arr, (n_elem, arr.shape[0]))
         if arr.shape != (n_elem, len(law.parameters)):
@@ -165,9 +166,11 @@ def _params_array(law: Law, params, n_elem: int) -> np.ndarray:
     return np.asfortranarray(arr.T)
 
 
-def _prepare(law, x, params, n_samples, w0):
+def _prepare(law, x, params, n_samples, w0, tol, max_periods):
     law = get_law(law)
-    x = np.asarray(x, dtype=float)
+    check_number("tol", tol, positive=True)
+    check_integer("max_periods", max_periods, minimum=1, maximum=2**31 - 1)
+    x = as_floats("x", x)
     if x.ndim == 2 and law.n_dir == 1:
         x = x[:, None, :]
     if x.ndim != 3 or x.shape[1] != law.n_dir:
@@ -177,15 +180,15 @@ def _prepare(law, x, params, n_samples, w0):
     n_elem = x.shape[0]
     if n_samples is None:
         n_samples = default_samples(h)
-    if not isinstance(n_samples, (int, np.integer)) or n_samples < 2 * h + 1:
-        raise_for_status(4, f"n_samples = {n_samples!r} for H = {h}: need an integer "
-                            f">= 2H+1 = {2 * h + 1}")
+    problem = samples_problem(h, n_samples, n_elem * law.n_dir)
+    if problem:
+        raise SamplesError(f"n_samples: expected {problem} for H = {h}, got {n_samples!r}")
     p = _params_array(law, params, n_elem)
     nsl = max(law.n_slider, 1)
     if w0 is None:
         w = np.zeros((nsl, n_elem), order="F")
     else:
-        w = np.asarray(w0, dtype=float)
+        w = as_floats("w0", w0)
         if law.n_slider == 1 and w.ndim <= 1:
             w = np.broadcast_to(w.reshape(-1), (n_elem,))[None, :] if w.size in (1, n_elem) else w
         if w.ndim == 2 and w.shape == (n_elem, law.n_slider):
@@ -218,7 +221,8 @@ def aft(law: str | Law, x, params, n_samples: int | None = None, w0=None,
         displacement amplitude.
     max_periods : periods marched at most before :class:`frirom.ConvergenceError`.
     """
-    law, xf, p, w, h, n_elem, n_samples = _prepare(law, x, params, n_samples, w0)
+    law, xf, p, w, h, n_elem, n_samples = _prepare(
+        law, x, params, n_samples, w0, tol, max_periods)
     nj = law.n_dir * (2 * h + 1)
     f, jac, periods, states, slider, info, msg = _kernels.aft_eval(
         law.code, n_samples, nj, n_elem if jacobian else 0, xf, p, w, float(tol),
@@ -236,7 +240,8 @@ def time_histories(law: str | Law, x, params, n_samples: int | None = None, w0=N
 
     Returns (tau, xt, ft): tau (N,) phases in rad; xt, ft (n_elem, n_dir, N).
     """
-    law, xf, p, w, h, n_elem, n_samples = _prepare(law, x, params, n_samples, w0)
+    law, xf, p, w, h, n_elem, n_samples = _prepare(
+        law, x, params, n_samples, w0, tol, max_periods)
     xt, ft, info, msg = _kernels.aft_time(law.code, n_samples, xf, p, w, float(tol),
                                           int(max_periods))
     raise_for_status(info, f"{law.name} AFT: " + msg.decode(errors="replace").strip())

@@ -11,15 +11,24 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from ._errors import NonFiniteError, ParameterError, SizeError
+from ._errors import (NonFiniteError, ParameterError, SingularMatrixError, SizeError,
+                      as_floats)
 from .contact import LAWS
 from .reduction.damping import modal_damping
 
 def _as_matrix(a, name: str, n: int | None = None) -> sp.csr_matrix:
     """A square real matrix as CSR, checked for shape and finite values."""
     try:
-        m = sp.csr_matrix(a, dtype=float)
+        m = sp.csr_matrix(a)
+        if np.iscomplexobj(m.data):
+            if np.any(m.data.imag != 0):
+                raise ParameterError(f"{name}: expected a real matrix, got complex entries "
+                                     f"(max |imag| = {abs(m.data.imag).max():.3g})")
+            m = m.real
+        m = sp.csr_matrix(m, dtype=float)
     except (TypeError, ValueError) as exc:
+        if isinstance(exc, ParameterError):
+            raise
         raise ParameterError(f"{name}: expected a real square matrix ({exc})") from None
     if m.ndim != 2 or m.shape[0] != m.shape[1]:
         raise SizeError(f"{name}: expected a square matrix, got shape {m.shape}")
@@ -37,6 +46,61 @@ def _check_symmetric(m: sp.csr_matrix, name: str) -> None:
     if m.nnz and abs(m - m.T).max() > 1e-10 * scale:
         raise ParameterError(f"{name}: must be symmetric (max |A - A^T| = "
                              f"{abs(m - m.T).max():.3g}, max |A| = {scale:.3g})")
+
+
+#: Largest matrix checked by a dense Cholesky; larger ones by a sparse LU with diagonal
+#: pivots (its pivots are the LDL^T ones: all positive if and only if the matrix is
+#: positive definite).
+DENSE_CHECK = 2000
+
+
+def _positive_definite(A: sp.csr_matrix) -> bool:
+    """True if the symmetric A is numerically positive definite."""
+    if A.shape[0] == 0:
+        return True
+    if A.shape[0] <= DENSE_CHECK:
+        try:
+            np.linalg.cholesky(A.toarray())
+            return True
+        except np.linalg.LinAlgError:
+            return False
+    import scipy.sparse.linalg as spla
+    try:
+        lu = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
+    except RuntimeError:           # an exactly zero pivot
+        return False
+    return bool(np.array_equal(lu.perm_r, lu.perm_c) and np.all(lu.U.diagonal() > 0))
+
+
+def check_definite(K: sp.csr_matrix, M: sp.csr_matrix, k_name: str = "K",
+                   m_name: str = "M", contacts=()) -> None:
+    """M positive definite and K positive semi-definite and, with the contacts tied
+    (each row of their G a spring of K's largest stiffness), not singular.
+
+    Checked by a Cholesky of M, of K + sigma M with sigma = 1e-6 max|K| / max|M| (an
+    eigenvalue of K below about -1e-6 max|K| max|M|^-1 min eig(M) fails it) and of K with
+    the contacts tied. ParameterError (SingularMatrixError for the last) names the matrix.
+    """
+    if not _positive_definite(M):
+        raise ParameterError(f"{m_name}: expected a positive definite mass matrix "
+                             "(its Cholesky factorisation fails)")
+    kmax = abs(K).max() if K.nnz else 0.0
+    mmax = abs(M).max() if M.nnz else 1.0
+    if kmax == 0.0:
+        return
+    if not _positive_definite((K + (1e-6 * kmax / mmax) * M).tocsr()):
+        raise ParameterError(f"{k_name}: expected a positive semi-definite stiffness "
+                             f"matrix (the Cholesky factorisation of K + sigma M, sigma = "
+                             f"1e-6 max|K|/max|M|, fails: K has a negative eigenvalue)")
+    tied = K
+    for G in contacts:
+        tied = tied + kmax * (G.T @ G)
+    if not _positive_definite(sp.csr_matrix(tied)):
+        raise SingularMatrixError(
+            f"{k_name}: singular stiffness matrix: a rigid-body motion that no contact "
+            "holds (its Cholesky factorisation fails with the contacts tied); the static "
+            "harmonic cannot be solved: constrain the structure")
 
 
 @dataclass
@@ -127,7 +191,7 @@ class ContactGroup:
             raise SizeError(f"contact {self.name!r}: no element (G has no rows)")
         if not np.all(np.isfinite(self.G.data)):
             raise NonFiniteError(f"contact {self.name!r}: G contains NaN or Inf")
-        p = np.asarray(self.params, dtype=float)
+        p = as_floats(f"contact {self.name!r}: params {names}", self.params)
         if p.ndim == 1 and p.size == len(names):
             p = np.tile(p, (ne, 1))
         if p.shape != (ne, len(names)):
@@ -149,7 +213,7 @@ class ContactGroup:
         if self.w0 is None:
             self.w0 = np.zeros((ne, nsl))
         else:
-            w0 = np.asarray(self.w0, dtype=float)
+            w0 = as_floats(f"contact {self.name!r}: w0", self.w0)
             if w0.shape != (ne, nsl):
                 raise SizeError(f"contact {self.name!r}: w0 must have shape ({ne}, {nsl}), "
                                 f"got {w0.shape}")
@@ -190,11 +254,6 @@ class Model:
         if np.any(d <= 0):
             raise ParameterError(f"M: diagonal entry {int(np.argmin(d))} is {d.min():.3g}; "
                                  "a mass matrix must be positive definite")
-        if n <= 2000:
-            try:
-                np.linalg.cholesky(self.M.toarray())
-            except np.linalg.LinAlgError:
-                raise ParameterError("M: not positive definite (Cholesky failed)") from None
         if not isinstance(self.damping, Damping):
             raise ParameterError("damping: expected a frirom.model.Damping")
         self.C = self.damping.assemble(self.M, self.K)
@@ -206,6 +265,7 @@ class Model:
             if g.G.shape[1] != n:
                 raise SizeError(f"contact {g.name!r}: G has {g.G.shape[1]} columns, the "
                                 f"model has {n} DoFs")
+        check_definite(self.K, self.M, contacts=[g.G for g in self.contacts])
         if self.dof_labels is not None and len(self.dof_labels) != n:
             raise SizeError(f"dof_labels: {len(self.dof_labels)} labels for {n} DoFs")
 

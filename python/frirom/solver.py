@@ -26,7 +26,8 @@ from typing import Callable
 
 import numpy as np
 
-from ._errors import CODES, ParameterError, SizeError, raise_for_status
+from ._errors import (CODES, MAX_HARMONICS, MAX_OMEGA, ParameterError, SizeError, check_integer,
+                      check_number, raise_for_status, samples_problem)
 from ._pack import HILL_MAX, MODES_MAX, TIMER_NAMES  # noqa: F401 - public here
 from ._pack import (START_CONTINUE, START_RESUME, START_SOLVE_ONLY, YSCALE_RELATIVE, _Packed,
                     _split_load, add_timings, pack)
@@ -141,12 +142,13 @@ class SolverOptions:
 
     def check(self) -> None:
         """Raise ParameterError naming the first invalid field."""
-        if not (isinstance(self.harmonics, (int, np.integer)) and 0 <= self.harmonics <= 200):
-            raise ParameterError(f"options.harmonics: expected an integer 0..200, got "
-                                 f"{self.harmonics!r}")
-        if self.samples is not None and self.samples < 2 * self.harmonics + 1:
-            raise ParameterError(f"options.samples: need >= 2H+1 = {2 * self.harmonics + 1}"
-                                 f", got {self.samples}")
+        check_integer("options.harmonics", self.harmonics, minimum=0, maximum=MAX_HARMONICS)
+        if self.samples is not None and samples_problem(self.harmonics, self.samples):
+            raise ParameterError(f"options.samples: expected "
+                                 f"{samples_problem(self.harmonics, self.samples)}, got "
+                                 f"{self.samples!r}")
+        for nm in ("max_iter", "max_points", "batch"):
+            check_integer(f"options.{nm}", getattr(self, nm), minimum=1, maximum=2**31 - 1)
         if self.formulation not in FORMULATIONS:
             raise ParameterError(f"options.formulation: expected one of "
                                  f"{sorted(FORMULATIONS)}, got {self.formulation!r}")
@@ -160,6 +162,9 @@ class SolverOptions:
                 raise ParameterError(f"options.{nm}: expected a positive number, got {v}")
         if self.ds_min > self.ds_max:
             raise ParameterError("options.ds_min must not exceed options.ds_max")
+        if self.ds > self.ds_max:
+            raise ParameterError(f"options.ds: expected a first step at most ds_max = "
+                                 f"{self.ds_max:g}, got {self.ds:g}")
         if self.modes is not None and (self.modes < 1 or self.formulation != "condensed"):
             raise ParameterError("options.modes: a positive number of modes, with "
                                  "formulation 'condensed'")
@@ -175,8 +180,6 @@ class SolverOptions:
             if getattr(self, nm) not in allowed:
                 raise ParameterError(f"options.{nm}: expected one of {list(allowed)}, got "
                                      f"{getattr(self, nm)!r}")
-        if self.max_iter < 1 or self.max_points < 1 or self.batch < 1:
-            raise ParameterError("options.max_iter, max_points and batch must be >= 1")
 
     @property
     def n_samples(self) -> int:
@@ -479,9 +482,8 @@ def frf(model: Model | CyclicModel, excitation: Excitation, omega_start: float,
     options = options or SolverOptions()
     if options.parameter != "frequency":
         options = dataclasses.replace(options, parameter="frequency")
-    for nm, v in (("omega_start", omega_start), ("omega_end", omega_end)):
-        if not (np.isfinite(v) and v > 0):
-            raise ParameterError(f"{nm}: expected a positive frequency in rad/s, got {v}")
+    for nm, v in (("omega_start [rad/s]", omega_start), ("omega_end [rad/s]", omega_end)):
+        check_number(nm, v, positive=True, maximum=MAX_OMEGA)
     if omega_start == omega_end:
         raise ParameterError("omega_start and omega_end must differ")
     packed = pack(model, excitation, options, outputs)
@@ -513,8 +515,9 @@ def load_curve(model: Model | CyclicModel, excitation: Excitation, omega: float,
     """
     options = options or SolverOptions()
     options = dataclasses.replace(options, parameter="load")
-    if not (np.isfinite(omega) and omega > 0):
-        raise ParameterError(f"omega: expected a positive frequency in rad/s, got {omega}")
+    check_number("omega [rad/s]", omega, positive=True, maximum=MAX_OMEGA)
+    check_number("scale_start", scale_start)
+    check_number("scale_end", scale_end)
     if scale_start == scale_end:
         raise ParameterError("scale_start and scale_end must differ")
     packed = pack(model, excitation, options, outputs, load_part=part)

@@ -17,10 +17,11 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
-from .._errors import InputError
+from .._errors import FriromError, InputError
 from ..contact import LAWS
 from ..io import DIRECTION_NAMES, read_mtx
-from ..model import ContactGroup, CyclicModel, Damping, Excitation, Model
+from ..io._common import read_text
+from ..model import ContactGroup, CyclicModel, Damping, Excitation, Model, check_definite
 from ..reduction.rom import PairSpec, build_reduced_model
 from ..solver import SolverOptions
 from .build_cyclic import check_sector_contacts, cyclic_modes, cyclic_sector_of
@@ -209,6 +210,11 @@ class _Builder:
                 raise ctx.error("damping.zeta", f"at most {n} modal ratios",
                                 s.damping.zeta.size)
             contacts = [self.dof_contact(c) for c in s.contacts]
+            try:
+                check_definite(K, M, f"model.stiffness ({s.model.stiffness.name})",
+                               f"model.mass ({s.model.mass.name})", [c.G for c in contacts])
+            except FriromError as exc:
+                raise InputError(f"{s.path}: {exc}") from None
         else:
             # everything checked: build (or reuse) the reduced model, resolve the nodes
             pairs = [PairSpec(name=c.name, a=c.a, b=c.b, normal=c.normal, tangent=c.tangent,
@@ -275,7 +281,13 @@ class _Builder:
         labels = None
         if m.dof_labels is not None:
             lp = m.dof_labels
-            labels = [s.strip() for s in lp.read_text().splitlines() if s.strip()]
+            if not lp.is_file():
+                raise ctx.error("model.dof_labels", "an existing file of DoF labels", str(lp))
+            try:
+                text = read_text(lp)
+            except InputError as exc:
+                raise InputError(f"{path}: model.dof_labels: {exc}") from None
+            labels = [s.strip() for s in text.splitlines() if s.strip()]
             if len(labels) != n:
                 raise ctx.error("model.dof_labels", f"{n} labels (one per line, matrix "
                                 f"order) in {lp}", f"{len(labels)} labels")

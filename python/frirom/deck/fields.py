@@ -41,6 +41,14 @@ class Context:
         return InputError(msg)
 
 
+def finite(x) -> bool:
+    """True for a finite number (a TOML integer too large for a float is not)."""
+    try:
+        return math.isfinite(x)
+    except OverflowError:
+        return False
+
+
 def table(ctx: Context, d, key: str, required: bool = True) -> dict:
     """The sub-table at ``key`` (its last dotted part is looked up in ``d``); {} if absent
     and not required."""
@@ -64,9 +72,15 @@ def unknown(ctx: Context, d: dict, allowed, prefix: str) -> None:
                             + " (unknown key)")
 
 
+#: The largest integer a deck field may hold: the Fortran interface's 32-bit integers.
+MAX_INT = 2**31 - 1
+
+
 def number(ctx: Context, d, name, key, *, default=None, required=False, positive=False,
-           nonneg=False, integer=False, minimum=None):
-    """A finite int or float (``integer``: an int), optionally > 0, >= 0 or >= minimum."""
+           nonneg=False, integer=False, minimum=None, maximum=None):
+    """A finite int or float (``integer``: an int), optionally > 0, >= 0, >= minimum or
+    <= maximum. Integers are at most :data:`MAX_INT`; other numbers come back as float
+    (a TOML integer too big for a float is refused as not finite)."""
     if name not in d:
         if required:
             raise ctx.error(key, "a number (missing)")
@@ -76,8 +90,20 @@ def number(ctx: Context, d, name, key, *, default=None, required=False, positive
         raise ctx.error(key, "an integer" if integer else "a number", v)
     if integer and not isinstance(v, int):
         raise ctx.error(key, "an integer", v)
-    if not math.isfinite(v):
-        raise ctx.error(key, "a finite number", v)
+    if integer:
+        top = MAX_INT if maximum is None else maximum
+        if v > top or v < -MAX_INT:
+            raise ctx.error(key, f"an integer at most {top}" if v > 0 else
+                            f"an integer >= {-MAX_INT}", v)
+    else:
+        try:
+            v = float(v)
+        except OverflowError:
+            v = math.inf
+        if not math.isfinite(v):
+            raise ctx.error(key, "a finite number", d[name])
+        if maximum is not None and v > maximum:
+            raise ctx.error(key, f"a number at most {maximum:g}", v)
     if positive and v <= 0:
         raise ctx.error(key, "a positive number", v)
     if nonneg and v < 0:
@@ -139,7 +165,8 @@ def integers(ctx: Context, d, name, key, required=False, minimum=None) -> tuple:
     if v is None and not required:
         return ()
     if (not isinstance(v, list) or not v
-            or any(isinstance(x, bool) or not isinstance(x, int) for x in v)
+            or any(isinstance(x, bool) or not isinstance(x, int) or abs(x) > MAX_INT
+                   for x in v)
             or (minimum is not None and min(v) < minimum)):
         what = "integers" if minimum is None else f"integers >= {minimum}"
         raise ctx.error(key, f"a non-empty list of {what}", v)
@@ -151,7 +178,7 @@ def vector(ctx: Context, d, name, key, default=None, nonzero=True) -> tuple:
     v = d.get(name, default)
     if (not isinstance(v, (list, tuple)) or len(v) != 3
             or any(isinstance(x, bool) or not isinstance(x, (int, float))
-                   or not math.isfinite(x) for x in v)
+                   or not finite(x) for x in v)
             or (nonzero and not any(v))):
         raise ctx.error(key, "a list of 3 finite numbers"
                         + (", not all zero" if nonzero else ""), v)
@@ -172,7 +199,7 @@ def per_element(ctx: Context, c, p, key, ne, required=False, nonneg=False) -> np
     out = np.empty(ne)
     for i, x in enumerate(vals):
         k = f"{key}[{i}]" if isinstance(v, list) else key
-        if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+        if isinstance(x, bool) or not isinstance(x, (int, float)) or not finite(x):
             raise ctx.error(k, "a finite number", x)
         if nonneg and x < 0:
             raise ctx.error(k, "a number >= 0", x)

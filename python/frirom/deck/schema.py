@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .._errors import InputError
+from .._errors import MAX_HARMONICS, MAX_OMEGA, InputError, samples_problem
+from ..io._common import read_text
 from ..reduction.rom import FESource, ReductionSpec
 from .fields import Context, DofRef, boolean, dof_ref, file, number, string, table, unknown
 from .schema_contacts import parse_contacts
@@ -203,13 +204,13 @@ def read_toml(path: Path) -> dict:
     if tomllib is None:
         raise InputError(f"{path}: reading a deck needs Python >= 3.11 (tomllib) "
                          "or the 'tomli' package")
+    if path.is_dir():
+        raise InputError(f"{path}: cannot read the deck (a folder, not a file)")
+    if not path.exists():
+        raise InputError(f"{path}: deck file does not exist")
+    text = read_text(path)
     try:
-        with open(path, "rb") as fh:
-            return tomllib.load(fh)
-    except FileNotFoundError:
-        raise InputError(f"{path}: deck file does not exist") from None
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read the deck ({exc.strerror})") from None
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"{path}: not valid TOML: {exc}") from None
 
@@ -254,10 +255,10 @@ def _solver(ctx, sol, cyc) -> SolverSettings:
     unknown(ctx, sol, {"harmonics", "samples", "formulation", "tol_residual",
                        "tol_update", "max_iterations", "stability"}, "solver")
     H = number(ctx, sol, "harmonics", "solver.harmonics", required=True, integer=True,
-               minimum=1)
+               minimum=1, maximum=MAX_HARMONICS)
     N = number(ctx, sol, "samples", "solver.samples", integer=True)
-    if N is not None and N < 2 * H + 1:
-        raise ctx.error("solver.samples", f"an integer >= 2*harmonics+1 = {2 * H + 1}", N)
+    if N is not None and samples_problem(H, N):
+        raise ctx.error("solver.samples", samples_problem(H, N), N)
     form = string(ctx, sol, "formulation", "solver.formulation", default="condensed",
                   choices=("condensed", "banded"))
     tols = []
@@ -328,7 +329,7 @@ def _excitation(ctx, exc, H, fe, labels, cyc) -> list:
         if h > H:
             raise ctx.error(f"{key}.harmonic", f"a harmonic in 0..solver.harmonics={H}", h)
         amp = number(ctx, ld, "amplitude", f"{key}.amplitude", required=True)
-        ph = number(ctx, ld, "phase", f"{key}.phase", default=0.0)
+        ph = _phase(ctx, ld, f"{key}.phase")
         if h == 0 and ph not in (0, 0.0):
             raise ctx.error(f"{key}.phase", "0 for a static load (harmonic 0)", ph)
         out.append(Load(d, h, amp * np.exp(1j * np.deg2rad(ph))))
@@ -355,7 +356,7 @@ def _excitation(ctx, exc, H, fe, labels, cyc) -> list:
         if h > H:
             raise ctx.error(f"{key}.harmonic", f"a harmonic in 1..solver.harmonics={H}", h)
         amp = number(ctx, eo, "amplitude", f"{key}.amplitude", required=True)
-        ph = number(ctx, eo, "phase", f"{key}.phase", default=0.0)
+        ph = _phase(ctx, eo, f"{key}.phase")
         a0 = amp * np.exp(1j * np.deg2rad(ph))
         for s, ds in enumerate(dofs):
             phase = np.exp(-2j * np.pi * order * s / ns)     # as engine_order_loads
@@ -364,6 +365,14 @@ def _excitation(ctx, exc, H, fe, labels, cyc) -> list:
                 k = f"{key}.dofs[{s}]" + (f"[{j}]" if isinstance(ds, list) else "")
                 out.append(Load(dof_ref(ctx, v, k, fe, labels), h, a0 * phase))
     return out
+
+
+def _phase(ctx, d, key) -> float:
+    """A phase in degrees, -360..360 (0 if absent)."""
+    ph = number(ctx, d, "phase", key, default=0.0)
+    if abs(ph) > 360:
+        raise ctx.error(key, "a phase in degrees, -360..360", ph)
+    return ph
 
 
 def _tables(ctx, entries: list, prefix: str, allowed):
@@ -380,18 +389,25 @@ def _frequency(ctx, fr) -> FrequencySettings:
     unknown(ctx, fr, {"start", "end", "unit"}, "frequency")
     unit = string(ctx, fr, "unit", "frequency.unit", default="hz",
                   choices=tuple(FREQUENCY_UNITS))
-    f0 = number(ctx, fr, "start", "frequency.start", required=True, positive=True)
-    f1 = number(ctx, fr, "end", "frequency.end", required=True, positive=True)
+    top = MAX_OMEGA / FREQUENCY_UNITS[unit]
+    f0 = number(ctx, fr, "start", "frequency.start", required=True, positive=True,
+                maximum=top)
+    f1 = number(ctx, fr, "end", "frequency.end", required=True, positive=True, maximum=top)
     if f1 == f0:
         raise ctx.error("frequency.end", "a frequency different from frequency.start", f1)
     return FrequencySettings(start=f0, end=f1, unit=unit)
+
+
+#: The largest arc-length step of a deck (dimensionless; the solver's default largest is
+#: 0.1): past it a step jumps over whole resonances.
+MAX_STEP = 10.0
 
 
 def _continuation(ctx, con) -> ContinuationSettings:
     unknown(ctx, con, {"step", "min_step", "max_step", "max_points"}, "continuation")
     steps = {}
     for k in ("step", "min_step", "max_step"):
-        v = number(ctx, con, k, f"continuation.{k}", positive=True)
+        v = number(ctx, con, k, f"continuation.{k}", positive=True, maximum=MAX_STEP)
         if v is not None:
             steps[k] = float(v)
     if "min_step" in steps and "max_step" in steps and steps["min_step"] > steps["max_step"]:

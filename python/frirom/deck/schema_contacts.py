@@ -8,11 +8,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..contact import LAWS
-from .fields import Context, dof_ref, number, per_element, string, unknown, vector
+from .fields import Context, dof_ref, finite, number, per_element, string, unknown, vector
 from .schema_model import CyclicSettings
 
 #: parameters that must be >= 0 (n0 may be negative: an initial gap)
-_NONNEGATIVE = {"kt", "kn", "mu", "fn0"}
+_NONNEGATIVE = {"kt", "kn", "mu", "fn0", "k1"}
 
 
 @dataclass(frozen=True)
@@ -175,7 +175,8 @@ def _frame(ctx, frame, key, nd, dirs) -> np.ndarray:
     D = np.empty((ndir, nd))
     for d, vec in enumerate(frame):
         if (not isinstance(vec, list) or len(vec) != nd
-                or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in vec)):
+                or any(isinstance(x, bool) or not isinstance(x, (int, float))
+                       or not finite(x) for x in vec)):
             raise ctx.error(f"{key}[{d}]", f"a list of {nd} numbers (one per node DoF)", vec)
         D[d] = vec
         nrm = np.linalg.norm(D[d])

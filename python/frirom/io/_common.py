@@ -52,6 +52,9 @@ class FEModel:
     constrained: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
     source: list = field(default_factory=list)
 
+    def __post_init__(self):
+        check_matrices(self.K, self.M, ", ".join(map(str, self.source)) or "the model")
+
     @property
     def n_dof(self) -> int:
         return self.K.shape[0]
@@ -68,6 +71,17 @@ class FEModel:
             raise InputError(f"no coordinates for node(s) {missing[:10].tolist()}")
         return self.coords[order[pos]]
 
+    def node_set(self, name: str) -> np.ndarray:
+        """The node ids of a node set (case-insensitive); InputError naming the sets the
+        model has (and where node sets come from when it has none)."""
+        ids = self.node_sets.get(name.upper())
+        if ids is None:
+            raise InputError(f"unknown node set {name!r}; the model has "
+                             f"{sorted(self.node_sets)}" + ("" if self.node_sets else
+                             " (matrix files carry no node sets: give [fe_model] inp, "
+                             "a file of *NODE and *NSET blocks, see docs/deck.md)"))
+        return ids
+
     def dof_indices(self, node_set=None, nodes=None, directions=(1, 2, 3),
                     missing: str = "error") -> np.ndarray:
         """Matrix indices of the DoFs of some nodes in some directions.
@@ -82,11 +96,7 @@ class FEModel:
         names = [] if node_set is None else ([node_set] if isinstance(node_set, str)
                                              else list(node_set))
         for name in names:
-            key = name.upper()
-            if key not in self.node_sets:
-                raise InputError(f"unknown node set {name!r}; the model has "
-                                 f"{sorted(self.node_sets)}")
-            ids.append(self.node_sets[key])
+            ids.append(self.node_set(name))
         want = np.unique(np.concatenate(ids)) if ids else np.zeros(0, np.int64)
         sel = np.isin(self.dofs[:, 0], want) & np.isin(self.dofs[:, 1], list(directions))
         idx = np.nonzero(sel)[0]
@@ -115,6 +125,26 @@ class FEModel:
                        source=list(self.source))
 
 
+def check_matrices(K, M, where) -> None:
+    """What every reader returns: K (and M) real, square, of one size and finite;
+    InputError naming ``where`` (the file read) otherwise."""
+    where = os.fspath(where)
+    for A, what in ((K, "stiffness"), (M, "mass")):
+        if A is None:
+            continue
+        if np.iscomplexobj(A.data if sp.issparse(A) else A):
+            raise InputError(f"{where}: {what} matrix: expected real entries, got complex")
+        if A.ndim != 2 or A.shape[0] != A.shape[1]:
+            raise InputError(f"{where}: {what} matrix: expected square, got shape {A.shape}")
+        data = A.data if sp.issparse(A) else np.asarray(A)
+        if not np.all(np.isfinite(data)):
+            raise InputError(f"{where}: {what} matrix: expected finite entries, got NaN or "
+                             "Inf")
+    if M is not None and M.shape != K.shape:
+        raise InputError(f"{where}: mass matrix: expected the stiffness matrix's shape "
+                         f"{K.shape}, got {M.shape}")
+
+
 def fail(path, line, expected: str, got: str | None = None):
     """Raise InputError naming the file, the 1-based line and what was expected."""
     where = f"{os.fspath(path)}" + (f", line {line}" if line else "")
@@ -125,22 +155,27 @@ def fail(path, line, expected: str, got: str | None = None):
     raise InputError(msg)
 
 
-def read_lines(path):
-    """All lines of a text file; InputError if it is missing or unreadable."""
-    try:
-        with open(path, encoding="ascii", errors="replace") as fh:
-            return fh.read().splitlines()
-    except OSError as exc:
-        raise InputError(f"{os.fspath(path)}: cannot read ({exc.strerror})") from None
-
-
 def read_text(path) -> str:
-    """The whole text of a file; InputError if it is missing or unreadable."""
+    """The whole text of a file, decoded as UTF-8 (ASCII is UTF-8); InputError if it is
+    missing, unreadable or not UTF-8 (naming the line and the byte)."""
     try:
-        with open(path, encoding="ascii", errors="replace") as fh:
-            return fh.read()
+        with open(path, "rb") as fh:
+            data = fh.read()
     except OSError as exc:
         raise InputError(f"{os.fspath(path)}: cannot read ({exc.strerror})") from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        col = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
+        raise InputError(f"{os.fspath(path)}, line {line}: expected UTF-8 text (ASCII "
+                         f"is UTF-8), got byte 0x{data[exc.start]:02x} at column {col}; "
+                         "save the file as UTF-8") from None
+
+
+def read_lines(path):
+    """All lines of a text file (:func:`read_text`)."""
+    return read_text(path).splitlines()
 
 
 def parse_table(path, lines, first: int, ncols: int, kinds: str, what: str,

@@ -49,15 +49,19 @@ __all__ = ["FESource", "PairSpec", "ReductionSpec", "ReducedModel", "build_reduc
 #: format -> (file roles, required roles); see docs/deck.md, [fe_model]
 FORMATS = {
     "calculix": (("job", "inp"), ("job",)),
-    "mtx": (("stiffness", "mass", "dofs"), ("stiffness", "mass")),
+    "mtx": (("stiffness", "mass", "dofs", "inp"), ("stiffness", "mass")),
     "abaqus": (("stiffness", "mass", "dofs", "inp"), ("stiffness", "mass")),
-    "hbmat": (("stiffness", "mass", "mapping"), ("stiffness", "mass")),
-    "op4": (("file", "dofs"), ("file",)),
+    "hbmat": (("stiffness", "mass", "mapping", "inp"), ("stiffness", "mass")),
+    "op4": (("file", "dofs", "inp"), ("file",)),
 }
 CACHE_VERSION = 3
 #: Environment variable naming the folder of the shared reduced-model cache (default: a
 #: folder .frirom_cache beside the FE files).
 CACHE_ENV = "FRIROM_CACHE"
+#: Interface modes without Craig-Bampton condense the interface from the whole FE model:
+#: refused above this many (FE DoFs x interface DoFs); the lap joint's 6 720 x 630 takes
+#: minutes (issue 13's parser "hang").
+GUYAN_WORK_MAX = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -143,6 +147,10 @@ def read_fe_model(src: FESource):
     else:
         model = fio.read_op4(f["file"], o.get("stiffness_name", "KAA"),
                              o.get("mass_name", "MAA"), f.get("dofs"))
+    if src.format in ("mtx", "hbmat", "op4") and f.get("inp") is not None:
+        # node coordinates and node sets from a *NODE / *NSET file (these formats have none)
+        model.node_ids, model.coords, model.node_sets, _ = fio.read_inp(f["inp"])
+        model.source.append(str(f["inp"]))
     if model.M is None:
         raise InputError(f"{src.paths()[0]}: no mass matrix (the reduction needs M)")
     return model
@@ -168,9 +176,7 @@ def pairs_from_node_sets(model, set_a: str, set_b: str | None, normal, kt: float
     b_rotation: (3, 3) rotation about ``origin`` applied to set b's coordinates before the
     matching (side b in the next sector of a cyclic rotor); dofs_b stay those of set b.
     """
-    na = model.node_sets.get(set_a.upper())
-    if na is None:
-        raise InputError(f"unknown node set {set_a!r}; the model has {sorted(model.node_sets)}")
+    na = model.node_set(set_a)
     xa = model.coordinates(na)
     da = _node_dofs(model, na)
     if np.any(da < 0):
@@ -180,10 +186,7 @@ def pairs_from_node_sets(model, set_a: str, set_b: str | None, normal, kt: float
     if set_b is None:
         db = -np.ones_like(da)
     else:
-        nb = model.node_sets.get(set_b.upper())
-        if nb is None:
-            raise InputError(f"unknown node set {set_b!r}; the model has "
-                             f"{sorted(model.node_sets)}")
+        nb = model.node_set(set_b)
         xb = model.coordinates(nb)
         if b_rotation is not None:
             o = np.asarray(origin, float)
@@ -556,6 +559,12 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
 
     pairs0 = {k: to0(v) for k, v in prs.items()}
     pre = f"{where}reduction.interface_modes"
+    if spec.method != "none" and T0 is None and n_fe * iface0.size > GUYAN_WORK_MAX:
+        raise InputError(f"{where}reduction.fixed_interface_modes: expected a number of "
+                         f"Craig-Bampton modes (e.g. 20) with interface_modes.method = "
+                         f"'{spec.method}' on a model of {n_fe} DoFs: without them the "
+                         f"{iface0.size} interface DoFs are condensed from the whole FE model "
+                         f"({iface0.size} sparse solves of size {n_fe}: minutes or more)")
     if spec.method == "none":
         basis = None
     elif spec.method == "gsi":
