@@ -268,7 +268,7 @@ def _cli_cases(d):
     afile = d / "afile"
     afile.write_text("x")
     return [
-        (["run", str(d / "none.toml")], ["none.toml", "does not exist"]),
+        (["run", str(d / "none.toml")], ["none.toml", "no such deck"]),
         (["run", str(deck), "--out", str(afile)], ["afile", "--out", "folder"]),
         (["demo", "--out", str(afile)], ["afile", "--out", "folder"]),
         (["run", str(deck), "--out", str(d / "o"), "--resume"], ["frf.h5", "nothing to resume"]),
