@@ -2,6 +2,7 @@
 
     frirom run DECK [--out DIR] [--resume]    forced response of a deck (docs/deck.md)
     frirom demo [--out DIR]                   contact hysteresis loops and harmonics
+    frirom study DECK [--out DIR]             a family or convergence study ([study])
 """
 
 from __future__ import annotations
@@ -45,6 +46,31 @@ def _demo(args) -> int:
     return 0
 
 
+def _add_study(sub) -> None:
+    p = sub.add_parser(
+        "study", help="run the [study] of a deck: a family of FRFs or a model-size ladder",
+        description="Run every member of the deck's [study] table (docs/deck.md) as a Dask "
+        "task, into OUT/members/<name>/; finished members are kept, so running again "
+        "continues an interrupted study. Writes OUT/study.h5 and the plots.")
+    p.add_argument("deck", type=Path, help="a TOML deck with a [study] table")
+    p.add_argument("--out", type=Path, default=None,
+                   help="output folder (default: results/<deck name>)")
+    p.add_argument("--scheduler", default=None,
+                   help='"local" (a LocalCluster, the default), "serial", or a Dask '
+                   "scheduler address (tcp://host:8786); overrides study.scheduler")
+    p.add_argument("--workers", type=int, default=None,
+                   help="LocalCluster workers (default: study.workers, or one per core)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_study)
+
+
+def _study(args) -> int:
+    from .study import run_study
+    res = run_study(args.deck, args.out, scheduler=args.scheduler, workers=args.workers,
+                    quiet=args.quiet, log=lambda s: print(f"frirom: {s}"))
+    return 0 if all(s["complete"] for s in res["summaries"]) else 1
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="frirom", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -52,6 +78,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     _add_run(sub)
     _add_demo(sub)
+    _add_study(sub)
     return parser
 
 
