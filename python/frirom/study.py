@@ -30,7 +30,7 @@ import re
 import resource
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -166,9 +166,10 @@ def run_member(deck_path, overrides: dict, folder, progress: bool = True) -> dic
     seconds = time.perf_counter() - t0
     writer.close(complete=result.complete, message=result.message)
     counter.flush()
-    if start is None and result.peaks is not None:
-        _write_peaks(h5, result.peaks)
     full = FRF.load(h5)
+    if len(full):
+        _write_peaks(h5, _peaks(full, result, len(full) - len(result)))
+        full = FRF.load(h5)
     n_nl = len(model.nonlinear_dofs())
     H = deck.harmonics
     nnz = sum(getattr(A, "nnz", 0) for A in (deck.M, deck.K))
@@ -208,10 +209,27 @@ class _Counter:
             self.t = time.monotonic()
 
 
+def _peaks(full, part, n_before: int) -> list:
+    """Per output the peak of the whole curve ``full``: the solver's (solved on the
+    curve) when it lies in the part this call computed (``part``, after the first
+    ``n_before`` points), else :meth:`FRF.peak` of the file's points."""
+    out = []
+    for j in range(full.amp_max.shape[1]):
+        i = int(np.argmax(full.amp_max[:, j])) if len(full) else 0
+        if part.peaks is not None and i >= n_before:
+            out.append(replace(part.peaks[j], index=part.peaks[j].index + n_before))
+        else:
+            out.append(full.peak(j))
+    return out
+
+
 def _write_peaks(h5, peaks) -> None:
     """The solver's refined peaks into a member's file, as FRF.save_h5 stores them."""
     import h5py
     with h5py.File(h5, "a") as f:
+        for k in ("peak_omega", "peak_amplitude", "peak_index"):
+            if k in f:
+                del f[k]
         f.create_dataset("peak_omega", data=[p.omega for p in peaks])
         f.create_dataset("peak_amplitude", data=[p.amplitude for p in peaks])
         f.create_dataset("peak_index", data=[p.index for p in peaks])
