@@ -38,7 +38,8 @@ def _runs(mask):
 
 
 def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = None,
-             amplitude_unit: str = "m", log: bool | None = None, ax=None) -> Figure:
+             amplitude_unit: str = "m", log: bool | None = None, ax=None,
+             linear: dict | None = None) -> Figure:
     """Max amplitude over a period against frequency, one curve per output.
 
     Stable stretches are solid, unstable dashed (Hill's method, ``frf.stable``); folds
@@ -60,6 +61,10 @@ def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = No
         Logarithmic amplitude axis; default when the amplitudes span more than 30x.
     ax : matplotlib.axes.Axes, optional
         Draw on these axes; default a new 7.5 x 4.6 in Figure at 130 dpi.
+    linear : dict, optional
+        Reference curves {"free": (omega (n,) rad/s, amp (n, n_out)), "stuck": ...}: the
+        linear responses with the contacts free (dotted) and stuck (dash-dot), thin, in
+        each output's colour (:meth:`frirom.modes.LinearCheck.linear_curves`).
 
     Returns
     -------
@@ -92,6 +97,17 @@ def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = No
         if fold.any():
             ax.plot(f[fold], amp[fold, j], "D", color="k", ms=4.5, zorder=5,
                     label="fold" if j == 0 else None)
+    for kind, ls in (("free", ":"), ("stuck", "-.")):
+        if linear and kind in linear:
+            wl, al = linear[kind]
+            al = np.asarray(al, float).reshape(len(wl), -1)
+            for j in range(al.shape[1]):
+                ax.plot(frequency_axis(wl, unit)[0], al[:, j], color=colors[j % len(colors)],
+                        lw=0.8, ls=ls, alpha=0.7,
+                        label=f"linear, contacts {kind}" if j == 0 else None)
+            if f.size > 1:              # the reference curves do not widen the axis
+                pad = 0.02 * (f.max() - f.min())
+                ax.set_xlim(f.min() - pad, f.max() + pad)
     if log is None:
         pos = amp[amp > 0]
         log = pos.size > 0 and pos.max() / pos.min() > 30.0
