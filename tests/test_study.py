@@ -290,3 +290,23 @@ def test_dask_equals_serial_and_lost_worker(tmp_path):
                  "--quiet"]) == 0
     assert all(p.stat().st_mtime_ns == t for p, t in kept.items())
     assert len(list(out2.glob("members/*/member.json"))) == 4
+
+
+def test_study_of_a_base_deck(tmp_path):
+    """``study.base``: the members vary another deck (the bundled family's form); a study
+    deck naming a base holds nothing else; the base has no [study] of its own."""
+    deck = write_case(tmp_path, "")
+    only = tmp_path / "family.toml"
+    only.write_text('[study]\nbase = "study.toml"\n' + STUDY.split("\n", 3)[3])
+    st = load_study(only, tmp_path / "out")
+    assert st.deck == deck and len(st.members) == 4 and "study" not in st.raw
+    bad = tmp_path / "bad.toml"
+    bad.write_text('title = "x"\n[study]\nbase = "study.toml"\n' + STUDY.split("\n", 3)[3])
+    with pytest.raises(InputError, match="study.base: expected a deck holding only"):
+        load_study(bad, tmp_path / "out")
+    write_case(tmp_path / "b", STUDY)
+    bad.write_text('[study]\nbase = "b/study.toml"\n' + STUDY.split("\n", 3)[3])
+    with pytest.raises(InputError, match="without its own"):
+        load_study(bad, tmp_path / "out")
+    bundled = load_study(ROOT / "cases" / "joint" / "joint_family.toml", tmp_path / "o")
+    assert bundled.deck == ROOT / "cases" / "joint" / "joint.toml"

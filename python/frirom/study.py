@@ -52,7 +52,11 @@ class Study:
     """A deck with a ``[study]`` table, its members expanded.
 
     path : Path
-        The deck file. raw : dict, its TOML. settings : StudySettings.
+        The study's deck file. settings : StudySettings.
+    deck : Path
+        The deck the members vary: ``study.base``, or ``path`` itself.
+    raw : dict
+        That deck's TOML (without [study]).
     members : list of dict
         Per member: ``name`` (``m000``...), ``values`` {key path: value} (what the study
         sets), ``overrides`` (values plus a ``reduction.cache`` file when the member's
@@ -60,6 +64,7 @@ class Study:
     """
 
     path: Path
+    deck: Path
     raw: dict
     settings: StudySettings
     members: list = field(default_factory=list)
@@ -75,9 +80,12 @@ def load_study(path, out: Path) -> Study:
     members whose reduction differs go to ``out/rom``)."""
     path = Path(path)
     raw = read_toml(path)
-    st = parse_study(path, raw)
+    st = parse_study(path, raw, read_toml)
     if st is None:
         raise InputError(f"{path}: no [study] table (see docs/deck.md, 'Studies')")
+    deck = path
+    if st.base is not None:
+        deck, raw = st.base, read_toml(st.base)
     members = []
     fe = "fe_model" in raw or "reduction" in raw
     for i, values in enumerate(st.members()):
@@ -87,11 +95,11 @@ def load_study(path, out: Path) -> Study:
             tag = hashlib.sha1(json.dumps(red, sort_keys=True).encode()).hexdigest()[:12]
             over["reduction.cache"] = str((Path(out) / "rom" / f"{tag}.rom.h5").resolve())
         try:
-            parse_deck(path, member_raw(raw, over))
+            parse_deck(deck, member_raw(raw, over))
         except InputError as exc:
             raise InputError(f"study member {i} ({_label(values)}): {exc}") from None
         members.append({"name": f"m{i:03d}", "values": values, "overrides": over})
-    return Study(path=path, raw=raw, settings=st, members=members)
+    return Study(path=path, deck=deck, raw=raw, settings=st, members=members)
 
 
 def load_member(deck_path, overrides: dict):
@@ -352,8 +360,9 @@ def run_study(deck_path, out=None, scheduler: str | None = None, workers: int | 
         runner.close()
     seconds = time.perf_counter() - t0
     for m, s in zip(study.members, summaries):
-        if m["overrides"].get("reduction.cache") in rom_seconds:
-            s["rom_seconds"] = rom_seconds[m["overrides"]["reduction.cache"]]
+        cache = m["overrides"].get("reduction.cache")
+        if cache in rom_seconds:
+            s["rom_seconds"] = rom_seconds[cache]
     res = {"study": study, "summaries": summaries, "seconds": seconds}
     res["file"] = write_study_file(study, out, summaries)
     res.update(_report(study, out, summaries, log))
@@ -372,7 +381,7 @@ def _prepare(study: Study, out: Path, runner: _Runner, log) -> dict:
             todo.append((m, cache))
     if not todo:
         return {}
-    res = runner.map(prepare_member, [(str(study.path), m["overrides"]) for m, _ in todo])
+    res = runner.map(prepare_member, [(str(study.deck), m["overrides"]) for m, _ in todo])
     built = sum(not r["reused"] for r in res)
     log(f"{len(todo)} reduced model(s): {built} built, {len(todo) - built} reused")
     return {c: r["seconds"] for (_, c), r in zip(todo, res)}
@@ -397,7 +406,7 @@ def _run_members(study: Study, out: Path, runner: _Runner, quiet: bool) -> list:
         bar.update(1)
         poll()
 
-    jobs = [(str(study.path), m["overrides"], str(f), runner.client is not None)
+    jobs = [(str(study.deck), m["overrides"], str(f), runner.client is not None)
             for m, f in zip(study.members, folders)]
     try:
         return runner.map(run_member, jobs, on_done, poll)
@@ -411,7 +420,8 @@ def write_study_file(study: Study, out: Path, summaries: list) -> Path:
     import h5py
     path = out / "study.h5"
     with h5py.File(path, "w") as f:
-        f.attrs["deck"] = str(study.path)
+        f.attrs["deck"] = str(study.deck)
+        f.attrs["study"] = str(study.path)
         f.attrs["kind"] = study.kind
         f.attrs["combine"] = study.settings.combine
         f.attrs["parameters"] = json.dumps([[k, list(v)] for k, v in
@@ -449,7 +459,9 @@ def _report(study: Study, out: Path, summaries: list, log) -> dict:
             f"{'Hz' if unit == 'hz' else 'rad/s'}, {s['points']} points, "
             f"{s['seconds']:.1f} s{flag}")
     if study.kind == "family":
-        figs["family.png"] = study_plots.plot_family(study, frfs, summaries, unit=unit)
+        figs["family.png"] = study_plots.plot_family(study, frfs, summaries, unit=unit,
+                                                     linear=_linear(study),
+                                                     per_load=_load_key(study))
         figs["peaks.png"] = study_plots.plot_peaks(study, summaries, unit=unit)
     else:
         table = convergence_table(study, frfs, summaries)
@@ -468,6 +480,31 @@ def _report(study: Study, out: Path, summaries: list, log) -> dict:
     log(f"wrote {out / 'study.h5'}, " + ", ".join(str(p) for p in paths))
     res["figures"] = paths
     return res
+
+
+def _load_key(study: Study):
+    """The swept key that is the amplitude of a load (the family is then drawn per unit
+    load), or None."""
+    keys = [k for k, _ in study.settings.parameters
+            if re.fullmatch(r"excitation\.load\[\d+\]\.amplitude", k)]
+    return keys[0] if len(keys) == 1 else None
+
+
+def _linear(study: Study):
+    """The first member's linear free/stuck curves at the studied output (frirom.modes),
+    per unit load when the load amplitude is swept; None when they cannot be made."""
+    from .modes import linear_check
+    m = study.members[0]
+    try:
+        check = linear_check(load_member(study.deck, m["overrides"]))
+    except (InputError, ValueError, RuntimeError, ArithmeticError):
+        return None
+    curves = check.linear_curves(study.settings.output)
+    key = _load_key(study)
+    if key is not None:
+        scale = abs(float(m["values"][key])) or 1.0
+        curves = {k: (w, a / scale) for k, (w, a) in curves.items()}
+    return curves
 
 
 def curve_distance(a, b) -> float:

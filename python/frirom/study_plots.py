@@ -22,14 +22,17 @@ def _label(values: dict) -> str:
                      f"{_short(k)} = {v}" for k, v in values.items())
 
 
-def plot_family(study, frfs, summaries, *, unit: str = "hz", linear=None) -> Figure:
+def plot_family(study, frfs, summaries, *, unit: str = "hz", linear=None,
+                per_load: str | None = None) -> Figure:
     """Every member's FRF at the studied output on one axes (the paper's Fig. 6 style):
     max amplitude over a period against frequency, one colour per member (in run order),
     unstable stretches dashed, each member's peak marked.
 
     study : frirom.study.Study; frfs : list of FRF (per member); summaries : list of dict
     (per member, :func:`frirom.study.run_member`); unit : "hz" or "rad/s"; linear :
-    optional {"free": (omega (n,) rad/s, amp (n,)), "stuck": ...} drawn thin and grey.
+    optional {"free": (omega (n,) rad/s, amp (n,)), "stuck": ...} drawn thin and grey;
+    per_load : a swept key path (a load amplitude): each curve is divided by its value
+    (amplitude per unit load: the linear limits are then one curve each).
     """
     j = study.settings.output
     fig = Figure(figsize=(7.5, 4.8), dpi=130)
@@ -41,13 +44,14 @@ def plot_family(study, frfs, summaries, *, unit: str = "hz", linear=None) -> Fig
         if len(fr) == 0:
             continue
         f, xlabel = frequency_axis(fr.omega, unit)
-        a = fr.amp_max[:, j]
+        scale = abs(float(m["values"][per_load])) or 1.0 if per_load else 1.0
+        a = fr.amp_max[:, j] / scale
         st = np.asarray(fr.stable, bool)
         ax.plot(f, np.where(st, a, np.nan), color=col, lw=1.4, label=_label(m["values"]))
         if not st.all():
             ax.plot(f, np.where(st, np.nan, a), color=col, lw=1.0, ls="--")
         w, pa = s["peaks"][j]
-        ax.plot(frequency_axis(w, unit)[0], pa, "o", color=col, ms=4)
+        ax.plot(frequency_axis(w, unit)[0], pa / scale, "o", color=col, ms=4)
         if not s["complete"]:
             ax.plot(f[-1], a[-1], "x", color="r", ms=8, mew=2)
     if linear:
@@ -56,13 +60,22 @@ def plot_family(study, frfs, summaries, *, unit: str = "hz", linear=None) -> Fig
                 w, a = linear[name]
                 ax.plot(frequency_axis(w, unit)[0], a, color="0.5", lw=0.9, ls=ls,
                         label=f"linear, contacts {name}")
+    fs = np.concatenate([frequency_axis(fr.omega, unit)[0] for fr in frfs if len(fr)]
+                        or [np.zeros(0)])
+    if fs.size > 1:                   # the linear curves do not widen the axis
+        pad = 0.02 * np.ptp(fs)
+        ax.set_xlim(fs.min() - pad, fs.max() + pad)
     ax.set_xlabel(frequency_axis(1.0, unit)[1])
-    ax.set_ylabel("max amplitude over a period")
+    ax.set_ylabel("max amplitude over a period" + (" / load amplitude" if per_load else ""))
     names = study.raw.get("outputs", {}).get("dofs", [])
     out = names[j] if j < len(names) else f"output {j}"
     title = study.raw.get("title", study.path.stem)
     ax.set_title(f"{title}: {study.kind}, {out}", fontsize=10)
     pos = np.concatenate([fr.amp_max[:, j] for fr in frfs if len(fr)] or [np.ones(1)])
+    if per_load:
+        pos = np.concatenate([fr.amp_max[:, j] / (abs(float(m["values"][per_load])) or 1.0)
+                              for m, fr in zip(study.members, frfs) if len(fr)]
+                             or [np.ones(1)])
     pos = pos[pos > 0]
     if pos.size and pos.max() / pos.min() > 30:
         ax.set_yscale("log")

@@ -13,9 +13,10 @@ import copy
 import itertools
 import re
 from dataclasses import dataclass
+from pathlib import Path
 
 from .._errors import InputError
-from .fields import Context, number, string, unknown
+from .fields import Context, file, number, string, unknown
 
 KINDS = ("family", "convergence")
 _PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)$")
@@ -43,6 +44,9 @@ class StudySettings:
     tolerance : float
         Convergence: relative error on the peak (amplitude and frequency) a model must
         meet.
+    base : Path or None
+        ``study.base``: the deck the members vary (relative to this deck's folder); None:
+        this deck itself (its other tables).
     """
 
     kind: str
@@ -52,6 +56,7 @@ class StudySettings:
     workers: int | None = None
     output: int = 0
     tolerance: float = 0.01
+    base: Path | None = None
 
     def members(self) -> list:
         """One dict {key path: value} per member, in run order."""
@@ -124,17 +129,28 @@ def _path(parts) -> str:
     return s
 
 
-def parse_study(path, raw: dict) -> StudySettings | None:
+def parse_study(path, raw: dict, read=None) -> StudySettings | None:
     """The deck's ``[study]`` table checked (None without one); each key path must name a
-    field of the deck."""
+    field of the deck (of ``study.base`` when given: ``read(path)`` reads it, and the
+    base's TOML is then what the paths are checked on)."""
     if "study" not in raw:
         return None
-    ctx = Context(path)
+    ctx = Context(Path(path))
     st = raw["study"]
     if not isinstance(st, dict):
         raise ctx.error("study", "a table [study]", st)
     unknown(ctx, st, {"kind", "parameters", "combine", "scheduler", "workers", "output",
-                      "tolerance"}, "study")
+                      "tolerance", "base"}, "study")
+    base = None
+    if "base" in st:
+        base = file(ctx, st, "base", "study.base")
+        extra = sorted(set(raw) - {"study"})
+        if extra:
+            raise ctx.error("study.base", "a deck holding only [study] when it names a "
+                            f"base deck (this one also has {extra})", str(base))
+        raw = read(base)
+        if "study" in raw:
+            raise ctx.error("study.base", "a deck without its own [study]", str(base))
     kind = string(ctx, st, "kind", "study.kind", default="family", choices=KINDS)
     combine = string(ctx, st, "combine", "study.combine",
                      default="product" if kind == "family" else "zip",
@@ -166,7 +182,7 @@ def parse_study(path, raw: dict) -> StudySettings | None:
                         output)
     tol = number(ctx, st, "tolerance", "study.tolerance", default=0.01, positive=True)
     s = StudySettings(kind=kind, parameters=tuple(params), combine=combine, scheduler=sched,
-                      workers=workers, output=output, tolerance=float(tol))
+                      workers=workers, output=output, tolerance=float(tol), base=base)
     if kind == "convergence" and len(s.members()) < 2:
         raise ctx.error("study.parameters", "at least two rungs for a convergence study")
     return s
