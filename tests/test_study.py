@@ -310,3 +310,34 @@ def test_study_of_a_base_deck(tmp_path):
         load_study(bad, tmp_path / "out")
     bundled = load_study(ROOT / "cases" / "joint" / "joint_family.toml", tmp_path / "o")
     assert bundled.deck == ROOT / "cases" / "joint" / "joint.toml"
+
+
+@pytest.mark.slow
+def test_reduction_ladder_gets_one_cache_per_rung(tmp_path):
+    """A ladder over GSI counts on the lap joint (coarse mesh, H = 1, a narrow range): each
+    rung's reduced model is built once into its own cache file under OUT/rom (before the
+    members run), and a rung equals the deck edited by hand and run alone (1e-10)."""
+    if shutil.which("ccx") is None:
+        pytest.skip("ccx not installed")
+    pytest.importorskip("gmsh")
+    sys.path.insert(0, str(ROOT / "cases" / "lap_joint"))
+    import make_lap_joint
+    from test_lap_joint_case import small
+    make_lap_joint.make(tmp_path, size=0.012)
+    (tmp_path / "lap.toml").write_text(small(16).replace("825.0", "835.0")
+                                       .replace("880.0", "860.0"))
+    (tmp_path / "ladder.toml").write_text(
+        '[study]\nbase = "lap.toml"\nkind = "convergence"\nscheduler = "serial"\n'
+        '[study.parameters]\n"reduction.interface_modes.free" = [4, 8]\n'
+        '"reduction.interface_modes.stick" = [4, 8]\n')
+    res = run_study(tmp_path / "ladder.toml", tmp_path / "out", quiet=True,
+                    log=lambda s: None)
+    roms = sorted((tmp_path / "out" / "rom").glob("*.rom.h5"))
+    assert len(roms) == 2 and all(s["rom_seconds"] > 0 for s in res["summaries"])
+    assert [s["n_nl"] for s in res["summaries"]] == [8, 16]
+    assert main(["run", str(tmp_path / "lap.toml"), "--out", str(tmp_path / "alone"),
+                 "--quiet"]) == 0
+    ref = FRF.load(tmp_path / "alone" / "frf.h5")
+    got = member_arrays(res["file"], "m001")
+    assert got["omega"].shape == ref.omega.shape
+    assert np.allclose(got["amp_max"], ref.amp_max, rtol=1e-10, atol=0)

@@ -180,7 +180,9 @@ def run_member(deck_path, overrides: dict, folder, progress: bool = True) -> dic
         full = FRF.load(h5)
     n_nl = len(model.nonlinear_dofs())
     H = deck.harmonics
-    nnz = sum(getattr(A, "nnz", 0) for A in (deck.M, deck.K))
+    # bytes of M and K: 12 per stored entry of a sparse matrix, 8 per entry of a dense one
+    model_bytes = sum(12.0 * A.nnz if hasattr(A, "nnz") else 8.0 * np.size(A)
+                      for A in (deck.M, deck.K))
     summary = {
         "points": len(full), "seconds": seconds, "complete": bool(result.complete),
         "message": result.message, "resumed": start is not None,
@@ -189,7 +191,7 @@ def run_member(deck_path, overrides: dict, folder, progress: bool = True) -> dic
         "fold": bool(np.any(full.fold)), "n_dof": int(deck.n_dof), "n_nl": int(n_nl),
         "harmonics": int(H), "unknowns": int(n_nl * (2 * H + 1)),
         "rom_seconds": float(getattr(deck.reduced, "build_seconds", 0.0) or 0.0),
-        "memory_mb": (12.0 * nnz + 8.0 * (n_nl * (2 * H + 1)) ** 2) / 2 ** 20,
+        "memory_mb": (model_bytes + 8.0 * (n_nl * (2 * H + 1)) ** 2) / 2 ** 20,
         "rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
         "values": {k: v for k, v in overrides.items() if k != "reduction.cache"},
     }
@@ -381,6 +383,9 @@ def _prepare(study: Study, out: Path, runner: _Runner, log) -> dict:
             todo.append((m, cache))
     if not todo:
         return {}
+    for _, cache in todo:
+        if cache is not None:
+            Path(cache).parent.mkdir(parents=True, exist_ok=True)
     res = runner.map(prepare_member, [(str(study.deck), m["overrides"]) for m, _ in todo])
     built = sum(not r["reused"] for r in res)
     log(f"{len(todo)} reduced model(s): {built} built, {len(todo) - built} reused")
