@@ -4,6 +4,8 @@ Each function builds a Figure and returns it; :func:`frirom.study.run_study` sav
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 from matplotlib import colormaps
 from matplotlib.figure import Figure
@@ -149,7 +151,7 @@ def plot_pareto(table, tol: float, choice=None) -> Figure:
     for r, xi, yi in zip(rows, x, y):
         txt = ", ".join(f"{_short(k).split('.')[-1]}={v}" for k, v in r["values"].items())
         if r["notes"]:
-            txt += "\n" + "; ".join(r["notes"])[:60]
+            txt += "\n" + "\n".join(textwrap.wrap("; ".join(r["notes"]), 50)[:3])
         ax.annotate(txt, (xi, yi), textcoords="offset points", xytext=(5, 4), fontsize=7,
                     color="r" if r["notes"] else "0.2")
     ax.axhline(tol, color="g", ls="--", lw=1, label=f"tolerance {tol:g}")
