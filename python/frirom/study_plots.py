@@ -168,6 +168,7 @@ def plot_pareto(table, tol: float, choice=None) -> Figure:
                   "curve distance: the largest)", fontsize=9)
     rc = max(ref["cost_s"], 1e-3)
     ax.set_xlim(min(x.min(), rc) / 1.5, max(x.max(), rc) * 3.0)
+    ax.set_ylim(top=max(y.max(), tol) * 8.0)      # room for the notes above the points
     ax.set_title("Speed against accuracy", fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, loc="best")
