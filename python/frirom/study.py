@@ -131,7 +131,8 @@ def run_member(deck_path, overrides: dict, folder, progress: bool = True) -> dic
     Returns
     -------
     dict
-        ``points``, ``seconds`` (FRF wall time of this call), ``complete``, ``message``,
+        ``points``, ``seconds`` (FRF wall time of this call), ``cpu_seconds`` (its CPU
+        time: over ``seconds``, the share of a core it had), ``complete``, ``message``,
         ``peaks`` [(omega rad/s, amplitude)] per output, ``n_dof``, ``n_nl`` (contact
         coordinates), ``harmonics``, ``unknowns`` (n_nl (2H+1), the nonlinear system's
         size), ``rom_seconds``, ``memory_mb`` (estimate: model matrices + the dense
@@ -164,14 +165,14 @@ def run_member(deck_path, overrides: dict, folder, progress: bool = True) -> dic
         writer.append(point)
         counter.add()
 
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     try:
         result = frf(model, excitation, deck.omega_start, deck.omega_end, options,
                      outputs=deck.outputs, sink=sink, start=start)
     except BaseException as exc:
         writer.close(complete=False, message=f"{type(exc).__name__}: {exc}")
         raise
-    seconds = time.perf_counter() - t0
+    seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     writer.close(complete=result.complete, message=result.message)
     counter.flush()
     full = FRF.load(h5)
@@ -184,7 +185,8 @@ def run_member(deck_path, overrides: dict, folder, progress: bool = True) -> dic
     model_bytes = sum(12.0 * A.nnz if hasattr(A, "nnz") else 8.0 * np.size(A)
                       for A in (deck.M, deck.K))
     summary = {
-        "points": len(full), "seconds": seconds, "complete": bool(result.complete),
+        "points": len(full), "seconds": seconds, "cpu_seconds": cpu,
+        "complete": bool(result.complete),
         "message": result.message, "resumed": start is not None,
         "peaks": [[full.peak(j).omega, full.peak(j).amplitude] if len(full) else
                   [float("nan")] * 2 for j in range(len(deck.outputs))],
