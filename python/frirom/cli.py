@@ -7,6 +7,8 @@
     frirom show OUT --at 470Hz | --point K | --peak
                                               one point of a run: time histories,
                                               hysteresis loops, energy, interface maps
+    frirom study DECK [--out DIR]             a family or convergence study ([study])
+    frirom modes DECK [--out DIR]             natural frequencies, linear FRFs free/stuck
 
 Exit codes of `frirom run` on several decks: 0 every run reached the end of its frequency
 range; 2 a deck is wrong (the message names the field); 3 a run stopped before the end of
@@ -104,6 +106,71 @@ def cmd_show(args) -> int:
     return run(args)
 
 
+def _add_study(sub) -> None:
+    p = sub.add_parser(
+        "study", help="run the [study] of a deck: a family of FRFs or a model-size ladder",
+        description="Run every member of the deck's [study] table (docs/deck.md) as a Dask "
+        "task, into OUT/members/<name>/; finished members are kept, so running again "
+        "continues an interrupted study. Writes OUT/study.h5 and the plots.")
+    p.add_argument("deck", type=Path, help="a TOML deck with a [study] table")
+    p.add_argument("--out", type=Path, default=None,
+                   help="output folder (default: results/<deck name>)")
+    p.add_argument("--scheduler", default=None,
+                   help='"local" (a LocalCluster, the default), "serial", or a Dask '
+                   "scheduler address (tcp://host:8786); overrides study.scheduler")
+    p.add_argument("--workers", type=int, default=None,
+                   help="LocalCluster workers (default: study.workers, or one per core)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_study)
+
+
+def _study(args) -> int:
+    from .study import run_study
+    res = run_study(args.deck, args.out, scheduler=args.scheduler, workers=args.workers,
+                    quiet=args.quiet, log=lambda s: print(f"frirom: {s}"))
+    return 0 if all(s["complete"] for s in res["summaries"]) else 1
+
+
+def _add_modes(sub) -> None:
+    p = sub.add_parser(
+        "modes", help="linear pre-check: natural frequencies and linear FRFs with the "
+        "contacts free and stuck, a suggested frequency range",
+        description="Natural frequencies of the deck's structure with the contacts free "
+        "and fully stuck (the contact stiffnesses added) in and around [frequency], the "
+        "linear free and stuck FRFs at the outputs (OUT/linear.png) and a suggested "
+        "frequency range. Nothing nonlinear is solved.")
+    p.add_argument("deck", type=Path, help="the TOML deck (see docs/deck.md)")
+    p.add_argument("--out", type=Path, default=None,
+                   help="output folder (default: results/<deck name>)")
+    p.set_defaults(func=_modes)
+
+
+def _modes(args) -> int:
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from .deck import load_deck
+    from .modes import linear_check
+    from .plots import plot_frf
+    deck = load_deck(args.deck)
+    for line in deck.log:
+        print(f"frirom: {line}")
+    check = linear_check(deck)
+    for line in check.lines(deck):
+        print(f"frirom: {line}")
+    out = args.out if args.out is not None else Path("results") / deck.path.stem
+    out.mkdir(parents=True, exist_ok=True)
+    n = check.omega.size
+    empty = SimpleNamespace(omega=check.omega[:0], amp_max=np.zeros((0, len(deck.outputs))))
+    fig = plot_frf(empty, output_names=deck.output_names, unit=deck.frequency_unit,
+                   title=f"{deck.title}: linear, contacts free and stuck", log=True,
+                   linear=check.linear_curves())
+    fig.savefig(out / "linear.png")
+    print(f"frirom: wrote {out / 'linear.png'} ({n} frequencies)")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="frirom", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -114,6 +181,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_run(sub)
     _add_demo(sub)
     _add_show(sub)
+    _add_study(sub)
+    _add_modes(sub)
     return parser
 
 
@@ -157,6 +226,7 @@ def cmd_run(args) -> int:
     deck = load_deck(args.deck)
     for line in deck.log:
         print(f"frirom: {line}")
+    linear = _linear_lines(deck)
     out = args.out if args.out is not None else Path("results") / deck.path.stem
     out.mkdir(parents=True, exist_ok=True)
     h5 = out / "frf.h5"
@@ -216,7 +286,8 @@ def cmd_run(args) -> int:
     written = [h5] + ([out / "frf.csv"] if deck.csv else [])
     if deck.plot and len(full) > 0:
         figures = {"frf.png": plot_frf(full, output_names=deck.output_names,
-                                       unit=deck.frequency_unit, title=deck.title)}
+                                       unit=deck.frequency_unit, title=deck.title,
+                                       linear=linear)}
         if deck.contacts:
             figures["states.png"] = plot_states(full, contact_names=names,
                                                 unit=deck.frequency_unit,
@@ -304,6 +375,21 @@ def cmd_run_decks(args) -> int:
     bad = [c for c in codes if c != 0]
     print(f"frirom: {codes.count(0)} of {len(decks)} runs complete")
     return bad[0] if bad else 0
+
+
+def _linear_lines(deck):
+    """Print the linear pre-check (frirom.modes); its free/stuck curves for the FRF plot
+    (None if it could not be made: the run goes on)."""
+    from .modes import linear_check
+    try:
+        check = linear_check(deck)
+    except (FriromError, ValueError, RuntimeError, ArithmeticError) as exc:
+        # a failed pre-check (a singular free structure, an eigen-solve) never stops a run
+        print(f"frirom: linear pre-check skipped ({type(exc).__name__}: {exc})")
+        return None
+    for line in check.lines(deck):
+        print(f"frirom: {line}")
+    return check.linear_curves()
 
 
 def _print_peaks(result, deck) -> None:

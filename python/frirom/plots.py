@@ -71,7 +71,7 @@ def fold_marks(f, amp, fold, max_marks: int = 4, share: float = 0.005) -> np.nda
 
 def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = None,
              amplitude_unit: str = "m", log: bool | None = None, ax=None,
-             phase: bool = False) -> Figure:
+             phase: bool = False, linear: dict | None = None) -> Figure:
     """Max amplitude over a period against frequency, one curve per output.
 
     The curve is drawn in the order of the continuation, so it stays a line against
@@ -102,6 +102,10 @@ def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = No
         Add a panel below with the phase of the first harmonic of each relevant output
         (x_1 = A cos(omega t + phase), deg in (-270, 90]; needs ``frf.X``); not with
         `ax`.
+    linear : dict, optional
+        Reference curves {"free": (omega (n,) rad/s, amp (n, n_out)), "stuck": ...}: the
+        linear responses with the contacts free (dotted) and stuck (dash-dot), thin, in
+        each output's colour (:meth:`frirom.modes.LinearCheck.linear_curves`).
 
     Returns
     -------
@@ -142,13 +146,25 @@ def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = No
         if marks.size:
             ax.plot(f[marks], amp[marks, top], "o", mfc="none", mec="k", ms=6, mew=1.0,
                     zorder=5, label="fold")
+    for kind, ls in (("free", ":"), ("stuck", "-.")):
+        if linear and kind in linear:
+            wl, al = linear[kind]
+            al = np.asarray(al, float).reshape(len(wl), -1)
+            for j in range(al.shape[1]):
+                ax.plot(frequency_axis(wl, unit)[0], al[:, j], color=colors[j % len(colors)],
+                        lw=0.8, ls=ls, alpha=0.7,
+                        label=f"linear, contacts {kind}" if j == 0 else None)
+            if f.size > 1:              # the reference curves do not widen the axis
+                pad = 0.02 * (f.max() - f.min())
+                ax.set_xlim(f.min() - pad, f.max() + pad)
     pos = amp[:, rel][amp[:, rel] > 0]
     if log is None:
         log = pos.size > 0 and pos.max() / pos.min() > 30.0
+    if log:
+        ax.set_yscale("log")
     if pos.size:
         hi = pos.max()
         if log:
-            ax.set_yscale("log")
             # the bottom: where the relevant outputs spend all but 5 % of the curve (a
             # direction that passes through zero at a few points dips below it), four
             # decades below the largest amplitude at most

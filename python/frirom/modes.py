@@ -1,0 +1,231 @@
+"""Linear pre-check of a deck: natural frequencies and linear FRFs with the contacts free
+and fully stuck, and a frequency range to sweep (``frirom modes DECK``).
+
+A friction contact moves between two linear limits: free (no contact force: every element
+slides at zero friction or is open) and fully stuck (every element a linear spring, its
+stick stiffnesses kt, kn of the law, k1 of the cubic law). The nonlinear resonance lies
+between the two, so their natural frequencies bracket it and their FRFs are reference
+curves for every nonlinear one. Stuck: K_s = K + sum over groups G^T diag(k) G.
+
+With ``[reduction.cyclic]`` the frequencies are per harmonic index (nodal diameter) k_h of
+the harmonics 0..H; the stuck ones need contacts inside the sector (a contact with the
+next sector is left out with a note), and the linear FRFs are the modal sums of harmonic
+1's index.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from .contact import LAWS
+from .results import amplitude_max
+
+__all__ = ["LinearCheck", "linear_check", "linear_response", "stuck_stiffness"]
+
+#: per law, the parameter giving the stuck stiffness of each local direction
+_STICK = {"jenkins": ("kt",), "normal1d": ("kt", "kn"), "normal2d": ("kt", "kt", "kn"),
+          "cubic": ("k1",)}
+
+
+@dataclass
+class LinearCheck:
+    """Free and stuck linear limits of a deck.
+
+    free, stuck : ndarray
+        Natural frequencies [rad/s] near the range (all of them up to ``n_show``), lowest
+        first (cyclic: those of harmonic 1's index).
+    omega : ndarray, (n_grid,)
+        Frequencies of the linear FRFs [rad/s].
+    amp_free, amp_stuck : ndarray, (n_grid, n_out)
+        Max over a period of the linear response at the outputs (loads of harmonics >= 1).
+    suggested : (float, float)
+        A range [rad/s] holding the free and stuck resonances of the strongest response.
+    per_index : dict
+        Cyclic: {k: (free, stuck or None)} frequencies per harmonic index.
+    notes : list of str
+    """
+
+    free: np.ndarray
+    stuck: np.ndarray
+    omega: np.ndarray
+    amp_free: np.ndarray
+    amp_stuck: np.ndarray
+    suggested: tuple
+    per_index: dict = field(default_factory=dict)
+    notes: list = field(default_factory=list)
+
+    def linear_curves(self, output: int | None = None) -> dict:
+        """{"free": (omega, amp), "stuck": (omega, amp)}: the ``linear=`` argument of
+        :func:`frirom.plots.plot_frf` (amp (n_grid, n_out), or one output's column)."""
+        sl = slice(None) if output is None else output
+        return {"free": (self.omega, self.amp_free[:, sl]),
+                "stuck": (self.omega, self.amp_stuck[:, sl])}
+
+    def lines(self, deck) -> list:
+        """What ``frirom modes`` and the first lines of ``frirom run`` print."""
+        from .plots import frequency_axis
+        unit = "Hz" if deck.frequency_unit == "hz" else "rad/s"
+
+        def fmt(w):
+            return ", ".join(f"{v:.5g}" for v in frequency_axis(w, deck.frequency_unit)[0])
+        a, b = frequency_axis(np.array([deck.omega_start, deck.omega_end]),
+                              deck.frequency_unit)[0]
+        out = [f"natural frequencies near {min(a, b):.5g}-{max(a, b):.5g} {unit}, "
+               f"contacts free: {fmt(self.free)}",
+               f"natural frequencies, contacts stuck: {fmt(self.stuck) or '-'}"]
+        for k, (fr, st) in sorted(self.per_index.items()):
+            out.append(f"  nodal diameter {k}: free {fmt(fr)}; stuck "
+                       + (fmt(st) if st is not None else "not computed"))
+        s0, s1 = frequency_axis(np.array(self.suggested), deck.frequency_unit)[0]
+        out.append(f"suggested range: {s0:.5g}-{s1:.5g} {unit} (the free and stuck "
+                   "resonances of the largest linear response)")
+        out.extend(self.notes)
+        return out
+
+
+def stuck_stiffness(contacts, n_dof: int) -> sp.csr_matrix:
+    """sum over groups of G^T diag(k) G: the contacts' springs when every element sticks.
+
+    contacts : list of objects with ``law``, ``G`` (n_elem*n_dir, n_dof) and ``params``
+    (n_elem, n_par) (:class:`frirom.deck.ContactSpec` or ContactGroup) [N/m].
+    """
+    Ks = sp.csr_matrix((n_dof, n_dof))
+    for c in contacts:
+        law = LAWS[c.law]
+        names = law.parameters
+        cols = [names.index(p) for p in _STICK[c.law]]
+        k = np.asarray(c.params, float)[:, cols].ravel()            # (n_elem*n_dir,)
+        G = sp.csr_matrix(c.G)
+        Ks = Ks + (G.T @ sp.diags(k) @ G)
+    return Ks.tocsr()
+
+
+def _frequencies(K, M, around: tuple, n_show: int) -> np.ndarray:
+    """Natural frequencies [rad/s]: those in ``around`` and ``n_show`` each side."""
+    n = K.shape[0]
+    if n <= 1500:
+        lam = sla.eigh(K.toarray(), M.toarray(), eigvals_only=True)
+    else:
+        import scipy.sparse.linalg as spla
+        sigma = (0.5 * sum(around)) ** 2
+        lam = spla.eigsh(K.tocsc(), k=min(3 * n_show + 10, n - 2), M=M.tocsc(),
+                         sigma=sigma, return_eigenvectors=False)
+    w = np.sqrt(np.clip(np.sort(lam.real), 0.0, None))
+    lo, hi = np.searchsorted(w, around[0]), np.searchsorted(w, around[1])
+    return w[max(lo - n_show, 0):hi + n_show]
+
+
+def _response(K, M, C, F, outputs, omega) -> np.ndarray:
+    """Max over a period at the outputs of the linear response to the loads of harmonics
+    >= 1 of F (n, H+1): (n_grid, n_out)."""
+    H = F.shape[1] - 1
+    out = np.zeros((omega.size, len(outputs)))
+    X = np.zeros((len(outputs), 2 * H + 1))
+    import scipy.sparse.linalg as spla
+    for i, w in enumerate(omega):
+        X[:] = 0.0
+        for h in range(1, H + 1):
+            if not np.any(F[:, h]):
+                continue
+            D = (K - (h * w) ** 2 * M + 1j * h * w * C).tocsc()
+            x = spla.spsolve(D, F[:, h])[outputs]
+            X[:, 2 * h - 1], X[:, 2 * h] = x.real, -x.imag
+        out[i] = amplitude_max(X)
+    return out
+
+
+def linear_response(deck, omega, stuck: bool) -> np.ndarray:
+    """Max over a period at the deck's outputs of the linear response, contacts free or
+    stuck, at the frequencies ``omega`` (n,) rad/s: (n, n_out) (non-cyclic decks)."""
+    M, K = sp.csr_matrix(deck.M), sp.csr_matrix(deck.K)
+    C = deck.damping_object().assemble(M, K)
+    if stuck:
+        K = K + stuck_stiffness(deck.contacts, deck.n_dof)
+    return _response(K, M, C, deck.F, deck.outputs, np.atleast_1d(omega))
+
+
+def linear_check(deck, n_grid: int | None = None, n_show: int = 2) -> LinearCheck:
+    """The free and stuck limits of a built deck (:class:`frirom.deck.Deck`).
+
+    n_grid: frequencies of the linear FRFs over the range widened by 25 % each side
+    (default 400, 100 above 2000 coordinates: one sparse factorisation each);
+    n_show: natural frequencies shown each side of the range.
+    """
+    if n_grid is None:
+        n_grid = 400 if deck.n_dof <= 2000 else 100
+    w0, w1 = sorted((deck.omega_start, deck.omega_end))
+    span = w1 - w0
+    lo, hi = max(w0 - 0.25 * span, 1e-6 * w1), w1 + 0.25 * span
+    omega = np.linspace(lo, hi, n_grid)
+    M, K = sp.csr_matrix(deck.M), sp.csr_matrix(deck.K)
+    Ks = K + stuck_stiffness(deck.contacts, deck.n_dof)
+    notes, per = [], {}
+    if deck.cyclic is None:
+        free, stuck = _frequencies(K, M, (w0, w1), n_show), _frequencies(Ks, M, (w0, w1),
+                                                                          n_show)
+        C = deck.damping_object().assemble(M, K)
+        amp_f = _response(K, M, C, deck.F, deck.outputs, omega)
+        amp_s = _response(Ks, M, C, deck.F, deck.outputs, omega)
+    else:
+        free, stuck, amp_f, amp_s = _cyclic(deck, Ks, (w0, w1), n_show, omega, per, notes)
+    # the resonances of the largest linear response, free and stuck, with a margin
+    peaks = []
+    for amp in (amp_f, amp_s):
+        if amp is not None and amp.size:
+            peaks.append(omega[int(np.argmax(amp.max(axis=1)))])
+    a, b = (min(peaks), max(peaks)) if peaks else (w0, w1)
+    margin = max(0.1 * (b - a), 0.03 * b)
+    return LinearCheck(free=free, stuck=stuck, omega=omega,
+                       amp_free=amp_f if amp_f is not None else np.zeros((0, 0)),
+                       amp_stuck=amp_s if amp_s is not None else np.zeros((0, 0)),
+                       suggested=(a - margin, b + margin), per_index=per, notes=notes)
+
+
+def _cyclic(deck, Ks, around, n_show, omega, per, notes):
+    """Cyclic decks: frequencies per harmonic index, FRFs as modal sums of harmonic 1."""
+    from .reduction.cyclic import sector_modes
+    c = deck.cyclic
+    model = deck.model()
+    across = [s.name for s in (deck.settings.contacts if deck.settings else ())
+              if getattr(s, "b_sector", 0)]
+    if across:
+        notes.append(f"stuck frequencies not computed: contact(s) {', '.join(across)} "
+                     "join the next sector")
+    k1 = model.harmonic_index(1)
+    stuck_modes = {}
+    for k, m in sorted(c["modes"].items()):
+        st = None
+        if not across:
+            sm = sector_modes(c["sector"], Ks, sp.csr_matrix(deck.M), k, None,
+                              min(max(m.omega.size, 1), deck.n_dof))
+            stuck_modes[k] = sm
+            st = _window(sm.omega, around, n_show)
+        per[k] = (_window(m.omega, around, n_show), st)
+    free, stuck = per.get(k1, (np.zeros(0), None))
+    F1 = deck.F[:, 1]
+
+    def modal(modes, zeta):
+        if modes is None:
+            return None
+        psi = modes.psi
+        q = psi.conj().T @ F1
+        den = modes.omega[None, :] ** 2 - omega[:, None] ** 2 \
+            + 2j * zeta[None, :] * modes.omega[None, :] * omega[:, None]
+        x = (q[None, :] / den) @ psi[deck.outputs, :].T                   # (n_grid, n_out)
+        return np.abs(x)
+    m1 = model.modes_of(k1)
+    amp_f = modal(m1, m1.zeta)
+    s1 = stuck_modes.get(k1)
+    amp_s = modal(s1, np.interp(s1.omega, m1.omega, m1.zeta) if s1 is not None else None)
+    return free, (stuck if stuck is not None else np.zeros(0)), amp_f, \
+        (amp_s if amp_s is not None else np.zeros_like(amp_f))
+
+
+def _window(w, around, n_show):
+    w = np.sort(np.asarray(w, float))
+    lo, hi = np.searchsorted(w, around[0]), np.searchsorted(w, around[1])
+    return w[max(lo - n_show, 0):hi + n_show]
