@@ -50,7 +50,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from ccx import matrix_storage_steps, nset, run_ccx, solid_material  # noqa: E402
 
 PAPER_STEEL = dict(E=2.1e11, nu=0.33, rho=7800.0)   # Pa, -, kg/m^3 (paper 3.3.1)
-CACHE_VERSION = 2
+CACHE_VERSION = 3
 
 
 @dataclass(frozen=True)
@@ -88,7 +88,7 @@ class FlangeSpec:
 
     def key(self) -> str:
         d = asdict(self)
-        d["ms_indices"] = list(d["ms_indices"])
+        d.pop("ms_indices")           # ROM_II is built from the cache (rom2): not keyed
         text = json.dumps([CACHE_VERSION, d], sort_keys=True)
         return hashlib.sha1(text.encode()).hexdigest()[:12]
 
@@ -224,28 +224,23 @@ def _positions(cb, nodes) -> np.ndarray:
 
 
 def _reduce_stage(job, spec: FlangeSpec, stage: int):
-    """Read ccx's matrices of one stage and reduce them (CB, then MS of the interface)."""
+    """Read ccx's matrices of one stage and reduce them by Craig-Bampton (ROM_I part)."""
     from frirom.io import read_calculix
     from frirom.reduction.cb import craig_bampton
-    from frirom.reduction.interface import reduce_interface
-    from frirom.reduction.multistage import ms_basis
 
     fe = read_calculix(job)
     cb = craig_bampton(fe, spec.n_modes, interface="CONTACT", active="ACTIVE")
     _, _, _, sets = stage_mesh(stage, spec.sectors, spec.z_per_sector, spec.coarse)
     contact, active = sets["CONTACT"], sets["ACTIVE"]
-    pc = _positions(cb, contact)
-    ms = ms_basis(fe.coordinates(contact), pc, spec.sectors, spec.ms_indices)
-    red = reduce_interface(cb.K, cb.M, ms.interface, ms.basis)
-    return dict(fe_dofs=fe.n_dof, K=cb.K, M=cb.M, contact_pos=pc,
-                active_pos=_positions(cb, active),
+    xyz = fe.coordinates(contact)
+    return dict(fe_dofs=fe.n_dof, K=cb.K, M=cb.M, contact_pos=_positions(cb, contact),
+                active_pos=_positions(cb, active), contact_xyz=xyz,
                 bolt_rows=np.nonzero(np.isin(contact, sets["BOLT"]))[0],
-                theta=np.arctan2(fe.coordinates(contact)[:, 1], fe.coordinates(contact)[:, 0]),
-                R=red.R, K2=red.K, M2=red.M, cutoff=cb.cutoff_frequency)
+                theta=np.arctan2(xyz[:, 1], xyz[:, 0]), cutoff=cb.cutoff_frequency)
 
 
 def _assemble(st1, st2, spec: FlangeSpec):
-    """ROM_I and ROM_II matrices, contact map, bolts and loads from the two stages."""
+    """ROM_I matrices, contact map, bolts and loads from the two stages' CB models."""
     n1, n2 = st1["K"].shape[0], st2["K"].shape[0]
     n = n1 + n2
     K = np.zeros((n, n))
@@ -293,20 +288,32 @@ def _assemble(st1, st2, spec: FlangeSpec):
         F[act[:, 1], 1] += amp * np.cos(thb) * ph
         F[act[:, 2], 1] += amp * ph
         outputs.append(act[:, 2])
-    outputs = np.concatenate(outputs)
-    # ROM_II: block-diagonal R of the two stages' MS reductions (each is x_cb = R x_r)
-    R = sp.block_diag([st1["R"], st2["R"]]).tocsr()
-    K2 = np.asarray((R.T @ sp.csr_matrix(K) @ R).todense())
-    M2 = np.zeros_like(K2)
-    m1 = st1["M2"].shape[0]
-    M2[:m1, :m1], M2[m1:, m1:] = st1["M2"], st2["M2"]
-    K2 = 0.5 * (K2 + K2.T)
-    G2 = sp.csr_matrix(G @ R)
-    F2 = R.T @ F
-    # outputs of ROM_II: kept CB DoFs are the identity columns of R
-    out2 = np.array([R[o].indices[0] for o in outputs])
-    return dict(K=K, M=M, G=G, F=F, outputs=outputs, K2=K2, M2=M2, G2=G2, F2=F2,
-                outputs2=out2, contact_a=pa, contact_b=pb)
+    return dict(K=K, M=M, G=G, F=F, outputs=np.concatenate(outputs), contact_a=pa,
+                contact_b=pb, n1=n1, xyz1=st1["contact_xyz"], xyz2=st2["contact_xyz"])
+
+
+def rom2(roms: dict, indices) -> dict:
+    """ROM_II of the cached ROM_I for the harmonic ``indices`` (0..NZ/2, NZ = pairs):
+    one ``ms_basis`` per stage (each face's own radial line segments; one call over both
+    faces would put the two coincident nodes of a segment in arbitrary order).
+
+    Returns K2, M2 (n_II, n_II), G2 (CSR), F2 (n_II, 2), outputs2, R (n_I, n_II CSR:
+    x_I = R x_II), ms (the two MultistageInterface objects), indices.
+    """
+    from frirom.reduction.interface import reduce_interface
+    from frirom.reduction.multistage import ms_basis
+
+    n = int(roms["spec"]["sectors"])
+    m1 = ms_basis(roms["xyz1"], roms["contact_a"], n, indices)
+    m2 = ms_basis(roms["xyz2"], roms["contact_b"], n, indices)
+    from scipy.linalg import block_diag
+    red = reduce_interface(roms["K"], roms["M"], np.concatenate([m1.interface, m2.interface]),
+                           block_diag(m1.basis, m2.basis))
+    R = red.R.tocsr()
+    out2 = np.array([R[o].indices[0] for o in roms["outputs"]])
+    return dict(K2=np.asarray(red.K), M2=np.asarray(red.M), G2=sp.csr_matrix(roms["G"] @ R),
+                F2=np.asarray(R.T @ roms["F"]), outputs2=out2, R=R, ms=(m1, m2),
+                indices=tuple(int(h) for h in np.atleast_1d(indices)))
 
 
 def _stuck_eo_frequency(K, M, G, spec: FlangeSpec, F) -> tuple[float, float]:
@@ -330,16 +337,34 @@ def flange_roms(spec: FlangeSpec | None = None, work=None, log=print) -> dict:
     params (pairs, 4) kt kn mu n0; F (n_I, 2) complex loads (harmonics 0, 1); outputs (axial
     DoFs of the active nodes); contact_a, contact_b (pairs, 3) ROM_I positions of the x, y,
     z DoFs of each pair's stage-1 and stage-2 node; K2, M2, G2, F2, outputs2: ROM_II;
-    beta: Rayleigh stiffness coefficient [s]; f_stuck, f_free: EO resonance [Hz] of the linear stuck / free
-    ROM_I; sizes (dict); t_ccx, t_reduce: generation times [s]; spec (dict); cache (path);
-    generated (False when read from the cache).
+    beta: Rayleigh stiffness coefficient [s]; f_stuck, f_free: EO resonance [Hz] of the
+    linear stuck / free ROM_I; sizes (dict); t_ccx, t_reduce: generation times [s] (ccx,
+    CB + assembly); t_ms: the MS reduction of this call [s]; spec (dict); cache (path);
+    generated (False when read from the cache). The npz holds ROM_I only (with xyz1, xyz2
+    the stages' contact node coordinates and n1 stage 1's size); ROM_II (K2 ... outputs2,
+    R, ms) is built by :func:`rom2` for ``spec.ms_indices`` on every call (milliseconds).
     """
     spec = spec or FlangeSpec()
     work = Path(work or "/tmp/frirom_flange")
     work.mkdir(parents=True, exist_ok=True)
     cache = work / f"flange_{spec.pairs}p_{spec.key()}.npz"
-    if cache.exists():
-        return _load(cache)
+    generated = not cache.exists()
+    if generated:
+        _generate(spec, work, cache, log)
+    out = _load(cache)
+    out["generated"] = generated
+    out["spec"]["ms_indices"] = tuple(int(h) for h in np.atleast_1d(spec.ms_indices))
+    t0 = time.perf_counter()
+    out.update(rom2(out, spec.ms_indices))
+    out["t_ms"] = time.perf_counter() - t0
+    s = out["sizes"]
+    s["rom2"] = out["K2"].shape[0]
+    s["ms_interface"] = s["rom2"] - s["active"] - s["modes"]
+    return out
+
+
+def _generate(spec: FlangeSpec, work: Path, cache: Path, log) -> None:
+    """Decks, ccx, CB of both stages, ROM_I assembly: saved to ``cache``."""
     jobdir = work / f"flange_{spec.key()}"
     t0 = time.perf_counter()
     jobs = []
@@ -354,28 +379,24 @@ def flange_roms(spec: FlangeSpec | None = None, work=None, log=print) -> dict:
     a = _assemble(st[0], st[1], spec)
     f_stuck, f_free = _stuck_eo_frequency(a["K"], a["M"], a["G"], spec, a["F"])
     t_reduce = time.perf_counter() - t0
-    log(f"flange: CB + MS + assembly in {t_reduce:.1f} s; EO {spec.eo} resonance "
+    log(f"flange: CB + assembly in {t_reduce:.1f} s; EO {spec.eo} resonance "
         f"{f_stuck:.1f} Hz stuck, {f_free:.1f} Hz free")
     beta = 2 * spec.zeta / (2 * np.pi * f_stuck)
     sizes = dict(fe_dofs=[s["fe_dofs"] for s in st], rom1=a["K"].shape[0],
-                 rom2=a["K2"].shape[0], interface=2 * 3 * spec.pairs,
+                 interface=2 * 3 * spec.pairs,
                  active=sum(s["active_pos"].size for s in st),
                  modes=2 * spec.n_modes, pairs=spec.pairs,
-                 contact_rows=a["G"].shape[0], ms_interface=a["K2"].shape[0] - sum(
-                     s["active_pos"].size for s in st) - 2 * spec.n_modes,
-                 cutoff_hz=[s["cutoff"] for s in st])
+                 contact_rows=a["G"].shape[0], cutoff_hz=[s["cutoff"] for s in st])
     params = np.tile([spec.kt, spec.kn, spec.mu, spec.n0], (spec.pairs, 1))
-    G, G2 = a["G"], a["G2"]
+    G = a["G"]
+    d = asdict(spec)
+    d["ms_indices"] = list(d["ms_indices"])
     np.savez(cache, K=a["K"], M=a["M"], G_data=G.data, G_indices=G.indices,
-             G_indptr=G.indptr, G_shape=G.shape, G2=G2.toarray(), params=params, F=a["F"],
-             outputs=a["outputs"], K2=a["K2"], M2=a["M2"], F2=a["F2"],
-             outputs2=a["outputs2"], contact_a=a["contact_a"],
-             contact_b=a["contact_b"], beta=beta, f_stuck=f_stuck, f_free=f_free,
-             t_ccx=t_ccx, t_reduce=t_reduce, sizes=json.dumps(sizes),
-             spec=json.dumps(asdict(spec)))
-    out = _load(cache)
-    out["generated"] = True
-    return out
+             G_indptr=G.indptr, G_shape=G.shape, params=params, F=a["F"],
+             outputs=a["outputs"], contact_a=a["contact_a"], contact_b=a["contact_b"],
+             xyz1=a["xyz1"], xyz2=a["xyz2"], n1=a["n1"],
+             beta=beta, f_stuck=f_stuck, f_free=f_free,
+             t_ccx=t_ccx, t_reduce=t_reduce, sizes=json.dumps(sizes), spec=json.dumps(d))
 
 
 def _load(path) -> dict:
@@ -383,11 +404,11 @@ def _load(path) -> dict:
     out = {k: z[k] for k in z.files if not k.startswith("G_")}
     out["G"] = sp.csr_matrix((z["G_data"], z["G_indices"], z["G_indptr"]),
                              shape=tuple(z["G_shape"]))
-    out["G2"] = sp.csr_matrix(z["G2"])
     out["sizes"] = json.loads(str(z["sizes"]))
     out["spec"] = json.loads(str(z["spec"]))
     for k in ("beta", "f_stuck", "f_free", "t_ccx", "t_reduce"):
         out[k] = float(out[k])
+    out["n1"] = int(out["n1"])
     out["cache"] = str(path)
     out["generated"] = False
     return out
