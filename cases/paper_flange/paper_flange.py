@@ -461,13 +461,18 @@ def figures(work: Path, quick: bool, res: dict) -> list:
 # --------------------------------------------------------------------------------------------
 
 def bench_rows(work: Path, quick: bool) -> list[dict]:
-    """One row per member of the F0 family for cases/bench/paper.py.
+    """Rows of cases/bench/paper.py: per member of the F0 family, ROM_II (h = 2, the
+    paper's) and ROM_II (the family) against ROM_I.
 
-    ROM_II (h = 2, the paper's) FRFs are run in this call. ROM_I: at paper size its FRF
-    takes minutes, so its time is sampled (solve_point at 3 frequencies: seconds per
-    evaluation x the evaluations of the ROM_II FRF; ``rom1_extrapolated`` True) and its
-    peaks are those of the case's stored run (family.json; members without one are run in
-    full here). quick: the coarse model, ROM_I run in full.
+    Keys: case, member, rom2 ('h=2' or 'family'), fe_dofs, rom1_dofs, rom2_dofs,
+    rom1_nonlinear, rom2_nonlinear, reduction_s (ROM_II's CB + MS, when its cache was
+    built), rom1_frf_s, rom1_extrapolated, rom2_frf_s, speedup, peak_amp_err,
+    peak_freq_err (largest over the two stages' peaks, relative). The ROM_II FRFs run in
+    this call. ROM_I at paper size: its time is sampled (solve_point at 3 frequencies:
+    seconds per Newton evaluation x the evaluations of the family ROM_II's FRF, which
+    follows the same solution path; ``rom1_extrapolated``) and its peaks are those of the
+    case's stored run (family.json, from ``paper_flange.py family``; a member without one
+    is run in full here). quick: the coarse model, ROM_I run in full.
     """
     work = Path(work)
     info = make(work, quick, log=lambda *a: None)
@@ -477,11 +482,11 @@ def bench_rows(work: Path, quick: bool) -> list[dict]:
     if res.get("spec_key") != spec.key():
         res = {"spec_key": spec.key(), "rom1": {}}
     d1, _ = load(work, "rom1")
-    d2, _ = load(work, "rom2")
-    s1, s2 = sizes(d1), sizes(d2)
+    s1 = sizes(d1)
+    two = {rom: load(work, rom)[0] for rom in ("rom2", "rom2_family")}
     rows = []
     for f0 in family_of(quick):
-        r2 = sweep(d2, f0)
+        r2 = {rom: sweep(d, f0) for rom, d in two.items()}
         stored = res.get("rom1", {}).get(f"{f0:g}")
         if quick or stored is None:
             r1 = sweep(d1, f0)
@@ -490,16 +495,20 @@ def bench_rows(work: Path, quick: bool) -> list[dict]:
             r1 = stored
             band = info["band"]
             pe = seconds_per_eval(d1, f0, np.linspace(band[0], band[1], 5)[1:4])
-            t1, extrap = pe * r2["evals"], True
-        ea = max(abs(r2["peak_amp"][k] / r1["peak_amp"][k] - 1) for k in range(2))
-        ef = max(abs(r2["peak_f"][k] / r1["peak_f"][k] - 1) for k in range(2))
-        rows.append(dict(case="flange", member=f"F0 = {f0:g} N", fe_dofs=info["fe_dofs"],
-                         rom1_dofs=s1["total"], rom2_dofs=s2["total"],
-                         rom1_nonlinear=s1["nonlinear"], rom2_nonlinear=s2["nonlinear"],
-                         reduction_s=d2.reduced.build_seconds, rom1_frf_s=t1,
-                         rom1_extrapolated=extrap, rom2_frf_s=r2["seconds"],
-                         speedup=t1 / max(r2["seconds"], 1e-12), peak_amp_err=ea,
-                         peak_freq_err=ef))
+            t1, extrap = pe * r2["rom2_family"]["evals"], True
+        for rom, d in two.items():
+            r, s2 = r2[rom], sizes(d)
+            ea = max(abs(r["peak_amp"][k] / r1["peak_amp"][k] - 1) for k in range(2))
+            ef = max(abs(r["peak_f"][k] / r1["peak_f"][k] - 1) for k in range(2))
+            rows.append(dict(case="flange", member=f"F0 = {f0:g} N",
+                             rom2="h=2" if rom == "rom2" else "family",
+                             fe_dofs=info["fe_dofs"], rom1_dofs=s1["total"],
+                             rom2_dofs=s2["total"], rom1_nonlinear=s1["nonlinear"],
+                             rom2_nonlinear=s2["nonlinear"],
+                             reduction_s=d.reduced.build_seconds, rom1_frf_s=t1,
+                             rom1_extrapolated=extrap, rom2_frf_s=r["seconds"],
+                             speedup=t1 / max(r["seconds"], 1e-12), peak_amp_err=ea,
+                             peak_freq_err=ef))
     return rows
 
 
