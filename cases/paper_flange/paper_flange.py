@@ -9,8 +9,9 @@ from ROM_I where it does.
 ``make`` writes the bolted two-stage assembly (cases/models/flange.py: 50 + 50 sectors, 4
 contact pairs per sector, one blade node per sector active), runs ccx, and writes the
 decks ``rom1.toml`` (Craig-Bampton: every flange DoF physical), ``rom2.toml`` (ms,
-``harmonic_indices = [2]``: the paper's ROM_II) and ``rom2_family.toml`` (ms, the whole
-family that EO 2 and its time harmonics 0..3 excite) with F0 = 20 N, and one deck per
+``harmonic_indices = [2]``: the paper's ROM_II), ``rom2_eo.toml`` (ms, ``engine_orders =
+[2]``: index 2 and its aliases z N +- 2, the family of time harmonic 1) and
+``rom2_family.toml`` (ms, the whole family that EO 2 and its time harmonics 0..3 excite) with F0 = 20 N, and one deck per
 member of the family (``rom1_F0_<F0>.toml`` ...): each runs with ``frirom run``.
 ``family`` solves the members with every ROM (ROM_I at paper size: each FRF takes minutes;
 ``--rom1 ends`` runs it at the smallest and largest F0 only and says so), prints Table 1,
@@ -58,6 +59,8 @@ ROMS = {
     "rom1": ("ROM_I", ""),
     "rom2": ("ROM_II", "\n[reduction.interface_modes]\nmethod = \"ms\"\nsectors = {n}\n"
                        "harmonic_indices = [{eo}]\n"),
+    "rom2_eo": ("ROM_II j=1", "\n[reduction.interface_modes]\nmethod = \"ms\"\n"
+                              "sectors = {n}\nengine_orders = [{eo}]\n"),
     "rom2_family": ("ROM_II family", "\n[reduction.interface_modes]\nmethod = \"ms\"\n"
                                      "sectors = {n}\nengine_orders = [{eo}]\n"
                                      "time_harmonics = [0, 1, 2, 3]\n"),
@@ -190,6 +193,8 @@ def make(work: Path, quick: bool, log=print) -> dict:
     if info_path.exists():
         info = json.loads(info_path.read_text())
         if info.get("spec_key") == spec.key():
+            _write_decks(work, spec, quick, info["sets"], info["band"], info["beta"],
+                         missing_only=True)
             return info
     t0 = time.perf_counter()
     n_ref = 20 if quick else 60
@@ -213,16 +218,22 @@ def make(work: Path, quick: bool, log=print) -> dict:
     cb_err = float(np.max(np.abs(np.sqrt(lam / ref) - 1)))
     log(f"paper_flange: EO {spec.eo} resonance {f_stuck:.2f} Hz stuck, {f_free:.2f} Hz free; "
         f"CB ROM within {100 * cb_err:.3f} % of ccx's lowest {n_ref} frequencies")
-    for rom in ROMS:
-        (work / deck_name(rom)).write_text(deck_text(spec, rom, F0_DECK, sets, band, beta))
-        for f0 in family_of(quick):
-            (work / deck_name(rom, f0)).write_text(deck_text(spec, rom, f0, sets, band, beta))
+    _write_decks(work, spec, quick, sets, band, beta)
     info = dict(spec_key=spec.key(), quick=quick, f_stuck=f_stuck, f_free=f_free, beta=beta,
                 band=band, t_ccx=t_ccx, cb_err=cb_err, n_ref=n_ref, sets=sets,
                 fe_dofs=int(d.reduced.T.shape[0]), t_rom1_reduction=d.reduced.build_seconds)
     info_path.write_text(json.dumps(info))
     log(f"paper_flange: decks written to {work} ({time.perf_counter() - t0:.1f} s)")
     return info
+
+
+def _write_decks(work, spec, quick, sets, band, beta, missing_only=False) -> None:
+    """rom*.toml (F0_DECK) and rom*_F0_<F0>.toml of every ROM."""
+    for rom in ROMS:
+        for f0, name in [(F0_DECK, deck_name(rom))] + [(f, deck_name(rom, f))
+                                                        for f in family_of(quick)]:
+            if not (missing_only and (work / name).exists()):
+                (work / name).write_text(deck_text(spec, rom, f0, sets, band, beta))
 
 
 # --------------------------------------------------------------------------------------------
@@ -433,6 +444,7 @@ def figures(work: Path, quick: bool, res: dict) -> list:
             c = f"C{i}"
             for rom, style in (("rom1", dict(ls="-", lw=1.4)),
                                ("rom2", dict(ls="none", marker="o", ms=3.5, mfc="none")),
+                               ("rom2_eo", dict(ls="none", marker="s", ms=3, mfc="none")),
                                ("rom2_family", dict(ls="none", marker="x", ms=3))):
                 r = res[rom].get(f"{f0:g}")
                 if r is None:
@@ -440,8 +452,10 @@ def figures(work: Path, quick: bool, res: dict) -> list:
                 f = np.asarray(r["f"]) / info["f_stuck"]
                 a = np.asarray(r["amp"][k]) / f0 / norm
                 step = max(1, len(f) // 40) if rom != "rom1" else 1
-                lab = {"rom1": f"ROM_I F0 = {f0:g} N", "rom2": "ROM_II (h = 2)" if i == 0
-                       else None, "rom2_family": "ROM_II family" if i == 0 else None}[rom]
+                lab = {"rom1": f"ROM_I F0 = {f0:g} N", "rom2": "ROM_II (h = 2)",
+                       "rom2_eo": "ROM_II (EO 2 family, j = 1)",
+                       "rom2_family": "ROM_II (family, j = 0..3)"}[rom]
+                lab = lab if rom == "rom1" or i == 0 else None
                 ax.plot(f[::step], a[::step], color=c, label=lab, **style)
         ax.set_xlabel("frequency / stuck EO 2 resonance")
         ax.set_ylabel("amplitude / F0, over the stuck peak")
@@ -483,7 +497,7 @@ def bench_rows(work: Path, quick: bool) -> list[dict]:
         res = {"spec_key": spec.key(), "rom1": {}}
     d1, _ = load(work, "rom1")
     s1 = sizes(d1)
-    two = {rom: load(work, rom)[0] for rom in ("rom2", "rom2_family")}
+    two = {rom: load(work, rom)[0] for rom in ("rom2", "rom2_eo", "rom2_family")}
     rows = []
     for f0 in family_of(quick):
         r2 = {rom: sweep(d, f0) for rom, d in two.items()}
@@ -501,7 +515,7 @@ def bench_rows(work: Path, quick: bool) -> list[dict]:
             ea = max(abs(r["peak_amp"][k] / r1["peak_amp"][k] - 1) for k in range(2))
             ef = max(abs(r["peak_f"][k] / r1["peak_f"][k] - 1) for k in range(2))
             rows.append(dict(case="flange", member=f"F0 = {f0:g} N",
-                             rom2="h=2" if rom == "rom2" else "family",
+                             rom2={"rom2": "h=2", "rom2_eo": "j=1"}.get(rom, "family"),
                              fe_dofs=info["fe_dofs"], rom1_dofs=s1["total"],
                              rom2_dofs=s2["total"], rom1_nonlinear=s1["nonlinear"],
                              rom2_nonlinear=s2["nonlinear"],
