@@ -48,21 +48,23 @@ mu = 0.3
 n0 = 10.0
 
 [damping]
-type = "rayleigh"
+type = "modal"
+zeta = 0.01
 
 [[excitation.load]]
-dof = "TIP0:x"
-amplitude = 1.0
+dof = "TIP0:y"
+amplitude = 2.0
+phase = 30.0
 
 [solver]
-harmonics = 1
+harmonics = 2
 
 [frequency]
-start = 100.0
-end = 200.0
+start = 50.0
+end = 80.0
 
 [outputs]
-dofs = ["TIP0:x"]
+dofs = ["TIP0:x", "TIP0:y"]
 """
 
 

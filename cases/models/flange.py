@@ -189,27 +189,36 @@ def stage_mesh(stage: int, n_sectors: int, z_per_sector: int, coarse: bool = Fal
     return ids, xyz, elems, sets
 
 
-def write_stage_deck(path, stage: int, n_sectors: int, z_per_sector: int,
-                     coarse: bool = False, material=PAPER_STEEL) -> Path:
-    """``stage<k>.inp``: mesh, node sets, steel, HUB clamped (stage 2), matrix storage."""
-    ids, xyz, elems, sets = stage_mesh(stage, n_sectors, z_per_sector, coarse)
+def _write_hex_deck(path, title: str, ids, xyz, elems, sets: dict, material,
+                    n_ref_modes: int = 0) -> Path:
+    """A CalculiX deck of C3D8 elements: nodes, elements, node sets (written in the given
+    order: CONTACT and ACTIVE keep their (angle, sector) order), steel, HUB clamped when
+    there is one, the matrix-storage steps (``n_ref_modes`` > 0: ccx's reference modes
+    first)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "w") as fh:
-        fh.write(f"** flange model stage {stage}, {n_sectors} sectors, C3D8\n*NODE, NSET=ALL\n")
+        fh.write(f"** {title}, C3D8\n*NODE, NSET=ALL\n")
         fh.writelines(f"{i}, {x:.13g}, {y:.13g}, {zz:.13g}\n" for i, (x, y, zz) in
                       zip(ids, xyz))
         fh.write("*ELEMENT, TYPE=C3D8, ELSET=EALL\n")
         fh.writelines(f"{e}, " + ", ".join(str(c) for c in conn) + "\n"
                       for e, conn in enumerate(elems, start=1))
         for name, nodes in sets.items():
-            # keep CONTACT and ACTIVE in their (angle, sector) order: nset() writes as given
             fh.write(nset(name, nodes))
         fh.write(solid_material(material))
         if "HUB" in sets:
             fh.write("*BOUNDARY\nHUB, 1, 3\n")
-        fh.write(matrix_storage_steps())
+        fh.write(matrix_storage_steps(n_ref_modes))
     return path
+
+
+def write_stage_deck(path, stage: int, n_sectors: int, z_per_sector: int,
+                     coarse: bool = False, material=PAPER_STEEL) -> Path:
+    """``stage<k>.inp``: mesh, node sets, steel, HUB clamped (stage 2), matrix storage."""
+    ids, xyz, elems, sets = stage_mesh(stage, n_sectors, z_per_sector, coarse)
+    return _write_hex_deck(path, f"flange model stage {stage}, {n_sectors} sectors", ids,
+                           xyz, elems, sets, material)
 
 
 def assembly_mesh(spec: FlangeSpec, bolt_radii=(0.10,)):
@@ -258,22 +267,8 @@ def write_assembly_deck(path, spec: FlangeSpec, n_ref_modes: int = 0,
     optional ``*FREQUENCY`` step of ``n_ref_modes`` modes (ccx's reference eigenvalues in
     the .dat, joint without contacts: the bolts alone) before the matrix storage."""
     ids, xyz, elems, sets = assembly_mesh(spec)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "w") as fh:
-        fh.write(f"** bolted two-stage flange, {spec.sectors} sectors per stage, C3D8\n"
-                 "*NODE, NSET=ALL\n")
-        fh.writelines(f"{i}, {x:.13g}, {y:.13g}, {zz:.13g}\n" for i, (x, y, zz) in
-                      zip(ids, xyz))
-        fh.write("*ELEMENT, TYPE=C3D8, ELSET=EALL\n")
-        fh.writelines(f"{e}, " + ", ".join(str(c) for c in conn) + "\n"
-                      for e, conn in enumerate(elems, start=1))
-        for name, nodes in sets.items():
-            fh.write(nset(name, nodes))
-        fh.write(solid_material(material))
-        fh.write("*BOUNDARY\nHUB, 1, 3\n")
-        fh.write(matrix_storage_steps(n_ref_modes))
-    return path
+    return _write_hex_deck(path, f"bolted two-stage flange, {spec.sectors} sectors per "
+                           "stage", ids, xyz, elems, sets, material, n_ref_modes)
 
 
 # --------------------------------------------------------------------------------------------
