@@ -29,6 +29,11 @@ reduction (frirom.reduction.multistage) of each stage's interface to the harmoni
 ``ms_indices`` (default 2: 6 coordinates per stage), one ``ms_basis`` call per stage (one
 call over both faces would mix the coincident nodes of the two stages in a segment).
 
+The paper case (cases/paper_flange) uses the same stages as one bolted assembly in one ccx
+job (:func:`assembly_mesh`, :func:`write_assembly_deck`): the stages share one face node
+per sector on the inner edge of the flange arm (the bolt), the contact circle keeps its
+pairs, and frirom's decks do the reductions.
+
 Nothing generated is committed: :func:`flange_roms` writes the decks, runs ccx, reduces and
 saves everything in one npz in ``work`` (named after the parameters); a rerun loads it.
 """
