@@ -98,3 +98,17 @@ def test_family_rom2_peaks_match_rom1(decks, f0):
     ef = abs(r2["peak_f"][0] / r1["peak_f"][0] - 1)
     assert ef > pf.TARGET_FREQ
     assert pf.row_flag(0.0, ef) == "DIFFERS"
+
+
+@pytest.mark.parametrize("rom", ["rom2", "rom2_eo", "rom2_family"])
+def test_derived_rom2_equals_the_decks(decks, rom):
+    """The case's ROM_II built from ROM_I (paper_flange.derived: MS on the CB matrices that
+    ROM_I keeps) is the deck's ROM_II (CB, then MS): K, M, contact map, loads and outputs
+    equal to 1e-12 relative (the same products in another order)."""
+    d = pf.derived(decks["rom1"], rom, pf.QUICK)
+    ref = decks[rom]
+    for a, b in ((d.K, ref.K), (d.M, ref.M), (d.contacts[0].G, ref.contacts[0].G)):
+        a, b = pf._dense(a), pf._dense(b)
+        assert a.shape == b.shape and np.abs(a - b).max() <= 1e-12 * np.abs(b).max()
+    assert np.abs(d.F - ref.F).max() <= 1e-12 * np.abs(ref.F).max()
+    assert list(d.outputs) == list(ref.outputs)
