@@ -409,7 +409,7 @@ def family(work: Path, quick: bool, rom1: str = "all", log=print) -> dict:
     res["rom1_reduction_s"] = d1.reduced.build_seconds
     # the ROM_IIs first (fast), then ROM_I; ROM_II family at paper size costs about what
     # ROM_I does (168 nonlinear coordinates), so it follows `rom1` too
-    for rom in ("rom2", "rom2_eo", "rom2_family", "rom1"):
+    for rom in ("rom2", "rom2_eo", "rom1", "rom2_family"):
         d = d1 if rom == "rom1" else derived(d1, rom, spec)
         res.setdefault(rom, {})
         res[rom + "_sizes"] = sizes(d)
