@@ -371,6 +371,7 @@ def spectrum(d, f0: float, f_hz: float, spec) -> dict:
                                              for j in range(1, H + 1)])
         out[k] = per_j / per_j.sum()
     out["states"] = curve.state_fractions[-1, 0].tolist()
+    out["scale"] = float(curve.parameter[-1])      # < 1: the continuation stopped early
     return out
 
 
@@ -378,6 +379,10 @@ def print_spectrum(sp_: dict, f0: float, f_hz: float, top: int = 4) -> list:
     """Print the energy table; returns the indices that carry > 1e-6 of a stage's energy."""
     keep = set()
     st = sp_["states"]
+    sc = float(sp_.get("scale", 1.0))
+    if sc < 1 - 1e-9:
+        print(f"  (load continuation stopped at {sc:.2f} F0: the table is at F0 = "
+              f"{sc * f0:.3g} N, not the peak's load)")
     print(f"  F0 {f0:g} N at {f_hz:.2f} Hz (stick {st[0]:.2f}, slip {st[1]:.2f}, lift-off "
           f"{st[2]:.2f}): energy of the flange motion per time harmonic j and spatial index h")
     for k in (1, 2):
@@ -448,7 +453,10 @@ def report(work: Path, quick: bool, res: dict) -> None:
     print(f"  {'ROM':<14} {'interface':>9} {'active':>7} {'CB modal':>9} {'total':>6} "
           f"{'nonlinear':>9} {'reduction s':>11}")
     for rom in ROMS:
-        s = res[rom + "_sizes"]
+        s = res.get(rom + "_sizes")
+        if s is None:
+            print(f"  {ROMS[rom][0]:<14} not built in this run")
+            continue
         print(f"  {ROMS[rom][0]:<14} {s['interface']:9d} {s['active']:7d} {s['modal']:9d} "
               f"{s['total']:6d} {s['nonlinear']:9d} {res[rom + '_reduction_s']:11.1f}")
     print(f"  CB ROM within {100 * info['cb_err']:.3f} % of ccx over its lowest "
@@ -459,9 +467,9 @@ def report(work: Path, quick: bool, res: dict) -> None:
         key = f"{f0:g}"
         r1 = res["rom1"].get(key)
         for rom in ROMS:
-            r = res[rom].get(key)
+            r = res.get(rom, {}).get(key)
             if r is None:
-                print(f"  F0 {f0:6g} {ROMS[rom][0]:<14} not run (--rom1 ends)")
+                print(f"  F0 {f0:6g} {ROMS[rom][0]:<14} not run (--rom1 ends, or stopped)")
                 continue
             line = (f"  F0 {f0:6g} {ROMS[rom][0]:<14} {r['peak_amp'][0]:.4e} m "
                     f"{r['peak_f'][0]:9.3f} Hz | {r['peak_amp'][1]:.4e} m "
@@ -501,7 +509,7 @@ def figures(work: Path, quick: bool, res: dict) -> list:
                                ("rom2", dict(ls="none", marker="o", ms=3.5, mfc="none")),
                                ("rom2_eo", dict(ls="none", marker="s", ms=3, mfc="none")),
                                ("rom2_family", dict(ls="none", marker="x", ms=3))):
-                r = res[rom].get(f"{f0:g}")
+                r = res.get(rom, {}).get(f"{f0:g}")
                 if r is None:
                     continue
                 f = np.asarray(r["f"]) / info["f_stuck"]
