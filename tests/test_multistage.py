@@ -320,3 +320,28 @@ def test_ms_exact_on_fe_stage_from_ccx(fe_stage, eo):
     print(f"\nMS on the ccx stage, EO {eo}: n_k = {ms.basis.shape[1]}, rel. error {err:.1e}")
     assert err < 1e-10, err                  # 13-digit node coordinates: tuned to ~1e-13
     assert red.K.shape[0] == n - 432 + 6 * (2 * idx.size - np.isin(idx, [0, 36]).sum())
+
+
+@pytest.mark.parametrize("h", [0, 2, 5, 10])
+def test_harmonic_content_of_one_index_field(rotor, h):
+    """A field built from the MS columns of index h alone (random coefficients) has all its
+    energy at h, and the energies sum to |x|^2 (F orthonormal): 1e-12 relative, round-off;
+    a sum of two indices splits as their coefficients do."""
+    from frirom.reduction.multistage import harmonic_content
+    nodes = rotor["iface_nodes"]
+    xyz = rotor["coords"][nodes]
+    rng = np.random.default_rng(h)
+    ms = _basis(rotor, [h])
+    a = rng.standard_normal(ms.basis.shape[1])
+    v = np.zeros(rotor["K"].shape[0])
+    v[ms.interface] = ms.basis @ a
+    field = v[rotor["dofs"][nodes]]                           # (n_nodes, 3)
+    e = harmonic_content(xyz, field, 7, ORIGIN, AXIS)[:, 0]
+    assert e.shape == (11,)
+    assert abs(e.sum() - np.sum(field ** 2)) < 1e-12 * np.sum(field ** 2)
+    assert abs(e[h] - a @ a) < 1e-12 * (a @ a)
+    ms2 = _basis(rotor, [3])
+    b = rng.standard_normal(ms2.basis.shape[1])
+    v[ms2.interface] += ms2.basis @ b
+    e2 = harmonic_content(xyz, v[rotor["dofs"][nodes]], 7, ORIGIN, AXIS)[:, 0]
+    assert abs(e2[3] - b @ b) < 1e-12 * (b @ b) and abs(e2[h] - a @ a) < 1e-12 * (a @ a)

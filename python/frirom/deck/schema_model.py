@@ -123,8 +123,8 @@ def parse_reduction(ctx: Context, red: dict) -> tuple[ReductionSpec, CyclicSetti
     method = string(ctx, im, "method", f"{pre}.method", default="none",
                     choices=("none", "gsi", "ms"))
     allowed = {"none": {"method"}, "gsi": {"method", "free", "stick", "per_side"},
-               "ms": {"method", "sectors", "engine_orders", "time_harmonics", "axis",
-                      "origin"}}[method]
+               "ms": {"method", "sectors", "engine_orders", "time_harmonics",
+                      "harmonic_indices", "axis", "origin"}}[method]
     unknown(ctx, im, allowed, pre)
     kw = {}
     if method == "gsi":
@@ -148,10 +148,18 @@ def parse_reduction(ctx: Context, red: dict) -> tuple[ReductionSpec, CyclicSetti
     if method == "ms":
         kw["sectors"] = number(ctx, im, "sectors", f"{pre}.sectors", required=True,
                                integer=True, minimum=1)
-        kw["engine_orders"] = integers(ctx, im, "engine_orders", f"{pre}.engine_orders",
-                                       required=True)
-        th = integers(ctx, im, "time_harmonics", f"{pre}.time_harmonics", minimum=0)
-        kw["time_harmonics"] = th or (1,)
+        hi = integers(ctx, im, "harmonic_indices", f"{pre}.harmonic_indices", minimum=0)
+        if hi:              # explicit indices: no engine-order family on top
+            for k in ("engine_orders", "time_harmonics"):
+                if k in im:
+                    raise ctx.error(f"{pre}.{k}", "no engine_orders/time_harmonics with "
+                                    "harmonic_indices (give one or the other)", im[k])
+            kw["harmonic_indices"] = tuple(sorted(set(hi)))
+        else:
+            kw["engine_orders"] = integers(ctx, im, "engine_orders", f"{pre}.engine_orders",
+                                           required=True)
+            th = integers(ctx, im, "time_harmonics", f"{pre}.time_harmonics", minimum=0)
+            kw["time_harmonics"] = th or (1,)
         kw["axis"] = vector(ctx, im, "axis", f"{pre}.axis", axis)
         kw["origin"] = vector(ctx, im, "origin", f"{pre}.origin", origin, nonzero=False)
     spec = ReductionSpec(interface=tuple(iface), active=tuple(active),

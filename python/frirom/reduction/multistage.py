@@ -33,7 +33,7 @@ from .interface import InterfaceReduction
 
 __all__ = ["RadialSegments", "MultistageInterface", "cylindrical_frame", "fourier_matrix",
            "fourier_columns", "harmonic_indices", "stage_indices", "radial_line_segments",
-           "ms_basis",
+           "ms_basis", "harmonic_content",
            "stage_contact_matrix", "assemble"]
 
 
@@ -354,6 +354,38 @@ def ms_basis(coords, dofs, n_sectors: int, indices, origin=(0.0, 0.0, 0.0),
     columns = [(table[c][0], table[c][1], j) for c in cols for j in range(n_l)]
     return MultistageInterface(segments=seg, indices=idx, interface=interface, basis=basis,
                                columns=columns)
+
+
+def harmonic_content(coords, values, n_sectors: int, origin=(0.0, 0.0, 0.0),
+                     axis=(0.0, 0.0, 1.0), reference=None, tol=None) -> np.ndarray:
+    """Energy of interface displacement fields per spatial harmonic index (Eq. 21-23).
+
+    coords: (n_nodes, 3) interface nodes of a whole stage; values: (n_nodes, 3, n_f) global
+    x y z displacements of ``n_f`` fields (e.g. the cosine and sine parts of each time
+    harmonic of a forced response). The fields are rotated to cylindrical components, grouped
+    in radial line segments and projected on the full real Fourier basis F_{NZ,NZ}; as F is
+    orthonormal, the squared coefficients split sum |x|^2 exactly by index. Returns
+    (NZ/2 + 1, n_f): energy [units^2] of harmonic index h = 0..NZ/2 in field f.
+    """
+    seg = radial_line_segments(coords, n_sectors, origin, axis, reference, tol)
+    v = np.asarray(values, dtype=float)
+    if v.ndim == 2:
+        v = v[:, :, None]
+    if v.shape[:2] != (len(np.asarray(coords)), 3):
+        raise SizeError(f"harmonic_content: values must be (n_nodes, 3, n_f), got {v.shape}")
+    nz, n_per = seg.nodes.shape
+    x = np.asarray(coords, dtype=float)
+    loc = (x - seg.origin) @ seg.frame.T
+    th = np.arctan2(loc[:, 1], loc[:, 0])[seg.nodes.ravel()]
+    rot = _rotations(th, seg.frame)                                   # cyl -> global
+    cyl = np.einsum("nji,njf->nif", rot, v[seg.nodes.ravel()])        # (NZ n_per, 3, n_f)
+    cyl = cyl.reshape(nz, 3 * n_per, -1)
+    a = np.einsum("kc,klf->clf", fourier_matrix(nz), cyl)             # (NZ, n_l, n_f)
+    e = np.sum(a ** 2, axis=1)
+    out = np.zeros((nz // 2 + 1, e.shape[1]))
+    for j, (h, _) in enumerate(_column_table(nz)):
+        out[h] += e[j]
+    return out
 
 
 # --------------------------------------------------------------------------------------------

@@ -33,6 +33,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import scipy.sparse as sp
+from scipy.linalg import block_diag
 from scipy.spatial import cKDTree
 
 from .. import io as fio
@@ -126,6 +127,7 @@ class ReductionSpec:
     sectors: int | None = None
     engine_orders: tuple = ()
     time_harmonics: tuple = (1,)
+    harmonic_indices: tuple = ()         # ms: explicit indices (else the EO family)
     axis: tuple = (0.0, 0.0, 1.0)
     origin: tuple = (0.0, 0.0, 0.0)
     cache: Path | None = None
@@ -594,26 +596,38 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
         iface_r = iface0
         mode_labels = [f"gsi {j + 1}" for j in range(basis.shape[1])]
     else:
-        nodes = np.unique(np.concatenate([model.node_sets[s.upper()] for s in spec.interface]))
-        nd = _node_dofs(model, nodes)
-        if np.any(nd < 0):
-            bad = nodes[np.any(nd < 0, axis=1)]
-            raise InputError(f"{where}reduction.interface: expected nodes with free x y z "
-                             f"DoFs for the MS reduction, got constrained node(s) "
-                             f"{bad[:5].tolist()}")
-        try:
-            xyz = model.coordinates(nodes)
-            nz = radial_line_segments(xyz, spec.sectors, spec.origin, spec.axis).n_segments
-            ms = ms_basis(xyz, pos[nd], spec.sectors,
-                          harmonic_indices(list(spec.engine_orders), spec.sectors, nz,
-                                           list(spec.time_harmonics)),
-                          spec.origin, spec.axis)
-        except InputError as exc:
-            raise InputError(f"{pre}: {exc}") from None
-        if ms.interface.size != iface0.size:
+        # one MS basis per interface node set (a stage's face): the radial line segments
+        # of one call over two coincident faces would mix the stages' nodes
+        bases, ifaces, mode_labels, seen = [], [], [], set()
+        for name in spec.interface:
+            nodes = np.unique(np.asarray(model.node_sets[name.upper()], np.int64))
+            if seen & set(nodes.tolist()):
+                raise InputError(f"{where}reduction.interface: node set {name} shares nodes "
+                                 "with another interface set; the MS reduction needs one "
+                                 "set per stage face")
+            seen |= set(nodes.tolist())
+            nd = _node_dofs(model, nodes)
+            if np.any(nd < 0):
+                bad = nodes[np.any(nd < 0, axis=1)]
+                raise InputError(f"{where}reduction.interface: expected nodes with free x y z "
+                                 f"DoFs for the MS reduction, got constrained node(s) "
+                                 f"{bad[:5].tolist()}")
+            try:
+                xyz = model.coordinates(nodes)
+                nz = radial_line_segments(xyz, spec.sectors, spec.origin,
+                                          spec.axis).n_segments
+                idx = spec.harmonic_indices or harmonic_indices(
+                    list(spec.engine_orders), spec.sectors, nz, list(spec.time_harmonics))
+                ms = ms_basis(xyz, pos[nd], spec.sectors, idx, spec.origin, spec.axis)
+            except InputError as exc:
+                raise InputError(f"{pre} (interface set {name}): {exc}") from None
+            bases.append(ms.basis)
+            ifaces.append(ms.interface)
+            mode_labels += ms.labels(f"{name} " if len(spec.interface) > 1 else "")
+        basis, iface_r = block_diag(*bases), np.concatenate(ifaces)
+        if iface_r.size != iface0.size:
             raise InputError(f"{where}reduction.interface: expected node sets whose nodes "
                              "all keep x y z DoFs for the MS reduction")
-        basis, iface_r, mode_labels = ms.basis, ms.interface, ms.labels()
     if basis is None:
         K, M, T1, labels = K0, M0, None, labels0
     else:

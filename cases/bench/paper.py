@@ -1,0 +1,109 @@
+"""Benchmark of the reference paper's two applications (issue 11): for every member of each
+family, the model sizes (FE, ROM_I, ROM_II, nonlinear DoFs), the reduction time, the time
+of one ROM_I and one ROM_II FRF measured in this run (ROM_I may be sampled at a few points
+and extrapolated while it is slow: marked "extrap."), the speed-up, and the errors of
+ROM_II's peak amplitude and frequency against ROM_I's.
+
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python cases/bench/paper.py [--quick] [--work DIR]
+
+Rows come from ``bench_rows(work, quick)`` of cases/paper_flange/paper_flange.py (ROM_II
+with index 2, the paper's, and with the whole EO 2 family) and of the module in
+cases/paper_hooks/ that offers it, when there is one. At paper size the flange's ROM_I
+peaks come from the case's stored run (``paper_flange.py family`` first, minutes per ROM_I
+FRF); ``--quick`` runs the coarse models whole in seconds.
+
+Last line: the speed-up of each application (median over its members) and the worst
+errors of each ROM_II against the paper's targets (1 % amplitude, 0.1 % frequency).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import os
+import sys
+from pathlib import Path
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+
+CASES = Path(__file__).resolve().parents[1]
+TARGET_AMP, TARGET_FREQ = 0.01, 0.001
+
+
+def _module(path: Path):
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    mod = importlib.util.module_from_spec(spec)
+    sys.path.insert(0, str(path.parent))
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def providers() -> dict:
+    """{application: bench_rows function} of the cases that offer one."""
+    out = {}
+    for name in ("paper_flange", "paper_hooks"):
+        folder = CASES / name
+        for path in sorted(folder.glob("*.py")) if folder.is_dir() else []:
+            if "def bench_rows(" in path.read_text():
+                out[name] = _module(path).bench_rows
+                break
+    return out
+
+
+def print_table(rows: list) -> None:
+    print(f"{'case':<7} {'member':<16} {'ROM_II':<7} {'FE':>7} {'ROM_I':>6} {'ROM_II':>6} "
+          f"{'nl I':>5} {'nl II':>5} {'red. s':>7} {'ROM_I FRF s':>16} {'ROM_II s':>8} "
+          f"{'speed-up':>8} {'amp err':>9} {'freq err':>9}")
+    for r in rows:
+        t1 = f"{r['rom1_frf_s']:.1f}" + (" extrap." if r["rom1_extrapolated"] else "")
+        bad = (abs(r["peak_amp_err"]) > TARGET_AMP or abs(r["peak_freq_err"]) > TARGET_FREQ)
+        print(f"{r['case']:<7} {r['member']:<16} {r.get('rom2', ''):<7} {r['fe_dofs']:7d} "
+              f"{r['rom1_dofs']:6d} {r['rom2_dofs']:6d} {r['rom1_nonlinear']:5d} "
+              f"{r['rom2_nonlinear']:5d} {r['reduction_s']:7.1f} {t1:>16} "
+              f"{r['rom2_frf_s']:8.2f} {r['speedup']:7.1f}x {100 * r['peak_amp_err']:8.3f}% "
+              f"{100 * r['peak_freq_err']:8.4f}%" + ("  ABOVE TARGET" if bad else ""))
+
+
+def summary(rows: list) -> str:
+    """The last line: median speed-up per case, worst errors per case and ROM_II kind."""
+    parts, errs = [], []
+    for case in dict.fromkeys(r["case"] for r in rows):
+        rc = [r for r in rows if r["case"] == case]
+        main = [r for r in rc if r.get("rom2", "") in ("", "h=2")] or rc
+        ext = " (ROM_I extrapolated)" if any(r["rom1_extrapolated"] for r in main) else ""
+        parts.append(f"{case} {np.median([r['speedup'] for r in main]):.1f}x{ext}")
+        for kind in dict.fromkeys(r.get("rom2", "") for r in rc):
+            rk = [r for r in rc if r.get("rom2", "") == kind]
+            label = f"{case} {kind}".strip()
+            errs.append(f"{label} {100 * max(abs(r['peak_amp_err']) for r in rk):.3f} % / "
+                        f"{100 * max(abs(r['peak_freq_err']) for r in rk):.4f} %")
+    return ("speed-up ROM_I -> ROM_II: " + ", ".join(parts)
+            + "; worst peak errors (amplitude / frequency): " + ", ".join(errs))
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="the coarse models (seconds)")
+    ap.add_argument("--work", default=None,
+                    help="folder of the cases' models and results (default results/)")
+    a = ap.parse_args(argv)
+    base = Path(a.work or "results").resolve()
+    rows = []
+    provs = providers()
+    for name, fn in provs.items():
+        work = base / (name + ("_quick" if a.quick else ""))
+        rows += fn(work, a.quick)
+    missing = {"paper_flange", "paper_hooks"} - set(provs)
+    print(f"paper benchmark ({'quick: coarse models' if a.quick else 'paper size'}), "
+          f"OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}"
+          + (f"; no bench_rows in cases/{', cases/'.join(sorted(missing))}" if missing else ""))
+    print_table(rows)
+    print("extrap.: ROM_I sampled by solve_point, FRF time = s/evaluation x the evaluations "
+          "of the (exact) family ROM_II's FRF; errors: largest over the outputs' peaks")
+    print(summary(rows))
+
+
+if __name__ == "__main__":
+    main()
