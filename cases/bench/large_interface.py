@@ -286,13 +286,17 @@ def print_row(r):
         diff += f" ABOVE {DIFF_TARGET:g}"
     if r["extrap"]:
         diff += f"; sampled: {r['sampled_evals']} evaluations"
+    tm = r.get("timings")
+    lus = f"{int(tm['factorizations']):5d} {int(tm['krylov_iterations']):6d}" if tm else \
+        f"{'-':>5} {'-':>6}"
     print(f"  {r['rom']:<7} {r['route']:<22} {r['unknowns']:8d} {pe['fortran_total']:10.4f} "
-          f"{fmt_split(pe)}  {frf_s} {pts:>6} {r['evals']:6d}  {diff}")
+          f"{fmt_split(pe)}  {frf_s} {pts:>6} {r['evals']:6d} {lus}  {diff}")
 
 
 def header():
     print(f"  {'ROM':<7} {'route':<22} {'unknowns':>8} {'s/eval':>10} split of an evaluation"
-          f"{'':>44}{'FRF s':>9}{'':8} {'points':>6} {'evals':>6}  diff vs reference")
+          f"{'':>44}{'FRF s':>9}{'':8} {'points':>6} {'evals':>6} {'LUs':>5} {'GMRES':>6}  "
+          f"diff vs reference")
 
 
 def scaling(a, sizes, kw, main_row, pairs, spec_for, roms, band, sectors, n_modes):
