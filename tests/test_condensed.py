@@ -211,31 +211,12 @@ def test_large_system_solves_by_gmres_on_the_held_lu():
     through slip: GMRES is used and most points need no LU; each point re-solved from its
     own unknowns and contact history by a fresh LU (the direct path) agrees to TOL (the
     GMRES solves reach 1e-8 of the right-hand side; Newton then converges to 1e-10)."""
-    rng = np.random.default_rng(3)
-    n, nc = 600, 80                          # 160 contact coordinates: 1 120 unknowns
-    v, _ = np.linalg.qr(rng.standard_normal((n, n)))
-    mm = rng.uniform(0.5, 2.0, n)
-    f = np.geomspace(100.0, 2.0e4, n)
-    r0 = int(np.argmin(abs(f - 520.0)))
-    f[r0] = 520.0
-    M = (v * mm) @ v.T
-    K = (v * mm * (2 * np.pi * f) ** 2) @ v.T
-    M, K = 0.5 * (M + M.T), 0.5 * (K + K.T)
-    dofs = rng.permutation(n)[:6 * nc].reshape(nc, 6)
-    rows, cols, vals = [], [], []
-    for e in range(nc):
-        for d in range(2):
-            w = rng.standard_normal(3)
-            w /= np.linalg.norm(w)
-            rows += [2 * e + d] * 6
-            cols += list(dofs[e])
-            vals += list(w) + list(-w)
-    G = sp.csr_matrix((vals, (rows, cols)), shape=(2 * nc, n))
-    model = Model(M, K, Damping.rayleigh(0.0, 0.004 / (2 * np.pi * 520.0)),
-                  [ContactGroup("normal1d", G, np.tile([2e5, 2e5, 0.3, 1.0], (nc, 1)))])
-    F = np.zeros((n, 2), complex)
-    F[:, 1] = 20.0 * (M @ v[:, r0])
-    ex, out = Excitation(F), np.arange(6)
+    import sys
+    from pathlib import Path
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "bench"))
+    from condensed import reduced_model      # ROM_I's kind: random modes, 6 DoFs/contact
+    model, ex = reduced_model(n=600, nc=80, seed=3)   # 160 coordinates: 1 120 unknowns
+    out = np.arange(6)
     o = SolverOptions(harmonics=3, samples=64, tol_residual=1e-10, tol_update=1e-10)
     kept = []
     r = frf(model, ex, 2 * np.pi * 516.0, 2 * np.pi * 524.0, o, outputs=out,
