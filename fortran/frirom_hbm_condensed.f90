@@ -13,6 +13,16 @@ submodule (frirom_hbm) frirom_hbm_condensed
     !> iterations above which the next J is factorised.
     real(wp), parameter :: GM_TOL = 1.0e-11_wp
     integer(ip), parameter :: GM_MAXIT = 40, GM_REFRESH = 8
+    !> Direct mode, modal route: the first solve after an eval with jac is GMRES on that
+    !> J preconditioned by the LU held (of an older J), to this relative residual. An LU
+    !> is worth gm_worth GMRES iterations (gm_cost: flops of each, the LU's counted
+    !> LU_SPEEDUP times faster, blocked against memory-bound); J is factorised instead
+    !> once the iterations since the last LU reach that, or when one solve needs more
+    !> than a third of it (at least GN_MINIT); always when an LU is worth less than
+    !> GN_WORTH_MIN iterations (a few hundred unknowns: LUs are cheap and each Newton
+    !> path stays the one of the LUs). Deterministic: sizes and counts only.
+    real(wp), parameter :: GN_TOL = 1.0e-8_wp, LU_SPEEDUP = 10.0_wp, GN_WORTH_MIN = 12.0_wp
+    integer(ip), parameter :: GN_MINIT = 4
 
 contains
 
@@ -143,6 +153,13 @@ contains
         if (this%modal) then
             this%gj = this%g
             this%wj = w
+            if (.not. use_krylov(this) .and. this%lu_any .and. gm_cost(this) >= GN_WORTH_MIN &
+                .and. this%gm_spent < gm_cost(this)) then
+                ! J for products only, the LU stays: the next solve by GMRES (cond_solve)
+                this%jfree = .true.
+                this%gm_next = .true.
+                return
+            end if
             if (use_krylov(this)) then
                 ! matrix-free J (jmul): R_h is formed only to factorise
                 this%jfree = .true.
@@ -346,6 +363,7 @@ contains
         sys%timers(N_FACT) = sys%timers(N_FACT) + 1
         sys%lu_fresh = linfo == 0
         sys%lu_any = linfo == 0
+        sys%gm_spent = 0.0_wp
         sys%refresh = .false.
         if (linfo > 0) then
             call set_status(info, FRIROM_ERR_SINGULAR, errmsg, 'condensed Jacobian: dgetrf '// &
@@ -358,15 +376,26 @@ contains
     module procedure cond_solve
         integer(ip) :: linfo, j, its
         real(wp) :: t0
-        logical :: ok
+        logical :: ok, krylov, direct_gm
         info = FRIROM_OK
         t0 = wtime()
-        if (use_krylov(this) .and. .not. this%lu_fresh) then
+        krylov = use_krylov(this) .and. .not. this%lu_fresh
+        direct_gm = this%gm_next
+        this%gm_next = .false.
+        j = 1
+        if (krylov .or. direct_gm) then
+            ok = .true.
             do j = 1, size(b, 2)
-                call gmres(this, b(:, j), its, ok)
+                if (direct_gm) then
+                    call gmres(this, b(:, j), its, ok, GN_TOL, &
+                               max(GN_MINIT, int(gm_cost(this)/3.0_wp, ip)))
+                    this%gm_spent = this%gm_spent + its
+                else
+                    call gmres(this, b(:, j), its, ok)
+                end if
                 this%timers(N_KRYLOV) = this%timers(N_KRYLOV) + its
                 ! a preconditioner that needs many iterations is renewed at the next J
-                if (its > GM_REFRESH) this%refresh = .true.
+                if (krylov .and. its > GM_REFRESH) this%refresh = .true.
                 if (ok) cycle
                 ! too slow: factorise this J and solve the remaining columns directly
                 this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
@@ -382,19 +411,30 @@ contains
                 t0 = wtime()
                 exit
             end do
-            if (.not. this%lu_fresh) then
+            if (ok) then
                 this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
                 return
             end if
-            call dgetrs('N', this%n, size(b, 2) - j + 1, this%jm, this%n, this%ipiv, b(:, j:), &
-                        size(b, 1), linfo)
-        else
-            call dgetrs('N', this%n, size(b, 2), this%jm, this%n, this%ipiv, b, size(b, 1), &
-                        linfo)
         end if
+        call dgetrs('N', this%n, size(b, 2) - j + 1, this%jm, this%n, this%ipiv, b(:, j:), &
+                    size(b, 1), linfo)
         this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
         if (linfo /= 0) call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'dgetrs failed')
     end procedure cond_solve
+
+    !> GMRES iterations an LU of J is worth (direct mode, modal route): LU 2/3 n^3 flops
+    !> at LU_SPEEDUP times the rate of an iteration's triangular solves (2 n^2) and
+    !> matrix-free product (8 (nh+1) nnl nm: projection and back, complex).
+    real(wp) function gm_cost(sys)
+        type(hbm_condensed), intent(inout) :: sys
+        real(wp) :: n
+        if (sys%gm_worth <= 0.0_wp) then
+            n = real(sys%n, wp)
+            sys%gm_worth = (2.0_wp/3.0_wp*n**3/LU_SPEEDUP)/(2.0_wp*n**2 + 8.0_wp* &
+                           real(sys%nh + 1, wp)*real(sys%nnl, wp)*real(size(sys%g, 1), wp))
+        end if
+        gm_cost = sys%gm_worth
+    end function gm_cost
 
     !> y = J x: the assembled jcur, or matrix-free (jfree: modal route) as
     !> x + R_h G^T J_loc G x at the Jacobian's frequency, element by element and mode by
@@ -403,9 +443,9 @@ contains
         type(hbm_condensed), intent(in) :: sys
         real(wp), intent(in) :: x(:)
         real(wp), intent(out) :: y(:)
-        real(wp), allocatable :: xv(:, :), f(:, :), xl(:, :), fl(:), y2(:, :)
+        real(wp), allocatable :: xv(:, :), f(:, :), xl(:, :), fl(:), y2(:, :), vr(:, :)
         complex(wp), allocatable :: fc(:), v(:, :), b1(:, :)
-        integer(ip) :: n, nu, nc, g, e, d, r, k, h
+        integer(ip) :: n, nu, nc, g, e, d, r, k, h, nm
         n = sys%n
         if (.not. sys%jfree) then
             call dgemm('N', 'N', n, 1, n, 1.0_wp, sys%jcur, n, x, n, 0.0_wp, y, n)
@@ -438,29 +478,50 @@ contains
                 deallocate (xl, fl)
             end associate
         end do
-        do h = 0, sys%nh
-            fc = harm_col(f, h)
-            call modal_project(sys, h, fc, v(:, 1))
-            v(:, 1) = sys%gj(:, h)*v(:, 1)
-            call modal_apply(sys, h, 1, nu, v, b1)
-            call harm_set(y2, h, b1(:, 1))
-        end do
+        if (allocated(sys%phr)) then
+            ! real modes, the same for every harmonic: all harmonics in two products (the
+            ! modes are read twice, not twice per harmonic); A^T commutes with harm_col
+            nm = size(sys%gj, 1)
+            allocate (vr(nm, nc))
+            call dgemm('T', 'N', nm, nc, nu, 1.0_wp, sys%phr, size(sys%phr, 1), f, nu, &
+                       0.0_wp, vr, nm)
+            do h = 0, sys%nh
+                call harm_set(vr, h, sys%gj(:, h)*harm_col(vr, h))
+            end do
+            call dgemm('N', 'N', nu, nc, nm, 1.0_wp, sys%phr, size(sys%phr, 1), vr, nm, &
+                       0.0_wp, y2, nu)
+        else
+            do h = 0, sys%nh
+                fc = harm_col(f, h)
+                call modal_project(sys, h, fc, v(:, 1))
+                v(:, 1) = sys%gj(:, h)*v(:, 1)
+                call modal_apply(sys, h, 1, nu, v, b1)
+                call harm_set(y2, h, b1(:, 1))
+            end do
+        end if
         y = x + reshape(y2, [n])
     end subroutine jmul
 
     !> b := J^-1 b by restarted GMRES on jcur, right-preconditioned by the LU in jm (from
     !> an earlier J), from the preconditioned start x0 = LU^-1 b, to a residual of GM_TOL
-    !> |b|; ok false (b unchanged) when GM_MAXIT iterations do not get there.
-    subroutine gmres(sys, b, its, ok)
+    !> |b| (or tol |b|); ok false (b unchanged) when GM_MAXIT (or maxit) iterations do not
+    !> get there.
+    subroutine gmres(sys, b, its, ok, tol, maxit)
         type(hbm_condensed), intent(inout) :: sys
         real(wp), intent(inout) :: b(:)
         integer(ip), intent(out) :: its
         logical, intent(out) :: ok
+        real(wp), intent(in), optional :: tol
+        integer(ip), intent(in), optional :: maxit
         integer(ip), parameter :: m = 30
         real(wp), allocatable :: v(:, :), hh(:, :), cs(:), sn(:), gv(:), x(:), r(:), w(:, :)
-        real(wp) :: beta, bn, tmp
-        integer(ip) :: n, j, i, k, linfo
+        real(wp) :: beta, bn, tmp, rtol
+        integer(ip) :: n, j, i, k, linfo, itmax
         n = sys%n
+        rtol = GM_TOL
+        if (present(tol)) rtol = tol
+        itmax = GM_MAXIT
+        if (present(maxit)) itmax = maxit
         allocate (v(n, m + 1), hh(m + 1, m), cs(m), sn(m), gv(m + 1), x(n), r(n), w(n, 1))
         its = 0
         ok = .false.
@@ -477,8 +538,8 @@ contains
             call jmul(sys, x, r)
             r = b - r
             beta = norm2(r)
-            if (beta <= GM_TOL*bn) exit
-            if (its >= GM_MAXIT) return
+            if (beta <= rtol*bn) exit
+            if (its >= itmax) return
             v(:, 1) = r/beta
             gv = 0.0_wp
             gv(1) = beta
@@ -513,7 +574,7 @@ contains
                 hh(j + 1, j) = 0.0_wp
                 gv(j + 1) = -sn(j)*gv(j)
                 gv(j) = cs(j)*gv(j)
-                if (abs(gv(j + 1)) <= 0.1_wp*GM_TOL*bn .or. its >= GM_MAXIT) exit
+                if (abs(gv(j + 1)) <= 0.1_wp*rtol*bn .or. its >= itmax) exit
             end do
             ! x += LU^-1 V y, H y = g (upper triangular)
             do i = k, 1, -1

@@ -76,6 +76,7 @@ contains
             if (allocated(sys%phr)) deallocate (sys%phr)
             if (allocated(sys%psi)) deallocate (sys%psi)
             if (allocated(sys%wm)) deallocate (sys%wm, sys%zm, sys%g, sys%dg, sys%qf, sys%qf1)
+            sys%gm_worth = 0.0_wp     ! gm_cost depends on the number of modes
             allocate (sys%wm(nm, 0:sys%nh), sys%zm(nm, 0:sys%nh), sys%g(nm, 0:sys%nh), &
                       sys%dg(nm, 0:sys%nh), sys%qf(nm, 0:sys%nh), sys%qf1(nm, 0:sys%nh), &
                       stat=stat)

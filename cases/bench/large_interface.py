@@ -21,9 +21,12 @@ the same with tolerances 1e-10 and 1e-12) to 1.4e-8: the round-off of the modal 
 the 1e-8 target on this model.
 
 Scaling (issue 10 item 5): ROM_I models of the same kind with 100, 200, 400, 800 contact
-pairs (2, 4, 8, 16 segments per sector), time per evaluation and per FRF of the first route
-and the growth exponent of a log-log fit; sizes whose sampled point would exceed --budget
-are predicted from the largest measured one by the route's n^3 LU law (marked "pred.").
+pairs (2, 4, 8, 16 segments per sector; generated like the main one, cached), per size the
+first route's FRF: points, evaluations, LUs, GMRES iterations, seconds, and the growth
+exponent of a log-log fit. A size whose whole FRF would exceed --budget (predicted from the
+largest whole one by the n^3 law of a dense LU) runs the first --short points of the same
+sweep, and its FRF time is their time per point x the points of the largest whole FRF
+(marked "short").
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python cases/bench/large_interface.py [--quick]
         [--pairs 200] [--threads 1] [--route "name:key=value,..."] [--budget 600]
@@ -70,6 +73,9 @@ def _parse(argv=None):
     ap.add_argument("--evals", type=int, default=None,
                     help="evaluations of an FRF for extrapolations when the table does not "
                          "run a ROM_II FRF (e.g. 768, today's condensed ROM_II count)")
+    ap.add_argument("--short", type=int, default=12,
+                    help="points of the short run of a scaling size whose FRF exceeds "
+                         "--budget")
     ap.add_argument("--mem-limit", type=float, default=2.0,
                     help="GB: a route whose estimated matrices exceed it is skipped")
     return ap.parse_args(argv)
@@ -162,7 +168,10 @@ def estimated_gb(model, kw) -> float:
         bw = (int(np.max(np.abs(c.row - c.col))) + 1) * n_h
         return 8.0 * (3 * bw + 1) * n / 1e9
     n = model.nonlinear_dofs().size * n_h
-    return 8.0 * 3 * n * n / 1e9
+    if kw.get("coordinates") != "dofs":
+        n = min(n, sum(g.G.shape[0] for g in model.contacts) * n_h)
+    # the LU (and, Krylov mode, the current J); R_h per harmonic is n^2 / (2H+1) more
+    return 8.0 * (1 + bool(kw.get("krylov"))) * n * n / 1e9
 
 
 def per_eval(t: dict) -> dict:
@@ -241,6 +250,7 @@ def run_route(name, kw, model, exc, outputs, band, n_eval_frf, ref_kw, a, label)
                       outputs=outputs, sink=got.append)
             row["frf_s"] = time.perf_counter() - t0
         row.update(points=len(res), evals=int(res.timings.get("evaluations", 0)),
+                   timings=res.timings,
                    complete=res.complete, pe=per_eval(res.timings), extrap=False,
                    peak=float(np.max(res.amp_max)),
                    f_peak=float(res.omega[np.argmax(np.max(res.amp_max, axis=1))]
@@ -276,13 +286,79 @@ def print_row(r):
         diff += f" ABOVE {DIFF_TARGET:g}"
     if r["extrap"]:
         diff += f"; sampled: {r['sampled_evals']} evaluations"
+    tm = r.get("timings")
+    lus = f"{int(tm['factorizations']):5d} {int(tm['krylov_iterations']):6d}" if tm else \
+        f"{'-':>5} {'-':>6}"
     print(f"  {r['rom']:<7} {r['route']:<22} {r['unknowns']:8d} {pe['fortran_total']:10.4f} "
-          f"{fmt_split(pe)}  {frf_s} {pts:>6} {r['evals']:6d}  {diff}")
+          f"{fmt_split(pe)}  {frf_s} {pts:>6} {r['evals']:6d} {lus}  {diff}")
 
 
 def header():
     print(f"  {'ROM':<7} {'route':<22} {'unknowns':>8} {'s/eval':>10} split of an evaluation"
-          f"{'':>44}{'FRF s':>9}{'':8} {'points':>6} {'evals':>6}  diff vs reference")
+          f"{'':>44}{'FRF s':>9}{'':8} {'points':>6} {'evals':>6} {'LUs':>5} {'GMRES':>6}  "
+          f"diff vs reference")
+
+
+def scaling(a, sizes, kw, main_row, pairs, spec_for, roms, band, sectors, n_modes):
+    """Time per FRF against contact pairs (ROM_I of the same kind at each size). A size
+    whose FRF fits --budget (predicted from the last measured one by the n^3 LU law) runs
+    the whole FRF; a larger one runs the first --short points of the same sweep and its
+    FRF time is s/point x the points of the largest whole FRF (marked "short")."""
+    print(f"\nscaling, route {first_route(a)!r}, ROM_I of the same kind (sectors {sectors}, "
+          f"{n_modes} modes per stage)")
+    print(f"  {'pairs':>6} {'ROM DoFs':>8} {'unknowns':>8} {'points':>6} {'evals':>6} "
+          f"{'LUs':>5} {'GMRES':>6} {'s/point':>8} {'FRF s':>9}  {'gen. s':>7}")
+    xs, ys = [], []
+    last = None          # (unknowns, FRF s, points) of the largest whole FRF
+    for p in sizes:
+        if p % sectors or p // sectors < 2:
+            print(f"  {p:6d} skipped: not >= 2 per sector of {sectors}")
+            continue
+        t0 = time.perf_counter()
+        rp = roms if p == pairs else flange.flange_roms(spec_for(p), a.work)
+        t_gen = time.perf_counter() - t0
+        mp, ep, op = flange.frirom_models(rp, "I")
+        gb = estimated_gb(mp, kw)
+        if gb > a.mem_limit:
+            print(f"  {p:6d} skipped: estimated {gb:.1f} GB > --mem-limit {a.mem_limit:g}")
+            continue
+        n_u = mp.nonlinear_dofs().size * (2 * H + 1)
+        if kw.get("coordinates") != "dofs":
+            n_u = min(n_u, sum(g.G.shape[0] for g in mp.contacts) * (2 * H + 1))
+        whole = last is None or last[1] * (n_u / last[0]) ** 3 <= a.budget
+        if p == pairs and main_row.get("points"):
+            res_t, npts, t_frf = main_row["timings"], main_row["points"], main_row["frf_s"]
+            note, whole = "(table above)", True
+        else:
+            o = options(kw, mp)
+            if not whole:
+                o = dataclasses.replace(o, max_points=a.short)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                t1 = time.perf_counter()
+                res = frf(mp, ep, 2 * np.pi * band[0], 2 * np.pi * band[1], o, outputs=op)
+                t_frf = time.perf_counter() - t1
+            res_t, npts, note = res.timings, len(res), ""
+            if not whole:
+                note = f"short: {npts} points x {last[2]} points of the {last[3]}-pair FRF"
+                t_frf = t_frf / npts * last[2]
+        if whole:
+            last = (n_u, t_frf, npts, p)
+        print(f"  {p:6d} {mp.n_dof:8d} {n_u:8d} {npts:6d} {int(res_t['evaluations']):6d} "
+              f"{int(res_t['factorizations']):5d} {int(res_t['krylov_iterations']):6d} "
+              f"{t_frf / (last[2] if not whole else npts):8.3f} {t_frf:9.1f}  {t_gen:7.1f} "
+              f"{note}")
+        xs.append(p)
+        ys.append(t_frf)
+        sys.stdout.flush()
+    if len(xs) >= 2 and min(ys) > 0:
+        slope = np.polyfit(np.log(xs), np.log(ys), 1)[0]
+        print(f"  growth exponent of the FRF time in contact pairs (log-log fit): {slope:.2f}"
+              f" (target <= 2)")
+
+
+def first_route(a):
+    return next(iter(routes(a.route, a.only)))
 
 
 def main(a):
@@ -361,61 +437,8 @@ def main(a):
     if quick and a.scaling == SCALING:
         scal = [16, 32]
     if scal:
-        kw = rts[first]
-        n_eval = rows[(first, "ROM_II")].get("evals", a.evals)
-        print(f"\nscaling, route {first!r}, ROM_I of the same kind (sectors {sectors}, "
-              f"{n_modes} modes per stage); FRF s = s/eval x {n_eval} evaluations")
-        print(f"  {'pairs':>6} {'ROM DoFs':>8} {'unknowns':>8} {'s/eval':>10} {'FRF s':>10}"
-              f"  {'gen. s':>7}")
-        xs, ys = [], []
-        law = None
-        for p in scal:
-            if p % sectors or p // sectors < 2:
-                print(f"  {p:6d} skipped: not >= 2 per sector of {sectors}")
-                continue
-            if law is not None:
-                # predicted: n^3 from the largest measured size (today's dense LU)
-                n_pred = law[0] * (p / law[1])
-                t_pred = law[2] * (n_pred / law[0]) ** 3
-                if t_pred * 4 > a.budget:
-                    t_frf = t_pred * (n_eval or 0)
-                    print(f"  {p:6d} {'':>8} {n_pred:8.0f} {t_pred:10.2f} {t_frf:10.1f}  "
-                          f"{'':>7} pred. (n^3 from {law[1]} pairs; a sampled point would "
-                          f"exceed --budget)")
-                    xs.append(p)
-                    ys.append(t_frf)
-                    continue
-            main_row = rows[(first, "ROM_I")]
-            if p == pairs and "pe" in main_row:       # measured above: not again
-                pe = main_row["pe"]
-                t_frf = pe["fortran_total"] * (n_eval or 0)
-                print(f"  {p:6d} {m1.n_dof:8d} {main_row['unknowns']:8d} "
-                      f"{pe['fortran_total']:10.4f} {t_frf:10.1f}  {'':>7} (table above)")
-                xs.append(p)
-                ys.append(t_frf)
-                law = (main_row["unknowns"], p, pe["fortran_total"])
-                continue
-            t0 = time.perf_counter()
-            rp = roms if p == pairs else flange.flange_roms(spec_for(p), a.work)
-            t_gen = time.perf_counter() - t0
-            mp, ep, op = flange.frirom_models(rp, "I")
-            if estimated_gb(mp, kw) > a.mem_limit:
-                print(f"  {p:6d} skipped: estimated {estimated_gb(mp, kw):.1f} GB")
-                continue
-            pts, t, _ = sampled(mp, ep, op, kw, [band[0]])
-            pe = per_eval(t)
-            t_frf = pe["fortran_total"] * (n_eval or 0)
-            n_u = pts[0].unknowns.size
-            print(f"  {p:6d} {mp.n_dof:8d} {n_u:8d} {pe['fortran_total']:10.4f} "
-                  f"{t_frf:10.1f}  {t_gen:7.1f}")
-            xs.append(p)
-            ys.append(t_frf)
-            law = (n_u, p, pe["fortran_total"])
-            sys.stdout.flush()
-        if len(xs) >= 2 and min(ys) > 0:
-            slope = np.polyfit(np.log(xs), np.log(ys), 1)[0]
-            print(f"  growth exponent of the FRF time in contact pairs (log-log fit): "
-                  f"{slope:.2f}")
+        scaling(a, scal, rts[first], rows.get((first, "ROM_I"), {}), pairs, spec_for, roms,
+                band, sectors, n_modes)
     print(f"\ntotal benchmark time {time.perf_counter() - t_start:.0f} s")
     r1, r2 = rows[(first, "ROM_I")], rows[(first, "ROM_II")]
 

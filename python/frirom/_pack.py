@@ -28,8 +28,11 @@ if TYPE_CHECKING:
 #: Largest Hill eigenproblem (2 n_dof (2H+1)) solved densely (all exponents, dgeev);
 #: above it the exponents of the strip |Im s| <= omega/2 come from shift-invert Arnoldi.
 HILL_MAX = int_constant("HILL_DENSE_MAX")
-#: Largest model whose receptances 'auto' takes from all its modes (a dense eigen-solve).
-MODES_MAX = 4000
+#: Largest model whose receptances 'auto' takes from all its modes (a dense eigen-solve):
+#: a memory bound (a few n^2 arrays, 0.5 GB each at 8 000); below it the flop test decides.
+#: The 800-pair flange's ROM_I (5 500 DoFs, dense CB interface block) takes the modes:
+#: ~2e12 flops once, where a sparse LU per harmonic costs ~1e12 at every frequency.
+MODES_MAX = 8000
 #: Evaluations of an FRF that 'auto' weighs one eigen-decomposition against (a 100-point
 #: curve takes some 500 to 1 500)
 EIG_EVALS = 500
