@@ -207,6 +207,7 @@ class _Continuation:
     yscale: float = 1.0
     prev_t: float | None = None   # parameter part of the previous point's tangent
     pending: bool = False         # points[-1] awaits its tangent from the next call
+    n_before: int = 0             # points a resumed run made before (count to max_points)
     t0: float = 0.0               # perf_counter at the start of the current call
 
     @property
@@ -223,7 +224,12 @@ class _Continuation:
 
     def start(self, start, H_start) -> None:
         """From nothing, or from a saved point (FRFPoint or dict): resume from its tangent,
-        or solve at its parameter first (no tangent, other H or unknown history)."""
+        or solve at its parameter first (no tangent, other H or unknown history). A
+        checkpoint (dict with 'ds', the step the run continued with, and 'n_points', the
+        points made up to it; FRFWriter.resume_point) continues exactly as the
+        uninterrupted run did: same step, arc-length scale, history and call boundaries;
+        its 'lscale' (parameter range of the run that wrote it) rescales the tangent when
+        the range was extended since."""
         p = self.packed
         self.t0 = time.perf_counter()
         self.ds = p.opts.ds
@@ -248,6 +254,7 @@ class _Continuation:
                 self.start_mode, self.tan0 = START_RESUME, np.asarray(tan, dtype=float)
                 if self.tan0.size != p.ny + 1:
                     raise SizeError("start.tangent: size does not match the unknowns")
+                self.n_before = int(start.get("n_points", 0))
         if self.start_mode == START_CONTINUE:
             self._first_point(start is None)
         self.yscale = float(np.linalg.norm(self.y0)) or 1.0
@@ -256,6 +263,15 @@ class _Continuation:
             # keep the arc-length scaling the saved tangent was computed with
             if start.get("yscale"):
                 self.yscale = float(start["yscale"])
+            if start.get("ds") is not None:
+                # a checkpoint: the uninterrupted run's next call, as _advance made it
+                tan = self.tan0
+                old_l = float(start.get("lscale") or self.lscale)
+                if old_l != self.lscale:        # the range changed: same direction
+                    tan = tan.copy()
+                    tan[-1] *= old_l / self.lscale
+                    tan /= np.linalg.norm(tan)
+                self._continue_from(self.y0, self.lam0, tan, float(start["ds"]))
 
     def _first_point(self, cold: bool) -> None:
         """Solve at fixed parameter with a purely relative update test; the size of that
@@ -287,6 +303,7 @@ class _Continuation:
             self.prev_t = new[0].tangent[-1]
             self.points[-1].tangent = new[0].tangent
             self.points[-1].yscale = self.yscale
+            self.points[-1].ds_next = new[0].ds_next
             self._emit(self.points[-1])
             new = new[1:]
         elif self.pending:
@@ -303,8 +320,9 @@ class _Continuation:
     def batches(self) -> tuple[bool, str]:
         """Continue until lam_end, a failure or max_points; returns (complete, message)."""
         o = self.packed.opts
-        while len(self.points) < o.max_points:
-            maxpts = min(o.batch, o.max_points - len(self.points)) + int(self.pending)
+        while self.n_before + len(self.points) < o.max_points:
+            maxpts = min(o.batch, o.max_points - self.n_before - len(self.points)) + \
+                int(self.pending)
             res = self._call(self.y0, self.start_mode, self.yscale, maxpts)
             t_call = time.perf_counter() - self.t0
             self.t0 = time.perf_counter()
@@ -312,6 +330,8 @@ class _Continuation:
             new = self.packed.points(res, self.omega_fix, t_call)
             for p in new:
                 p.yscale = self.yscale
+            if new and res.info == 0:
+                new[-1].ds_next = res.ds_out      # a checkpoint (FRFWriter.resume_point)
             self._take(new)
             if res.info != 0:
                 return False, self._stopped(res.info, res.msg.strip())
@@ -326,7 +346,7 @@ class _Continuation:
         """Explain a run Fortran stopped; raise if it made no point at all."""
         if info == CODES["FRIROM_ERR_CONT"] and self.packed.nw:
             message += _contact_advice(self.packed.opts, message)
-        if not self.points:
+        if not self.points and not self.n_before:
             raise_for_status(info, message)
         warnings.warn(f"frirom: continuation stopped early, {len(self.points)} points kept: "
                       f"{message}", RuntimeWarning, stacklevel=5)
@@ -337,8 +357,13 @@ class _Continuation:
         against the largest solution so far: near a resonance 100x above the first point,
         steps would otherwise crawl in frequency."""
         last = self.points[-1]
-        self.y0, self.lam0, self.tan0 = last.unknowns, last.parameter, last.tangent
-        self.ds, self.start_mode = ds_out, START_RESUME
+        self._continue_from(last.unknowns, last.parameter, last.tangent, ds_out)
+
+    def _continue_from(self, y, lam, tan, ds) -> None:
+        """The next call starts from the converged point (y, lam) with tangent tan and
+        step ds (the arc-length scale grows with the solution, see _advance)."""
+        self.y0, self.lam0, self.tan0 = y, lam, tan
+        self.ds, self.start_mode = ds, START_RESUME
         ny0 = float(np.linalg.norm(self.y0))
         if ny0 > 2.0 * self.yscale:
             self.tan0 = self.tan0.copy()
