@@ -66,7 +66,8 @@ class SolverOptions:
         Initial, smallest and largest arc-length step, in scaled variables (unknowns /
         |first point|, parameter / range): dimensionless.
     max_points : int
-        Points per run; a run that reaches it stops with ``complete`` False.
+        Points per run; a run that reaches it stops with ``complete`` False (a run resumed
+        from a checkpoint counts the points made before it).
     parameter : {'frequency', 'load'}
         The continuation parameter: frequency omega (rad/s) or a load factor (set by
         :func:`frf`, :func:`load_curve` and :func:`solve_point` themselves).
@@ -489,7 +490,9 @@ def frf(model: Model | CyclicModel, excitation: Excitation, omega_start: float,
         ``sink(point)`` receives every converged FRFPoint as it comes.
     start : FRFPoint or dict, optional
         Resume from a saved point: {'parameter' (or 'omega'), 'unknowns', 'tangent',
-        'slider', 'yscale'} (e.g. FRFWriter.resume_point).
+        'slider', 'yscale'}; a checkpoint (FRFWriter.resume_point) adds 'ds' and
+        'n_points' (and 'lscale' when the range was extended) and continues exactly as the
+        uninterrupted run did.
     start_harmonics : int, optional
         H of the start's unknowns when it differs from options.harmonics: they are padded
         or cut and re-solved first.
