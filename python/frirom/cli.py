@@ -133,7 +133,7 @@ def _run_locked(args, deck, out: Path) -> int:
     h5 = out / "frf.h5"
     names = [c.name for c in deck.contacts]
     fingerprint = deck_fingerprint(deck)
-    start, done = _resume_start(h5, deck, fingerprint, out) if args.resume else (None, False)
+    start, done = _resume_start(h5, deck, fingerprint) if args.resume else (None, False)
     if not done:
         shutil.copyfile(deck.path, out / "deck.toml")
 
@@ -204,7 +204,7 @@ def _run_locked(args, deck, out: Path) -> int:
     return EXIT_OK
 
 
-def _resume_start(h5: Path, deck, fingerprint: str, out: Path):
+def _resume_start(h5: Path, deck, fingerprint: str):
     """(start, done) of ``frirom run --resume``: the checkpoint to continue from (None:
     from the beginning), done when the stored run is complete and the deck does not
     extend it. Refuses (InputError) a changed deck, listing the changes, a range that is

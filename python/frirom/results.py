@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import functools
+import os
 import signal
 import threading
 import warnings
@@ -380,16 +381,23 @@ def _committed_rows(f, path) -> tuple[int, int, int]:
 
 @contextlib.contextmanager
 def _signals_deferred():
-    """Hold SIGINT and SIGTERM until the block ends: a Ctrl-C lands between records."""
-    if (not hasattr(signal, "pthread_sigmask")
-            or threading.current_thread() is not threading.main_thread()):
+    """Hold SIGINT and SIGTERM until the block ends (a Ctrl-C lands between records): the
+    Python handlers are swapped for one that notes the signal, which is sent again once
+    the old handlers are back (Python runs handlers in the main thread, whichever thread
+    the OS chose, so masking the signal in one thread would not do)."""
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+    got = []
+    sigs = (signal.SIGINT, signal.SIGTERM)
+    old = {s: signal.signal(s, lambda n, _frame: got.append(n)) for s in sigs}
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        for s in sigs:
+            signal.signal(s, old[s])
+        for n in dict.fromkeys(got):
+            os.kill(os.getpid(), n)
 
 
 class FRFWriter:
@@ -399,7 +407,7 @@ class FRFWriter:
     every dataset has its row, so a run killed at any moment (SIGKILL, power loss between
     HDF5 flushes aside) leaves a readable file whose extra rows, if any, are a torn record
     that :meth:`FRF.load` ignores and reopening with ``append=True`` removes
-    (:attr:`repaired`); SIGINT and SIGTERM wait until the record is whole.
+    (:attr:`repaired`); SIGINT and SIGTERM wait until the record is whole (main thread).
 
     Points that end a call into Fortran (``FRFPoint.ds_next`` finite) are checkpoints: the
     file keeps the solver's state there (unknowns, tangent, step, arc-length scale; the
