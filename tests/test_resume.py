@@ -123,15 +123,20 @@ def test_ctrl_c_inside_append_waits_for_the_record(joint, tmp_path, monkeypatch)
         sink=pts.append)
     real = FRFWriter._append
     w.append(pts[0])
+    # Python's own SIGINT handler (gmsh, imported by other tests, installs SIG_DFL)
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
 
     def interrupted(self, p):
         os.kill(os.getpid(), signal.SIGINT)       # lands in the middle of the record
         time.sleep(0.05)
         real(self, p)
     monkeypatch.setattr(FRFWriter, "_append", interrupted)
-    with pytest.raises(KeyboardInterrupt):
-        w.append(pts[1])
-        time.sleep(0.05)        # the handler runs at the next bytecode after append
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            w.append(pts[1])
+            time.sleep(0.05)    # the handler runs at the next bytecode after append
+    finally:
+        signal.signal(signal.SIGINT, old)
     w.close(False, "interrupted")
     with h5py.File(path, "r") as f:
         assert list(f.attrs["committed"][:1]) == [2]
