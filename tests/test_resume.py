@@ -165,36 +165,60 @@ def test_unequal_datasets_from_before_are_repaired(joint, tmp_path):
         assert f["omega"].shape[0] == f["fold"].shape[0] == 12
 
 
-def _frirom(*args, **kw):
+def _frirom(*args, script=None):
+    """`frirom ARGS` (or the Python `script` with ARGS) in another process."""
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
-    return subprocess.Popen([sys.executable, "-m", "frirom.cli", *map(str, args)], env=env,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                            **kw)
+    head = ["-c", script] if script else ["-m", "frirom.cli"]
+    return subprocess.Popen([sys.executable, *head, *map(str, args)], env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+
+
+#: `frirom run` that SIGKILLs itself when its file holds K points, before the next
+#: record or (WHERE = "inside") in the middle of it: some datasets have its row
+_DYING_RUN = """
+import os, signal, sys
+from frirom import results
+from frirom.cli import main
+k, where = int(sys.argv[1]), sys.argv[2]
+real = results.FRFWriter._append
+def dying(self, p):
+    if self._commit[0] == k:
+        if where == "inside":
+            for name in ("slider", "omega", "X"):
+                self.f[name].resize(k + 1, axis=0)
+                self.f[name][k] = getattr(p, name)
+            self.f.flush()
+        os.kill(os.getpid(), signal.SIGKILL)
+    real(self, p)
+results.FRFWriter._append = dying
+sys.exit(main(sys.argv[3:]))
+"""
 
 
 @pytest.mark.slow
 def test_sigkill_then_resume_equals_uninterrupted(deck, tmp_path):
-    """`frirom run` killed by SIGKILL at several moments, then `--resume`: frf.h5 is
-    readable after every kill and the finished file equals an uninterrupted run's (run
-    in another process: the same build gives the same points bit for bit)."""
-    t0 = time.perf_counter()
+    """`frirom run` killed by SIGKILL at several moments (before the first checkpoint,
+    inside a record, between records), each time resumed: frf.h5 is readable after every
+    kill, the torn record is removed and said so, and the finished file equals an
+    uninterrupted run's (run in another process: the same build gives the same points bit
+    for bit)."""
     ref = _frirom("run", deck, "--out", tmp_path / "ref", "--quiet")
-    assert ref.wait(120) == 0, ref.stderr.read()
-    t_ref = time.perf_counter() - t0        # start-up (imports, deck) and the run
+    assert ref.wait(300) == 0, ref.stderr.read()
     ref = FRF.load(tmp_path / "ref" / "frf.h5")
     out = tmp_path / "out"
-    kills = 0
-    for delay in t_ref * np.array([0.7, 0.6, 0.8, 0.9]):
-        p = _frirom("run", deck, "--out", out, "--quiet", *(["--resume"] * kills))
-        time.sleep(delay)
-        p.send_signal(signal.SIGKILL)
-        p.wait(60)
-        if (out / "frf.h5").is_file() and p.returncode == -signal.SIGKILL:
-            kills += 1
-            FRF.load(out / "frf.h5")        # readable whatever the moment
-    assert kills >= 2
+    resume = []
+    for k, where in ((5, "before"), (48, "inside"), (77, "before")):
+        p = _frirom(str(k), where, "run", deck, "--out", out, "--quiet", *resume,
+                    script=_DYING_RUN)
+        assert p.wait(300) == -signal.SIGKILL, p.stderr.read()
+        err = p.stderr.read()
+        if resume and k == 77:
+            assert "removed a torn last record" in err
+        cut = FRF.load(out / "frf.h5")        # readable
+        assert len(cut) == k and not cut.complete
+        resume = ["--resume"]
     p = _frirom("run", deck, "--out", out, "--quiet", "--resume")
-    assert p.wait(120) == 0, p.stderr.read()
+    assert p.wait(300) == 0, p.stderr.read()
     _same(FRF.load(out / "frf.h5"), ref, "after SIGKILLs")
 
 

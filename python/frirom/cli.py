@@ -146,8 +146,8 @@ def _run_locked(args, deck, out: Path) -> int:
                            attrs={"deck_fingerprint": fingerprint,
                                   "omega_range": [deck.omega_start, deck.omega_end]})
         if writer.repaired:
-            print(f"frirom: {h5}: removed a torn last record ({writer.repaired} rows of a "
-                  "point whose writing was cut short)", file=sys.stderr)
+            print(f"frirom: {h5}: removed a torn last record (a point whose writing was "
+                  "cut short)", file=sys.stderr)
         if args.resume:
             n0 = start["n_points"] if start and "n_points" in start else 0
             print(f"frirom: resuming after point {n0} (the last checkpoint)"
