@@ -252,14 +252,14 @@ contains
         integer(ip), intent(in) :: nsamp                !! N
         integer(ip), intent(out) :: info
         character(len=*), intent(inout), optional :: errmsg
-        logical, intent(in), optional :: measure        !! FFTW_MEASURE (default for N <= 4096;
-                                                        !! planning costs once per process, size)
+        logical, intent(in), optional :: measure        !! FFTW_MEASURE (default FFTW_ESTIMATE)
         integer(ip), intent(in), optional :: nbatch     !! elements per batch (default 16)
         logical :: meas
         integer(ip) :: nb, nc
-        ! FFTW_MEASURE pays for itself at the sizes Newton loops use; for very long
-        ! periods (N > 4096, accuracy studies) its planning time would dominate.
-        meas = nsamp <= 4096
+        ! FFTW_ESTIMATE by default: FFTW_MEASURE times candidate algorithms and may pick a
+        ! different one run to run (under another machine load), whose round-off differs,
+        ! so the same deck would not give the same points bit for bit.
+        meas = .false.
         if (present(measure)) meas = measure
         nb = DEFAULT_BATCH
         if (present(nbatch)) nb = max(1_ip, nbatch)

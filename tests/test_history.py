@@ -181,9 +181,16 @@ def test_resume_restores_history_and_reads_files_from_before(tmp_path):
     assert np.allclose(saved.X[n_stop:, 0, 0], full.X[-1, 0, 0], rtol=1e-9, atol=0)
     assert saved.omega[-1] == full.omega[-1]
 
-    # the same file as written before this change
+    # the same file as written before the history was kept (and before checkpoints: the
+    # last point's state in last_* datasets and attributes)
+    last = FRFWriter.resume_point(path)
     with h5py.File(path, "a") as f:
-        del f["slider"], f["last_slider"]
+        for name in ("slider", "ck_unknowns", "ck_tangent", "ck_scalars"):
+            del f[name]
+        del f.attrs["committed"]
+        f["last_unknowns"], f["last_tangent"] = last["unknowns"], last["tangent"]
+        f.attrs["last_parameter"] = f.attrs["last_omega"] = last["parameter"]
+        f.attrs["last_yscale"] = last["yscale"]
     old = FRF.load(path)
     assert old.slider is None and len(old) == n
     with pytest.warns(RuntimeWarning, match="before frirom kept the contact history"):

@@ -27,14 +27,31 @@ from pathlib import Path
 
 from . import __version__
 from ._errors import FriromError, InputError
+from ._resume import EXIT_INPUT, EXIT_INTERRUPTED, EXIT_OK, EXIT_STOPPED
+
+
+_RUN_EPILOG = """\
+One run at a time writes a results folder (a second one on the same --out is refused).
+The same deck on the same build gives the same points bit for bit, and a run killed at any
+moment then resumed gives the points the uninterrupted run would have.
+
+exit codes:
+  0    the run reached the end of its frequency range
+  2    bad input, refused --resume, or the folder is in use: nothing computed
+  3    the run stopped before the end of its range (continuation failure, max_points,
+       the curve turned back); where and why are printed, the points are in OUT/frf.h5
+  130  interrupted (Ctrl-C); the points are kept, continue with --resume
+"""
 
 
 def _add_run(sub) -> None:
     p = sub.add_parser(
         "run", help="compute the forced response of a deck",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
         description="Compute the forced response (FRF) described by a TOML deck. Points are "
         "appended to OUT/frf.h5 as they converge (an interrupted run continues with "
-        "--resume); at the end OUT/frf.csv, OUT/frf.png and OUT/states.png are written.")
+        "--resume); at the end OUT/frf.csv, OUT/frf.png and OUT/states.png are written.",
+        epilog=_RUN_EPILOG)
     p.add_argument("decks", type=Path, nargs="+", metavar="DECK",
                    help="the TOML deck (see docs/deck.md); several decks, or folders whose "
                    "*.toml decks all run, in one go")
@@ -42,8 +59,10 @@ def _add_run(sub) -> None:
                    help="output folder (default: results/<deck name>); with several decks "
                    "the parent folder of one subfolder per deck (OUT/<deck name>)")
     p.add_argument("--resume", action="store_true",
-                   help="continue the run stored in OUT/frf.h5 from its last point (each "
-                   "deck's own folder with several decks)")
+                   help="continue the run stored in OUT/frf.h5 from its last checkpoint "
+                   "(the same points as an uninterrupted run); refused if the deck or a file "
+                   "it names changed, except frequency.end and continuation.max_points, "
+                   "which may extend the run (each deck's own folder with several decks)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_run_decks)
 
@@ -218,38 +237,54 @@ class _Progress:
 
 
 def cmd_run(args) -> int:
+    from ._resume import ResultsLock
     from .deck import load_deck
-    from .plots import plot_frf, plot_states
-    from .results import FRF, FRFWriter
-    from .solver import frf
 
     deck = load_deck(args.deck)
     for line in deck.log:
         print(f"frirom: {line}")
     linear = _linear_lines(deck)
     out = args.out if args.out is not None else Path("results") / deck.path.stem
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out}: is a file; expected a folder for the results")
     out.mkdir(parents=True, exist_ok=True)
+    lock = ResultsLock(out)     # before anything in out is opened or replaced
+    try:
+        return _run_locked(args, deck, out)
+    finally:
+        lock.release()
+
+
+def _run_locked(args, deck, out: Path) -> int:
+    """cmd_run once the results folder is locked."""
+    from ._resume import deck_fingerprint
+    from .plots import plot_frf, plot_states
+    from .results import FRF, FRFWriter
+    from .solver import frf
+
     h5 = out / "frf.h5"
     names = [c.name for c in deck.contacts]
-    start = None
-    if args.resume:
-        if not h5.is_file():
-            raise InputError(f"{h5}: nothing to resume (run without --resume first)")
-        previous = FRF.load(h5)
-        if previous.complete:
-            print(f"frirom: {h5} is already complete ({len(previous)} points); "
-                  "rewriting the CSV and plots", file=sys.stderr)
-        else:
-            start = FRFWriter.resume_point(h5)
-    else:
+    fingerprint = deck_fingerprint(deck)
+    start, done = _resume_start(h5, deck, fingerprint) if args.resume else (None, False)
+    if not done:
         shutil.copyfile(deck.path, out / "deck.toml")
 
     model, excitation, options = deck.model(), deck.excitation(), deck.options()
     print(f"frirom: {model.n_dof} coordinates, {len(model.nonlinear_dofs())} in contact, "
           f"{sum(g.n_elem for g in model.contacts)} contact elements, H = {deck.harmonics}")
-    if start is not None or not args.resume:
+    result = None
+    if not done:
         writer = FRFWriter(h5, deck.outputs, names, deck.harmonics, append=args.resume,
-                           output_labels=deck.output_names, meta=deck.result_meta())
+                           attrs={"deck_fingerprint": fingerprint,
+                                  "omega_range": [deck.omega_start, deck.omega_end]})
+        if writer.repaired:
+            print(f"frirom: {h5}: removed a torn last record (a point whose writing was "
+                  "cut short)", file=sys.stderr)
+        if args.resume:
+            n0 = start["n_points"] if start and "n_points" in start else 0
+            print(f"frirom: resuming after point {n0} (the last checkpoint)"
+                  + (f"; the {writer.dropped} points after it are computed again"
+                     if writer.dropped else ""), file=sys.stderr)
         progress = _Progress(deck, args.quiet)
 
         def sink(point):
@@ -265,7 +300,7 @@ def cmd_run(args) -> int:
             writer.close(complete=False, message="interrupted")
             print(f"frirom: interrupted; {h5} keeps every converged point: continue with "
                   f"`frirom run {args.deck} --out {out} --resume`", file=sys.stderr)
-            return 130
+            return EXIT_INTERRUPTED
         except BaseException as exc:
             progress.close()
             writer.close(complete=False, message=f"{type(exc).__name__}: {exc}")
@@ -274,9 +309,6 @@ def cmd_run(args) -> int:
         writer.close(complete=result.complete, message=result.message)
         elapsed = time.perf_counter() - t0
         print(f"frirom: {result.solver_info}")
-        if not result.complete:
-            print(f"frirom: the run stopped early: {result.message}; the points computed "
-                  f"are in {h5}", file=sys.stderr)
     else:
         elapsed = 0.0
 
@@ -299,15 +331,79 @@ def cmd_run(args) -> int:
           + ", ".join(str(p) for p in written))
     # a resumed run's own peaks cover only its part: the whole file's then (between points)
     _print_peaks(full if args.resume else result, deck)
-    return 0
+    if not full.complete:
+        _print_stop(full, deck, h5)
+        return EXIT_STOPPED
+    return EXIT_OK
 
 
-#: Exit code of a run that stopped before the end of its frequency range.
-EXIT_INCOMPLETE = 3
-#: Exit code of a deck that cannot be read (a FriromError; the message names the field).
-EXIT_BAD_DECK = 2
-#: Exit code of an interrupted run (Ctrl-C).
-EXIT_INTERRUPTED = 130
+def _resume_start(h5: Path, deck, fingerprint: str):
+    """(start, done) of ``frirom run --resume``: the checkpoint to continue from (None:
+    from the beginning), done when the stored run is complete and the deck does not
+    extend it. Refuses (InputError) a changed deck, listing the changes, a range that is
+    not extended, and a file that cannot be read."""
+    import h5py
+    import numpy as np
+
+    from ._resume import EXTENDABLE, deck_changes
+    from .results import FRF, FRFWriter
+    if not h5.is_file():
+        raise InputError(f"{h5}: nothing to resume (run without --resume first)")
+    try:
+        f = h5py.File(h5, "r")
+    except OSError as exc:
+        raise InputError(f"{h5}: cannot be read as HDF5 ({exc}); it cannot be resumed: run "
+                         "without --resume (the folder's results are replaced)") from None
+    with f:
+        old = f.attrs.get("deck_fingerprint")
+        rng = f.attrs.get("omega_range")
+    redo = "run without --resume (the results in that folder are replaced) or choose " \
+           "another --out"
+    if old is None:
+        print(f"frirom: {h5} was written before frirom kept the deck's fingerprint: "
+              "not checked against the deck", file=sys.stderr)
+    else:
+        changes = deck_changes(str(old), fingerprint)
+        if changes:
+            raise InputError(f"{h5}: the deck changed since these results were made (only "
+                             f"{' and '.join(EXTENDABLE)} may change on --resume):\n  "
+                             + "\n  ".join(changes) + f"\n{redo}")
+    previous = FRF.load(h5)         # refuses an inconsistent file
+    extended = rng is not None and float(rng[1]) != deck.omega_end
+    if extended and (deck.omega_end - rng[1]) * np.sign(rng[1] - rng[0]) < 0:
+        raise InputError(f"{deck.path}: frequency.end: --resume may extend the range, not "
+                         f"shorten it ({rng[1]:.6g} rad/s then, {deck.omega_end:.6g} now); "
+                         + redo)
+    if previous.complete and not extended:
+        print(f"frirom: {h5} is already complete ({len(previous)} points); rewriting the "
+              "CSV and plots", file=sys.stderr)
+        return None, True
+    try:
+        start = FRFWriter.resume_point(h5)
+    except InputError as exc:
+        print(f"frirom: {exc}: starting from the beginning", file=sys.stderr)
+        return None, False
+    if rng is not None:
+        start["lscale"] = abs(float(rng[1]) - float(rng[0]))
+    return start, False
+
+
+def _print_stop(full, deck, h5) -> None:
+    """Where and why a run stopped before the end of its range."""
+    from .plots import frequency_axis
+    where = ""
+    if len(full):
+        f, label = frequency_axis(full.omega[-1], deck.frequency_unit)
+        where = f" at {float(f):.6g} {label[label.index('[') + 1:-1]} after {len(full)} points"
+    if "max_points" in full.message:
+        hint = "raise continuation.max_points and continue with --resume"
+    elif full.message == "interrupted" or full.message.startswith("running"):
+        hint = "continue with --resume"
+    else:
+        hint = ("the same deck resumed stops at the same place: change the deck and run "
+                "without --resume")
+    print(f"frirom: the run stopped before the end of its range{where}: {full.message}; "
+          f"the points are in {h5}; {hint} (exit code 3)", file=sys.stderr)
 
 
 def _deck_files(paths) -> list[Path]:
@@ -336,19 +432,14 @@ def _deck_files(paths) -> list[Path]:
 
 
 def _run_one(args, deck: Path, out: Path | None) -> int:
-    """cmd_run on one deck of a batch: its exit code, EXIT_BAD_DECK for a deck it could not
-    read, EXIT_INCOMPLETE for a run that returned 0 but whose frf.h5 does not reach the end
-    of the range."""
-    from .results import FRF
+    """cmd_run on one deck of a batch: its exit code (EXIT_INPUT for a deck it could not
+    read)."""
     one = argparse.Namespace(**{**vars(args), "deck": deck, "out": out})
     try:
         code = cmd_run(one)
     except FriromError as exc:
         print(f"frirom: error: {exc}", file=sys.stderr)
-        return EXIT_BAD_DECK
-    h5 = (out if out is not None else Path("results") / deck.stem) / "frf.h5"
-    if code == 0 and h5.is_file() and not FRF.load(h5).complete:
-        return EXIT_INCOMPLETE
+        return EXIT_INPUT
     return code
 
 
@@ -368,7 +459,7 @@ def cmd_run_decks(args) -> int:
         if codes[-1] == EXIT_INTERRUPTED:
             print(f"frirom: interrupted; {len(decks) - i - 1} decks not run", file=sys.stderr)
             break
-    what = {0: "complete", EXIT_BAD_DECK: "error in the deck", EXIT_INCOMPLETE:
+    what = {0: "complete", EXIT_INPUT: "error in the deck", EXIT_STOPPED:
             "stopped before the end of its range", EXIT_INTERRUPTED: "interrupted"}
     for deck, code in zip(decks, codes):
         print(f"frirom: {deck}: {what.get(code, f'exit code {code}')}")

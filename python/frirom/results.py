@@ -3,8 +3,12 @@ writer for long runs that can be reopened to resume."""
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import functools
+import os
+import signal
+import threading
 import warnings
 from dataclasses import dataclass, field
 
@@ -186,6 +190,10 @@ class FRFPoint:
     #: w0 a run restarted from this point needs; a contact stuck all cycle keeps it).
     #: With SolverOptions(history=False) it is the w0 every point started from.
     slider: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: arc-length step the run continues with after this point when the point ends a call
+    #: into Fortran (a checkpoint: resuming there repeats the uninterrupted run exactly);
+    #: NaN for the other points
+    ds_next: float = float("nan")
 
 
 @dataclass
@@ -396,11 +404,12 @@ class FRF:
             missing = [n for n in cls._ARRAYS if n not in f]
             if missing:
                 raise InputError(f"{path}: not a frirom FRF file (missing {missing})")
-            kw = {n: f[n][...] for n in cls._ARRAYS}
+            n = _committed_rows(f, path)[0]    # rows beyond: a torn record
+            kw = {k: f[k][...] if k == "output_dofs" else f[k][:n] for k in cls._ARRAYS}
             kw["stable"] = kw["stable"].astype(bool)
             kw["fold"] = kw["fold"].astype(bool)
             # files written before the contact history was kept have no slider
-            kw["slider"] = f["slider"][...] if "slider" in f else None
+            kw["slider"] = f["slider"][:n] if "slider" in f else None
             if kw["slider"] is not None and kw["slider"].shape[0] != kw["omega"].shape[0]:
                 raise InputError(f"{path}: 'slider' has {kw['slider'].shape[0]} rows for "
                                  f"{kw['omega'].shape[0]} points")
@@ -421,28 +430,96 @@ class FRF:
                        solver_info=str(f.attrs.get("solver_info", "")))
 
 
+#: File attribute of an FRFWriter file: [points committed, points up to the last
+#: checkpoint, slot of its state in ck_* (-1: none, or the last_* datasets of a file from
+#: before checkpoints)]. Rows beyond the first are a torn record (never committed).
+_COMMIT = "committed"
+
+
+def _row_datasets(f) -> list:
+    """The per-point (row-resizable) datasets of an FRFWriter file."""
+    import h5py
+    return [f[k] for k in f if isinstance(f[k], h5py.Dataset) and f[k].maxshape[:1] == (None,)
+            and f[k].ndim >= 1]
+
+
+def _committed_rows(f, path) -> tuple[int, int, int]:
+    """(points, points up to the last checkpoint, slot) of an FRFWriter file; a file
+    without the commit record (written before it, or by FRF.save_h5) has as many points as
+    its shortest per-point dataset."""
+    c = f.attrs.get(_COMMIT)
+    if c is not None:
+        n, nck, slot = (int(v) for v in c)
+        short = [d.name for d in _row_datasets(f) if d.shape[0] < n]
+        if short or not 0 <= nck <= n:
+            raise InputError(f"{path}: inconsistent file: {n} points committed but "
+                             f"{short or 'the checkpoint'} disagree; it cannot be repaired, "
+                             "start a new run (without --resume)")
+        return n, nck, slot
+    rows = _row_datasets(f) or ([f["omega"]] if "omega" in f else [])
+    n = min((d.shape[0] for d in rows), default=0)
+    return n, n, -1
+
+
+@contextlib.contextmanager
+def _signals_deferred():
+    """Hold SIGINT and SIGTERM until the block ends (a Ctrl-C lands between records): the
+    Python handlers are swapped for one that notes the signal, which is sent again once
+    the old handlers are back (Python runs handlers in the main thread, whichever thread
+    the OS chose, so masking the signal in one thread would not do)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    got = []
+    sigs = (signal.SIGINT, signal.SIGTERM)
+    old = {s: signal.signal(s, lambda n, _frame: got.append(n)) for s in sigs}
+    try:
+        yield
+    finally:
+        for s in sigs:
+            signal.signal(s, old[s])
+        for n in dict.fromkeys(got):
+            os.kill(os.getpid(), n)
+
+
 class FRFWriter:
     """Append points to an HDF5 file as they come (resizable datasets, flushed per point).
 
-    The file also keeps the solver unknowns and tangent of the last point, so a run that
-    stopped can resume: ``FRFWriter.resume_point(path)`` gives the `start` argument of
-    :func:`frirom.solver.frf`. Use as the `sink` of frf (``sink=writer.append``).
+    A point counts once its record is whole: the file attribute ``committed`` is set after
+    every dataset has its row, so a run killed at any moment (SIGKILL, power loss between
+    HDF5 flushes aside) leaves a readable file whose extra rows, if any, are a torn record
+    that :meth:`FRF.load` ignores and reopening with ``append=True`` removes
+    (:attr:`repaired`); SIGINT and SIGTERM wait until the record is whole (main thread).
+
+    Points that end a call into Fortran (``FRFPoint.ds_next`` finite) are checkpoints: the
+    file keeps the solver's state there (unknowns, tangent, step, arc-length scale; the
+    sliders are in every row), so ``FRFWriter.resume_point(path)`` gives the `start` of
+    :func:`frirom.solver.frf` from which the run continues exactly as the uninterrupted one
+    would have. Opening with ``append=True`` drops the points after the last checkpoint
+    (:attr:`dropped`; the resumed run computes them again, the same). Use as the `sink` of
+    frf (``sink=writer.append``).
+
+    Parameters
+    ----------
+    attrs : dict, optional
+        File attributes written on opening (e.g. the deck's fingerprint).
     """
 
     def __init__(self, path, output_dofs, group_names, harmonics: int,
-                 parameter_name: str = "omega", append: bool = False,
+                 parameter_name: str = "omega", append: bool = False, attrs=None,
                  output_labels=None, meta: dict | None = None):
         import h5py
         self.path = path
-        mode = "a" if append else "w"
-        self.f = h5py.File(path, mode)
+        self.repaired = 0   #: rows of a torn last record removed on opening
+        self.dropped = 0    #: committed points after the last checkpoint removed on opening
+        self.f = h5py.File(path, "a" if append else "w")
         nc = 2 * harmonics + 1
         n_out = len(output_dofs)
         ng = len(group_names)
         if "omega" not in self.f:
             def mk(name, tail, dtype=float):
                 self.f.create_dataset(name, shape=(0,) + tail, maxshape=(None,) + tail,
-                                      dtype=dtype, chunks=(64,) + tail)
+                                      dtype=dtype, chunks=(64,) + tail if all(tail) else True)
             mk("omega", ())
             mk("parameter", ())
             mk("X", (n_out, nc))
@@ -455,16 +532,46 @@ class FRFWriter:
             self.f.create_dataset("output_dofs", data=np.asarray(output_dofs, dtype=int))
             self.f.attrs["group_names"] = np.array(list(group_names), dtype="S")
             self.f.attrs["parameter_name"] = parameter_name
-            self.f.attrs["complete"] = False
-            self.f.attrs["message"] = "running"
             _write_labels_meta(self.f, output_labels, meta)
+            self._commit = (0, 0, -1)
         elif self.f["X"].shape[1:] != (n_out, nc):
-            raise InputError(f"{path}: existing file has X of shape {self.f['X'].shape[1:]}"
-                             f", this run makes {(n_out, nc)}")
+            shape = self.f["X"].shape[1:]
+            self.f.close()
+            raise InputError(f"{path}: existing file has X of shape {shape}, this run makes "
+                             f"{(n_out, nc)}")
+        else:
+            self._rewind()
+        for k, v in (attrs or {}).items():
+            self.f.attrs[k] = v
+        self.f.attrs["complete"] = False
+        self.f.attrs["message"] = "running"
+        self._set_commit(*self._commit)
+
+    def _rewind(self) -> None:
+        """Cut every per-point dataset to the last checkpoint (a file from before
+        checkpoints: to its shortest dataset)."""
+        n, nck, slot = _committed_rows(self.f, self.path)
+        rows = _row_datasets(self.f)
+        self.repaired = max((d.shape[0] for d in rows), default=0) - n
+        self.dropped = n - nck
+        for d in rows:
+            if d.shape[0] != nck:
+                d.resize(nck, axis=0)
+        self._commit = (nck, nck, slot)
+
+    def _set_commit(self, n: int, nck: int, slot: int) -> None:
+        self._commit = (n, nck, slot)
+        self.f.attrs[_COMMIT] = np.array([n, nck, slot], dtype=np.int64)
+        self.f.flush()
 
     def append(self, p: FRFPoint) -> None:
+        """Add one point (whole, or not at all if the process dies meanwhile)."""
+        with _signals_deferred():
+            self._append(p)
+
+    def _append(self, p: FRFPoint) -> None:
         f = self.f
-        n = f["omega"].shape[0]
+        n, nck, slot = self._commit
         sl = np.asarray(p.slider, dtype=float).ravel()
         if "slider" not in f:
             # points already in a file from before the history was kept: unknown (NaN)
@@ -481,16 +588,20 @@ class FRFWriter:
             d = f[name]
             d.resize(n + 1, axis=0)
             d[n] = getattr(p, name)
-        for name, v in (("last_unknowns", p.unknowns), ("last_tangent", p.tangent),
-                        ("last_slider", sl)):
-            if name in f:
-                del f[name]
-            f.create_dataset(name, data=v)
         _append_readable(f, n, p)
-        f.attrs["last_parameter"] = p.parameter
-        f.attrs["last_omega"] = p.omega
-        f.attrs["last_yscale"] = p.yscale
-        f.flush()
+        if np.isfinite(p.ds_next):
+            # the checkpoint's state goes to the slot the commit does not point at
+            slot = 0 if slot != 0 else 1
+            for name, v in (("ck_unknowns", p.unknowns), ("ck_tangent", p.tangent),
+                            ("ck_scalars", [n + 1, p.parameter, p.ds_next, p.yscale])):
+                v = np.asarray(v, dtype=float)
+                if name in f and f[name].shape[1:] != v.shape:
+                    del f[name]
+                if name not in f:
+                    f.create_dataset(name, shape=(2,) + v.shape, dtype=float)
+                f[name][slot] = v
+            nck = n + 1
+        self._set_commit(n + 1, nck, slot)
 
     def close(self, complete: bool = True, message: str = "") -> None:
         if self.f:
@@ -507,25 +618,44 @@ class FRFWriter:
 
     @staticmethod
     def resume_point(path) -> dict:
-        """{'parameter', 'omega', 'unknowns', 'tangent', 'yscale', 'slider'} of the last
-        point in the file: the `start` argument of frirom.solver.frf. A file written before
-        the contact history was kept gives slider None (the run resumes from the model's
-        w0, with a warning: a contact stuck all cycle there may settle differently)."""
+        """The `start` argument of frirom.solver.frf at the file's last checkpoint:
+        {'parameter', 'omega', 'unknowns', 'tangent', 'yscale', 'slider', 'ds' (the step
+        the run continued with), 'n_points' (points up to it)}. A file written before
+        checkpoints gives its last point without 'ds' (the run resumes with the deck's
+        first step); one written before the contact history was kept gives slider None
+        (the run resumes from the model's w0, with a warning: a contact stuck all cycle
+        there may settle differently)."""
         import h5py
-        with h5py.File(path, "r") as f:
-            if "last_unknowns" not in f:
-                raise InputError(f"{path}: no point to resume from")
-            slider = f["last_slider"][...] if "last_slider" in f else None
+        try:
+            f = h5py.File(path, "r")
+        except OSError as exc:
+            raise InputError(f"{path}: cannot open as HDF5 ({exc})") from None
+        with f:
+            n, nck, slot = _committed_rows(f, path)
+            if slot < 0 and "last_unknowns" in f:       # a file from before checkpoints
+                state = {"parameter": float(f.attrs["last_parameter"]),
+                         "omega": float(f.attrs["last_omega"]),
+                         "unknowns": f["last_unknowns"][...],
+                         "tangent": f["last_tangent"][...],
+                         "yscale": float(f.attrs.get("last_yscale", 0.0))}
+                slider = f["last_slider"][...] if "last_slider" in f else None
+            elif nck == 0 or slot < 0:
+                raise InputError(f"{path}: no point to resume from (the run stopped "
+                                 "before its first checkpoint)")
+            else:
+                sc = f["ck_scalars"][slot]
+                if int(sc[0]) != nck:
+                    raise InputError(f"{path}: inconsistent file: the checkpoint is at point "
+                                     f"{int(sc[0])}, the commit record says {nck}")
+                state = {"parameter": float(sc[1]), "omega": float(f["omega"][nck - 1]),
+                         "unknowns": f["ck_unknowns"][slot], "tangent": f["ck_tangent"][slot],
+                         "yscale": float(sc[3]), "ds": float(sc[2]), "n_points": nck}
+                slider = f["slider"][nck - 1] if "slider" in f else None
             if slider is None:
                 warnings.warn(f"{path}: written before frirom kept the contact history "
                               "(sliders); resuming from the model's initial sliders w0",
                               RuntimeWarning, stacklevel=2)
-            return {"parameter": float(f.attrs["last_parameter"]),
-                    "omega": float(f.attrs["last_omega"]),
-                    "unknowns": f["last_unknowns"][...],
-                    "tangent": f["last_tangent"][...],
-                    "yscale": float(f.attrs.get("last_yscale", 0.0)),
-                    "slider": slider}
+            return {**state, "slider": slider}
 
 
 # ---- the readable datasets of a result file (frequency in Hz, harmonics' amplitude and

@@ -67,7 +67,8 @@ class SolverOptions:
         Initial, smallest and largest arc-length step, in scaled variables (unknowns /
         |first point|, parameter / range): dimensionless.
     max_points : int
-        Points per run; a run that reaches it stops with ``complete`` False.
+        Points per run; a run that reaches it stops with ``complete`` False (a run resumed
+        from a checkpoint counts the points made before it).
     parameter : {'frequency', 'load'}
         The continuation parameter: frequency omega (rad/s) or a load factor (set by
         :func:`frf`, :func:`load_curve` and :func:`solve_point` themselves).
@@ -210,6 +211,7 @@ class _Continuation:
     yscale: float = 1.0
     prev_t: float | None = None   # parameter part of the previous point's tangent
     pending: bool = False         # points[-1] awaits its tangent from the next call
+    n_before: int = 0             # points a resumed run made before (count to max_points)
     t0: float = 0.0               # perf_counter at the start of the current call
 
     @property
@@ -226,7 +228,12 @@ class _Continuation:
 
     def start(self, start, H_start) -> None:
         """From nothing, or from a saved point (FRFPoint or dict): resume from its tangent,
-        or solve at its parameter first (no tangent, other H or unknown history)."""
+        or solve at its parameter first (no tangent, other H or unknown history). A
+        checkpoint (dict with 'ds', the step the run continued with, and 'n_points', the
+        points made up to it; FRFWriter.resume_point) continues exactly as the
+        uninterrupted run did: same step, arc-length scale, history and call boundaries;
+        its 'lscale' (parameter range of the run that wrote it) rescales the tangent when
+        the range was extended since."""
         p = self.packed
         self.t0 = time.perf_counter()
         self.ds = p.opts.ds
@@ -251,6 +258,7 @@ class _Continuation:
                 self.start_mode, self.tan0 = START_RESUME, np.asarray(tan, dtype=float)
                 if self.tan0.size != p.ny + 1:
                     raise SizeError("start.tangent: size does not match the unknowns")
+                self.n_before = int(start.get("n_points", 0))
         if self.start_mode == START_CONTINUE:
             self._first_point(start is None)
         self.yscale = float(np.linalg.norm(self.y0)) or 1.0
@@ -259,6 +267,15 @@ class _Continuation:
             # keep the arc-length scaling the saved tangent was computed with
             if start.get("yscale"):
                 self.yscale = float(start["yscale"])
+            if start.get("ds") is not None:
+                # a checkpoint: the uninterrupted run's next call, as _advance made it
+                tan = self.tan0
+                old_l = float(start.get("lscale") or self.lscale)
+                if old_l != self.lscale:        # the range changed: same direction
+                    tan = tan.copy()
+                    tan[-1] *= old_l / self.lscale
+                    tan /= np.linalg.norm(tan)
+                self._continue_from(self.y0, self.lam0, tan, float(start["ds"]))
 
     def _first_point(self, cold: bool) -> None:
         """Solve at fixed parameter with a purely relative update test; the size of that
@@ -290,6 +307,7 @@ class _Continuation:
             self.prev_t = new[0].tangent[-1]
             self.points[-1].tangent = new[0].tangent
             self.points[-1].yscale = self.yscale
+            self.points[-1].ds_next = new[0].ds_next
             self._emit(self.points[-1])
             new = new[1:]
         elif self.pending:
@@ -306,8 +324,9 @@ class _Continuation:
     def batches(self) -> tuple[bool, str]:
         """Continue until lam_end, a failure or max_points; returns (complete, message)."""
         o = self.packed.opts
-        while len(self.points) < o.max_points:
-            maxpts = min(o.batch, o.max_points - len(self.points)) + int(self.pending)
+        while self.n_before + len(self.points) < o.max_points:
+            maxpts = min(o.batch, o.max_points - self.n_before - len(self.points)) + \
+                int(self.pending)
             res = self._call(self.y0, self.start_mode, self.yscale, maxpts)
             t_call = time.perf_counter() - self.t0
             self.t0 = time.perf_counter()
@@ -315,6 +334,8 @@ class _Continuation:
             new = self.packed.points(res, self.omega_fix, t_call)
             for p in new:
                 p.yscale = self.yscale
+            if new and res.info == 0:
+                new[-1].ds_next = res.ds_out      # a checkpoint (FRFWriter.resume_point)
             self._take(new)
             if res.info != 0:
                 return False, self._stopped(res.info, res.msg.strip())
@@ -329,7 +350,7 @@ class _Continuation:
         """Explain a run Fortran stopped; raise if it made no point at all."""
         if info == CODES["FRIROM_ERR_CONT"] and self.packed.nw:
             message += _contact_advice(self.packed.opts, message)
-        if not self.points:
+        if not self.points and not self.n_before:
             raise_for_status(info, message)
         warnings.warn(f"frirom: continuation stopped early, {len(self.points)} points kept: "
                       f"{message}", RuntimeWarning, stacklevel=5)
@@ -340,8 +361,13 @@ class _Continuation:
         against the largest solution so far: near a resonance 100x above the first point,
         steps would otherwise crawl in frequency."""
         last = self.points[-1]
-        self.y0, self.lam0, self.tan0 = last.unknowns, last.parameter, last.tangent
-        self.ds, self.start_mode = ds_out, START_RESUME
+        self._continue_from(last.unknowns, last.parameter, last.tangent, ds_out)
+
+    def _continue_from(self, y, lam, tan, ds) -> None:
+        """The next call starts from the converged point (y, lam) with tangent tan and
+        step ds (the arc-length scale grows with the solution, see _advance)."""
+        self.y0, self.lam0, self.tan0 = y, lam, tan
+        self.ds, self.start_mode = ds, START_RESUME
         ny0 = float(np.linalg.norm(self.y0))
         if ny0 > 2.0 * self.yscale:
             self.tan0 = self.tan0.copy()
@@ -468,7 +494,9 @@ def frf(model: Model | CyclicModel, excitation: Excitation, omega_start: float,
         ``sink(point)`` receives every converged FRFPoint as it comes.
     start : FRFPoint or dict, optional
         Resume from a saved point: {'parameter' (or 'omega'), 'unknowns', 'tangent',
-        'slider', 'yscale'} (e.g. FRFWriter.resume_point).
+        'slider', 'yscale'}; a checkpoint (FRFWriter.resume_point) adds 'ds' and
+        'n_points' (and 'lscale' when the range was extended) and continues exactly as the
+        uninterrupted run did.
     start_harmonics : int, optional
         H of the start's unknowns when it differs from options.harmonics: they are padded
         or cut and re-solved first.
