@@ -278,3 +278,20 @@ def test_cantilever_friction_resonance_stable_against_time_integration(cantileve
     assert p.stable and new < 0 and old > 50.0
     d5, d20 = perturbed_drifts(model, ex, p, w, H, (5, 20), max_phase_step=1.0)
     assert d20 < 0.5 * d5, (d5, d20)
+
+
+def test_hill_refused_with_its_memory_when_it_cannot_fit(monkeypatch):
+    """A dense reduced model of the paper's size (1 900 DoFs, H = 3: the band is full) needs
+    tens of GiB for the banded Hill matrices; the run is refused up front naming
+    options.stability and the figure, instead of being killed by the kernel. Here the
+    machine's memory is made small so that the 12-DoF chain's Hill (a few MiB) is refused."""
+    import frirom._pack as pk
+    assert pk.hill_bytes(1900, 3, 1899) > 16 * 2**30
+    assert pk.hill_bytes(6, 3, 2) < 2**20            # the dense path: small
+    model, ex = duffing_plus_oscillators(n_extra=5)
+    opts = SolverOptions(harmonics=3, samples=64, stability=True)
+    monkeypatch.setattr(pk, "_physical_memory", lambda: 2 * pk.hill_bytes(model.n_dof, 3, 1) - 1)
+    from frirom._errors import ParameterError
+    with pytest.raises(ParameterError, match=r"options\.stability: Hill's method on this model "
+                                        r"needs .* GiB"):
+        frf(model, ex, 0.8, 1.2, opts)

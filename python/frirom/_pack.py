@@ -17,7 +17,8 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import eigsh
 
 from . import _kernels
-from ._errors import ParameterError, SizeError, int_constant, raise_for_status
+from ._errors import (ParameterError, SizeError, _physical_memory, int_constant,
+                      raise_for_status)
 from .contact import LAWS
 from .model import CyclicModel, Excitation, Model
 from .results import FRFPoint, amplitude_max
@@ -510,14 +511,16 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
     out = _check_outputs((np.arange(n) if n <= 100 else nl) if outputs is None else outputs, n)
     tcontact, sparse, info = False, False, f"banded: {n * (2 * H + 1)} unknowns"
     modes = _Modes.none(n, H)
+    iperm = np.empty(n, dtype=np.int64)
+    iperm[perm - 1] = np.arange(n)
+    pc = pat.tocoo()
+    bw = int(np.abs(iperm[pc.row] - iperm[pc.col]).max())
+    if opts.stability:
+        _check_hill_memory(n, H, bw)
     if opts.formulation == "condensed":
         nrows = c.G.shape[0]
         tcontact = opts.coordinates == "contact" or (
             opts.coordinates == "auto" and nrows < nl.size and not opts.stability)
-        iperm = np.empty(n, dtype=np.int64)
-        iperm[perm - 1] = np.arange(n)
-        pc = pat.tocoo()
-        bw = int(np.abs(iperm[pc.row] - iperm[pc.col]).max())
         modes, route, sparse = _receptance_route(model, opts, H, bw)
         nu = nrows if tcontact else nl.size
         info = (f"condensed: {nu * (2 * H + 1)} unknowns, "
@@ -529,6 +532,32 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
                    group_names=c.names, group_sizes=c.sizes, outputs=out, out_f=out,
                    stability=bool(opts.stability), modes=modes, tcontact=tcontact, sparse=sparse,
                    info=info)
+
+
+def hill_bytes(n_dof: int, H: int, bw: int) -> int:
+    """Memory [bytes] Hill's method needs at one point for n_dof DoFs (band half-width bw
+    after RCM) and H harmonics: the dense 2n(2H+1) eigenproblem up to HILL_MAX, else the
+    banded J, D1, M and the factored complex Q(s) (LAPACK band storage, 2 kl + ku + 1 rows)
+    and the Arnoldi basis (fortran/frirom_hbm_hill.f90, NEV_MAX = 256)."""
+    nh = n_dof * (2 * H + 1)
+    if 2 * nh <= HILL_MAX:
+        return 16 * (2 * nh) ** 2 * 3
+    kl = min((2 * H + 1) * (bw + 1) - 1, nh - 1)
+    return nh * (3 * kl + 1) * (3 * 8 + 16) + 2 * nh * 513 * 16
+
+
+def _check_hill_memory(n_dof: int, H: int, bw: int) -> None:
+    """Refuse Hill's method (ParameterError naming options.stability) when it needs more
+    than half of this machine's memory: a dense reduced model of thousands of DoFs fills
+    its band, and the Linux kernel would kill the run rather than fail the allocation."""
+    need = hill_bytes(n_dof, H, bw)
+    avail = _physical_memory()
+    if avail and need > avail // 2:
+        raise ParameterError(
+            f"options.stability: Hill's method on this model needs {need / 2**30:.3g} GiB "
+            f"({n_dof} DoFs x {2 * H + 1} harmonic coefficients, band half-width {bw} after "
+            f"reordering), more than half of this machine's {avail / 2**30:.3g} GiB; set "
+            "stability = false (`[solver] stability = false` in a deck)")
 
 
 def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Packed:
