@@ -10,7 +10,8 @@ ground on DoFs 0 and 1). The damper rests on the platform's inclined face (30 de
 held by centrifugal load; it is modelled as ground, so the contact in joint.toml has the
 tangential direction (cos 30, sin 30) in the platform's (x, y) DoFs (and, for a law with
 normal load variation, the normal direction (-sin 30, cos 30)). First bending mode: 445 Hz
-free, 475 Hz with the damper stuck. joint.toml models the damper as a Jenkins element
+free; with the damper stuck 469 Hz (joint.toml's kt) or 475 Hz (joint_liftoff.toml's kt
+and kn). joint.toml models the damper as a Jenkins element
 (constant normal load); joint_liftoff.toml as a 1-D normal-load contact with a balanced
 100 N preload, which lifts off near resonance (the periodic response is unstable from
 the peak on).
