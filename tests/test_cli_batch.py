@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from frirom.cli import EXIT_BAD_DECK, EXIT_INCOMPLETE, main
+from frirom.cli import EXIT_INPUT, EXIT_STOPPED, main
 from frirom.results import FRF
 
 JOINT = Path(__file__).resolve().parents[1] / "cases" / "joint"
@@ -45,14 +45,14 @@ def test_batch_runs_each_deck_as_alone(decks, tmp_path, capsys):
 
 
 def test_batch_exit_code_and_resume(decks, tmp_path, capsys):
-    """A deck whose run stops at max_points makes the batch exit EXIT_INCOMPLETE while
+    """A deck whose run stops at max_points makes the batch exit EXIT_STOPPED while
     the other deck still runs to the end; --resume with more points completes it and
-    leaves the complete one as it was (exit 0). A deck with an error: EXIT_BAD_DECK."""
+    leaves the complete one as it was (exit 0). A deck with an error: EXIT_INPUT."""
     short = decks / "b.toml"
     short.write_text(short.read_text().replace("max_points = 1000", "max_points = 4"))
     out = tmp_path / "out"
     code = main(["run", str(decks / "a.toml"), str(short), "--out", str(out), "--quiet"])
-    assert code == EXIT_INCOMPLETE
+    assert code == EXIT_STOPPED
     assert FRF.load(out / "a" / "frf.h5").complete
     part = FRF.load(out / "b" / "frf.h5")
     assert not part.complete and len(part) == 4
@@ -64,7 +64,7 @@ def test_batch_exit_code_and_resume(decks, tmp_path, capsys):
     assert done.complete and np.array_equal(done.omega[:4], part.omega)
     assert np.array_equal(FRF.load(out / "a" / "frf.h5").omega, a_before.omega)
     (decks / "c.toml").write_text(short.read_text().replace("mu = 0.5", "mu = -0.5"))
-    assert main(["run", str(decks), "--out", str(out), "--quiet"]) == EXIT_BAD_DECK
+    assert main(["run", str(decks), "--out", str(out), "--quiet"]) == EXIT_INPUT
     captured = capsys.readouterr()
     assert "contacts[0].mu" in captured.err and "2 of 3 runs complete" in captured.out
 
@@ -73,6 +73,6 @@ def test_batch_refuses_clashing_names(decks, tmp_path, capsys):
     other = tmp_path / "other"
     other.mkdir()
     shutil.copy(decks / "a.toml", other / "a.toml")
-    assert main(["run", str(decks), str(other), "--quiet"]) == EXIT_BAD_DECK
+    assert main(["run", str(decks), str(other), "--quiet"]) == EXIT_INPUT
     assert "same name" in capsys.readouterr().err
-    assert main(["run", str(tmp_path / "nothing.toml")]) == EXIT_BAD_DECK
+    assert main(["run", str(tmp_path / "nothing.toml")]) == EXIT_INPUT

@@ -138,9 +138,9 @@ def test_member_equals_deck_run_alone(tmp_path):
 
 
 def test_resume_member_by_member_and_point_by_point(tmp_path, monkeypatch):
-    """A study interrupted in member m001 after 8 points: run again, m000 (finished) is
-    not recomputed (its member.json untouched), m001 continues from its 8th point (those
-    8 points kept bit for bit) and reaches the end of the range; its peak matches the
+    """A study interrupted in member m001 after 15 points: run again, m000 (finished) is
+    not recomputed (its member.json untouched), m001 continues from its last checkpoint
+    (point 11, the end of a batch: FRFWriter.resume_point; the 15 points kept bit for bit) and reaches the end of the range; its peak matches the
     uninterrupted study's within 1e-4 (both solved on the curve by the solver, from
     neighbours that differ after the restart; measured 1e-5)."""
     import frirom.solver as solver
@@ -155,7 +155,7 @@ def test_resume_member_by_member_and_point_by_point(tmp_path, monkeypatch):
 
         def stop(p):
             sink(p)
-            if calls["n"] == 2 and stop.k == 7:
+            if calls["n"] == 2 and stop.k == 14:
                 raise KeyboardInterrupt
             stop.k += 1
         stop.k = 0
@@ -169,13 +169,13 @@ def test_resume_member_by_member_and_point_by_point(tmp_path, monkeypatch):
     first = (out / "members" / "m000" / "member.json").stat().st_mtime_ns
     assert not (out / "members" / "m001" / "member.json").exists()
     part = FRF.load(out / "members" / "m001" / "frf.h5")
-    assert len(part) == 8 and not part.complete
+    assert len(part) == 15 and not part.complete
     res = run_study(deck, out, quiet=True, log=lambda s: None)
     assert (out / "members" / "m000" / "member.json").stat().st_mtime_ns == first
     s1 = res["summaries"][1]
     assert s1["resumed"] and s1["complete"]
     got = member_arrays(res["file"], "m001")
-    assert np.array_equal(got["X"][:8], part.X)
+    assert np.array_equal(got["X"][:15], part.X)
     assert got["omega"][-1] == pytest.approx(2 * np.pi * 500.0, rel=1e-12)
     a_ref = clean["summaries"][1]["peaks"][0][1]
     assert abs(s1["peaks"][0][1] - a_ref) <= 1e-4 * a_ref

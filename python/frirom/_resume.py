@@ -28,9 +28,11 @@ LOCK_NAME = ".frirom.lock"
 class ResultsLock:
     """An exclusive OS lock (fcntl.flock) on OUT/.frirom.lock, held while the object
     lives and released by the OS when the process dies, however it dies. Taken before
-    anything in OUT is opened: a second run on the same folder is refused untouched."""
+    anything in OUT is opened: a second run on the same folder is refused untouched, or,
+    with ``wait`` > 0 seconds, waited for that long first (a study's member whose worker
+    outlived a killed study: the OS frees the lock when that worker dies)."""
 
-    def __init__(self, folder: Path):
+    def __init__(self, folder: Path, wait: float = 0.0):
         self.fd = None
         try:
             import fcntl
@@ -38,13 +40,21 @@ class ResultsLock:
             return
         path = Path(folder) / LOCK_NAME
         fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            holder = os.read(fd, 64).decode(errors="replace").strip() or "?"
-            os.close(fd)
-            raise InputError(f"{folder}: another frirom run (pid {holder}) is writing these "
-                             "results; wait for it to end, or choose another --out") from None
+        import time
+        t_end = time.monotonic() + wait
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except OSError:
+                if time.monotonic() < t_end:
+                    time.sleep(0.1)
+                    continue
+                holder = os.read(fd, 64).decode(errors="replace").strip() or "?"
+                os.close(fd)
+                raise InputError(f"{folder}: another frirom run (pid {holder}) is writing "
+                                 "these results; wait for it to end, or choose another "
+                                 "--out") from None
         os.ftruncate(fd, 0)
         os.write(fd, f"{os.getpid()}\n".encode())
         self.fd = fd

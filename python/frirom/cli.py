@@ -243,7 +243,6 @@ def cmd_run(args) -> int:
     deck = load_deck(args.deck)
     for line in deck.log:
         print(f"frirom: {line}")
-    linear = _linear_lines(deck)
     out = args.out if args.out is not None else Path("results") / deck.path.stem
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out}: is a file; expected a folder for the results")
@@ -262,6 +261,7 @@ def _run_locked(args, deck, out: Path) -> int:
     from .results import FRF, FRFWriter
     from .solver import frf
 
+    linear = _linear_lines(deck)
     h5 = out / "frf.h5"
     names = [c.name for c in deck.contacts]
     fingerprint = deck_fingerprint(deck)
@@ -276,7 +276,8 @@ def _run_locked(args, deck, out: Path) -> int:
     if not done:
         writer = FRFWriter(h5, deck.outputs, names, deck.harmonics, append=args.resume,
                            attrs={"deck_fingerprint": fingerprint,
-                                  "omega_range": [deck.omega_start, deck.omega_end]})
+                                  "omega_range": [deck.omega_start, deck.omega_end]},
+                           output_labels=deck.output_names, meta=deck.result_meta())
         if writer.repaired:
             print(f"frirom: {h5}: removed a torn last record (a point whose writing was "
                   "cut short)", file=sys.stderr)

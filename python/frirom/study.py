@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from ._errors import InputError
+from ._resume import ResultsLock
 from .deck.schema import parse_deck, read_toml
 from .deck.schema_study import StudySettings, member_raw, parse_study
 
@@ -120,12 +121,18 @@ def prepare_member(deck_path, overrides: dict) -> dict:
             "reused": bool(getattr(rom, "from_cache", False))}
 
 
+#: Seconds a member waits for its folder's lock (held by a worker that outlived a killed
+#: study until the OS ends it) before it is refused.
+LOCK_WAIT = 120.0
+
+
 def run_member(deck_path, overrides: dict, folder, progress: bool = True) -> dict:
     """Run one member into ``folder`` (a Dask task: paths and values in, a summary out).
 
     A finished member (``folder/member.json``) returns its summary without running; an
-    unfinished one continues from the last point of ``folder/frf.h5`` (a file that cannot
-    be read is started again). Points are flushed as they come; ``folder/points`` counts
+    unfinished one continues from the last checkpoint of ``folder/frf.h5`` (a file that
+    cannot be read, or holds no checkpoint, is started again). One process at a time
+    writes a member (an OS lock on the folder, waited for up to LOCK_WAIT s). Points are flushed as they come; ``folder/points`` counts
     them for the progress display.
 
     Returns
@@ -138,14 +145,26 @@ def run_member(deck_path, overrides: dict, folder, progress: bool = True) -> dic
         size), ``rom_seconds``, ``memory_mb`` (estimate: model matrices + the dense
         condensed Jacobian), ``rss_mb`` (the process's peak resident size), ``resumed``.
     """
-    from .results import FRF, FRFWriter
-    from .solver import frf
-
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     done = folder / "member.json"
     if done.is_file():
         return json.loads(done.read_text())
+    # one writer per member: a worker of a killed study may still be running it
+    lock = ResultsLock(folder, wait=LOCK_WAIT)
+    try:
+        if done.is_file():
+            return json.loads(done.read_text())
+        return _run_member_locked(deck_path, overrides, folder, done, progress)
+    finally:
+        lock.release()
+
+
+def _run_member_locked(deck_path, overrides, folder: Path, done: Path, progress) -> dict:
+    """run_member once the member's folder is locked."""
+    from .results import FRF, FRFWriter
+    from .solver import frf
+
     deck = load_member(deck_path, overrides)
     h5 = folder / "frf.h5"
     start = None
