@@ -146,7 +146,8 @@ def run_member(deck_path, overrides: dict, folder, progress: bool = True) -> dic
     done = folder / "member.json"
     if done.is_file():
         return json.loads(done.read_text())
-    deck = load_member(deck_path, overrides)
+    from .auto import resolve_deck
+    deck = resolve_deck(load_member(deck_path, overrides), lambda s: None)
     h5 = folder / "frf.h5"
     start = None
     if h5.is_file():
