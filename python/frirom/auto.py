@@ -95,6 +95,16 @@ class AutoChoice:
                              + ")")
         return "; ".join(parts) + f", tolerance {self.tolerance:g}"
 
+    def title(self) -> str:
+        """A short line for a plot's title: the choice, and a failed estimate."""
+        text = ", ".join(f"{n} = {v}" for n, v, est in (
+            ("H", self.harmonics, self.h_estimates), ("N", self.samples, self.n_estimates))
+            if est)
+        bad = [n for n, est, met in (("H", self.h_estimates, self.met_h),
+                                     ("N", self.n_estimates, self.met_n)) if est and not met]
+        return (f"auto: {text} for {self.tolerance:g}" + (
+            f" - {' and '.join(bad)} estimate NOT within it: the maximum" if bad else ""))
+
     def lines(self) -> list:
         """The log lines: probes, the estimates climbed, the choice, the failures."""
         out = [f"auto: probe points at {', '.join(f'{w / 2 / np.pi:.6g}' for w in self.probes)}"

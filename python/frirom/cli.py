@@ -328,7 +328,8 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
     written = [h5] + ([out / "frf.csv"] if deck.csv else [])
     if deck.plot and len(full) > 0:
         figures = {"frf.png": plot_frf(full, output_names=deck.output_names,
-                                       unit=deck.frequency_unit, title=deck.title,
+                                       unit=deck.frequency_unit, title=deck.title + (
+                                           f"\n{deck.auto.title()}" if deck.auto else ""),
                                        linear=linear)}
         if deck.contacts:
             figures["states.png"] = plot_states(full, contact_names=names,
