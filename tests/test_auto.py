@@ -16,6 +16,7 @@ from frirom.cli import main
 from frirom.auto import _excitation, resolve_deck
 from frirom.deck import build_deck, load_deck, parse_deck
 from frirom.deck.schema import read_toml
+from frirom.results import FRF
 from frirom.solver import frf
 
 JOINT = Path(__file__).resolve().parents[1] / "cases" / "joint"
@@ -112,3 +113,27 @@ def test_frirom_run_logs_and_stores_the_choice(tmp_path, capsys):
     assert "frirom: auto: H = " in text and "tolerance 0.01" in text
     with h5py.File(out / "frf.h5", "r") as f:
         assert "H estimate" in f.attrs["auto"]
+
+
+def test_samples_only_meets_tolerance_against_many_samples():
+    # H fixed at 5: only N is chosen; its peak amplitudes are within the tolerance of the
+    # same H with N = 4096 (the AFT error alone).
+    tol = 1e-3
+    deck = resolve_deck(_deck("joint.toml", {"samples": "auto", "tolerance_auto": tol},
+                              (455.0, 480.0)), lambda s: None)
+    ch = deck.auto
+    assert deck.harmonics == 5 and not ch.h_estimates and ch.met_n
+    assert [n for n, _ in ch.n_estimates][0] == 16          # first power of two >= 11
+    err = np.abs(_peaks(deck, 5, deck.samples) / _peaks(deck, 5, 4096) - 1)
+    assert np.all(err <= tol), (ch.lines(), err)
+
+
+def test_study_member_uses_the_choice(tmp_path):
+    # A study member (frirom.study.run_member) of an "auto" deck runs at the H and N that
+    # the deck alone would choose.
+    from frirom.study import run_member
+    over = {"frequency.start": 455.0, "frequency.end": 480.0}
+    s = run_member(JOINT / "joint_auto.toml", over, tmp_path / "m", progress=False)
+    alone = resolve_deck(_deck("joint_auto.toml", {}, (455.0, 480.0)), lambda s: None)
+    assert s["complete"] and s["harmonics"] == alone.harmonics
+    assert FRF.load(tmp_path / "m" / "frf.h5").X.shape[2] == 2 * alone.harmonics + 1
