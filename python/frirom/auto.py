@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._errors import ConvergenceError, FriromError
 from .harmonics import default_samples
 
 __all__ = ["AutoChoice", "choose", "resolve_deck"]
@@ -145,7 +146,8 @@ def _probes(model, F, omega_start, omega_end, opts, outputs, H0, notes) -> list:
         notes.append(f"the coarse run at H = {H0} stopped ({r.message}); probes from the "
                      "points it made")
     if not pts:
-        raise RuntimeError(f"auto: the coarse run at H = {H0} made no point: {r.message}")
+        raise ConvergenceError(f"solver.harmonics = \"auto\": the coarse run at H = {H0} "
+                               f"made no point ({r.message}); give integers")
     amp = np.array([p.amp_max for p in pts])
     out = []
     for j in range(amp.shape[1]):
@@ -165,8 +167,8 @@ def _follow(model, F, opts, outputs, probe, H, N, prev):
         return solve_point(model, _excitation(F, H), probe.omega, o, outputs=outputs,
                            start={"unknowns": point.unknowns, "slider": probe.slider},
                            start_harmonics=Hp)
-    except Exception:       # noqa: BLE001 - a failed solve is reported as an estimate of inf
-        return None
+    except (FriromError, ArithmeticError, np.linalg.LinAlgError):
+        return None                 # a failed solve: an estimate of inf, reported
 
 
 def choose(model, F, omega_start, omega_end, options, outputs=None, *, harmonics=True,
