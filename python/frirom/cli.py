@@ -238,30 +238,32 @@ class _Progress:
 
 def cmd_run(args) -> int:
     from ._resume import ResultsLock
+    from .auto import resolve_deck
     from .deck import load_deck
 
     deck = load_deck(args.deck)
     for line in deck.log:
         print(f"frirom: {line}")
+    linear = _linear_lines(deck)
+    deck = resolve_deck(deck, lambda s: print(f"frirom: {s}"))
     out = args.out if args.out is not None else Path("results") / deck.path.stem
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out}: is a file; expected a folder for the results")
     out.mkdir(parents=True, exist_ok=True)
     lock = ResultsLock(out)     # before anything in out is opened or replaced
     try:
-        return _run_locked(args, deck, out)
+        return _run_locked(args, deck, out, linear)
     finally:
         lock.release()
 
 
-def _run_locked(args, deck, out: Path) -> int:
+def _run_locked(args, deck, out: Path, linear=None) -> int:
     """cmd_run once the results folder is locked."""
     from ._resume import deck_fingerprint
     from .plots import plot_frf, plot_states
     from .results import FRF, FRFWriter
     from .solver import frf
 
-    linear = _linear_lines(deck)
     h5 = out / "frf.h5"
     names = [c.name for c in deck.contacts]
     fingerprint = deck_fingerprint(deck)
@@ -276,7 +278,9 @@ def _run_locked(args, deck, out: Path) -> int:
     if not done:
         writer = FRFWriter(h5, deck.outputs, names, deck.harmonics, append=args.resume,
                            attrs={"deck_fingerprint": fingerprint,
-                                  "omega_range": [deck.omega_start, deck.omega_end]},
+                                  "omega_range": [deck.omega_start, deck.omega_end],
+                                  **({"auto": "\n".join(deck.auto.lines())} if deck.auto
+                                     else {})},
                            output_labels=deck.output_names, meta=deck.result_meta())
         if writer.repaired:
             print(f"frirom: {h5}: removed a torn last record (a point whose writing was "
@@ -309,6 +313,12 @@ def _run_locked(args, deck, out: Path) -> int:
         progress.close()
         writer.close(complete=result.complete, message=result.message)
         elapsed = time.perf_counter() - t0
+        if deck.auto is not None:
+            result.solver_info += f"; {deck.auto.summary()}"
+            if not result.complete:
+                print(f"frirom: auto: the run with the chosen H = {deck.harmonics}, N = "
+                      f"{options.n_samples} stopped early: the choice failed here (give "
+                      "integers, or more samples)", file=sys.stderr)
         print(f"frirom: {result.solver_info}")
     else:
         elapsed = 0.0
@@ -319,7 +329,8 @@ def _run_locked(args, deck, out: Path) -> int:
     written = [h5] + ([out / "frf.csv"] if deck.csv else [])
     if deck.plot and len(full) > 0:
         figures = {"frf.png": plot_frf(full, output_names=deck.output_names,
-                                       unit=deck.frequency_unit, title=deck.title,
+                                       unit=deck.frequency_unit, title=deck.title + (
+                                           f"\n{deck.auto.title()}" if deck.auto else ""),
                                        linear=linear)}
         if deck.contacts:
             figures["states.png"] = plot_states(full, contact_names=names,

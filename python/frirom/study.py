@@ -165,7 +165,8 @@ def _run_member_locked(deck_path, overrides, folder: Path, done: Path, progress)
     from .results import FRF, FRFWriter
     from .solver import frf
 
-    deck = load_member(deck_path, overrides)
+    from .auto import resolve_deck
+    deck = resolve_deck(load_member(deck_path, overrides), lambda s: None)
     h5 = folder / "frf.h5"
     start = None
     if h5.is_file():

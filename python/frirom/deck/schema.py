@@ -49,6 +49,14 @@ class SolverSettings:
         Newton iterations per point (None: the solver's default).
     stability : bool
         Hill stability of every point (false with [reduction.cyclic]).
+    auto_harmonics, auto_samples : bool
+        ``harmonics = "auto"`` / ``samples = "auto"``: :mod:`frirom.auto` chooses them
+        before the run (``harmonics`` then holds ``max_harmonics``, the largest allowed;
+        ``samples`` None).
+    tolerance_auto : float
+        Relative error on the response amplitude that the chosen H and N must meet.
+    max_harmonics, max_samples : int
+        The largest H and N the choice may use.
     """
 
     harmonics: int
@@ -58,6 +66,11 @@ class SolverSettings:
     tol_update: float | None
     max_iterations: int | None
     stability: bool
+    auto_harmonics: bool = False
+    auto_samples: bool = False
+    tolerance_auto: float = 1e-3
+    max_harmonics: int = 15
+    max_samples: int = 4096
 
 
 @dataclass(frozen=True)
@@ -260,12 +273,19 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
 
 def _solver(ctx, sol, cyc) -> SolverSettings:
     unknown(ctx, sol, {"harmonics", "samples", "formulation", "tol_residual",
-                       "tol_update", "max_iterations", "stability"}, "solver")
-    H = number(ctx, sol, "harmonics", "solver.harmonics", required=True, integer=True,
-               minimum=1, maximum=MAX_HARMONICS)
-    N = number(ctx, sol, "samples", "solver.samples", integer=True)
+                       "tol_update", "max_iterations", "stability", "tolerance_auto",
+                       "max_harmonics", "max_samples"}, "solver")
+    auto = _auto(ctx, sol, cyc)
+    H = auto["max_harmonics"] if auto["auto_harmonics"] else number(
+        ctx, sol, "harmonics", "solver.harmonics", required=True, integer=True, minimum=1,
+        maximum=MAX_HARMONICS)
+    N = None if auto["auto_samples"] else number(ctx, sol, "samples", "solver.samples",
+                                                 integer=True)
     if N is not None and samples_problem(H, N):
         raise ctx.error("solver.samples", samples_problem(H, N), N)
+    if auto["auto_samples"] and samples_problem(H, auto["max_samples"]):
+        raise ctx.error("solver.max_samples", samples_problem(H, auto["max_samples"]),
+                        auto["max_samples"])
     form = string(ctx, sol, "formulation", "solver.formulation", default="condensed",
                   choices=("condensed", "banded"))
     tols = []
@@ -284,7 +304,33 @@ def _solver(ctx, sol, cyc) -> SolverSettings:
                             "stability is not implemented for cyclic sectors)", True)
         stability = False
     return SolverSettings(harmonics=H, samples=N, formulation=form, tol_residual=tols[0],
-                          tol_update=tols[1], max_iterations=max_it, stability=stability)
+                          tol_update=tols[1], max_iterations=max_it, stability=stability,
+                          **auto)
+
+
+def _auto(ctx, sol, cyc) -> dict:
+    """``harmonics = "auto"``, ``samples = "auto"`` and their keys (frirom.auto)."""
+    out = {f"auto_{k}": sol.get(k) == "auto" for k in ("harmonics", "samples")}
+    for k in ("harmonics", "samples"):
+        if isinstance(sol.get(k), str) and sol[k] != "auto":
+            raise ctx.error(f"solver.{k}", 'an integer or "auto"', sol[k])
+    on = out["auto_harmonics"] or out["auto_samples"]
+    given = [k for k in ("tolerance_auto", "max_harmonics", "max_samples") if k in sol]
+    if given and not on:
+        raise ctx.error(f"solver.{given[0]}", 'harmonics = "auto" or samples = "auto" '
+                        "(it only bounds that choice)", sol[given[0]])
+    if on and cyc is not None:
+        key = "harmonics" if out["auto_harmonics"] else "samples"
+        raise ctx.error(f"solver.{key}", "an integer with [reduction.cyclic] (\"auto\" is "
+                        "not available for cyclic sectors)", "auto")
+    out["tolerance_auto"] = float(number(ctx, sol, "tolerance_auto", "solver.tolerance_auto",
+                                         default=1e-3, positive=True, maximum=0.5))
+    out["max_harmonics"] = int(number(ctx, sol, "max_harmonics", "solver.max_harmonics",
+                                      default=15, integer=True, minimum=3,
+                                      maximum=MAX_HARMONICS))
+    out["max_samples"] = int(number(ctx, sol, "max_samples", "solver.max_samples",
+                                    default=4096, integer=True, minimum=8))
+    return out
 
 
 def _damping(ctx, damp, fe) -> DampingSettings:

@@ -1,0 +1,299 @@
+"""``[solver] harmonics = "auto"`` and ``samples = "auto"``: the smallest H and N whose a
+posteriori error estimate on the response amplitude is within a tolerance (docs/deck.md).
+
+The estimate costs a coarse run and a few point solves, not a ladder of FRFs:
+
+1. a run at the smallest H (the highest loaded harmonic, at least 1) finds, per output, the
+   point of largest amplitude: the **probe points** (distinct frequencies);
+2. at each probe frequency the solution is followed up the harmonics, H -> H+1, each solve
+   started from the one below (padded with zeros) and from the coarse point's contact
+   history, so it stays on the coarse curve's branch;
+3. the **H estimate** e(H) is the largest relative change of the outputs' amplitudes
+   (max over the period of |x(t)|) from H to H+2 over the probes: H+2, not H+1, because
+   a symmetric friction contact excites odd harmonics only and an even H+1 adds nothing;
+   the error of H is taken as the geometric tail e(H) / (1 - r), r = e(H) / e(H-2) the
+   observed rate (at most :data:`RATE_MAX`; 1/2 before two rungs), and the smallest H
+   whose tail is within the budget is chosen: the tolerance, or half of it when N is
+   chosen too (the other half is N's);
+4. the **N estimate** e(N) at the chosen H is the same change from N to 2N AFT samples
+   (aliasing of the contact forces; it falls like 1/N^2 for smooth laws, slower at state
+   switches), N over the powers of two from the first >= 2H+1, with the tail
+   e(N) / (1 - e(N) / e(N/2)) within the budget.
+
+Where the estimate does not reach the tolerance within ``max_harmonics`` /
+``max_samples`` (it stalls, rises, or a solve fails) the choice is the maximum and the
+log and ``FRF.solver_info`` say so: never a silent pick.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ._errors import ConvergenceError, FriromError
+from .harmonics import default_samples
+
+__all__ = ["AutoChoice", "choose", "resolve_deck"]
+
+#: the largest ratio of successive estimates trusted as a rate of convergence
+RATE_MAX = 0.9
+
+
+def _tail(est: list, back: int) -> float:
+    """The error of the last rung from its estimate e (its change to the next rung) and
+    the rate r = e / (the estimate ``back`` rungs below, 1 for H: the same parity, 1 for
+    N): the geometric tail e / (1 - r), r clamped to [0, RATE_MAX]; r = 1/2 for the first
+    rungs."""
+    e = est[-1][1]
+    r = 0.5 if len(est) <= back else min(max(e / max(est[-1 - back][1], 1e-300), 0.0),
+                                         RATE_MAX)
+    return e / (1.0 - r)
+
+
+@dataclass
+class AutoChoice:
+    """What :func:`choose` found.
+
+    harmonics, samples : int
+        The chosen H and N (samples None when N was not chosen: the deck's or default).
+    tolerance : float
+        Relative amplitude error asked for.
+    probes : list of float
+        Probe frequencies, rad/s.
+    h_estimates, n_estimates : list of (int, float)
+        (H, e(H)) and (N, e(N)) as climbed (inf: a solve failed).
+    met_h, met_n : bool
+        The estimate reached the tolerance (False: the maximum was used).
+    notes : list of str
+        What failed, in words (also in :meth:`lines`).
+    seconds : float
+        Wall time of the choice.
+    """
+
+    harmonics: int
+    samples: int | None
+    tolerance: float
+    probes: list = field(default_factory=list)
+    h_estimates: list = field(default_factory=list)
+    n_estimates: list = field(default_factory=list)
+    met_h: bool = True
+    met_n: bool = True
+    notes: list = field(default_factory=list)
+    seconds: float = 0.0
+
+    def summary(self) -> str:
+        """One line for ``FRF.solver_info``."""
+        parts = []
+        for name, v, est, met in (("H", self.harmonics, self.h_estimates, self.met_h),
+                                  ("N", self.samples, self.n_estimates, self.met_n)):
+            if est:
+                e = dict(est).get(v, est[-1][1])
+                parts.append(f"{name} = {v} auto (estimate {e:.2e}"
+                             + ("" if met else ", NOT within the tolerance: the maximum")
+                             + ")")
+        return "; ".join(parts) + f", tolerance {self.tolerance:g}"
+
+    def title(self) -> str:
+        """A short line for a plot's title: the choice, and a failed estimate."""
+        text = ", ".join(f"{n} = {v}" for n, v, est in (
+            ("H", self.harmonics, self.h_estimates), ("N", self.samples, self.n_estimates))
+            if est)
+        bad = [n for n, est, met in (("H", self.h_estimates, self.met_h),
+                                     ("N", self.n_estimates, self.met_n)) if est and not met]
+        return (f"auto: {text} for {self.tolerance:g}" + (
+            f" - {' and '.join(bad)} estimate NOT within it: the maximum" if bad else ""))
+
+    def lines(self) -> list:
+        """The log lines: probes, the estimates climbed, the choice, the failures."""
+        out = [f"auto: probe points at {', '.join(f'{w / 2 / np.pi:.6g}' for w in self.probes)}"
+               f" Hz (largest amplitude of each output on a run at the smallest H)"]
+        for name, est in (("H", self.h_estimates), ("N", self.n_estimates)):
+            if est:
+                out.append(f"auto: {name} estimate (relative change of the amplitudes at "
+                           f"{'H+2' if name == 'H' else '2N'}): "
+                           + ", ".join(f"{k}: {e:.2e}" for k, e in est))
+        out.append(f"auto: {self.summary()} ({self.seconds:.1f} s)")
+        out += [f"auto: WARNING: {n}" for n in self.notes]
+        return out
+
+
+def _rel(a: np.ndarray, b: np.ndarray) -> float:
+    """Largest |a - b| / |b| over the outputs whose amplitude is not negligible."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    keep = np.abs(b) > 1e-12 * max(np.max(np.abs(b)), 1e-300)
+    return float(np.max(np.abs(a[keep] - b[keep]) / np.abs(b[keep]))) if keep.any() else 0.0
+
+
+def _excitation(F: np.ndarray, H: int):
+    from .model import Excitation
+    G = np.zeros((F.shape[0], H + 1), complex)
+    k = min(H + 1, F.shape[1])
+    G[:, :k] = F[:, :k]
+    return Excitation(G)
+
+
+def _probes(model, F, omega_start, omega_end, opts, outputs, H0, notes) -> list:
+    """The coarse run at H0: per output its largest-amplitude point (distinct omegas)."""
+    from .solver import frf
+    pts = []
+    o = dataclasses.replace(opts, harmonics=H0, stability=False, refine_peak=False)
+    r = frf(model, _excitation(F, H0), omega_start, omega_end, o, outputs=outputs,
+            sink=pts.append)
+    if not r.complete:
+        notes.append(f"the coarse run at H = {H0} stopped ({r.message}); probes from the "
+                     "points it made")
+    if not pts:
+        raise ConvergenceError(f"solver.harmonics = \"auto\": the coarse run at H = {H0} "
+                               f"made no point ({r.message}); give integers")
+    amp = np.array([p.amp_max for p in pts])
+    out = []
+    for j in range(amp.shape[1]):
+        p = pts[int(np.argmax(amp[:, j]))]
+        if all(abs(p.omega - q.omega) > 1e-9 * p.omega for q in out):
+            out.append(p)
+    return out
+
+
+def _follow(model, F, opts, outputs, probe, H, N, prev):
+    """The solution at the probe's frequency with H harmonics and N samples, started from
+    ``prev`` (a point and its H) and the probe's contact history; None if it fails."""
+    from .solver import solve_point
+    o = dataclasses.replace(opts, harmonics=H, samples=N, stability=False)
+    point, Hp = prev
+    try:
+        return solve_point(model, _excitation(F, H), probe.omega, o, outputs=outputs,
+                           start={"unknowns": point.unknowns, "slider": probe.slider},
+                           start_harmonics=Hp)
+    except (FriromError, ArithmeticError, np.linalg.LinAlgError):
+        return None                 # a failed solve: an estimate of inf, reported
+
+
+def choose(model, F, omega_start, omega_end, options, outputs=None, *, harmonics=True,
+           samples=True, tolerance=1e-3, max_harmonics=15, max_samples=4096) -> AutoChoice:
+    """Choose H (``harmonics``) and/or N (``samples``) by the a posteriori estimate of the
+    module docstring.
+
+    Parameters
+    ----------
+    model : Model
+    F : ndarray, complex (n_dof, >= 1)
+        Load harmonics 0.. [N]; columns above the H in use are dropped, missing ones zero.
+    omega_start, omega_end : float
+        Frequency range, rad/s.
+    options : SolverOptions
+        Everything else; its ``harmonics`` is the H used when ``harmonics`` is False, its
+        ``samples`` the N used when ``samples`` is False (None: the default rule).
+    outputs : as :func:`frirom.solver.frf`; the amplitudes compared are theirs.
+    harmonics, samples : bool
+        What to choose.
+    tolerance : float
+        Relative amplitude change allowed.
+    max_harmonics, max_samples : int
+        The largest H and N tried (the choice when the estimate does not reach the
+        tolerance).
+
+    Returns
+    -------
+    AutoChoice
+    """
+    t0 = time.perf_counter()
+    budget = tolerance / 2 if harmonics and samples else tolerance
+    loaded = [h for h in range(F.shape[1]) if np.any(F[:, h] != 0)]
+    H_lo = max([1] + loaded)
+    notes = []
+    fixed_N = None if samples else options.samples
+
+    def n_for(H):
+        return fixed_N if fixed_N is not None else default_samples(H)
+
+    H = options.harmonics
+    H0 = H_lo if harmonics else H
+    probes = _probes(model, F, omega_start, omega_end,
+                     dataclasses.replace(options, samples=n_for(H0)), outputs, H0, notes)
+    ch = AutoChoice(harmonics=H, samples=options.samples, tolerance=tolerance,
+                    probes=[p.omega for p in probes], notes=notes)
+    sols = [{H0: p} for p in probes]             # per probe: H -> solution
+    if harmonics:
+        H, ch.met_h = max_harmonics, False
+        for h in range(H0, max_harmonics - 1):
+            N = n_for(h + 2)
+            if N is not None and N < 2 * (h + 2) + 1:
+                notes.append(f"samples = {N} is too few for H = {h + 2}: H climbed no "
+                             "higher")
+                break
+            errs = []
+            for s, p in zip(sols, probes):
+                for k in (h + 1, h + 2):
+                    if k not in s and s.get(k - 1) is not None:
+                        s[k] = _follow(model, F, options, outputs, p, k, n_for(k),
+                                       (s[k - 1], k - 1))
+                a, b = s.get(h), s.get(h + 2)
+                errs.append(float("inf") if a is None or b is None else
+                            _rel(a.amp_max, b.amp_max))
+            ch.h_estimates.append((h, max(errs)))
+            if _tail(ch.h_estimates, 2) <= budget:
+                H, ch.met_h = h, True
+                break
+        if not ch.met_h:
+            last = ch.h_estimates[-1][1] if ch.h_estimates else float("nan")
+            why = ("a solve failed" if not np.isfinite(last) else
+                   "it did not fall" if len(ch.h_estimates) > 1 and
+                   last >= ch.h_estimates[0][1] else "it fell too slowly")
+            notes.append(f"the H estimate did not reach {budget:g} up to max_harmonics = "
+                         f"{max_harmonics} ({why}; last {last:.2e}): the run uses H = "
+                         f"{H}, raise solver.max_harmonics or the tolerance")
+        ch.harmonics = H
+    if samples:
+        N = 1 << (2 * H).bit_length()               # first power of two >= 2H+1
+        ch.met_n = False
+        starts = []
+        for s in sols:
+            k = H if s.get(H) is not None else max(k for k, v in s.items() if v is not None)
+            starts.append((s[k], k))
+        cur = [_follow(model, F, options, outputs, p, H, N, st)
+               for p, st in zip(probes, starts)]
+        while 2 * N <= max_samples:
+            nxt = [_follow(model, F, options, outputs, p, H, 2 * N, (c, H))
+                   if c is not None else None for p, c in zip(probes, cur)]
+            errs = [float("inf") if a is None or b is None else _rel(a.amp_max, b.amp_max)
+                    for a, b in zip(cur, nxt)]
+            ch.n_estimates.append((N, max(errs)))
+            if _tail(ch.n_estimates, 1) <= budget:
+                ch.met_n = True
+                break
+            N, cur = 2 * N, nxt
+        if not ch.met_n:
+            last = ch.n_estimates[-1][1] if ch.n_estimates else float("nan")
+            N = max_samples
+            notes.append(f"the N estimate did not reach {budget:g} up to max_samples = "
+                         f"{max_samples} (last {last:.2e}): the run uses N = {N}")
+        ch.samples = N
+    ch.seconds = time.perf_counter() - t0
+    return ch
+
+
+def resolve_deck(deck, log=print):
+    """The deck with ``harmonics = "auto"`` / ``samples = "auto"`` replaced by the chosen
+    values (the deck itself when neither is asked); ``deck.auto`` is the
+    :class:`AutoChoice` (None without auto), and its lines go to ``log``."""
+    sol = getattr(deck.settings, "solver", None)
+    if sol is None or not (sol.auto_harmonics or sol.auto_samples):
+        deck.auto = None
+        return deck
+    opts = deck.options()
+    if sol.auto_samples:
+        opts = dataclasses.replace(opts, samples=None)
+    ch = choose(deck.model(), deck.F, deck.omega_start, deck.omega_end, opts,
+                deck.solver_outputs, harmonics=sol.auto_harmonics,
+                samples=sol.auto_samples, tolerance=sol.tolerance_auto,
+                max_harmonics=sol.max_harmonics, max_samples=sol.max_samples)
+    for line in ch.lines():
+        log(line)
+    H = ch.harmonics
+    F = _excitation(deck.F, H).F
+    new = dataclasses.replace(deck, harmonics=H, samples=ch.samples, F=F)
+    new.auto = ch
+    return new
