@@ -415,14 +415,17 @@ contains
             npts = npts + 1
             if (.not. last) then
                 ! the curve has a corner at the new point: its tangent turns more than 60
-                ! degrees from the chord that reached it (carried contact history: sliders
-                ! left where they last slipped make every point of a rising response a
-                ! corner between the stick tangent J gives and the slip branch ahead).
-                ! Predict along the chord (secant) instead.
+                ! degrees from the chord that reached it, or 3 angle_target once steps
+                ! have shrunk below ds_max / 20 (carried contact history: sliders left
+                ! where they last slipped make every point of a rising response a corner
+                ! between the stick tangent J gives and the slip branch ahead, 40-80
+                ! degrees on the paper_hooks ROM_II). Predict along the chord (secant).
                 cy(1:n) = (y1 - y)/opts%yscale
                 dist = sqrt(sum(cy**2) + ((lam1 - lam)/opts%lscale)**2)
+                frac = 0.5_wp
+                if (ds < 0.05_wp*opts%ds_max) frac = cos(3.0_wp*opts%angle_target)
                 if (dist > 0.0_wp .and. dot_product(cy, t1(1:n)) + &
-                    (lam1 - lam)/opts%lscale*t1(n + 1) < 0.5_wp*dist) then
+                    (lam1 - lam)/opts%lscale*t1(n + 1) < frac*dist) then
                     t1(1:n) = cy/dist
                     t1(n + 1) = (lam1 - lam)/opts%lscale/dist
                 end if
