@@ -214,12 +214,14 @@ contains
             end do
         end function pattern_bw
 
-        !> Spread, under perm, of the full DoFs an element's rows touch.
+        !> Spread, under perm, of the full DoFs an element's rows touch (condensed: G's
+        !> columns are nl entries, or with contact coordinates rows of T = G, whose own
+        !> columns are the DoFs).
         function elem_bw(gg, r1, r2, s) result(bw)
             type(csr_matrix), intent(in) :: gg
             integer(ip), intent(in) :: r1, r2
             class(hbm_system), intent(in) :: s
-            integer(ip) :: bw, lo, hi, rr, kk, col
+            integer(ip) :: bw, lo, hi, rr, kk, col, kt
             lo = huge(lo)
             hi = -huge(hi)
             do rr = r1, r2
@@ -227,6 +229,13 @@ contains
                     col = gg%i(kk)
                     select type (s)
                     type is (hbm_condensed)
+                        if (s%tcontact) then
+                            do kt = s%t%p(col), s%t%p(col + 1) - 1
+                                lo = min(lo, s%iperm(s%t%i(kt)))
+                                hi = max(hi, s%iperm(s%t%i(kt)))
+                            end do
+                            cycle
+                        end if
                         col = nl(col)
                     end select
                     lo = min(lo, s%iperm(col))

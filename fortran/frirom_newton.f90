@@ -359,18 +359,19 @@ contains
                 call newton_correct(sys, y1, lam1, yp, lp, cy, cl, fresh_opts, iters, info, &
                                     errmsg, have_fact, nf)
             end if
-            turned = .false.
-            if (info /= 0 .and. .not. last) call turn_corner(sys, y, lam, t, ds, fresh_opts, &
-                                                             y1, lam1, t1, iters, nf, turned, &
-                                                             info, errmsg, have_fact)
             if (info == 0 .and. .not. last) then
-                ! a corrector that wandered far from the predictor found another branch
+                ! a corrector that wandered far from the predictor found another branch, or
+                ! met this one far off because it turns at a corner (then turn_corner)
                 if (sqrt(sum(((y1 - y)/opts%yscale)**2) + ((lam1 - lam)/opts%lscale)**2) > &
                     3.0_wp*ds) then
                     call set_status(info, FRIROM_ERR_NOCONV, errmsg, 'corrector converged '// &
                                     'more than 3 steps away from the predictor')
                 end if
             end if
+            turned = .false.
+            if (info /= 0 .and. .not. last) call turn_corner(sys, y, lam, t, ds, fresh_opts, &
+                                                             y1, lam1, t1, iters, nf, turned, &
+                                                             info, errmsg, have_fact)
             if (info == 0 .and. .not. (last .or. retried .or. turned) .and. &
                 ds > 0.25_wp*opts%ds_max) then
                 ! a long step far too long for the curve's shape (the corrector moved off
@@ -412,6 +413,23 @@ contains
             have_fact = .true.
             retried = .false.
             npts = npts + 1
+            if (.not. last) then
+                ! the curve has a corner at the new point: its tangent turns more than 60
+                ! degrees from the chord that reached it, or 3 angle_target once steps
+                ! have shrunk below ds_max / 20 (carried contact history: sliders left
+                ! where they last slipped make every point of a rising response a corner
+                ! between the stick tangent J gives and the slip branch ahead, 40-80
+                ! degrees on the paper_hooks ROM_II). Predict along the chord (secant).
+                cy(1:n) = (y1 - y)/opts%yscale
+                dist = sqrt(sum(cy**2) + ((lam1 - lam)/opts%lscale)**2)
+                frac = 0.5_wp
+                if (ds < 0.05_wp*opts%ds_max) frac = cos(3.0_wp*opts%angle_target)
+                if (dist > 0.0_wp .and. dot_product(cy, t1(1:n)) + &
+                    (lam1 - lam)/opts%lscale*t1(n + 1) < frac*dist) then
+                    t1(1:n) = cy/dist
+                    t1(n + 1) = (lam1 - lam)/opts%lscale/dist
+                end if
+            end if
             angle = acos(max(-1.0_wp, min(1.0_wp, dot_product(t, t1))))
             dist = 0.0_wp
             if (.not. (last .or. turned)) dist = sqrt(sum(((y1 - yp)/opts%yscale)**2) + &

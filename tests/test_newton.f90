@@ -3,6 +3,8 @@
 !> lam = -2), with a dense 2x2 system extending nl_system; and of the corner of the
 !> piecewise linear curve y = a (1 - |lam|) (a = 1.5: it turns by 113 degrees at lam = 0,
 !> as a contact state switching at one AFT sample can make a harmonic balance curve turn).
+!> And a ratchet, y = a lam with the history moved to every converged point, each point a
+!> corner (as a contact history carried from point to point makes them).
 module newton_test_system
     use frirom_kinds, only: wp, ip
     use frirom_newton, only: nl_system
@@ -24,6 +26,17 @@ module newton_test_system
         procedure :: eval => vee_eval
         procedure :: solve => vee_solve
     end type vee_curve
+    !> y = a lam while lam rises past every point made so far, slope b below it: the
+    !> accept hook moves the history h to each converged lam, so every point is a corner
+    !> whose Jacobian (taken on the side lam <= h, as the AFT's stick Jacobian of a
+    !> contact left at the friction limit) gives the slope b, while the curve ahead has
+    !> slope a (a ratchet: a contact history carried from point to point).
+    type, extends(vee_curve) :: ratchet_curve
+        real(wp) :: b = 0.1_wp, h = -huge(1.0_wp)   !! slope below h (a: vee_curve's)
+    contains
+        procedure :: eval => ratchet_eval
+        procedure :: accept => ratchet_accept
+    end type ratchet_curve
 contains
     !> The hook must see every converged point once, at the converged (y, lam).
     subroutine cc_accept(this, y, lam, info, errmsg)
@@ -95,6 +108,34 @@ contains
         if (.false.) errmsg = ''
         if (.false.) b = b*this%a
     end subroutine vee_solve
+    subroutine ratchet_eval(this, y, lam, r, rref, jac, rlam, info, errmsg)
+        class(ratchet_curve), intent(inout) :: this
+        real(wp), intent(in) :: y(:), lam
+        real(wp), intent(out) :: r(:), rref, rlam(:)
+        logical, intent(in) :: jac
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        info = 0
+        if (lam > this%h) then
+            r(1) = y(1) - this%a*lam
+            rlam(1) = -this%a
+        else
+            r(1) = y(1) - this%a*this%h - this%b*(lam - this%h)
+            rlam(1) = -this%b
+        end if
+        rref = max(abs(y(1)), 1.0_wp)
+        if (jac .and. .false.) errmsg = ''
+    end subroutine ratchet_eval
+    subroutine ratchet_accept(this, y, lam, info, errmsg)
+        class(ratchet_curve), intent(inout) :: this
+        real(wp), intent(in) :: y(:), lam
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        info = 0
+        this%h = max(this%h, lam)
+        if (.false.) errmsg = ''
+        if (.false.) info = int(y(1))
+    end subroutine ratchet_accept
 end module newton_test_system
 
 program test_newton
@@ -106,6 +147,7 @@ program test_newton
     implicit none
     type(cubic_curve) :: s
     type(vee_curve) :: v
+    type(ratchet_curve) :: r
     type(cont_options) :: o
     real(wp) :: y(2), lam, t(3), ds, yout(2, 500), lout(500), tout(3, 500), y1ref
     integer(ip) :: it(500), npts, info, k, iters, nfold
@@ -193,5 +235,27 @@ program test_newton
     call check(all(lout(2:npts) < lout(1:npts - 1)), 'lam decreases monotonically')
     call check(count(lout(1:npts) < 0.0_wp) > 10 .and. maxval(yout(1, 1:npts)) > 1.4_wp, &
                'the branch beyond the corner followed')
+    ! the ratchet: a corner of 66 degrees at every point (slopes 3 and 0.1); following
+    ! the tangent J gives (slope b), every step lands 2.5 ds off its predictor and the next
+    ! one shrinks (144 points). From y = 0 at lam = 0 to 1.
+    r%n = 1
+    r%a = 3.0_wp
+    o = cont_options(lam_end=1.0_wp, ds=0.05_wp, ds_max=0.05_wp, max_points=500, &
+                     tol_r=1.0e-12_wp, tol_x=1.0e-10_wp)
+    y(1) = 0.0_wp
+    lam = 0.0_wp
+    r%h = 0.0_wp
+    call cont_tangent(r, y(1:1), lam, o, [0.0_wp, 0.0_wp], 1.0_wp, t(1:2), info, msg)
+    ds = o%ds
+    hf = .true.
+    call cont_run(r, y(1:1), lam, t(1:2), ds, -0.1_wp, o, yout(1:1, :), lout, tout(1:2, :), &
+                  it, npts, fin, info, msg, hf)
+    print '(a,i0,a,l1,a,es10.2)', 'ratchet: ', npts, ' points, finished ', fin, &
+        ', last lam ', lout(max(npts, 1))
+    call check(info == 0 .and. fin .and. lout(npts) == 1.0_wp, 'ratchet followed: '//trim(msg))
+    call check(all(abs(yout(1, 1:npts) - r%a*lout(1:npts)) < 1.0e-10_wp), &
+               'every ratchet point on y = a lam')
+    ! steps of ds = 0.05 along (1, a) / |(1, a)|: 0.016 in lam each, about 63, not 500
+    call check(npts < 100, 'ratchet: under 100 points (predicting along the chord)')
     call check_done('test_newton')
 end program test_newton

@@ -1,0 +1,98 @@
+!> frirom_hbm contact_assemble into a dense matrix: the matrix products it takes for a
+!> group whose rows are dense over its columns (an interface reduced to GSI modes) against
+!> the element loops (loops = .true., the path every earlier release took), on random G
+!> and random local Jacobians: dense columns (all of them, or a scattered subset with a
+!> column map and a wider harmonic stride), and sparse rows (where the loops are kept).
+!> Tolerance 1e-12 relative: the same sums in another order, ~50 terms of size ~1.
+program test_assemble
+    use frirom_kinds, only: wp, ip
+    use frirom_check, only: check, check_done
+    use frirom_hbm, only: contact_set, contact_assemble
+    implicit none
+    call compare('dense, 40 columns, normal1d, H = 1', ne=30, nd=2, nh=1, ncol=40, &
+                 per_row=40, stride=0)
+    call compare('dense, 12 of 30 columns, normal2d, H = 3, column map', ne=9, nd=3, nh=3, &
+                 ncol=30, per_row=12, stride=5)
+    call compare('sparse rows (element loops kept), 60 columns, H = 2', ne=20, nd=2, nh=2, &
+                 ncol=60, per_row=3, stride=0)
+    call check_done('test_assemble')
+
+contains
+
+    !> Random contact set: ne elements of nd directions, each row reading per_row of the
+    !> ncol columns (the same per_row for the whole group when per_row > 3: dense GSI-like
+    !> rows; else 3 random ones); stride > 0 maps column j to j + stride (a colmap) and
+    !> uses ldc = ncol + 2 stride.
+    subroutine compare(name, ne, nd, nh, ncol, per_row, stride)
+        character(len=*), intent(in) :: name
+        integer(ip), intent(in) :: ne, nd, nh, ncol, per_row, stride
+        type(contact_set) :: cs
+        real(wp), allocatable :: k1(:, :), k2(:, :)
+        integer(ip), allocatable :: sub(:), colmap(:)
+        real(wp) :: u(ncol)
+        integer(ip) :: nc, nr, r, k, info, ldc, j
+        character(len=200) :: msg
+        nc = 2*nh + 1
+        nr = ne*nd
+        cs%nc = nc
+        cs%g%nrow = nr
+        cs%g%ncol = ncol
+        allocate (cs%g%p(nr + 1), cs%g%i(nr*per_row), cs%g%x(nr*per_row))
+        ! the group's columns: a random subset of per_row (dense) or 3 per row
+        call random_number(u)
+        sub = sort_idx(u, per_row)
+        do r = 1, nr
+            cs%g%p(r) = (r - 1)*per_row + 1
+            if (per_row <= 3) then
+                call random_number(u)
+                sub = sort_idx(u, per_row)
+            end if
+            cs%g%i(cs%g%p(r):cs%g%p(r) + per_row - 1) = sub
+        end do
+        cs%g%p(nr + 1) = nr*per_row + 1
+        call random_number(cs%g%x)
+        cs%g%x = cs%g%x - 0.5_wp
+        allocate (cs%grp(1))
+        cs%grp(1)%ne = ne
+        cs%grp(1)%ndir = nd
+        cs%grp(1)%row0 = 0
+        allocate (cs%grp(1)%jac(nc*nd, nc*nd, ne))
+        call random_number(cs%grp(1)%jac)
+        cs%grp(1)%jac = cs%grp(1)%jac - 0.5_wp
+        cs%grp(1)%jac(1, 2, 1) = 0.0_wp         ! an exact zero (skipped) among the entries
+        ldc = ncol + 2*stride
+        allocate (k1(ldc*nc, ldc*nc), k2(ldc*nc, ldc*nc), colmap(ncol))
+        colmap = [(j + stride, j=1, ncol)]
+        call random_number(k1)
+        k2 = k1                                 ! both add to the same existing entries
+        if (stride > 0) then
+            call contact_assemble(cs, kd=k1, info=info, errmsg=msg, colmap=colmap, ldc=ldc)
+            call check(info == 0, name//': '//trim(msg))
+            call contact_assemble(cs, kd=k2, info=info, errmsg=msg, colmap=colmap, ldc=ldc, &
+                                  loops=.true.)
+        else
+            call contact_assemble(cs, kd=k1, info=info, errmsg=msg)
+            call check(info == 0, name//': '//trim(msg))
+            call contact_assemble(cs, kd=k2, info=info, errmsg=msg, loops=.true.)
+        end if
+        call check(info == 0, name//' (loops): '//trim(msg))
+        k = 0
+        print '(a,a,es10.2)', name, ': max |products - loops| / max |loops| =', &
+            maxval(abs(k1 - k2))/maxval(abs(k2))
+        call check(maxval(abs(k1 - k2)) <= 1.0e-12_wp*maxval(abs(k2)), name)
+    end subroutine compare
+
+    !> Indices of the m smallest entries of u, ascending by index (a random m-subset).
+    function sort_idx(u, m) result(idx)
+        real(wp), intent(in) :: u(:)
+        integer(ip), intent(in) :: m
+        integer(ip), allocatable :: idx(:)
+        logical :: take(size(u))
+        integer(ip) :: j
+        take = .false.
+        do j = 1, m
+            take(minloc(u, 1, mask=.not. take)) = .true.
+        end do
+        idx = pack([(j, j=1, size(u))], take)
+    end function sort_idx
+end program test_assemble
