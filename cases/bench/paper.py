@@ -63,7 +63,8 @@ def print_table(rows: list) -> None:
               f"{r['rom1_dofs']:6d} {r['rom2_dofs']:6d} {r['rom1_nonlinear']:5d} "
               f"{r['rom2_nonlinear']:5d} {r['reduction_s']:7.1f} {t1:>16} "
               f"{r['rom2_frf_s']:8.2f} {r['speedup']:7.1f}x {100 * r['peak_amp_err']:8.3f}% "
-              f"{100 * r['peak_freq_err']:8.4f}%" + ("  ABOVE TARGET" if bad else ""))
+              f"{100 * r['peak_freq_err']:8.4f}%" + ("  ABOVE TARGET" if bad else "")
+              + ("" if r.get("complete", True) else "  INCOMPLETE (an FRF stopped early)"))
 
 
 def summary(rows: list) -> str:

@@ -396,9 +396,18 @@ def print_spectrum(sp_: dict, f0: float, f_hz: float, top: int = 4) -> list:
     return sorted(keep)
 
 
-def row_flag(amp_err: float, f_err: float) -> str:
+def row_flag(amp_err: float, f_err: float, complete: bool = True) -> str:
+    """'match' within the paper's targets, 'DIFFERS' outside; 'UNKNOWN' when one of the
+    two FRFs stopped before the end of the band (its peak may not be the peak)."""
+    if not complete:
+        return "UNKNOWN (an FRF stopped early)"
     ok = abs(amp_err) <= TARGET_AMP and abs(f_err) <= TARGET_FREQ
     return "match" if ok else "DIFFERS"
+
+
+def stopped(r: dict) -> str:
+    """'' for a complete FRF, else where it stopped: ' STOPPED at <f> Hz'."""
+    return "" if r.get("complete", True) else f" STOPPED at {r['f'][-1]:.1f} Hz"
 
 
 def family(work: Path, quick: bool, rom1: str = "all", log=print) -> dict:
@@ -415,8 +424,9 @@ def family(work: Path, quick: bool, rom1: str = "all", log=print) -> dict:
     d1, _ = load(work, "rom1")
     res["rom1_sizes"] = sizes(d1)
     res["rom1_reduction_s"] = d1.reduced.build_seconds
-    # the ROM_IIs first (fast), then ROM_I; ROM_II family at paper size costs about what
-    # ROM_I does (168 nonlinear coordinates), so it follows `rom1` too
+    # the ROM_IIs first (fast), then ROM_I; ROM_II family at paper size costs more than
+    # ROM_I (every pair reads its 168 MS coordinates: the solver's entry-by-entry G^T J G
+    # assembly is ~90 % of its time), so it follows `rom1` too
     for rom in ("rom2", "rom2_eo", "rom1", "rom2_family"):
         d = d1 if rom == "rom1" else derived(d1, rom, spec)
         res.setdefault(rom, {})
@@ -474,11 +484,12 @@ def report(work: Path, quick: bool, res: dict) -> None:
             line = (f"  F0 {f0:6g} {ROMS[rom][0]:<14} {r['peak_amp'][0]:.4e} m "
                     f"{r['peak_f'][0]:9.3f} Hz | {r['peak_amp'][1]:.4e} m "
                     f"{r['peak_f'][1]:9.3f} Hz  {r['seconds']:7.1f} s  slip {r['slip']:.2f} "
-                    f"lift {r['lift']:.2f}")
+                    f"lift {r['lift']:.2f}{stopped(r)}")
             if rom != "rom1" and r1 is not None:
                 ea = max(abs(r["peak_amp"][k] / r1["peak_amp"][k] - 1) for k in range(2))
                 ef = max(abs(r["peak_f"][k] / r1["peak_f"][k] - 1) for k in range(2))
-                line += f"  err {100 * ea:.3f} % / {100 * ef:.4f} % {row_flag(ea, ef)}"
+                done = r.get("complete", True) and r1.get("complete", True)
+                line += f"  err {100 * ea:.3f} % / {100 * ef:.4f} % {row_flag(ea, ef, done)}"
             elif rom != "rom1":
                 line += "  (no ROM_I at this F0)"
             print(line)
@@ -544,7 +555,8 @@ def bench_rows(work: Path, quick: bool) -> list[dict]:
     Keys: case, member, rom2 ('h=2' or 'family'), fe_dofs, rom1_dofs, rom2_dofs,
     rom1_nonlinear, rom2_nonlinear, reduction_s (ROM_II's CB + MS, when its cache was
     built), rom1_frf_s, rom1_extrapolated, rom2_frf_s, speedup, peak_amp_err,
-    peak_freq_err (largest over the two stages' peaks, relative). The ROM_II FRFs run in
+    peak_freq_err (largest over the two stages' peaks, relative), complete (False when
+    the ROM_I or ROM_II FRF stopped before the band's end). The ROM_II FRFs run in
     this call. ROM_I at paper size: its time is sampled (solve_point at 3 frequencies:
     seconds per Newton evaluation x the evaluations of the family ROM_II's FRF, which
     follows the same solution path; ``rom1_extrapolated``) and its peaks are those of the
@@ -586,7 +598,8 @@ def bench_rows(work: Path, quick: bool) -> list[dict]:
                              rom1_frf_s=t1,
                              rom1_extrapolated=extrap, rom2_frf_s=r["seconds"],
                              speedup=t1 / max(r["seconds"], 1e-12), peak_amp_err=ea,
-                             peak_freq_err=ef))
+                             peak_freq_err=ef,
+                             complete=bool(r["complete"] and r1.get("complete", True))))
     return rows
 
 
