@@ -388,8 +388,8 @@ def _stuck_eo_frequency(K, M, G, spec: FlangeSpec, F,
     The dominant mode is the EO pair of the lowest family (mode 3 or 4 of 1 300 to 3 100
     at 100 to 400 pairs), so a partial eigh (LAPACK dsygvx, the lowest ``n_low`` pairs)
     replaces every mode of the dense ROM_I (dsygvd): about half the time (a window of 200:
-    7.8 s against 16 s per call at 400 pairs), the same frequencies to 6e-10. A maximum at the top of the window
-    falls back to every mode.
+    7.8 s against 16 s per call at 400 pairs), the same frequencies to 6e-10. A maximum at
+    the top of the window falls back to every mode.
     """
     import scipy.linalg as sl
     Kc = (G.T @ sp.diags(np.tile([spec.kt, spec.kn], G.shape[0] // 2)) @ G).toarray()
