@@ -27,10 +27,10 @@ evaluation (and its split), per point and per FRF, the generation time, and the 
 exponents (least squares, log-log) of the FRF time and of the time per evaluation, with the
 machine load (load averages). Generation on this machine (2 cores shared, load ~6-8): 100
 pairs 11 s, 200 pairs 28 s, 400 pairs 90 s, 800 pairs 7-13 min (CB of 63 000 + 66 000 FE
-DoFs with 2 550 masters each), so run the 800-pair size once: it is cached. A size whose whole FRF would exceed --budget (predicted from the
-largest whole one by the n^3 law of a dense LU) runs the first --short points of the same
-sweep, and its FRF time is their time per point x the points of the largest whole FRF
-(marked "short").
+DoFs with 2 550 masters each), so run the 800-pair size once: it is cached. A size whose
+whole FRF would exceed --budget (predicted from the largest whole one by the n^3 law of a
+dense LU) runs the first --short points of the same sweep, and its FRF time is their time
+per point x the points of the largest whole FRF (marked "short").
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python cases/bench/large_interface.py [--quick]
         [--pairs 200] [--threads 1] [--route "name:key=value,..."] [--budget 600]
