@@ -22,11 +22,15 @@ the 1e-8 target on this model.
 
 Scaling (issue 10 item 5): ROM_I models of the same kind with 100, 200, 400, 800 contact
 pairs (2, 4, 8, 16 segments per sector; generated like the main one, cached), per size the
-first route's FRF: points, evaluations, LUs, GMRES iterations, seconds, and the growth
-exponent of a log-log fit. A size whose whole FRF would exceed --budget (predicted from the
-largest whole one by the n^3 law of a dense LU) runs the first --short points of the same
-sweep, and its FRF time is their time per point x the points of the largest whole FRF
-(marked "short").
+first route's FRF: FE DoFs, points, evaluations, LUs, GMRES iterations, seconds per
+evaluation (and its split), per point and per FRF, the generation time, and the growth
+exponents (least squares, log-log) of the FRF time and of the time per evaluation, with the
+machine load (load averages). Generation on this machine (2 cores shared, load ~6-8): 100
+pairs 11 s, 200 pairs 28 s, 400 pairs 90 s, 800 pairs 7-13 min (CB of 63 000 + 66 000 FE
+DoFs with 2 550 masters each), so run the 800-pair size once: it is cached. A size whose
+whole FRF would exceed --budget (predicted from the largest whole one by the n^3 law of a
+dense LU) runs the first --short points of the same sweep, and its FRF time is their time
+per point x the points of the largest whole FRF (marked "short").
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python cases/bench/large_interface.py [--quick]
         [--pairs 200] [--threads 1] [--route "name:key=value,..."] [--budget 600]
@@ -299,24 +303,46 @@ def header():
           f"diff vs reference")
 
 
+def _load() -> str:
+    """The machine load (1, 5, 15 min averages) and core count, as uptime prints it."""
+    return ("load average " + ", ".join(f"{v:.2f}" for v in os.getloadavg())
+            + f" on {os.cpu_count()} cores")
+
+
+def _exponent(xs, ys) -> float:
+    """Least-squares slope of log y against log x."""
+    return float(np.polyfit(np.log(xs), np.log(ys), 1)[0])
+
+
 def scaling(a, sizes, kw, main_row, pairs, spec_for, roms, band, sectors, n_modes):
     """Time per FRF against contact pairs (ROM_I of the same kind at each size). A size
     whose FRF fits --budget (predicted from the last measured one by the n^3 LU law) runs
     the whole FRF; a larger one runs the first --short points of the same sweep and its
-    FRF time is s/point x the points of the largest whole FRF (marked "short")."""
+    FRF time is s/point x the points of the largest whole FRF (marked "short"). The growth
+    exponents (least squares over the sizes measured so far, printed after each size) are
+    on the FRF time and on the time per Newton evaluation (less sensitive to the load and
+    to where a short run stops). Per evaluation, the receptances cost (contact rows)^2 x
+    (ROM_I DoFs) per harmonic and a dense LU (unknowns)^3: with every interface DoF kept in
+    ROM_I both grow about like pairs^3, so the FRF stays under pairs^2 only as far as held
+    LUs and GMRES replace factorisations."""
     print(f"\nscaling, route {first_route(a)!r}, ROM_I of the same kind (sectors {sectors}, "
-          f"{n_modes} modes per stage)")
-    print(f"  {'pairs':>6} {'ROM DoFs':>8} {'unknowns':>8} {'points':>6} {'evals':>6} "
-          f"{'LUs':>5} {'GMRES':>6} {'s/point':>8} {'FRF s':>9}  {'gen. s':>7}")
-    xs, ys = [], []
+          f"{n_modes} CB modes per stage, {2 * sectors} active nodes x 3; every interface DoF "
+          "kept)")
+    print("  the FE mesh refines circumferentially with the pairs (pairs / sectors angular "
+          "cells per sector), so FE DoFs grow like the interface; gen. s = ccx + CB + "
+          "assembly (from the cache: the time it took when generated)")
+    print(f"  {_load()} at the start")
+    print(f"  {'pairs':>6} {'FE DoFs':>7} {'ROM DoFs':>8} {'unknowns':>8} {'points':>6} "
+          f"{'evals':>6} {'LUs':>5} {'GMRES':>6} {'s/eval':>8} {'s/point':>8} {'FRF s':>9}"
+          f"  {'gen. s':>7}")
+    xs, ys, ye = [], [], []
     last = None          # (unknowns, FRF s, points) of the largest whole FRF
     for p in sizes:
         if p % sectors or p // sectors < 2:
             print(f"  {p:6d} skipped: not >= 2 per sector of {sectors}")
             continue
-        t0 = time.perf_counter()
         rp = roms if p == pairs else flange.flange_roms(spec_for(p), a.work)
-        t_gen = time.perf_counter() - t0
+        t_gen = rp["t_ccx"] + rp["t_reduce"]
         mp, ep, op = flange.frirom_models(rp, "I")
         gb = estimated_gb(mp, kw)
         if gb > a.mem_limit:
@@ -344,17 +370,22 @@ def scaling(a, sizes, kw, main_row, pairs, spec_for, roms, band, sectors, n_mode
                 t_frf = t_frf / npts * last[2]
         if whole:
             last = (n_u, t_frf, npts, p)
-        print(f"  {p:6d} {mp.n_dof:8d} {n_u:8d} {npts:6d} {int(res_t['evaluations']):6d} "
-              f"{int(res_t['factorizations']):5d} {int(res_t['krylov_iterations']):6d} "
+        n_ev = max(int(res_t["evaluations"]), 1)
+        s_eval = res_t.get("fortran_total", 0.0) / n_ev
+        print(f"  {p:6d} {sum(rp['sizes']['fe_dofs']):7d} {mp.n_dof:8d} {n_u:8d} {npts:6d} "
+              f"{n_ev:6d} {int(res_t['factorizations']):5d} "
+              f"{int(res_t['krylov_iterations']):6d} {s_eval:8.3f} "
               f"{t_frf / (last[2] if not whole else npts):8.3f} {t_frf:9.1f}  {t_gen:7.1f} "
               f"{note}")
+        print(f"         split of an evaluation: {fmt_split(per_eval(res_t))}")
         xs.append(p)
         ys.append(t_frf)
+        ye.append(s_eval)
+        if len(xs) >= 2 and min(ys) > 0 and min(ye) > 0:
+            print(f"         growth exponent over {xs} pairs (least squares, log-log): FRF "
+                  f"time {_exponent(xs, ys):.2f}, time per evaluation {_exponent(xs, ye):.2f}"
+                  f" (target <= 2); {_load()}")
         sys.stdout.flush()
-    if len(xs) >= 2 and min(ys) > 0:
-        slope = np.polyfit(np.log(xs), np.log(ys), 1)[0]
-        print(f"  growth exponent of the FRF time in contact pairs (log-log fit): {slope:.2f}"
-              f" (target <= 2)")
 
 
 def first_route(a):
@@ -375,7 +406,7 @@ def main(a):
                                  n_modes=n_modes, coarse=quick)
 
     print(f"large_interface: OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}, "
-          f"H = {H}, {SAMPLES} samples, work folder {a.work}")
+          f"H = {H}, {SAMPLES} samples, work folder {a.work}; {_load()}")
     t0 = time.perf_counter()
     roms = flange.flange_roms(spec_for(pairs), a.work)
     s = roms["sizes"]
@@ -439,7 +470,7 @@ def main(a):
     if scal:
         scaling(a, scal, rts[first], rows.get((first, "ROM_I"), {}), pairs, spec_for, roms,
                 band, sectors, n_modes)
-    print(f"\ntotal benchmark time {time.perf_counter() - t_start:.0f} s")
+    print(f"\ntotal benchmark time {time.perf_counter() - t_start:.0f} s; {_load()}")
     r1, r2 = rows[(first, "ROM_I")], rows[(first, "ROM_II")]
 
     def sec(r):
