@@ -269,6 +269,17 @@ end subroutine hbm_continue
 !> T_*, N_EVAL, N_FACT, N_KRYLOV, N_TIMERS (timings slots, frirom_hbm) and the FRIROM_*
 !> status codes.
 !> An unknown name returns info = FRIROM_ERR_PARAM.
+!> The default AFT samples per period for nh harmonics (frirom_solve's rule, the one place
+!> it is written; frirom.harmonics.default_samples reads it).
+subroutine default_samples(nh, ns)
+    use frirom_kinds, only: ip
+    use frirom_solve, only: frf_default_samples
+    implicit none
+    integer(4), intent(in) :: nh
+    integer(4), intent(out) :: ns
+    ns = int(frf_default_samples(int(nh, ip)), 4)
+end subroutine default_samples
+
 subroutine int_constant(name, value, info, msg)
     use frirom_kinds, only: ip
     use frirom_status, only: FRIROM_ERR_PARAM, frirom_status_code, set_status

@@ -74,7 +74,7 @@ module frirom_solve
 
 contains
 
-    !> AFT samples per period by default for H harmonics (frirom.harmonics.default_samples):
+    !> AFT samples per period by default for H harmonics (also frirom.harmonics.default_samples):
     !> 512, or 16 per period of harmonic H rounded up to a power of two when more.
     pure function frf_default_samples(nh) result(ns)
         integer(ip), intent(in) :: nh
