@@ -137,3 +137,97 @@ def test_study_member_uses_the_choice(tmp_path):
     alone = resolve_deck(_deck("joint_auto.toml", {}, (455.0, 480.0)), lambda s: None)
     assert s["complete"] and s["harmonics"] == alone.harmonics
     assert FRF.load(tmp_path / "m" / "frf.h5").X.shape[2] == 2 * alone.harmonics + 1
+
+
+# ---- interface modes "auto" (frirom.auto.choose_modes) on the lap joint ----------------
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def lap(tmp_path_factory):
+    """The lap joint, coarse (element 12 mm: 65 node pairs), as test_lap_joint_case: H = 1,
+    825-880 Hz; ``text(n or None, **auto keys)`` its deck with n GSI modes or "auto"."""
+    import re
+    import shutil
+    import sys
+    if shutil.which("ccx") is None:
+        pytest.skip("ccx not installed")
+    pytest.importorskip("gmsh")
+    sys.path.insert(0, str(ROOT / "cases" / "lap_joint"))
+    import make_lap_joint
+    from test_lap_joint_case import small
+    out = tmp_path_factory.mktemp("lap_auto")
+    make_lap_joint.make(out, size=0.012)
+
+    def text(n=None, **keys):
+        if n is not None:
+            return small(n)
+        extra = "".join(f"\n{k} = {v}" for k, v in keys.items())
+        return re.sub(r"\nfree = \d+\nstick = \d+", '\nfree = "auto"\nstick = "auto"' + extra,
+                      small(40))
+    return out, text
+
+
+def test_interface_modes_auto_meets_tolerance_on_lap_joint(lap, tmp_path, monkeypatch,
+                                                           capsys):
+    # `frirom run` with free = stick = "auto" for 1 %: each rung is its own reduced model
+    # (one cache entry each, the run's model read back), the choice is logged, stored in
+    # frf.h5 and put on the plot; the run's peak is within 1 % in amplitude and frequency
+    # of a separately run, much richer model (60 + 60 GSI modes, twice the ladder's top,
+    # over the whole range: not a rung the estimate saw). Measured: 20 + 20 chosen,
+    # 7e-4 in amplitude, 5e-4 in frequency.
+    case, text = lap
+    monkeypatch.setenv("FRIROM_CACHE", str(tmp_path / "cache"))
+    (case / "auto.toml").write_text(text(tolerance_auto=0.01, max_modes=30))
+    (case / "rich.toml").write_text(text(120))
+    assert main(["run", str(case / "auto.toml"), "--out", str(tmp_path / "a"),
+                 "--quiet"]) == 0
+    log = capsys.readouterr().out
+    assert "frirom: auto: interface modes free = 20, stick = 20 auto" in log, log
+    assert "WARNING" not in log and "(cached)" not in log    # every rung built once
+    assert len(list((tmp_path / "cache").glob("rom-*.h5"))) == 4       # 5, 10, 20, 30
+    assert "reduced model reused" not in log.split("auto: interface modes")[0]
+    with h5py.File(tmp_path / "a" / "frf.h5", "r") as f:
+        assert "interface-mode estimate" in f.attrs["auto"]
+    got = FRF.load(tmp_path / "a" / "frf.h5")
+    assert main(["run", str(case / "rich.toml"), "--out", str(tmp_path / "r"),
+                 "--quiet"]) == 0
+    ref = FRF.load(tmp_path / "r" / "frf.h5")
+    (w, a), (wr, ar) = [(r.peak(0).omega, r.peak(0).amplitude) for r in (got, ref)]
+    assert abs(a / ar - 1) <= 0.01 and abs(w / wr - 1) <= 0.01, (w, a, wr, ar)
+    assert load_deck(case / "auto.toml").settings.reduction.free == 5    # first rung
+
+
+def test_interface_modes_auto_not_reached_uses_largest(lap, tmp_path, monkeypatch):
+    # Two rungs (5 and 10 modes per key) cannot meet 1e-3: the largest is used, and the
+    # log, the summary and the plot's title say so.
+    case, text = lap
+    monkeypatch.setenv("FRIROM_CACHE", str(tmp_path / "cache"))
+    (case / "few.toml").write_text(text(tolerance_auto=1e-3, max_modes=10))
+    lines = []
+    deck = resolve_deck(load_deck(case / "few.toml"), lines.append)
+    ch = deck.auto
+    assert not ch.met_modes and ch.modes == {"free": 10, "stick": 10}
+    assert [k for k, _ in ch.mode_estimates] == ["free = 5, stick = 5"]
+    assert len(deck.model().nonlinear_dofs()) == 20 and deck.settings.modes_auto is None
+    assert any("WARNING" in s and "did not reach" in s for s in lines), lines
+    assert "NOT within" in ch.summary() and "NOT within" in ch.title()
+
+
+@pytest.mark.parametrize("keys, key", [
+    ({"free": '"many"'}, "reduction.interface_modes.free"),
+    ({"tolerance_auto": 0.01}, "reduction.interface_modes.tolerance_auto"),
+    ({"free": '"auto"', "max_modes": 4}, "reduction.interface_modes.max_modes"),
+    ({"free": '"auto"', "max_index": 4}, "reduction.interface_modes.max_index"),
+    ({"stick": '"auto"', "tolerance_auto": 0.0}, "reduction.interface_modes.tolerance_auto"),
+])
+def test_bad_interface_auto_keys_name_the_field(lap, keys, key):
+    import re
+    case, text = lap
+    t = text(40)
+    for k, v in keys.items():
+        t = re.sub(rf"\n{k} = \d+", "", t).replace("\nstick = ", f"\n{k} = {v}\nstick = ", 1) \
+            if k != "stick" else t.replace("\nstick = 20", f"\nstick = {v}")
+    (case / "bad.toml").write_text(t)
+    with pytest.raises(InputError, match=key.replace(".", r"\.")):
+        parse_deck(case / "bad.toml")

@@ -23,6 +23,18 @@ The estimate costs a coarse run and a few point solves, not a ladder of FRFs:
 Where the estimate does not reach the tolerance within ``max_harmonics`` /
 ``max_samples`` (it stalls, rises, or a solve fails) the choice is the maximum and the
 log and ``FRF.solver_info`` say so: never a silent pick.
+
+Interface modes (``[reduction.interface_modes]`` ``free`` / ``stick`` or
+``harmonic_indices = "auto"``, :func:`choose_modes`) change the reduced coordinates, so no
+solution is carried from rung to rung: each rung of the ladder
+(:meth:`frirom.deck.schema_study.ModesAuto.rungs`) is its own reduced model (built once,
+then read from the content-keyed cache) and its own FRF, the first over the deck's range,
+the others only over the **peak region**: the previous rung's peaks +- :data:`WINDOW`
+(the whole range again when a peak lands on the window's edge). The estimate e(k) is the
+largest relative change of the peak amplitude and the peak frequency from rung k to k+1
+over the outputs; the error of rung k is the tail e(k) / (1 - r), r = e(k) / e(k-1) the
+observed rate (as for H), and the smallest rung within the tolerance is chosen. The modes
+are chosen first, at the smallest H when H is auto too.
 """
 
 from __future__ import annotations
@@ -36,10 +48,13 @@ import numpy as np
 from ._errors import ConvergenceError, FriromError
 from .harmonics import default_samples
 
-__all__ = ["AutoChoice", "choose", "resolve_deck"]
+__all__ = ["AutoChoice", "choose", "choose_modes", "resolve_deck"]
 
 #: the largest ratio of successive estimates trusted as a rate of convergence
 RATE_MAX = 0.9
+#: half-width of the peak region a rung of interface modes is run on, relative to the
+#: peak frequency (the lap joint's peak moves 1 % between rungs)
+WINDOW = 0.05
 
 
 def _tail(est: list, back: int) -> float:
@@ -71,6 +86,12 @@ class AutoChoice:
         What failed, in words (also in :meth:`lines`).
     seconds : float
         Wall time of the choice.
+    modes : dict
+        Interface-mode counts chosen {key: value} (empty: not chosen).
+    mode_estimates : list of (str, float)
+        (rung, e(rung)) as climbed. met_modes : bool. modes_tolerance : float.
+    mode_lines : list of str
+        The rungs' log lines (logged as they ran).
     """
 
     harmonics: int
@@ -83,9 +104,24 @@ class AutoChoice:
     met_n: bool = True
     notes: list = field(default_factory=list)
     seconds: float = 0.0
+    modes: dict = field(default_factory=dict)
+    mode_estimates: list = field(default_factory=list)
+    met_modes: bool = True
+    modes_tolerance: float = 0.0
+    mode_lines: list = field(default_factory=list)
+
+    def modes_text(self) -> str:
+        """``"free = 20, stick = 20"``: the chosen interface-mode counts."""
+        return _rung_label(self.modes)
 
     def summary(self) -> str:
         """One line for ``FRF.solver_info``."""
+        out = []
+        if self.modes:
+            e = dict(self.mode_estimates).get(self.modes_text(), float("nan"))
+            out.append(f"interface modes {self.modes_text()} auto (estimate {e:.2e}"
+                       + ("" if self.met_modes else ", NOT within the tolerance: the "
+                          "largest") + f", tolerance {self.modes_tolerance:g})")
         parts = []
         for name, v, est, met in (("H", self.harmonics, self.h_estimates, self.met_h),
                                   ("N", self.samples, self.n_estimates, self.met_n)):
@@ -94,7 +130,9 @@ class AutoChoice:
                 parts.append(f"{name} = {v} auto (estimate {e:.2e}"
                              + ("" if met else ", NOT within the tolerance: the maximum")
                              + ")")
-        return "; ".join(parts) + f", tolerance {self.tolerance:g}"
+        if parts:
+            out.append("; ".join(parts) + f", tolerance {self.tolerance:g}")
+        return "; ".join(out)
 
     def title(self) -> str:
         """A short line for a plot's title: the choice, and a failed estimate."""
@@ -103,13 +141,23 @@ class AutoChoice:
             if est)
         bad = [n for n, est, met in (("H", self.h_estimates, self.met_h),
                                      ("N", self.n_estimates, self.met_n)) if est and not met]
-        return (f"auto: {text} for {self.tolerance:g}" + (
-            f" - {' and '.join(bad)} estimate NOT within it: the maximum" if bad else ""))
+        out = []
+        if self.modes:
+            out.append(f"auto: modes {self.modes_text()} for {self.modes_tolerance:g}"
+                       + ("" if self.met_modes else " - NOT within it: the largest"))
+        if text:
+            out.append(f"auto: {text} for {self.tolerance:g}" + (
+                f" - {' and '.join(bad)} estimate NOT within it: the maximum" if bad
+                else ""))
+        return "; ".join(out)
 
     def lines(self) -> list:
         """The log lines: probes, the estimates climbed, the choice, the failures."""
-        out = [f"auto: probe points at {', '.join(f'{w / 2 / np.pi:.6g}' for w in self.probes)}"
-               f" Hz (largest amplitude of each output on a run at the smallest H)"]
+        out = list(self.mode_lines)
+        if self.probes:
+            out.append(f"auto: probe points at "
+                       f"{', '.join(f'{w / 2 / np.pi:.6g}' for w in self.probes)} Hz "
+                       "(largest amplitude of each output on a run at the smallest H)")
         for name, est in (("H", self.h_estimates), ("N", self.n_estimates)):
             if est:
                 out.append(f"auto: {name} estimate (relative change of the amplitudes at "
@@ -275,13 +323,145 @@ def choose(model, F, omega_start, omega_end, options, outputs=None, *, harmonics
     return ch
 
 
+def _rung_label(values: dict) -> str:
+    """``free = 20, stick = 20`` / ``harmonic_indices = 0-3``."""
+    return ", ".join(f"{k} = {v[0]}-{v[-1]}" if isinstance(v, tuple) else f"{k} = {v}"
+                     for k, v in values.items())
+
+
+def _rung_deck(deck, values: dict):
+    """The deck with the interface-mode counts ``values``, built by the deck builder (the
+    reduced model comes from the content-keyed cache when it was built before)."""
+    from .deck import build_deck
+    s = deck.settings
+    return build_deck(dataclasses.replace(
+        s, reduction=dataclasses.replace(s.reduction, **values), modes_auto=None))
+
+
+def _rung_peaks(deck, H, opts, window, full):
+    """The peaks [(omega rad/s, amplitude)] per output of the deck's FRF at H over
+    ``window`` (the whole range ``full`` again when a peak lies on its edge), and the
+    run's (points, seconds, message); peaks None when the curve stopped."""
+    from .solver import frf
+    model, exc = deck.model(), _excitation(deck.F, H)
+    t0 = time.perf_counter()
+    down = full[0] > full[1]
+    for lo, hi in (window, (min(full), max(full))):
+        r = frf(model, exc, *((hi, lo) if down else (lo, hi)), opts,
+                outputs=deck.solver_outputs)
+        n = len(r)
+        peaks = r.peaks if r.peaks is not None else [r.peak(j) for j in
+                                                      range(r.amp_max.shape[1])] if n else []
+        edge = any(p.index in (0, n - 1) for p in peaks)
+        if not edge or (lo, hi) == (min(full), max(full)):
+            break
+    info = (n, time.perf_counter() - t0, (lo, hi), r.message)
+    if not r.complete or not peaks:
+        return None, info
+    return [(p.omega, p.amplitude) for p in peaks], info
+
+
+def _peak_change(a, b) -> float:
+    """Largest relative change of the peak amplitude or frequency from ``a`` to ``b``
+    (lists of (omega, amplitude) per output); inf when either is missing."""
+    if a is None or b is None:
+        return float("inf")
+    return max(max(abs(wa - wb) / wb, abs(xa - xb) / xb) for (wa, xa), (wb, xb) in zip(a, b))
+
+
+def choose_modes(deck, log=print):
+    """Choose the interface-mode counts of ``deck.settings.modes_auto`` by the rung
+    estimate of the module docstring.
+
+    Parameters
+    ----------
+    deck : Deck
+        Built with the first rung (what the parser gives for ``"auto"``).
+    log : callable(str)
+        Each rung's line as it finishes.
+
+    Returns
+    -------
+    (Deck, AutoChoice)
+        The deck built with the chosen counts, and the choice (``modes``,
+        ``mode_estimates``, ``met_modes``, ``mode_lines``, ``notes``).
+    """
+    t0 = time.perf_counter()
+    s = deck.settings
+    ma, sol = s.modes_auto, s.solver
+    loaded = [h for h in range(deck.F.shape[1]) if np.any(deck.F[:, h] != 0)]
+    H = max([1] + loaded) if sol.auto_harmonics else deck.harmonics
+    opts = dataclasses.replace(deck.options(), harmonics=H, stability=False,
+                               **({"samples": None} if sol.auto_samples else {}))
+    full = (deck.omega_start, deck.omega_end)
+    rungs = ma.rungs()
+    ch = AutoChoice(harmonics=deck.harmonics, samples=deck.samples,
+                    tolerance=sol.tolerance_auto, modes_tolerance=ma.tolerance)
+    prev, chosen, d = None, None, deck
+    for i, values in enumerate(rungs):
+        if i > 0:
+            d = _rung_deck(deck, values)
+        window = (min(full), max(full))
+        if prev is not None:
+            ws = [w for w, _ in prev]
+            window = (max(min(full), min(ws) * (1 - WINDOW)),
+                      min(max(full), max(ws) * (1 + WINDOW)))
+        peaks, (n, sec, (lo, hi), msg) = _rung_peaks(d, H, opts, window, full)
+        rom = d.reduced
+        head = (f"auto: modes {_rung_label(values)}: {d.n_dof} coordinates, "
+                f"{len(d.model().nonlinear_dofs())} in contact; ")
+        tail = (f"{n} points over {lo / 2 / np.pi:.5g}-{hi / 2 / np.pi:.5g} Hz, reduction "
+                f"{getattr(rom, 'build_seconds', 0.0) or 0.0:.1f} s"
+                f"{' (cached)' if getattr(rom, 'from_cache', False) else ''}, FRF {sec:.1f} s")
+        if peaks is None:
+            ch.notes.append(f"modes {_rung_label(values)}: the curve stopped ({msg})")
+            line = head + f"curve stopped ({msg}); " + tail
+        else:
+            line = head + "peak " + ", ".join(f"{a:.4g} at {w / 2 / np.pi:.6g} Hz"
+                                              for w, a in peaks) + f" ({tail})"
+        log(line)
+        ch.mode_lines.append(line)
+        if i > 0:
+            ch.mode_estimates.append((_rung_label(rungs[i - 1]), _peak_change(prev, peaks)))
+            if np.isfinite(ch.mode_estimates[-1][1]) and \
+                    _tail(ch.mode_estimates, 1) <= ma.tolerance:
+                chosen = i - 1
+                break
+        prev = peaks
+    if chosen is None:
+        chosen, ch.met_modes = len(rungs) - 1, False
+        last = ch.mode_estimates[-1][1] if ch.mode_estimates else float("nan")
+        ch.notes.append(f"the interface-mode estimate did not reach {ma.tolerance:g} up to "
+                        f"{_rung_label(rungs[-1])} (last {last:.2e}): the run uses the "
+                        "largest rung; raise max_modes / max_index or the tolerance")
+    ch.modes = dict(rungs[chosen])
+    est = ", ".join(f"{k}: {e:.2e}" for k, e in ch.mode_estimates)
+    ch.mode_lines.append(f"auto: interface-mode estimate (relative change of the peak "
+                         f"amplitude and frequency to the next rung): {est}")
+    if chosen != i:
+        d = _rung_deck(deck, rungs[chosen])
+    ch.seconds = time.perf_counter() - t0
+    return d, ch
+
+
 def resolve_deck(deck, log=print):
-    """The deck with ``harmonics = "auto"`` / ``samples = "auto"`` replaced by the chosen
-    values (the deck itself when neither is asked); ``deck.auto`` is the
-    :class:`AutoChoice` (None without auto), and its lines go to ``log``."""
+    """The deck with ``harmonics = "auto"`` / ``samples = "auto"`` and the interface-mode
+    counts ``"auto"`` replaced by the chosen values (the deck itself when none is asked);
+    ``deck.auto`` is the :class:`AutoChoice` (None without auto), and its lines go to
+    ``log`` (the interface-mode rungs as they run)."""
     sol = getattr(deck.settings, "solver", None)
-    if sol is None or not (sol.auto_harmonics or sol.auto_samples):
+    modes = getattr(deck.settings, "modes_auto", None)
+    hn = sol is not None and (sol.auto_harmonics or sol.auto_samples)
+    if modes is None and not hn:
         deck.auto = None
+        return deck
+    mc = None
+    if modes is not None:
+        deck, mc = choose_modes(deck, log)
+    if not hn:
+        for line in mc.lines()[len(mc.mode_lines) - 1:]:
+            log(line)
+        deck.auto = mc
         return deck
     opts = deck.options()
     if sol.auto_samples:
@@ -290,7 +470,13 @@ def resolve_deck(deck, log=print):
                 deck.solver_outputs, harmonics=sol.auto_harmonics,
                 samples=sol.auto_samples, tolerance=sol.tolerance_auto,
                 max_harmonics=sol.max_harmonics, max_samples=sol.max_samples)
-    for line in ch.lines():
+    if mc is not None:
+        for k in ("modes", "mode_estimates", "met_modes", "modes_tolerance"):
+            setattr(ch, k, getattr(mc, k))
+        ch.mode_lines, ch.notes = mc.mode_lines, mc.notes + ch.notes
+        ch.seconds += mc.seconds
+        log(mc.mode_lines[-1])
+    for line in ch.lines()[len(ch.mode_lines):]:
         log(line)
     H = ch.harmonics
     F = _excitation(deck.F, H).F

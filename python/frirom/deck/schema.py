@@ -189,6 +189,8 @@ class DeckSettings:
     contacts : tuple of DofContact (with [model]) or NodeSetContact (with [fe_model])
     raw : dict
         The TOML as read.
+    modes_auto : ModesAuto or None
+        Interface-mode counts ``"auto"`` (frirom.auto); ``reduction`` holds the first rung.
     """
 
     path: Path
@@ -205,6 +207,7 @@ class DeckSettings:
     continuation: ContinuationSettings
     outputs: OutputSettings
     raw: dict = field(default_factory=dict, repr=False)
+    modes_auto: object = None
 
     @property
     def fe(self) -> bool:
@@ -245,13 +248,13 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
     title = string(ctx, raw, "title", "title", default=path.stem)
 
     # structure: [model] (matrices as they are) or [fe_model] + [reduction]
-    model = source = spec = cyc = None
+    model = source = spec = cyc = modes_auto = None
     if "fe_model" in raw or "reduction" in raw:
         if "model" in raw:
             raise ctx.error("model", "either [model] (matrices used as they are) or "
                             "[fe_model] + [reduction] (FE matrices to reduce), not both")
         source = parse_fe_model(ctx, table(ctx, raw, "fe_model"))
-        spec, cyc = parse_reduction(ctx, table(ctx, raw, "reduction"))
+        spec, cyc, modes_auto = parse_reduction(ctx, table(ctx, raw, "reduction"))
     else:
         model = parse_matrix_model(ctx, table(ctx, raw, "model"))
     fe = model is None
@@ -268,7 +271,8 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
     return DeckSettings(path=path, title=title, model=model, fe_model=source, reduction=spec,
                         cyclic=cyc, solver=solver, damping=damping, loads=tuple(loads),
                         contacts=tuple(contacts), frequency=frequency,
-                        continuation=continuation, outputs=outputs, raw=raw)
+                        continuation=continuation, outputs=outputs, raw=raw,
+                        modes_auto=modes_auto)
 
 
 def _solver(ctx, sol, cyc) -> SolverSettings:

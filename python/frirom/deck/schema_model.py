@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..reduction.rom import FORMATS, FESource, ReductionSpec
+from .schema_study import parse_modes_auto
 from .fields import Context, boolean, file, integers, names, number, string, table, unknown, \
     vector
 
@@ -105,8 +106,10 @@ def parse_fe_model(ctx: Context, fe: dict) -> FESource:
     return FESource(fmt, files, options)
 
 
-def parse_reduction(ctx: Context, red: dict) -> tuple[ReductionSpec, CyclicSettings | None]:
-    """The checked ``[reduction]`` table and its ``[reduction.cyclic]`` (or None)."""
+def parse_reduction(ctx: Context, red: dict) -> tuple:
+    """The checked ``[reduction]`` table: (ReductionSpec, its ``[reduction.cyclic]``
+    CyclicSettings or None, ModesAuto or None: interface-mode counts ``"auto"``, the spec
+    then holding the first rung)."""
     if "pairs" in red:
         raise ctx.error("reduction.pairs", "no [[reduction.pairs]]: contact pairs are "
                         "[[contacts]] tables with node sets a, b and a normal")
@@ -125,6 +128,7 @@ def parse_reduction(ctx: Context, red: dict) -> tuple[ReductionSpec, CyclicSetti
     allowed = {"none": {"method"}, "gsi": {"method", "free", "stick", "per_side"},
                "ms": {"method", "sectors", "engine_orders", "time_harmonics",
                       "harmonic_indices", "axis", "origin"}}[method]
+    im, modes_auto = parse_modes_auto(ctx, im, method)
     unknown(ctx, im, allowed, pre)
     kw = {}
     if method == "gsi":
@@ -143,6 +147,10 @@ def parse_reduction(ctx: Context, red: dict) -> tuple[ReductionSpec, CyclicSetti
             raise ctx.error(f"{pre}.method", "'none' or 'gsi' with [reduction.cyclic] "
                             "(multi-stage modes are for whole 360-degree stages)", method)
         cyc = parse_cyclic(ctx, table(ctx, red, "reduction.cyclic"))
+        if modes_auto is not None:
+            raise ctx.error(f"{pre}.{modes_auto.keys[0]}", "an integer with "
+                            "[reduction.cyclic] (\"auto\" is not available for cyclic "
+                            "sectors)", "auto")
         kw["sectors"] = cyc.sectors
         kw["cyclic"] = (cyc.left, cyc.right)
     if method == "ms":
@@ -164,7 +172,7 @@ def parse_reduction(ctx: Context, red: dict) -> tuple[ReductionSpec, CyclicSetti
         kw["origin"] = vector(ctx, im, "origin", f"{pre}.origin", origin, nonzero=False)
     spec = ReductionSpec(interface=tuple(iface), active=tuple(active),
                          fixed_interface_modes=n_cb, method=method, cache=cache, **kw)
-    return spec, cyc
+    return spec, cyc, modes_auto
 
 
 def parse_cyclic(ctx: Context, cy: dict) -> CyclicSettings:

@@ -19,6 +19,8 @@ from .._errors import InputError
 from .fields import Context, file, number, string, unknown
 
 KINDS = ("family", "convergence")
+#: GSI counts climbed by ``free``/``stick = "auto"`` (those up to max_modes, then max_modes)
+GSI_LADDER = (5, 10, 20, 30, 40, 60, 80, 120, 160, 240, 320)
 _PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)$")
 
 
@@ -64,6 +66,71 @@ class StudySettings:
         lists = [v for _, v in self.parameters]
         combos = itertools.product(*lists) if self.combine == "product" else zip(*lists)
         return [dict(zip(keys, c)) for c in combos]
+
+
+@dataclass(frozen=True)
+class ModesAuto:
+    """``[reduction.interface_modes]`` counts given as ``"auto"`` (frirom.auto chooses them).
+
+    keys : tuple of str
+        ``("free", "stick")`` or one of them (GSI), or ``("harmonic_indices",)`` (MS).
+    tolerance : float
+        Relative change of the peak amplitude and frequency allowed (tail estimate).
+    largest : int
+        ``max_modes`` (GSI: the largest count of an auto key) or ``max_index`` (MS: the
+        largest harmonic index).
+    """
+
+    keys: tuple
+    tolerance: float = 0.01
+    largest: int = 40
+
+    def rungs(self) -> list:
+        """The ladder: one dict {key: value} per rung, smallest first. GSI: every auto
+        key the same count, :data:`GSI_LADDER` up to ``largest``; MS: the indices 0..k,
+        k = 0..largest."""
+        if self.keys == ("harmonic_indices",):
+            return [{"harmonic_indices": tuple(range(k + 1))} for k in range(self.largest + 1)]
+        counts = [n for n in GSI_LADDER if n < self.largest] + [self.largest]
+        return [{k: n for k in self.keys} for n in counts]
+
+
+def parse_modes_auto(ctx: Context, im: dict, method: str) -> tuple:
+    """``"auto"`` counts of a ``[reduction.interface_modes]`` table and their keys
+    (``tolerance_auto``, ``max_modes`` / ``max_index``).
+
+    Returns (table, ModesAuto or None): the table with each ``"auto"`` replaced by the
+    first rung and the auto keys removed (what the reduction parser then checks), and
+    the settings.
+    """
+    pre = "reduction.interface_modes"
+    cand = {"gsi": ("free", "stick"), "ms": ("harmonic_indices",)}.get(method, ())
+    keys = tuple(k for k in cand if im.get(k) == "auto")
+    big = "max_index" if method == "ms" else "max_modes"
+    given = [k for k in ("tolerance_auto", "max_modes", "max_index") if k in im]
+    if not keys:
+        if given:
+            raise ctx.error(f"{pre}.{given[0]}", f"{' or '.join(cand) or 'a count'} = "
+                            "\"auto\" (it only bounds that choice)", im[given[0]])
+        return im, None
+    for k in given:
+        if k not in ("tolerance_auto", big):
+            raise ctx.error(f"{pre}.{k}", f"{big} with method = {method!r}", im[k])
+    tol = float(number(ctx, im, "tolerance_auto", f"{pre}.tolerance_auto", default=0.01,
+                       positive=True, maximum=0.5))
+    if method == "ms":
+        n = im.get("sectors")
+        top = n // 2 if isinstance(n, int) and not isinstance(n, bool) and n > 0 else 8
+        largest = number(ctx, im, big, f"{pre}.{big}", default=min(top, 8), integer=True,
+                         minimum=1, maximum=top)
+    else:
+        largest = number(ctx, im, big, f"{pre}.{big}", default=40, integer=True,
+                         minimum=GSI_LADDER[1])
+    auto = ModesAuto(keys=keys, tolerance=tol, largest=int(largest))
+    first = auto.rungs()[0]
+    out = {k: v for k, v in im.items() if k not in given}
+    out.update({k: list(v) if isinstance(v, tuple) else v for k, v in first.items()})
+    return out, auto
 
 
 def split_key(key: str) -> list:
