@@ -25,7 +25,8 @@ Where the estimate does not reach the tolerance within ``max_harmonics`` /
 log and ``FRF.solver_info`` say so: never a silent pick.
 
 Interface modes (``[reduction.interface_modes]`` ``free`` / ``stick`` or
-``harmonic_indices = "auto"``, :func:`choose_modes`) change the reduced coordinates, so no
+``time_harmonics = "auto"``: the MS harmonic indices of the engine orders' time
+harmonics 0..j, :func:`choose_modes`) change the reduced coordinates, so no
 solution is carried from rung to rung: each rung of the ladder
 (:meth:`frirom.deck.schema_study.ModesAuto.rungs`) is its own reduced model (built once,
 then read from the content-keyed cache) and its own FRF, the first over the deck's range,
@@ -42,6 +43,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -324,9 +326,9 @@ def choose(model, F, omega_start, omega_end, options, outputs=None, *, harmonics
 
 
 def _rung_label(values: dict) -> str:
-    """``free = 20, stick = 20`` / ``harmonic_indices = 0-3``."""
-    return ", ".join(f"{k} = {v[0]}-{v[-1]}" if isinstance(v, tuple) else f"{k} = {v}"
-                     for k, v in values.items())
+    """``free = 20, stick = 20`` / ``time_harmonics = 0-3``."""
+    return ", ".join(f"{k} = {v[0]}" + (f"-{v[-1]}" if len(v) > 1 else "")
+                     if isinstance(v, tuple) else f"{k} = {v}" for k, v in values.items())
 
 
 def _rung_deck(deck, values: dict):
@@ -334,8 +336,11 @@ def _rung_deck(deck, values: dict):
     reduced model comes from the content-keyed cache when it was built before)."""
     from .deck import build_deck
     s = deck.settings
-    return build_deck(dataclasses.replace(
-        s, reduction=dataclasses.replace(s.reduction, **values), modes_auto=None))
+    cache = s.reduction.cache       # a file names one model: the rungs go beside it
+    if cache is not None and Path(cache).suffix == ".h5":
+        cache = Path(cache).parent
+    return build_deck(dataclasses.replace(s, reduction=dataclasses.replace(
+        s.reduction, cache=cache, **values), modes_auto=None))
 
 
 def _rung_peaks(deck, H, opts, window, full):
@@ -397,16 +402,40 @@ def choose_modes(deck, log=print):
     rungs = ma.rungs()
     ch = AutoChoice(harmonics=deck.harmonics, samples=deck.samples,
                     tolerance=sol.tolerance_auto, modes_tolerance=ma.tolerance)
-    prev, chosen, d = None, None, deck
+    prev, chosen, d, last, size = None, None, deck, None, None  # last: the rung run before
+
+    def step(i, line, peaks):
+        """Log a rung; True when the rung before it is within the tolerance."""
+        log(line)
+        ch.mode_lines.append(line)
+        if last is None:
+            return False
+        ch.mode_estimates.append((_rung_label(rungs[last]), _peak_change(prev, peaks)))
+        return bool(np.isfinite(ch.mode_estimates[-1][1])
+                    and _tail(ch.mode_estimates, 1) <= ma.tolerance)
+
     for i, values in enumerate(rungs):
-        if i > 0:
-            d = _rung_deck(deck, values)
         window = (min(full), max(full))
         if prev is not None:
             ws = [w for w, _ in prev]
             window = (max(min(full), min(ws) * (1 - WINDOW)),
                       min(max(full), max(ws) * (1 + WINDOW)))
-        peaks, (n, sec, (lo, hi), msg) = _rung_peaks(d, H, opts, window, full)
+        try:
+            d = _rung_deck(deck, values) if i > 0 else deck
+            if d.n_dof == size:     # MS: the new time harmonic adds no harmonic index
+                line = (f"auto: modes {_rung_label(values)}: the same {size} coordinates "
+                        "as the rung before (no new harmonic index): skipped")
+                log(line)
+                ch.mode_lines.append(line)
+                continue
+            size = d.n_dof
+            peaks, (n, sec, (lo, hi), msg) = _rung_peaks(d, H, opts, window, full)
+        except (FriromError, ArithmeticError, np.linalg.LinAlgError) as exc:
+            d = None                # a rung that cannot be built or solved: inf
+            ch.notes.append(f"modes {_rung_label(values)}: {exc}")
+            step(i, f"auto: modes {_rung_label(values)}: failed ({exc})", None)
+            prev, last = None, i
+            continue
         rom = d.reduced
         head = (f"auto: modes {_rung_label(values)}: {d.n_dof} coordinates, "
                 f"{len(d.model().nonlinear_dofs())} in contact; ")
@@ -419,26 +448,21 @@ def choose_modes(deck, log=print):
         else:
             line = head + "peak " + ", ".join(f"{a:.4g} at {w / 2 / np.pi:.6g} Hz"
                                               for w, a in peaks) + f" ({tail})"
-        log(line)
-        ch.mode_lines.append(line)
-        if i > 0:
-            ch.mode_estimates.append((_rung_label(rungs[i - 1]), _peak_change(prev, peaks)))
-            if np.isfinite(ch.mode_estimates[-1][1]) and \
-                    _tail(ch.mode_estimates, 1) <= ma.tolerance:
-                chosen = i - 1
-                break
-        prev = peaks
+        if step(i, line, peaks):
+            chosen = last
+            break
+        prev, last = peaks, i
     if chosen is None:
-        chosen, ch.met_modes = len(rungs) - 1, False
-        last = ch.mode_estimates[-1][1] if ch.mode_estimates else float("nan")
+        chosen, ch.met_modes = len(rungs) - 1 if last is None else last, False
+        e_last = ch.mode_estimates[-1][1] if ch.mode_estimates else float("nan")
         ch.notes.append(f"the interface-mode estimate did not reach {ma.tolerance:g} up to "
-                        f"{_rung_label(rungs[-1])} (last {last:.2e}): the run uses the "
-                        "largest rung; raise max_modes / max_index or the tolerance")
+                        f"{_rung_label(rungs[-1])} (last {e_last:.2e}): the run uses the "
+                        "largest rung; raise max_modes / max_time_harmonic or the tolerance")
     ch.modes = dict(rungs[chosen])
     est = ", ".join(f"{k}: {e:.2e}" for k, e in ch.mode_estimates)
     ch.mode_lines.append(f"auto: interface-mode estimate (relative change of the peak "
                          f"amplitude and frequency to the next rung): {est}")
-    if chosen != i:
+    if chosen != i or d is None:
         d = _rung_deck(deck, rungs[chosen])
     ch.seconds = time.perf_counter() - t0
     return d, ch

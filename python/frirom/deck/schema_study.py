@@ -73,12 +73,13 @@ class ModesAuto:
     """``[reduction.interface_modes]`` counts given as ``"auto"`` (frirom.auto chooses them).
 
     keys : tuple of str
-        ``("free", "stick")`` or one of them (GSI), or ``("harmonic_indices",)`` (MS).
+        ``("free", "stick")`` or one of them (GSI), or ``("time_harmonics",)`` (MS: the
+        harmonic indices that the engine orders excite through time harmonics 0..j).
     tolerance : float
         Relative change of the peak amplitude and frequency allowed (tail estimate).
     largest : int
-        ``max_modes`` (GSI: the largest count of an auto key) or ``max_index`` (MS: the
-        largest harmonic index).
+        ``max_modes`` (GSI: the largest count of an auto key) or ``max_time_harmonic``
+        (MS: the largest j).
     """
 
     keys: tuple
@@ -87,27 +88,28 @@ class ModesAuto:
 
     def rungs(self) -> list:
         """The ladder: one dict {key: value} per rung, smallest first. GSI: every auto
-        key the same count, :data:`GSI_LADDER` up to ``largest``; MS: the indices 0..k,
-        k = 0..largest."""
-        if self.keys == ("harmonic_indices",):
-            return [{"harmonic_indices": tuple(range(k + 1))} for k in range(self.largest + 1)]
+        key the same count, :data:`GSI_LADDER` up to ``largest``; MS: time harmonics
+        (1,), (0, 1), (0, 1, 2), ... up to ``largest``."""
+        if self.keys == ("time_harmonics",):
+            return [{"time_harmonics": (1,)}] + [{"time_harmonics": tuple(range(j + 1))}
+                                                 for j in range(1, self.largest + 1)]
         counts = [n for n in GSI_LADDER if n < self.largest] + [self.largest]
         return [{k: n for k in self.keys} for n in counts]
 
 
 def parse_modes_auto(ctx: Context, im: dict, method: str) -> tuple:
     """``"auto"`` counts of a ``[reduction.interface_modes]`` table and their keys
-    (``tolerance_auto``, ``max_modes`` / ``max_index``).
+    (``tolerance_auto``, ``max_modes`` / ``max_time_harmonic``).
 
     Returns (table, ModesAuto or None): the table with each ``"auto"`` replaced by the
     first rung and the auto keys removed (what the reduction parser then checks), and
     the settings.
     """
     pre = "reduction.interface_modes"
-    cand = {"gsi": ("free", "stick"), "ms": ("harmonic_indices",)}.get(method, ())
+    cand = {"gsi": ("free", "stick"), "ms": ("time_harmonics",)}.get(method, ())
     keys = tuple(k for k in cand if im.get(k) == "auto")
-    big = "max_index" if method == "ms" else "max_modes"
-    given = [k for k in ("tolerance_auto", "max_modes", "max_index") if k in im]
+    big = "max_time_harmonic" if method == "ms" else "max_modes"
+    given = [k for k in ("tolerance_auto", "max_modes", "max_time_harmonic") if k in im]
     if not keys:
         if given:
             raise ctx.error(f"{pre}.{given[0]}", f"{' or '.join(cand) or 'a count'} = "
@@ -119,10 +121,10 @@ def parse_modes_auto(ctx: Context, im: dict, method: str) -> tuple:
     tol = float(number(ctx, im, "tolerance_auto", f"{pre}.tolerance_auto", default=0.01,
                        positive=True, maximum=0.5))
     if method == "ms":
-        n = im.get("sectors")
-        top = n // 2 if isinstance(n, int) and not isinstance(n, bool) and n > 0 else 8
-        largest = number(ctx, im, big, f"{pre}.{big}", default=min(top, 8), integer=True,
-                         minimum=1, maximum=top)
+        if "engine_orders" not in im:
+            raise ctx.error(f"{pre}.engine_orders", 'the engine orders whose harmonic '
+                            'indices time_harmonics = "auto" climbs (missing)')
+        largest = number(ctx, im, big, f"{pre}.{big}", default=5, integer=True, minimum=1)
     else:
         largest = number(ctx, im, big, f"{pre}.{big}", default=40, integer=True,
                          minimum=GSI_LADDER[1])
