@@ -23,6 +23,7 @@ import pytest
 
 from frirom import InputError
 from frirom.cli import main
+from frirom.deck import load_deck
 from frirom.deck.schema_study import member_raw, parse_study, set_key
 from frirom.results import FRF
 from frirom.study import curve_distance, load_study, run_study, smallest_within
@@ -100,10 +101,10 @@ def test_key_paths_and_errors(tmp_path):
             set_key(dict(raw), key, 1)
     deck = write_case(tmp_path, STUDY.replace("contacts[0].mu", "contacts[3].mu"))
     with pytest.raises(InputError, match=r'study.parameters."contacts\[3\].mu"'):
-        load_study(deck, tmp_path / "out")
+        load_study(deck)
     deck = write_case(tmp_path, STUDY.replace("0.3, 0.5", "-0.3, 0.5"))
     with pytest.raises(InputError, match=r"study member 0 .*contacts\[0\]\.mu"):
-        load_study(deck, tmp_path / "out")
+        load_study(deck)
     bad = STUDY.replace('scheduler = "serial"', 'combine = "zip"\nscheduler = "serial"')
     bad = bad.replace("[0.3, 0.5]", "[0.3, 0.5, 0.7]")
     with pytest.raises(InputError, match="one length"):
@@ -298,31 +299,34 @@ def test_study_of_a_base_deck(tmp_path):
     deck = write_case(tmp_path, "")
     only = tmp_path / "family.toml"
     only.write_text('[study]\nbase = "study.toml"\n' + STUDY.split("\n", 3)[3])
-    st = load_study(only, tmp_path / "out")
+    st = load_study(only)
     assert st.deck == deck and len(st.members) == 4 and "study" not in st.raw
     bad = tmp_path / "bad.toml"
     bad.write_text('title = "x"\n[study]\nbase = "study.toml"\n' + STUDY.split("\n", 3)[3])
     with pytest.raises(InputError, match="study.base: expected a deck holding only"):
-        load_study(bad, tmp_path / "out")
+        load_study(bad)
     write_case(tmp_path / "b", STUDY)
     bad.write_text('[study]\nbase = "b/study.toml"\n' + STUDY.split("\n", 3)[3])
     with pytest.raises(InputError, match="without its own"):
-        load_study(bad, tmp_path / "out")
-    bundled = load_study(ROOT / "cases" / "joint" / "joint_family.toml", tmp_path / "o")
+        load_study(bad)
+    bundled = load_study(ROOT / "cases" / "joint" / "joint_family.toml")
     assert bundled.deck == ROOT / "cases" / "joint" / "joint.toml"
 
 
 @pytest.mark.slow
-def test_reduction_ladder_gets_one_cache_per_rung(tmp_path):
+def test_reduction_ladder_gets_one_cache_per_rung(tmp_path, monkeypatch):
     """A ladder over GSI counts on the lap joint (coarse mesh, H = 1, a narrow range): each
-    rung's reduced model is built once into its own cache file under OUT/rom (before the
-    members run), and a rung equals the deck edited by hand and run alone (1e-10)."""
+    rung's reduced model is built once, before the members run, into the content-keyed
+    cache shared with the decks (one entry per rung; the deck run alone after the study
+    reads the top rung's back), and a rung equals the deck edited by hand and run alone
+    (1e-10)."""
     if shutil.which("ccx") is None:
         pytest.skip("ccx not installed")
     pytest.importorskip("gmsh")
     sys.path.insert(0, str(ROOT / "cases" / "lap_joint"))
     import make_lap_joint
     from test_lap_joint_case import small
+    monkeypatch.setenv("FRIROM_CACHE", str(tmp_path / "cache"))
     make_lap_joint.make(tmp_path, size=0.012)
     (tmp_path / "lap.toml").write_text(small(16).replace("825.0", "835.0")
                                        .replace("880.0", "860.0"))
@@ -330,13 +334,18 @@ def test_reduction_ladder_gets_one_cache_per_rung(tmp_path):
         '[study]\nbase = "lap.toml"\nkind = "convergence"\nscheduler = "serial"\n'
         '[study.parameters]\n"reduction.interface_modes.free" = [4, 8]\n'
         '"reduction.interface_modes.stick" = [4, 8]\n')
+    lines = []
     res = run_study(tmp_path / "ladder.toml", tmp_path / "out", quiet=True,
-                    log=lambda s: None)
-    roms = sorted((tmp_path / "out" / "rom").glob("*.rom.h5"))
+                    log=lines.append)
+    roms = sorted((tmp_path / "cache").glob("rom-*.h5"))
     assert len(roms) == 2 and all(s["rom_seconds"] > 0 for s in res["summaries"])
+    assert "2 reduced model(s): 2 built, 0 reused" in lines, lines
+    assert sorted(str(p) for p in roms) == sorted(m["rom"] for m in res["study"].members)
     assert [s["n_nl"] for s in res["summaries"]] == [8, 16]
     assert main(["run", str(tmp_path / "lap.toml"), "--out", str(tmp_path / "alone"),
                  "--quiet"]) == 0
+    assert load_deck(tmp_path / "lap.toml").reduced.from_cache
+    assert len(list((tmp_path / "cache").glob("rom-*.h5"))) == 2
     ref = FRF.load(tmp_path / "alone" / "frf.h5")
     got = member_arrays(res["file"], "m001")
     assert got["omega"].shape == ref.omega.shape

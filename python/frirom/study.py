@@ -13,7 +13,8 @@ with its parameter values as attributes) and the plots are drawn.
 Members run on a ``distributed.LocalCluster`` (one single-threaded worker process per core),
 on a Dask scheduler named by its address, or in this process (``"serial"``). A task gets the
 deck path and its overrides, never arrays: with ``[fe_model]`` the reduced models are built
-first (one task per distinct reduction) into cache files that the members read back.
+first (one task per distinct reduction) into the content-keyed cache
+(:func:`frirom.deck.build.rom_file`), which the members then read back.
 
 A convergence study is a ladder of model sizes (H, N, CB modes, GSI counts, ...); the last
 rung is the reference. :func:`convergence_table` gives per rung the errors against it (peak
@@ -23,7 +24,6 @@ smallest model meeting the tolerance.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import re
@@ -43,11 +43,6 @@ from .deck.schema_study import StudySettings, member_raw, parse_study
 __all__ = ["Study", "load_study", "run_member", "run_study", "convergence_table",
            "smallest_within", "curve_distance"]
 
-#: key paths (regular expressions) whose values change a reduced model ([fe_model] decks)
-_REDUCTION_KEYS = re.compile(r"^(reduction|fe_model)\b|^contacts\[\d+\]\.(kt|kn|a|b|normal|"
-                             r"tangent|tol|b_sector|name|law)$")
-
-
 @dataclass
 class Study:
     """A deck with a ``[study]`` table, its members expanded.
@@ -60,8 +55,9 @@ class Study:
         That deck's TOML (without [study]).
     members : list of dict
         Per member: ``name`` (``m000``...), ``values`` {key path: value} (what the study
-        sets), ``overrides`` (values plus a ``reduction.cache`` file when the member's
-        reduction differs from the deck's).
+        sets and the member's deck is written with), ``rom`` (str: the content-keyed
+        cache file of its reduced model, shared by every member and deck with the same
+        reduction; None with ``[model]``).
     """
 
     path: Path
@@ -75,10 +71,9 @@ class Study:
         return self.settings.kind
 
 
-def load_study(path, out: Path) -> Study:
+def load_study(path) -> Study:
     """Read a deck's ``[study]`` and check every member's deck (parse only, no matrices);
-    an error names the member and its values. ``out``: the study folder (cache files of
-    members whose reduction differs go to ``out/rom``)."""
+    an error names the member and its values."""
     path = Path(path)
     raw = read_toml(path)
     st = parse_study(path, raw, read_toml)
@@ -87,19 +82,15 @@ def load_study(path, out: Path) -> Study:
     deck = path
     if st.base is not None:
         deck, raw = st.base, read_toml(st.base)
+    from .deck.build import rom_file
     members = []
-    fe = "fe_model" in raw or "reduction" in raw
     for i, values in enumerate(st.members()):
-        over = dict(values)
-        red = {k: v for k, v in values.items() if _REDUCTION_KEYS.search(k)}
-        if fe and red:
-            tag = hashlib.sha1(json.dumps(red, sort_keys=True).encode()).hexdigest()[:12]
-            over["reduction.cache"] = str((Path(out) / "rom" / f"{tag}.rom.h5").resolve())
         try:
-            parse_deck(deck, member_raw(raw, over))
+            rom = rom_file(parse_deck(deck, member_raw(raw, values)))
         except InputError as exc:
             raise InputError(f"study member {i} ({_label(values)}): {exc}") from None
-        members.append({"name": f"m{i:03d}", "values": values, "overrides": over})
+        members.append({"name": f"m{i:03d}", "values": values,
+                        "rom": None if rom is None else str(rom)})
     return Study(path=path, deck=deck, raw=raw, settings=st, members=members)
 
 
@@ -215,7 +206,7 @@ def _run_member_locked(deck_path, overrides, folder: Path, done: Path, progress)
         "rom_seconds": float(getattr(deck.reduced, "build_seconds", 0.0) or 0.0),
         "memory_mb": (model_bytes + 8.0 * (n_nl * (2 * H + 1)) ** 2) / 2 ** 20,
         "rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
-        "values": {k: v for k, v in overrides.items() if k != "reduction.cache"},
+        "values": dict(overrides),
     }
     tmp = done.with_suffix(".tmp")
     tmp.write_text(json.dumps(summary, indent=1, default=float))
@@ -365,7 +356,7 @@ def run_study(deck_path, out=None, scheduler: str | None = None, workers: int | 
     deck_path = Path(deck_path)
     out = Path(out) if out is not None else Path("results") / deck_path.stem
     out.mkdir(parents=True, exist_ok=True)
-    study = load_study(deck_path, out)
+    study = load_study(deck_path)
     st = study.settings
     sched = scheduler or st.scheduler
     n_done = sum((out / "members" / m["name"] / "member.json").is_file()
@@ -384,9 +375,8 @@ def run_study(deck_path, out=None, scheduler: str | None = None, workers: int | 
         runner.close()
     seconds = time.perf_counter() - t0
     for m, s in zip(study.members, summaries):
-        cache = m["overrides"].get("reduction.cache")
-        if cache in rom_seconds:
-            s["rom_seconds"] = rom_seconds[cache]
+        if m["rom"] in rom_seconds:
+            s["rom_seconds"] = rom_seconds[m["rom"]]
     res = {"study": study, "summaries": summaries, "seconds": seconds}
     res["file"] = write_study_file(study, out, summaries)
     res.update(_report(study, out, summaries, log))
@@ -399,16 +389,12 @@ def _prepare(study: Study, out: Path, runner: _Runner, log) -> dict:
         return {}
     todo, seen = [], set()
     for m in study.members:
-        cache = m["overrides"].get("reduction.cache")
-        if cache not in seen and not (out / "members" / m["name"] / "member.json").is_file():
-            seen.add(cache)
-            todo.append((m, cache))
+        if m["rom"] not in seen and not (out / "members" / m["name"] / "member.json").is_file():
+            seen.add(m["rom"])
+            todo.append((m, m["rom"]))
     if not todo:
         return {}
-    for _, cache in todo:
-        if cache is not None:
-            Path(cache).parent.mkdir(parents=True, exist_ok=True)
-    res = runner.map(prepare_member, [(str(study.deck), m["overrides"]) for m, _ in todo])
+    res = runner.map(prepare_member, [(str(study.deck), m["values"]) for m, _ in todo])
     built = sum(not r["reused"] for r in res)
     log(f"{len(todo)} reduced model(s): {built} built, {len(todo) - built} reused")
     return {c: r["seconds"] for (_, c), r in zip(todo, res)}
@@ -433,7 +419,7 @@ def _run_members(study: Study, out: Path, runner: _Runner, quiet: bool) -> list:
         bar.update(1)
         poll()
 
-    jobs = [(str(study.deck), m["overrides"], str(f), runner.client is not None)
+    jobs = [(str(study.deck), m["values"], str(f), runner.client is not None)
             for m, f in zip(study.members, folders)]
     try:
         return runner.map(run_member, jobs, on_done, poll)
@@ -523,7 +509,7 @@ def _linear(study: Study):
     from .modes import linear_check
     m = study.members[0]
     try:
-        check = linear_check(load_member(study.deck, m["overrides"]))
+        check = linear_check(load_member(study.deck, m["values"]))
     except (InputError, ValueError, RuntimeError, ArithmeticError):
         return None
     curves = check.linear_curves(study.settings.output)

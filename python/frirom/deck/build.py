@@ -22,7 +22,7 @@ from ..contact import LAWS
 from ..io import DIRECTION_NAMES, read_mtx
 from ..io._common import read_text
 from ..model import ContactGroup, CyclicModel, Damping, Excitation, Model, check_definite
-from ..reduction.rom import PairSpec, build_reduced_model
+from ..reduction.rom import PairSpec, build_reduced_model, cache_file, rom_key
 from ..solver import SolverOptions
 from .build_cyclic import check_sector_contacts, cyclic_modes, cyclic_sector_of
 from .fields import Context, DofRef
@@ -217,10 +217,8 @@ class _Builder:
                 raise InputError(f"{s.path}: {exc}") from None
         else:
             # everything checked: build (or reuse) the reduced model, resolve the nodes
-            pairs = [PairSpec(name=c.name, a=c.a, b=c.b, normal=c.normal, tangent=c.tangent,
-                              n_dir=LAWS[c.law].n_dir, kt=c.stick[0], kn=c.stick[1],
-                              tol=c.tol, key=c.key, b_sector=c.b_sector) for c in s.contacts]
-            rom = build_reduced_model(s.fe_model, s.reduction, pairs, s.path, log=log.append)
+            rom = build_reduced_model(s.fe_model, s.reduction, pair_specs(s), s.path,
+                                      log=log.append)
             M, K, n = rom.M, rom.K, rom.K.shape[0]
             self.n, self.rom = n, rom
             if s.cyclic is not None:
@@ -401,6 +399,22 @@ class _Builder:
             raise self.ctx.error(ref.key, "a node id or a node set name (known sets: "
                                  + ", ".join(sorted(self.rom.node_sets)) + ")", nd.text)
         return [int(i) for i in ids]
+
+
+def pair_specs(settings: DeckSettings) -> list:
+    """The contact pairs of an ``[fe_model]`` deck as the reduction takes them."""
+    return [PairSpec(name=c.name, a=c.a, b=c.b, normal=c.normal, tangent=c.tangent,
+                     n_dir=LAWS[c.law].n_dir, kt=c.stick[0], kn=c.stick[1], tol=c.tol,
+                     key=c.key, b_sector=c.b_sector) for c in settings.contacts]
+
+
+def rom_file(settings: DeckSettings) -> Path | None:
+    """Where the reduced model of an ``[fe_model]`` deck is cached (its content key,
+    :func:`frirom.reduction.rom.rom_key`), without building it; None with ``[model]``."""
+    if settings.fe_model is None:
+        return None
+    key = rom_key(settings.fe_model, settings.reduction, pair_specs(settings))
+    return cache_file(settings.fe_model, settings.reduction, key)
 
 
 def build_deck(settings: DeckSettings) -> Deck:
