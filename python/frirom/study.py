@@ -130,7 +130,9 @@ def run_member(deck_path, overrides: dict, folder, progress: bool = True) -> dic
     -------
     dict
         ``points``, ``seconds`` (FRF wall time of this call), ``cpu_seconds`` (its CPU
-        time: over ``seconds``, the share of a core it had), ``complete``, ``message``,
+        time: over ``seconds``, the share of a core it had), ``pid`` (the process that ran
+        it), ``started``/``ended`` (its FRF's wall-clock interval, s since the epoch),
+        ``complete``, ``message``,
         ``peaks`` [(omega rad/s, amplitude)] per output, ``n_dof``, ``n_nl`` (contact
         coordinates), ``harmonics``, ``unknowns`` (n_nl (2H+1), the nonlinear system's
         size), ``rom_seconds``, ``memory_mb`` (estimate: model matrices + the dense
@@ -176,7 +178,7 @@ def _run_member_locked(deck_path, overrides, folder: Path, done: Path, progress)
         writer.append(point)
         counter.add()
 
-    t0, c0 = time.perf_counter(), time.process_time()
+    t0, c0, epoch = time.perf_counter(), time.process_time(), time.time()
     try:
         result = frf(model, excitation, deck.omega_start, deck.omega_end, options,
                      outputs=deck.outputs, sink=sink, start=start)
@@ -197,6 +199,7 @@ def _run_member_locked(deck_path, overrides, folder: Path, done: Path, progress)
                       for A in (deck.M, deck.K))
     summary = {
         "points": len(full), "seconds": seconds, "cpu_seconds": cpu,
+        "pid": os.getpid(), "started": epoch, "ended": epoch + seconds,
         "complete": bool(result.complete),
         "message": result.message, "resumed": start is not None,
         "peaks": [[full.peak(j).omega, full.peak(j).amplitude] if len(full) else
