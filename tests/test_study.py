@@ -141,7 +141,8 @@ def test_member_equals_deck_run_alone(tmp_path):
 def test_resume_member_by_member_and_point_by_point(tmp_path, monkeypatch):
     """A study interrupted in member m001 after 15 points: run again, m000 (finished) is
     not recomputed (its member.json untouched), m001 continues from its last checkpoint
-    (point 11, the end of a batch: FRFWriter.resume_point; the 15 points kept bit for bit) and reaches the end of the range; its peak matches the
+    (point 11, the end of a batch: FRFWriter.resume_point; the 15 points kept bit for
+    bit) and reaches the end of the range; its peak matches the
     uninterrupted study's within 1e-4 (both solved on the curve by the solver, from
     neighbours that differ after the restart; measured 1e-5)."""
     import frirom.solver as solver

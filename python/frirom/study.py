@@ -123,8 +123,8 @@ def run_member(deck_path, overrides: dict, folder, progress: bool = True) -> dic
     A finished member (``folder/member.json``) returns its summary without running; an
     unfinished one continues from the last checkpoint of ``folder/frf.h5`` (a file that
     cannot be read, or holds no checkpoint, is started again). One process at a time
-    writes a member (an OS lock on the folder, waited for up to LOCK_WAIT s). Points are flushed as they come; ``folder/points`` counts
-    them for the progress display.
+    writes a member (an OS lock on the folder, waited for up to LOCK_WAIT s). Points are
+    flushed as they come; ``folder/points`` counts them for the progress display.
 
     Returns
     -------
