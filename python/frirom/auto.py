@@ -346,7 +346,8 @@ def _rung_deck(deck, values: dict):
 def _rung_peaks(deck, H, opts, window, full):
     """The peaks [(omega rad/s, amplitude)] per output of the deck's FRF at H over
     ``window`` (the whole range ``full`` again when a peak lies on its edge), and the
-    run's (points, seconds, message); peaks None when the curve stopped."""
+    run's (points, seconds, (lo, hi) range run, message); peaks None when the curve
+    stopped. Frequencies in rad/s, swept in the direction of ``full``."""
     from .solver import frf
     model, exc = deck.model(), _excitation(deck.F, H)
     t0 = time.perf_counter()
