@@ -15,6 +15,12 @@
 !> v at the two samples around it). The 2-D law, whose slip direction remembers the past,
 !> propagates the slider tangent instead.
 !>
+!> The 2-D slider corrects only its component along each slip direction, so plain
+!> marching can contract its mismatch as little as 0.99 a period (the onset of partial
+!> slip); its march takes Newton steps on the slider fixed point between periods, with
+!> the 2x2 derivative of the period map from the slip tangents (frirom_aft_march), and
+!> the Jacobian then solves the closed cycle's slider tangent directly.
+!>
 !> Cost per element: O(N) marching per period (usually 2 periods from a cold slider),
 !> one inverse and one forward real FFT of length N per direction, and for the Jacobian
 !> an O(N) scan plus O(H^2) per run and per stick segment.
@@ -79,6 +85,13 @@ module frirom_aft
         real(wp), allocatable :: anchor_dtv(:)       !! (nbatch) its d ft / dv
         real(wp), allocatable :: dw(:, :), dw0(:, :) !! (2, 3(2H+1)) 2-D slider tangent
         real(wp), allocatable :: dft(:, :)           !! (2, 3(2H+1)) 2-D force tangent
+        ! 2-D slider fixed point: Newton steps between periods (frirom_aft_march)
+        real(wp), allocatable :: wplain(:, :)        !! (nbatch, 2) plain march from the base
+        real(wp), allocatable :: res_base(:)         !! (nbatch) mismatch of the base period
+        real(wp), allocatable :: res_last(:)         !! (nbatch) mismatch of the last period
+        logical, allocatable :: stepped(:)           !! (nbatch) period started from a step
+        logical, allocatable :: accelerated(:)       !! (nbatch) a step was accepted
+        integer(ip), allocatable :: hold(:)          !! (nbatch) plain periods before a step
     end type aft_plan
 
     ! The two entry points are generic names over separate module procedures: gfortran 12
@@ -152,6 +165,18 @@ module frirom_aft
             integer(ip), intent(in) :: law, e0, m, max_periods
             real(wp), intent(in) :: x(:, :, :), params(:, :), w0(:, :), tol
         end subroutine time_batch
+
+        !> Derivative m(2, 2) of the end-of-period 2-D slider of element j of the batch with
+        !> respect to its start, from the states and slip tangents of the period just
+        !> marched: the product over the samples of A_k/kt at slip, I at stick, 0 at
+        !> lift-off (frirom_aft_march). opened: the period has a lift-off sample.
+        pure module subroutine slider_map(plan, j, kt, m, opened)
+            type(aft_plan), intent(in) :: plan
+            integer(ip), intent(in) :: j
+            real(wp), intent(in) :: kt
+            real(wp), intent(out) :: m(2, 2)
+            logical, intent(out) :: opened
+        end subroutine slider_map
 
         !> Same-sample coefficient series of the Jacobian, written after the forces:
         !> Jenkins slot 2 = kt [stick]; normal1d slot 3 = kt [stick], slot 4 = d ft/dv (the
@@ -274,6 +299,8 @@ contains
         allocate (plan%anchor(nb), plan%anchor_state(nb), plan%anchor_dtv(nb), &
                   plan%events(nsamp))
         allocate (plan%dw(2, 3*nc), plan%dw0(2, 3*nc), plan%dft(2, 3*nc))
+        allocate (plan%wplain(nb, 2), plan%res_base(nb), &
+                  plan%res_last(nb), plan%stepped(nb), plan%accelerated(nb), plan%hold(nb))
     end subroutine aft_plan_create
 
     !> Release the plans and work arrays (a destroyed or never created plan is fine).
@@ -286,5 +313,7 @@ contains
                                                    plan%events)
         if (allocated(plan%tangent)) deallocate (plan%tangent, plan%follow)
         if (allocated(plan%dw)) deallocate (plan%dw, plan%dw0, plan%dft)
+        if (allocated(plan%wplain)) deallocate (plan%wplain, plan%res_base, plan%res_last, &
+                                                plan%stepped, plan%accelerated, plan%hold)
     end subroutine aft_plan_destroy
 end module frirom_aft

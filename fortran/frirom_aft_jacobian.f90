@@ -213,6 +213,10 @@ contains
         call jac_diagonal(plan, j, 4_ip, jac, nc, nc)           ! d f2/du2, stick
         call jac_diagonal(plan, j, 5_ip, jac, 2*nc, 2*nc)       ! d fn/dv, contact
         plan%dw = 0.0_wp
+        if (plan%accelerated(j)) then
+            if (fixed_point2d(plan, j, kt, jac)) return
+            plan%dw = 0.0_wp
+        end if
         if (plan%closed_at(j) > 1 .and. any(plan%w(j, 1:2) /= w0j(1:2))) &
             call settle2d(plan, j, kt, w0j, jac)
         if (all(plan%state(j, :) == STATE_STICK)) then
@@ -226,6 +230,37 @@ contains
         end do
         call propagate2d(plan, j, kt, .true., jac)
     end subroutine jac_friction2d
+
+    !> Jacobian terms of a 2-D cycle that the march closed by Newton steps on its slider
+    !> (frirom_aft_march): a slipping cycle whose slider is the unique fixed point, so its
+    !> tangent solves dw = M dw + r exactly, M = slider_map, r the tangent one period
+    !> leaves from dw = 0, instead of the recursion repeated until it closes (which
+    !> contracts as slowly as the march did). .false. (nothing added) when I - M is singular.
+    logical function fixed_point2d(plan, j, kt, jac) result(done)
+        type(aft_plan), intent(inout) :: plan
+        integer(ip), intent(in) :: j
+        real(wp), intent(in) :: kt
+        real(wp), intent(inout) :: jac(:, :)
+        real(wp), parameter :: DET_MIN = 1.0e-8_wp   !! as in the march's steps
+        real(wp) :: mm(2, 2), a11, a12, a21, a22, det
+        real(wp) :: r1(size(plan%dw, 2)), r2(size(plan%dw, 2))
+        logical :: opened
+        call slider_map(plan, j, kt, mm, opened)
+        a11 = 1.0_wp - mm(1, 1)
+        a12 = -mm(1, 2)
+        a21 = -mm(2, 1)
+        a22 = 1.0_wp - mm(2, 2)
+        det = a11*a22 - a12*a21
+        done = abs(det) >= DET_MIN
+        if (.not. done) return
+        plan%dw = 0.0_wp
+        call propagate2d(plan, j, kt, .false., jac)
+        r1 = plan%dw(1, :)
+        r2 = plan%dw(2, :)
+        plan%dw(1, :) = (a22*r1 - a12*r2)/det
+        plan%dw(2, :) = (a11*r2 - a21*r1)/det
+        call propagate2d(plan, j, kt, .true., jac)
+    end function fixed_point2d
 
     !> Slider tangent dw that the settling periods of element j leave: march them again
     !> from w0j (dw = 0 there), propagating the tangent through each.
