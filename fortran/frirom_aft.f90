@@ -66,6 +66,11 @@ module frirom_aft
     integer(ip), parameter :: DEFAULT_BATCH = 16
     real(wp), parameter :: DEFAULT_TOL = 1.0e-12_wp
     integer(ip), parameter :: DEFAULT_MAX_PERIODS = 200
+    !> A closed 2-D cycle is an isolated fixed point of the period map when
+    !> det(I - dw_end/dw_start) >= this (stuck all cycle: 0; touching the friction limit
+    !> with a slip of the order of the closure tolerance: ~1e-12; onset of partial slip at
+    !> 0.991 a period: ~1e-2).
+    real(wp), parameter :: DET_ISOLATED = 1.0e-6_wp
 
     !> Everything one caller needs to evaluate contact forces at H harmonics and N samples:
     !> FFTW plans, buffers and per-batch work arrays. Owned by the caller (one per thread).

@@ -180,12 +180,10 @@ contains
     end subroutine settle_step2d
 
     !> Whether the closed 2-D cycle of element j is an isolated fixed point of the period
-    !> map: det(I - M) >= DET_ISOLATED. Stuck all cycle, M = I; touching the friction
-    !> limit with a slip of the order of the closure tolerance, 1 - det ~ 1e-12.
+    !> map: det(I - M) >= DET_ISOLATED.
     logical function isolated2d(plan, j)
         type(aft_plan), intent(in) :: plan
         integer(ip), intent(in) :: j
-        real(wp), parameter :: DET_ISOLATED = 1.0e-6_wp
         real(wp) :: mm(2, 2)
         logical :: opened
         call slider_map(plan, j, plan%par(j, 1), mm, opened)
