@@ -21,7 +21,8 @@
 !> the 2x2 derivative of the period map from the slip tangents (frirom_aft_march), and
 !> the Jacobian then solves the closed cycle's slider tangent directly.
 !>
-!> Cost per element: O(N) marching per period (usually 2 periods from a cold slider),
+!> Cost per element: O(N) marching per period (usually 2 periods from a cold slider, about
+!> 5 for the 2-D law near the onset of partial slip),
 !> one inverse and one forward real FFT of length N per direction, and for the Jacobian
 !> an O(N) scan plus O(H^2) per run and per stick segment.
 !>

@@ -4,8 +4,9 @@
 !> submodule so that the compiler sees them together.
 submodule (frirom_aft) frirom_aft_march
     use frirom_fourier, only: clear_input, load_harmonics, exec_c2r
-    use frirom_contact, only: STATE_STICK, STATE_SLIP, STATE_LIFTOFF, jenkins_march, friction1d_march, friction2d_march, &
-                              cubic_spring, recontact_follow
+    use frirom_contact, only: STATE_STICK, STATE_SLIP, STATE_LIFTOFF, jenkins_march, &
+                              friction1d_march, friction2d_march, cubic_spring, &
+                              recontact_follow
     implicit none
 
 contains
