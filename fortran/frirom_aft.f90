@@ -15,7 +15,14 @@
 !> v at the two samples around it). The 2-D law, whose slip direction remembers the past,
 !> propagates the slider tangent instead.
 !>
-!> Cost per element: O(N) marching per period (usually 2 periods from a cold slider),
+!> The 2-D slider corrects only its component along each slip direction, so plain
+!> marching can contract its mismatch as little as 0.99 a period (the onset of partial
+!> slip); its march takes Newton steps on the slider fixed point between periods, with
+!> the 2x2 derivative of the period map from the slip tangents (frirom_aft_march), and
+!> the Jacobian then solves the closed cycle's slider tangent directly.
+!>
+!> Cost per element: O(N) marching per period (usually 2 periods from a cold slider, about
+!> 5 for the 2-D law near the onset of partial slip),
 !> one inverse and one forward real FFT of length N per direction, and for the Jacobian
 !> an O(N) scan plus O(H^2) per run and per stick segment.
 !>
@@ -60,6 +67,11 @@ module frirom_aft
     integer(ip), parameter :: DEFAULT_BATCH = 16
     real(wp), parameter :: DEFAULT_TOL = 1.0e-12_wp
     integer(ip), parameter :: DEFAULT_MAX_PERIODS = 200
+    !> A closed 2-D cycle is an isolated fixed point of the period map when
+    !> det(I - dw_end/dw_start) >= this (stuck all cycle: 0; touching the friction limit
+    !> with a slip of the order of the closure tolerance: ~1e-12; onset of partial slip at
+    !> 0.991 a period: ~1e-2).
+    real(wp), parameter :: DET_ISOLATED = 1.0e-6_wp
 
     !> Everything one caller needs to evaluate contact forces at H harmonics and N samples:
     !> FFTW plans, buffers and per-batch work arrays. Owned by the caller (one per thread).
@@ -79,6 +91,13 @@ module frirom_aft
         real(wp), allocatable :: anchor_dtv(:)       !! (nbatch) its d ft / dv
         real(wp), allocatable :: dw(:, :), dw0(:, :) !! (2, 3(2H+1)) 2-D slider tangent
         real(wp), allocatable :: dft(:, :)           !! (2, 3(2H+1)) 2-D force tangent
+        ! 2-D slider fixed point: Newton steps between periods (frirom_aft_march)
+        real(wp), allocatable :: wplain(:, :)        !! (nbatch, 2) plain march from the base
+        real(wp), allocatable :: res_base(:)         !! (nbatch) mismatch of the base period
+        real(wp), allocatable :: res_last(:)         !! (nbatch) mismatch of the last period
+        logical, allocatable :: stepped(:)           !! (nbatch) period started from a step
+        logical, allocatable :: accelerated(:)       !! (nbatch) a step was accepted
+        integer(ip), allocatable :: hold(:)          !! (nbatch) plain periods before a step
     end type aft_plan
 
     ! The two entry points are generic names over separate module procedures: gfortran 12
@@ -152,6 +171,18 @@ module frirom_aft
             integer(ip), intent(in) :: law, e0, m, max_periods
             real(wp), intent(in) :: x(:, :, :), params(:, :), w0(:, :), tol
         end subroutine time_batch
+
+        !> Derivative m(2, 2) of the end-of-period 2-D slider of element j of the batch with
+        !> respect to its start, from the states and slip tangents of the period just
+        !> marched: the product over the samples of A_k/kt at slip, I at stick, 0 at
+        !> lift-off (frirom_aft_march). opened: the period has a lift-off sample.
+        pure module subroutine slider_map(plan, j, kt, m, opened)
+            type(aft_plan), intent(in) :: plan
+            integer(ip), intent(in) :: j
+            real(wp), intent(in) :: kt
+            real(wp), intent(out) :: m(2, 2)
+            logical, intent(out) :: opened
+        end subroutine slider_map
 
         !> Same-sample coefficient series of the Jacobian, written after the forces:
         !> Jenkins slot 2 = kt [stick]; normal1d slot 3 = kt [stick], slot 4 = d ft/dv (the
@@ -274,6 +305,8 @@ contains
         allocate (plan%anchor(nb), plan%anchor_state(nb), plan%anchor_dtv(nb), &
                   plan%events(nsamp))
         allocate (plan%dw(2, 3*nc), plan%dw0(2, 3*nc), plan%dft(2, 3*nc))
+        allocate (plan%wplain(nb, 2), plan%res_base(nb), &
+                  plan%res_last(nb), plan%stepped(nb), plan%accelerated(nb), plan%hold(nb))
     end subroutine aft_plan_create
 
     !> Release the plans and work arrays (a destroyed or never created plan is fine).
@@ -286,5 +319,7 @@ contains
                                                    plan%events)
         if (allocated(plan%tangent)) deallocate (plan%tangent, plan%follow)
         if (allocated(plan%dw)) deallocate (plan%dw, plan%dw0, plan%dft)
+        if (allocated(plan%wplain)) deallocate (plan%wplain, plan%res_base, plan%res_last, &
+                                                plan%stepped, plan%accelerated, plan%hold)
     end subroutine aft_plan_destroy
 end module frirom_aft

@@ -195,12 +195,12 @@ contains
     end subroutine anchor_rows
 
     !> Jacobian of the 2-D element. The slip direction depends on the whole history, so
-    !> the slider tangent dw (2 x 3(2H+1)) is propagated through the period, repeated until
-    !> it closes (slip contracts it; lift-off resets it), then once more accumulating.
-    !> The propagation starts from the tangent the settling periods leave (marched again
-    !> from w0): a contact that slipped while the march settled and then sticks all cycle,
-    !> or only touches the friction limit, keeps a slider that depends on that history
-    !> (along the limit circle the recursion does not contract).
+    !> the slider tangent dw (2 x 3(2H+1)) is propagated through the period from the
+    !> closed cycle's own tangent, solved directly when that cycle is an isolated fixed
+    !> point (fixed_point2d). Otherwise (stuck all cycle, or only touching the friction
+    !> limit, where the recursion does not contract) the slider depends on the path: the
+    !> propagation starts from the tangent the settling periods leave (marched again from
+    !> w0) and is repeated until it closes (or max_periods), then once more accumulating.
     subroutine jac_friction2d(plan, j, kt, w0j, tol, max_periods, jac)
         type(aft_plan), intent(inout) :: plan
         integer(ip), intent(in) :: j, max_periods
@@ -212,6 +212,7 @@ contains
         call jac_diagonal(plan, j, 4_ip, jac, 0_ip, 0_ip)       ! d f1/du1, stick
         call jac_diagonal(plan, j, 4_ip, jac, nc, nc)           ! d f2/du2, stick
         call jac_diagonal(plan, j, 5_ip, jac, 2*nc, 2*nc)       ! d fn/dv, contact
+        if (fixed_point2d(plan, j, kt, jac)) return
         plan%dw = 0.0_wp
         if (plan%closed_at(j) > 1 .and. any(plan%w(j, 1:2) /= w0j(1:2))) &
             call settle2d(plan, j, kt, w0j, jac)
@@ -226,6 +227,36 @@ contains
         end do
         call propagate2d(plan, j, kt, .true., jac)
     end subroutine jac_friction2d
+
+    !> Jacobian terms of a 2-D cycle that is an isolated fixed point of the period map
+    !> (det(I - M) >= DET_ISOLATED, M = slider_map): its slider, unique, does not depend on
+    !> the settling periods, and its tangent solves dw = M dw + r exactly, r the tangent
+    !> one period leaves from dw = 0 (the recursion repeated until it closes contracts as
+    !> slowly as plain marching). .false. (nothing added) for a cycle that is not isolated.
+    logical function fixed_point2d(plan, j, kt, jac) result(done)
+        type(aft_plan), intent(inout) :: plan
+        integer(ip), intent(in) :: j
+        real(wp), intent(in) :: kt
+        real(wp), intent(inout) :: jac(:, :)
+        real(wp) :: mm(2, 2), a11, a12, a21, a22, det
+        real(wp) :: r1(size(plan%dw, 2)), r2(size(plan%dw, 2))
+        logical :: opened
+        call slider_map(plan, j, kt, mm, opened)
+        a11 = 1.0_wp - mm(1, 1)
+        a12 = -mm(1, 2)
+        a21 = -mm(2, 1)
+        a22 = 1.0_wp - mm(2, 2)
+        det = a11*a22 - a12*a21
+        done = det >= DET_ISOLATED
+        if (.not. done) return
+        plan%dw = 0.0_wp
+        call propagate2d(plan, j, kt, .false., jac)
+        r1 = plan%dw(1, :)
+        r2 = plan%dw(2, :)
+        plan%dw(1, :) = (a22*r1 - a12*r2)/det
+        plan%dw(2, :) = (a11*r2 - a21*r1)/det
+        call propagate2d(plan, j, kt, .true., jac)
+    end function fixed_point2d
 
     !> Slider tangent dw that the settling periods of element j leave: march them again
     !> from w0j (dw = 0 there), propagating the tangent through each.

@@ -4,8 +4,9 @@
 !> submodule so that the compiler sees them together.
 submodule (frirom_aft) frirom_aft_march
     use frirom_fourier, only: clear_input, load_harmonics, exec_c2r
-    use frirom_contact, only: STATE_STICK, jenkins_march, friction1d_march, friction2d_march, &
-                              cubic_spring, recontact_follow
+    use frirom_contact, only: STATE_STICK, STATE_SLIP, STATE_LIFTOFF, jenkins_march, &
+                              friction1d_march, friction2d_march, cubic_spring, &
+                              recontact_follow
     implicit none
 
 contains
@@ -69,6 +70,9 @@ contains
                 end do
             end if
             plan%closed_at(1:m) = max_periods + 1
+            plan%stepped(1:m) = .false.
+            plan%accelerated(1:m) = .false.
+            plan%hold(1:m) = 0
             do nper = 1, max_periods
                 plan%wstart(1:m, :) = w
                 select case (law)
@@ -88,14 +92,163 @@ contains
                 call record_anchors(plan, law, m)
                 do j = 1, m
                     if (plan%closed_at(j) > max_periods) then
-                        if (maxval(abs(w(j, 1:ns) - plan%wstart(j, 1:ns))) <= tol*plan%scale(j)) &
+                        if (law == LAW_NORMAL2D) then
+                            call settle_step2d(plan, j, nper, tol*plan%scale(j))
+                        else if (maxval(abs(w(j, 1:ns) - plan%wstart(j, 1:ns))) <= &
+                                 tol*plan%scale(j)) then
                             plan%closed_at(j) = nper
+                        end if
                     end if
                 end do
-                if (all(plan%closed_at(1:m) <= max_periods)) return
+                if (all(plan%closed_at(1:m) <= max_periods)) exit
             end do
+            if (law == LAW_NORMAL2D) then
+                do j = 1, m
+                    if (plan%accelerated(j)) then
+                        if (.not. isolated2d(plan, j)) &
+                            call march_plain2d(plan, j, w0(:, j), tol, max_periods)
+                    end if
+                end do
+            end if
         end associate
     end subroutine march_closed
+
+    !> Closure test and slider update of 2-D element j after period nper: plain marching
+    !> accelerated by Newton steps on the slider fixed point w = P(w) (P: one period).
+    !>
+    !> Each slip sample corrects the slider only along its slip direction, so P contracts
+    !> the mismatch orthogonal to it by little more than the ratio of friction limit to
+    !> trial force: about 0.99 a period at the onset of partial slip. Its derivative
+    !> M = dP/dw (slider_map) is known from the period just marched, so when plain marching
+    !> is slow (the mismatch shrank less than SLOW times in the last period) or the last
+    !> step was good, the next period starts from w_s + (I - M)^-1 (P(w_s) - w_s) instead of
+    !> P(w_s). The step is kept if the period marched from it still slips and has a smaller
+    !> mismatch than its base; otherwise the slider goes back to P(w_s), where plain
+    !> marching would be, and HOLD plain periods follow. A cycle is closed only by a plain
+    !> or kept period. A slipping cycle with I - M regular is the isolated fixed point
+    !> plain marching tends to; one that sticks, or only touches the friction limit, is one
+    !> of a set (the sliders that stick all cycle and its border), reached at a point that
+    !> depends on the path: march_closed then marches the element again without steps
+    !> (march_plain2d).
+    subroutine settle_step2d(plan, j, nper, tolj)
+        type(aft_plan), intent(inout) :: plan
+        integer(ip), intent(in) :: j, nper
+        real(wp), intent(in) :: tolj         !! closure tolerance of the element, m
+        !> plain contraction per period below which no step is tried
+        real(wp), parameter :: SLOW = 0.1_wp
+        !> smallest det(I - M) a step is taken with
+        real(wp), parameter :: DET_MIN = 1.0e-8_wp
+        integer(ip), parameter :: HOLD = 2
+        real(wp) :: res, mm(2, 2), a(2, 2), det, g(2)
+        logical :: opened, try
+        associate (w => plan%w(j, 1:2), ws => plan%wstart(j, 1:2))
+            res = maxval(abs(w - ws))
+            try = .false.
+            if (plan%stepped(j)) then
+                plan%stepped(j) = .false.
+                if (all(plan%state(j, :) == STATE_STICK) .or. res >= plan%res_base(j)) then
+                    w = plan%wplain(j, :)
+                    plan%res_last(j) = plan%res_base(j)
+                    plan%hold(j) = HOLD
+                    return
+                end if
+                try = .true.
+            end if
+            if (res <= tolj) then
+                plan%closed_at(j) = nper
+                return
+            end if
+            if (nper > 1) try = try .or. res > SLOW*plan%res_last(j)
+            try = try .and. plan%hold(j) == 0
+            plan%hold(j) = max(plan%hold(j) - 1, 0_ip)
+            plan%res_last(j) = res
+            if (.not. try) return
+            call slider_map(plan, j, plan%par(j, 1), mm, opened)
+            a(1, 1) = 1.0_wp - mm(1, 1)
+            a(2, 1) = -mm(2, 1)
+            a(1, 2) = -mm(1, 2)
+            a(2, 2) = 1.0_wp - mm(2, 2)
+            det = a(1, 1)*a(2, 2) - a(1, 2)*a(2, 1)
+            if (opened .or. abs(det) < DET_MIN) return
+            g = w - ws
+            plan%wplain(j, :) = w
+            plan%res_base(j) = res
+            w(1) = ws(1) + (a(2, 2)*g(1) - a(1, 2)*g(2))/det
+            w(2) = ws(2) + (a(1, 1)*g(2) - a(2, 1)*g(1))/det
+            plan%stepped(j) = .true.
+            plan%accelerated(j) = .true.
+        end associate
+    end subroutine settle_step2d
+
+    !> Whether the closed 2-D cycle of element j is an isolated fixed point of the period
+    !> map: det(I - M) >= DET_ISOLATED.
+    logical function isolated2d(plan, j)
+        type(aft_plan), intent(in) :: plan
+        integer(ip), intent(in) :: j
+        real(wp) :: mm(2, 2)
+        logical :: opened
+        call slider_map(plan, j, plan%par(j, 1), mm, opened)
+        isolated2d = (1.0_wp - mm(1, 1))*(1.0_wp - mm(2, 2)) - mm(1, 2)*mm(2, 1) >= DET_ISOLATED
+    end function isolated2d
+
+    module procedure slider_map
+        integer(ip) :: k
+        real(wp) :: b(2, 2)
+        m = reshape([1.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [2, 2])
+        opened = .false.
+        do k = 1, plan%fp%nsamp
+            select case (plan%state(j, k))
+            case (STATE_SLIP)
+                b = reshape(plan%tangent(j, 1:4, k), [2, 2])/kt
+                m = matmul(b, m)
+            case (STATE_LIFTOFF)
+                m = 0.0_wp
+                opened = .true.
+            end select
+        end do
+    end procedure slider_map
+
+    !> March 2-D element j again from w0j without steps, for a march with a kept step whose
+    !> closed cycle is not isolated (isolated2d): if plain marching closes within
+    !> max_periods its cycle replaces the stepped one (the plain march's stuck slider,
+    !> which settle2d of frirom_aft_jacobian differentiates); otherwise the stepped cycle
+    !> stays, closed where plain marching does not close.
+    subroutine march_plain2d(plan, j, w0j, tol, max_periods)
+        type(aft_plan), intent(inout) :: plan
+        integer(ip), intent(in) :: j, max_periods
+        real(wp), intent(in) :: w0j(:)    !! (2) initial slider, m
+        real(wp), intent(in) :: tol
+        integer(ip) :: nper
+        integer(ip), allocatable :: st_keep(:)
+        real(wp), allocatable :: f_keep(:, :), tg_keep(:, :), w_keep(:), ws_keep(:)
+        st_keep = plan%state(j, :)
+        f_keep = plan%fp%rout(j, :, 1:3)
+        tg_keep = plan%tangent(j, :, :)
+        w_keep = plan%w(j, 1:2)
+        ws_keep = plan%wstart(j, 1:2)
+        associate (rin => plan%fp%rin, rout => plan%fp%rout, par => plan%par, &
+                   uf => plan%follow)
+            plan%w(j, 1:2) = w0j(1:2)
+            do nper = 1, max_periods
+                plan%wstart(j, 1:2) = plan%w(j, 1:2)
+                call friction2d_march(uf(j:j, :, 1), uf(j:j, :, 2), rin(j:j, :, 3), &
+                                      par(j:j, 1), par(j:j, 2), par(j:j, 3), par(j:j, 4), &
+                                      plan%w(j:j, 1:2), rout(j:j, :, 1), rout(j:j, :, 2), &
+                                      rout(j:j, :, 3), plan%state(j:j, :), &
+                                      plan%tangent(j:j, :, :))
+                if (maxval(abs(plan%w(j, 1:2) - plan%wstart(j, 1:2))) <= tol*plan%scale(j)) then
+                    plan%closed_at(j) = nper
+                    plan%accelerated(j) = .false.
+                    return
+                end if
+            end do
+        end associate
+        plan%state(j, :) = st_keep
+        plan%fp%rout(j, :, 1:3) = f_keep
+        plan%tangent(j, :, :) = tg_keep
+        plan%w(j, 1:2) = w_keep
+        plan%wstart(j, 1:2) = ws_keep
+    end subroutine march_plain2d
 
     !> Remember the last slip or lift-off sample of the period just marched: a contact that
     !> slips while the march settles and then sticks for good keeps its slider where that

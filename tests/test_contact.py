@@ -294,6 +294,11 @@ JAC_CASES = {
     # tangent recursion does not contract): it is propagated through the settling periods.
     # Before that was done the error was 0.55 here (0.92 when stuck all cycle)
     "normal2d-settles": ("normal2d", None, {"kt": KT, "kn": KT, "mu": MU, "n0": 80.0}, 0),
+    # the onset of partial slip (5 % of the samples slip): plain marching contracts the
+    # slider mismatch 0.991 a period and needs 568 periods; the march closes it by Newton
+    # steps on the slider in 5, and the Jacobian solves the closed cycle's slider tangent
+    # directly (the recursion repeated 200 times, as before, would not have closed)
+    "normal2d-onset": ("normal2d", None, {"kt": KT, "kn": 0.0, "mu": MU, "n0": FN0}, 0),
     # the issue 9 lift-off case: re-contact followed by stick, so the slider of that stick
     # is the interpolated re-contact point and moves with u and v at the two samples around
     # it (the analytical Jacobian without that dependence is off by 6e-2 here)
@@ -317,6 +322,9 @@ def _jac_input(name):
         x = np.zeros((1, 3, 7))
         x[0, 0, 0], x[0, 1, 0], x[0, 2, 0] = 1e-3, 0.6e-3, 1e-4
         x[0, 0, 1], x[0, 1, 2], x[0, 2, 1] = 0.5e-4, 0.3e-4, 0.2e-4
+    elif name == "normal2d-onset":   # stick limit mu n0 / kt = 0.3 mm
+        x = np.zeros((1, 3, 7))
+        x[0, 0, 1], x[0, 1, 1], x[0, 1, 2] = 0.301e-3, 0.02e-3 * np.cos(0.3), 0.02e-3 * np.sin(0.3)
     else:
         x = build()
     return law, x, params

@@ -1,4 +1,4 @@
-"""Benchmark: AFT forces + Jacobian of the 1-D contact element with normal load variation.
+"""Benchmark: AFT forces + Jacobian of the contact elements with normal load variation.
 
 frirom's Fortran kernel against a vectorised numpy implementation of the same law (march
 vectorised over elements, numpy FFTs, Jacobian by the same chain rule written as dense
@@ -6,7 +6,14 @@ einsums), timed in the same run on the same inputs; the numpy results are also c
 against frirom's, so the two compute the same thing. Prints element-samples per second and
 the speed-up; the last line is the speed-up at 1 000 elements, H = 3, N = 256.
 
-    python cases/bench/aft.py [--quick]
+The 2-D element (normal2d) has no numpy twin: its table gives, for 1 000 elements of two
+kinds (a mix of stick, slip and lift-off; cycles within 5 % above the onset of partial
+slip), the periods the march needed (mean, max, how many beyond the default limit of 200;
+max_periods is raised to 5 000 here so that a plain march closes too) and the time of
+forces + Jacobian. Run it with an older build to compare (the march of that build is
+the reference: `cd OLD && .venv/bin/python NEW/cases/bench/aft.py --law normal2d`).
+
+    python cases/bench/aft.py [--quick] [--law normal1d|normal2d|both]
 
 Both run on one core (OPENBLAS_NUM_THREADS=1 is set before numpy loads).
 """
@@ -112,6 +119,40 @@ def make_inputs(ne, h, rng):
     return x, kt, kn, mu, n0
 
 
+def make_inputs_2d(ne, h, kind, rng):
+    """normal2d cycles (ne, 3, 2H+1) and parameters (ne, 4): kind "mixed" (the 1-D mix with
+    an out-of-phase second tangential direction: stick, slip, lift-off) or "onset"
+    (constant normal load, elliptic motion 0-5 % beyond the stick limit mu n0 / kt)."""
+    x = np.zeros((ne, 3, 2 * h + 1))
+    if kind == "mixed":
+        x1, kt, kn, mu, n0 = make_inputs(ne, h, rng)
+        x[:, 0], x[:, 2] = x1[:, 0], x1[:, 1]
+        x[:, 1, 2] = rng.uniform(0.0, 0.7, ne) * x1[:, 0, 1]
+    else:
+        kt, kn, mu, n0 = (np.full(ne, 1e5), np.zeros(ne), np.full(ne, 0.3), np.full(ne, 100.0))
+        a = mu * n0 / kt * rng.uniform(1.0, 1.05, ne)
+        phi = rng.uniform(0.0, np.pi, ne)
+        b = rng.uniform(0.0, 0.3, ne) * a
+        x[:, 0, 1] = a
+        x[:, 1, 1], x[:, 1, 2] = b * np.cos(phi), b * np.sin(phi)
+    return x, np.stack([kt, kn, mu, n0], axis=1)
+
+
+def bench_normal2d(quick):
+    """Table of the 2-D element: periods marched and time of forces + Jacobian."""
+    rng = np.random.default_rng(1)
+    ne, h, n = (200 if quick else 1000), 3, 256
+    print(f"normal2d, {ne} elements, H = {h}, N = {n}, max_periods 5000")
+    print(f"{'kind':>6} {'mean per':>8} {'max per':>7} {'> 200':>5} {'s':>9} {'Mel-samp/s':>10}")
+    for kind in ("mixed", "onset"):
+        x, params = make_inputs_2d(ne, h, kind, rng)
+        r = contact.aft("normal2d", x, params, n, max_periods=5000)
+        t = best_of(lambda: contact.aft("normal2d", x, params, n, max_periods=5000), 3)
+        per = r.periods
+        print(f"{kind:>6} {per.mean():8.1f} {per.max():7d} {(per > 200).sum():5d} {t:9.2e} "
+              f"{ne * n / t / 1e6:10.2f}", flush=True)
+
+
 def best_of(fn, repeat):
     best = np.inf
     for _ in range(repeat):
@@ -124,7 +165,12 @@ def best_of(fn, repeat):
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller grid (smoke run)")
+    ap.add_argument("--law", choices=("normal1d", "normal2d", "both"), default="both")
     args = ap.parse_args()
+    if args.law != "normal1d":
+        bench_normal2d(args.quick)
+    if args.law == "normal2d":
+        return
     sizes = (10, 100, 1000) if args.quick else (10, 100, 1000, 10000)
     rng = np.random.default_rng(0)
     print(f"{'elements':>8} {'H':>2} {'N':>4} {'frirom s':>10} {'numpy s':>10} "
