@@ -40,7 +40,7 @@ KT_TOTAL, KN_TOTAL = 2.0e9, 4.0e9
 #: the interlocking lug's contact (8 node pairs on both meshes): stiffness per pair [N/m],
 #: stiff against the sector (the tied lug is its rigid limit), friction coefficient, and
 #: the total preload [N], high enough that the lug stays stuck over the f0 family
-KT_LUG, KN_LUG, MU_LUG, F_LUG = 2.0e11, 2.0e11, 0.3, 1.0e5
+KT_LUG, KN_LUG, MU_LUG, F_LUG = 2.0e11, 2.0e11, 0.3, 3.0e5
 
 LAWS = ("normal1d", "normal2d")
 INTERLOCKS = ("contact", "tied")
