@@ -1,9 +1,11 @@
 """The vane segment with hook joints (cases/paper_hooks, paper section 3.2.1), coarse mesh.
 
-ROM_I (Craig-Bampton, every hook DoF nonlinear) is the reference; ROM_II reduces the hooks
-by GSI modes (half free, half full-stick). Both run on the same cyclic sector (Tran modes
-on the boundary), so their difference is the interface reduction alone. Needs gmsh-free
-structured meshing and ccx (calculix-ccx); about 20 s, hence slow.
+ROM_I (Craig-Bampton, every contact DoF nonlinear) is the reference; ROM_II reduces the
+hook and lug faces by GSI modes (half free, half full-stick). Both run on the same cyclic
+sector (Tran modes on the boundary), so their difference is the interface reduction alone.
+The interlocking lug is a preloaded contact; the same mesh with the lug tied is its
+reference. Needs gmsh-free structured meshing and ccx (calculix-ccx); about 40 s, hence
+slow.
 """
 
 from __future__ import annotations
@@ -22,8 +24,8 @@ sys.path.insert(0, str(ROOT / "cases" / "paper_hooks"))
 pytestmark = [pytest.mark.slow,
               pytest.mark.skipif(shutil.which("ccx") is None, reason="needs ccx")]
 
-#: the preload with the most slip in the coarse family (42 % of the hooks' cycle at the
-#: peak): where the interface modes are tested hardest
+#: the preload with the most slip in the coarse family (40 % of the hooks' cycle at the
+#: peak): where the interface modes and the lug are tested hardest
 F0 = 1000.0
 
 
@@ -32,6 +34,14 @@ def case(tmp_path_factory):
     import make_paper_hooks as mk
     work = tmp_path_factory.mktemp("hooks")
     mk.make(work, "coarse")
+    return work
+
+
+@pytest.fixture(scope="module")
+def tied(tmp_path_factory):
+    import make_paper_hooks as mk
+    work = tmp_path_factory.mktemp("hooks_tied")
+    mk.make(work, "coarse", interlock="tied")
     return work
 
 
@@ -55,30 +65,57 @@ def test_rom1_stuck_peak_is_the_stick_eigenfrequency(case):
     import scipy.linalg as sla
     r1 = ph.Rom(case, "rom1", "coarse")
     (f, a), res = _peak(r1, 1e5)
-    assert res.state_fractions[res.peak(0).index, 0, 0] == pytest.approx(1.0)
+    assert np.all(res.state_fractions[res.peak(0).index, :, 0] == pytest.approx(1.0))
     red, cs = r1.deck.reduced, r1.deck.cyclic["sector"]
-    G = red.contact_matrix("hooks").toarray()
-    k = red.pairs["hooks"].stiffness.ravel()
-    Ks = red.K + G.T @ (k[:, None] * G)
+    Ks = red.K.copy()
+    for g in r1.groups:                 # the hooks and the lug, all stuck
+        G = red.contact_matrix(g).toarray()
+        k = red.pairs[g].stiffness.ravel()
+        Ks = Ks + G.T @ (k[:, None] * G)
     kk = r1.model.harmonic_index(1)
     Kk, Mk = cs.matrices(Ks, red.M, kk)
     lam = sla.eigh(Kk.toarray(), Mk.toarray(), eigvals_only=True, subset_by_index=[0, 0])
     assert f == pytest.approx(np.sqrt(lam[0]) / (2 * np.pi), rel=1e-4)
 
 
+def test_contact_lug_stays_stuck_and_equals_the_tied_lug(case, tied):
+    """The interlocking lug as a preloaded contact (F_LUG = 300 kN, mu 0.3) against the
+    same mesh with the lug's face tied to the platform, ROM_I at the preload where the
+    hooks slip most: the lug's groups stick at every time sample of every point of the
+    FRF (the results' state fractions), and the peak equals the tied one within 1e-3 in
+    amplitude and 1e-4 in frequency. Why so close: stuck, the lug is a spring of 2e11 N/m
+    per pair, about 200 times the sector's stiffness at the lug (E x 6 mm ~ 1e9 N/m), so
+    the stuck sector's frequency moves by 1e-6 (measured); through the hooks' friction,
+    which amplifies it, the peak moves by 1e-4 in amplitude and 1e-6 in frequency
+    (measured), and the soft mount is in both models."""
+    import paper_hooks as ph
+    rc, rt = ph.Rom(case, "rom1", "coarse"), ph.Rom(tied, "rom1", "coarse")
+    assert [g for g in rc.groups if g.startswith("lug")] == ["lug_t", "lug_z"]
+    assert rt.groups == ["hooks"]
+    (fc, ac), res_c = _peak(rc, F0)
+    (ft, at), res_t = _peak(rt, F0)
+    assert ph.lug_stick(rc, res_c) == 1.0
+    slip = res_c.state_fractions[:, rc._hooks, 1].max()
+    assert slip > 0.3                   # the hooks do slip: the lug is loaded by it
+    assert ac == pytest.approx(at, rel=1e-3)
+    assert fc == pytest.approx(ft, rel=1e-4)
+
+
 def test_gsi_error_decreases_with_modes_and_rom2_matches(case):
     """ROM_II against ROM_I at the preload with the most slip: the peak-frequency error
-    falls with every step 4 -> 10 -> 20 -> 40 GSI modes, the peak-amplitude error of 40
-    modes is below those of 4, 10 and 20, and 40 modes (20 free + 20 stick, the paper's
-    ROM_II) are within the issue's targets: 1 % in peak amplitude, 0.1 % in peak
-    frequency (measured: 0.08 %, 0.006 %)."""
+    falls with every step 10 -> 20 -> 40 -> 80 GSI modes, the peak-amplitude error of 80
+    modes is below those of 10, 20 and 40, and 80 modes (40 free + 40 stick) are within
+    the issue's targets: 1 % in peak amplitude, 0.1 % in peak frequency (measured: 0.26 %,
+    8e-6). The paper's 40 modes miss 1 % here (measured 1.8 %: the lug's 48 DoFs share the
+    basis with the hooks'; with the lug tied, 40 modes are within 0.1 %); the case's table
+    shows that row flagged."""
     import paper_hooks as ph
     (f1, a1), _ = _peak(ph.Rom(case, "rom1", "coarse"), F0)
     errs = {}
-    for n in (4, 10, 20, 40):
+    for n in (10, 20, 40, 80):
         (f2, a2), _ = _peak(ph.Rom(case, "rom2", "coarse", n), F0)
         errs[n] = (abs(a2 / a1 - 1), abs(f2 / f1 - 1))
-    df = [errs[n][1] for n in (4, 10, 20, 40)]
+    df = [errs[n][1] for n in (10, 20, 40, 80)]
     assert all(b < a for a, b in zip(df, df[1:])), errs
-    assert errs[40][0] < min(errs[n][0] for n in (4, 10, 20)), errs
-    assert errs[40][0] < 0.01 and errs[40][1] < 0.001, errs
+    assert errs[80][0] < min(errs[n][0] for n in (10, 20, 40)), errs
+    assert errs[80][0] < 0.01 and errs[80][1] < 0.001, errs

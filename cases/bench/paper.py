@@ -72,14 +72,17 @@ def summary(rows: list) -> str:
     parts, errs = [], []
     for case in dict.fromkeys(r["case"] for r in rows):
         rc = [r for r in rows if r["case"] == case]
-        main = [r for r in rc if r.get("rom2", "") in ("", "h=2")] or rc
+        main = [r for r in rc if r.get("rom2", "") in ("", "h=2", "gsi40")] or rc
         ext = " (ROM_I extrapolated)" if any(r["rom1_extrapolated"] for r in main) else ""
         parts.append(f"{case} {np.median([r['speedup'] for r in main]):.1f}x{ext}")
         for kind in dict.fromkeys(r.get("rom2", "") for r in rc):
-            rk = [r for r in rc if r.get("rom2", "") == kind]
+            rk = [r for r in rc if r.get("rom2", "") == kind and r.get("complete", True)]
+            n_out = sum(1 for r in rc if r.get("rom2", "") == kind) - len(rk)
             label = f"{case} {kind}".strip()
+            out = f" ({n_out} incomplete, not compared)" if n_out else ""
             errs.append(f"{label} {100 * max(abs(r['peak_amp_err']) for r in rk):.3f} % / "
-                        f"{100 * max(abs(r['peak_freq_err']) for r in rk):.4f} %")
+                        f"{100 * max(abs(r['peak_freq_err']) for r in rk):.4f} %{out}"
+                        if rk else f"{label}: none compared{out}")
     return ("speed-up ROM_I -> ROM_II: " + ", ".join(parts)
             + "; worst peak errors (amplitude / frequency): " + ", ".join(errs))
 

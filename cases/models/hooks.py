@@ -19,15 +19,27 @@ coordinates (r, theta, z), so that the faces in contact match node to node:
   other on the cylinder r = R_h (node sets HOOK_V, vane side, and HOOK_C, casing side,
   node to node; the contact elements of the deck join them);
 - the interlocking: a lug of the casing (r in [R_h, R_c], mid-length, over the airfoil's
-  theta cell) whose face r = R_h shares its nodes with the vane's platform: the stuck
-  limit of a preloaded interlocking contact (tied), which also carries the hooks' preload
-  (the contact preload n0 pushes the hook faces apart; the lug holds them).
+  theta cell) whose face r = R_h faces the vane's platform. ``interlock="contact"``
+  (default): the lug and the platform are separate meshes matching node to node (node
+  sets LUG_V, vane side, and LUG_C, casing side, in pair order), joined by the deck's
+  preloaded interlocking contact elements; ``interlock="tied"``: the lug's face shares
+  its nodes with the platform (the stuck, rigid limit of that contact: the reference).
 
 Node sets: HOOK_V, HOOK_C (contact faces; the vane's side first), AIRFOIL (nodes of the
 airfoil's mid-chord line on its pressure side, the excitation/response points),
 CASING_OUT (nodes of the casing's outer surface on the mid-sector line), ACTIVE = both,
 EXC (the airfoil node at mid-span), OUT (the airfoil node nearest the inner platform),
-LEFT, RIGHT, FIX, ALL. ``size`` "coarse" (tests) or "paper" (about 450 contact DoFs per
+LEFT, RIGHT, FIX, ALL, and LUG_V, LUG_C with the contact interlocking, and MOUNT (the
+vane's nodes on the inner platform's inner face r = R_i).
+
+The soft mount: grounded springs (SPRING1, x, y and z) on the MOUNT nodes, K_MOUNT in all
+per direction, which put the vane's six rigid-body modes near 1 Hz. With the contact
+interlocking nothing else holds the vane when the contacts are left out, and the cyclic
+sector's modes (computed without contacts, as the solver's modal model needs) would
+have rigid-body modes at every nodal diameter. The springs are in both variants, so that
+the contact lug and the tied one differ by the lug alone; their effect on the 120-200 Hz
+resonances is about K_MOUNT / (the modes' modal stiffness), below 1e-4.
+ ``size`` "coarse" (tests) or "paper" (about 450 contact DoFs per
 hook side, as in the paper). Nothing generated is committed.
 """
 
@@ -60,6 +72,7 @@ L, A_HOOK, E_FL = 0.050, 0.012, 0.010   # axial length, hook length, casing flan
 C0, C1 = 0.015, 0.035            # airfoil chord z in [C0, C1]
 LUG = 0.006                      # axial length of the interlocking lug (mid-length)
 THICK = 0.004                    # airfoil thickness at r = R_P
+K_MOUNT = 12.0                   # soft mount of the vane [N/m per direction, all springs]
 
 
 def _subdivide(breaks, counts):
@@ -70,8 +83,10 @@ def _subdivide(breaks, counts):
     return np.array(out)
 
 
-def hooks_mesh(n_theta=1, n_hook=1, n_span=4, n_chord=2, sectors=24):
-    """Structured C3D20 mesh of the vane-casing sector.
+def hooks_mesh(n_theta=1, n_hook=1, n_span=4, n_chord=2, sectors=24,
+               interlock="contact"):
+    """Structured C3D20 mesh of the vane-casing sector; interlock "contact" (the lug's face
+    and the platform's as separate matching nodes) or "tied" (shared nodes).
 
     Returns node ids (n,), coordinates (n, 3), connectivity (ne, 20) and the node sets.
     """
@@ -127,7 +142,10 @@ def hooks_mesh(n_theta=1, n_hook=1, n_span=4, n_chord=2, sectors=24):
             elems.append([node(body, k) for k in keys])
     lug_face = [k[1:] for k in ids if k[0] == "c" and k[1] == j_h
                 and abs(zf[k[3]] - L / 2) <= LUG / 2 + 1e-12 and abs(tf[k[2]]) <= dth + 1e-12]
-    remap = {ids[("v",) + k]: ids[("c",) + k] for k in lug_face if ("v",) + k in ids}
+    lug_pairs = [(ids[("v",) + k], ids[("c",) + k]) for k in lug_face if ("v",) + k in ids]
+    if interlock not in ("contact", "tied"):
+        raise ValueError(f"interlock must be 'contact' or 'tied', got {interlock!r}")
+    remap = dict(lug_pairs) if interlock == "tied" else {}
     elems = np.array([[remap.get(n, n) for n in e] for e in elems], dtype=np.int64)
     keys = np.array([k[1:] for k in ids], dtype=np.int64)
     body = np.array([k[0] for k in ids])
@@ -162,22 +180,29 @@ def hooks_mesh(n_theta=1, n_hook=1, n_span=4, n_chord=2, sectors=24):
     ra = np.hypot(xyz[airfoil - 1, 0], xyz[airfoil - 1, 1])
     exc = airfoil[[int(np.argmin(np.abs(ra - 0.5 * (R_I + R_P))))]]
     out = airfoil[[int(np.argmin(ra))]]
-    sets = dict(HOOK_V=hook_v, HOOK_C=hook_c, HOOKS=np.union1d(hook_v, hook_c),
+    mount = nid[(body == "v") & (np.abs(r - R_I) < eps)]
+    sets = {"MOUNT": mount}
+    if interlock == "contact":        # the lug's pairs, vane side first, in the same order
+        sets["LUG_V"] = np.array([new[v] for v, _ in lug_pairs], dtype=np.int64)
+        sets["LUG_C"] = np.array([new[c] for _, c in lug_pairs], dtype=np.int64)
+    sets.update(HOOK_V=hook_v, HOOK_C=hook_c, HOOKS=np.union1d(hook_v, hook_c),
                 AIRFOIL=airfoil, CASING_OUT=casing_out,
                 ACTIVE=np.union1d(airfoil, casing_out), EXC=exc, OUT=out, LEFT=left,
                 RIGHT=right, FIX=fix)
     return nid, xyz, elems, sets
 
 
-def write_hooks_deck(path, size="coarse", n_ref_modes=0, material=STEEL_PAPER) -> Path:
+def write_hooks_deck(path, size="coarse", n_ref_modes=0, material=STEEL_PAPER,
+                     interlock="contact") -> Path:
     """Mesh the sector and write its CalculiX deck (matrix storage); returns the path."""
     if size not in SIZES:
         raise ValueError(f"size must be one of {sorted(SIZES)}, got {size!r}")
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    ids, xyz, elems, sets = hooks_mesh(**SIZES[size])
+    ids, xyz, elems, sets = hooks_mesh(**SIZES[size], interlock=interlock)
     with open(path, "w") as fh:
-        fh.write(f"** vane segment hooked into a casing sector, C3D20, size {size}\n")
+        fh.write(f"** vane segment hooked into a casing sector, C3D20, size {size}, "
+                 f"interlocking {interlock}\n")
         fh.write("*NODE, NSET=ALL\n")
         for i, (x, y, z) in zip(ids, xyz):
             fh.write(f"{i}, {x:.12g}, {y:.12g}, {z:.12g}\n")
@@ -187,24 +212,40 @@ def write_hooks_deck(path, size="coarse", n_ref_modes=0, material=STEEL_PAPER) -
             fh.write(", ".join(items[:16]) + ",\n" + ", ".join(items[16:]) + "\n")
         for name, nodes in sets.items():
             fh.write(nset(name, nodes))
+        fh.write(soft_mount(sets["MOUNT"], len(elems) + 1))
         fh.write(solid_material(material) + "*BOUNDARY\nFIX, 1, 3\n"
                  + matrix_storage_steps(n_ref_modes))
     return path
 
 
-def make_hooks(out, size="coarse") -> Path:
-    """Write and run the deck in ``out`` (job ``hooks``) unless ccx's files are there and
-    newer than this generator; returns the job path."""
+def soft_mount(nodes, first: int) -> str:
+    """SPRING1 elements (numbered from ``first``) grounding ``nodes`` in x, y and z, with
+    K_MOUNT per direction shared equally: the CalculiX text."""
+    k = K_MOUNT / len(nodes)
+    out = []
+    for d in (1, 2, 3):
+        e0 = first + (d - 1) * len(nodes)
+        out.append(f"*ELEMENT, TYPE=SPRING1, ELSET=EMOUNT{d}\n")
+        out += [f"{e0 + j}, {n}\n" for j, n in enumerate(nodes)]
+        out.append(f"*SPRING, ELSET=EMOUNT{d}\n{d}\n{k:.9g}\n")
+    return "".join(out)
+
+
+def make_hooks(out, size="coarse", interlock="contact") -> Path:
+    """Write and run the deck in ``out`` (job ``hooks``) unless ccx's files are there, newer
+    than this generator and of the same size and interlocking; returns the job path."""
     out = Path(out)
     job = out / "hooks"
     gen = Path(__file__).stat().st_mtime
     done = all(job.with_suffix(s).exists() and job.with_suffix(s).stat().st_mtime > gen
                for s in (".inp", ".sti", ".mas", ".dof"))
     stamp = out / "hooks.size"
-    if done and stamp.exists() and stamp.read_text() == size:
+    tag = size if interlock == "contact" else f"{size} {interlock}"
+    if done and stamp.exists() and stamp.read_text() == tag:
         return job
-    run_ccx(write_hooks_deck(job.with_suffix(".inp"), size), expect=(".sti", ".mas", ".dof"))
-    stamp.write_text(size)
+    run_ccx(write_hooks_deck(job.with_suffix(".inp"), size, interlock=interlock),
+            expect=(".sti", ".mas", ".dof"))
+    stamp.write_text(tag)
     return job
 
 
@@ -212,8 +253,9 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", default="coarse", choices=sorted(SIZES))
     ap.add_argument("--out", default="hooks")
+    ap.add_argument("--interlock", default="contact", choices=("contact", "tied"))
     a = ap.parse_args(argv)
-    job = make_hooks(Path(a.out), a.size)
+    job = make_hooks(Path(a.out), a.size, a.interlock)
     print(f"wrote {job}.inp/.sti/.mas/.dof")
 
 

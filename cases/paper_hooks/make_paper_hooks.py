@@ -1,14 +1,23 @@
 """Make the vane-with-hooks case: the sector's CalculiX matrices and its two decks.
 
     python cases/paper_hooks/make_paper_hooks.py [--size coarse|paper] [--out DIR]
+        [--law normal1d|normal2d] [--interlock contact|tied]
     frirom run results/paper_hooks/coarse/rom2.toml      # ROM_II: 40 GSI modes
-    frirom run results/paper_hooks/coarse/rom1.toml      # ROM_I: every hook DoF
+    frirom run results/paper_hooks/coarse/rom1.toml      # ROM_I: every contact DoF
 
 Writes DIR (default results/paper_hooks/<size>) with the ccx model of
 cases/models/hooks.py (job ``hooks``, not committed) and ``rom1.toml`` / ``rom2.toml``
-filled from the template hooks.toml: ROM_I keeps every hook DoF nonlinear (Craig-Bampton
-only), ROM_II reduces the hooks by 20 free + 20 full-stick GSI modes. Both reduce the
-cyclic boundary by Tran's interface modes (``boundary_modes``).
+filled from the template hooks.toml: ROM_I keeps every hook (and lug) DoF nonlinear
+(Craig-Bampton only), ROM_II reduces them by 20 free + 20 full-stick GSI modes. Both reduce
+the cyclic boundary by Tran's interface modes (``boundary_modes``).
+
+The hooks are one contact group of ``--law`` (normal1d: one tangent, circumferential;
+normal2d: friction in the face's plane). The interlocking lug is, with ``--interlock
+contact`` (default), a contact of the same law preloaded by :data:`F_LUG` so that it stays
+stuck (normal1d: two groups on the lug's pairs, one per tangent, circumferential and
+axial, each with half the normal stiffness and preload; normal2d: one group), or, with
+``tied``, the lug's face sharing its nodes with the platform (the rigid limit: the
+reference for the contact).
 """
 
 from __future__ import annotations
@@ -28,30 +37,52 @@ from hooks import make_hooks  # noqa: E402
 #: node pairs (so the coarse and the paper-size meshes model the same joint)
 KT_TOTAL, KN_TOTAL = 2.0e9, 4.0e9
 
+#: the interlocking lug's contact (8 node pairs on both meshes): stiffness per pair [N/m],
+#: stiff against the sector (the tied lug is its rigid limit), friction coefficient, and
+#: the total preload [N], high enough that the lug stays stuck over the f0 family
+KT_LUG, KN_LUG, MU_LUG, F_LUG = 2.0e11, 2.0e11, 0.3, 3.0e5
+
+LAWS = ("normal1d", "normal2d")
+INTERLOCKS = ("contact", "tied")
+
 #: per size: CB modes, Tran boundary modes, harmonics, frequency range [Hz], load [N]
 SETTINGS = {
     "coarse": dict(CB=30, TRAN=40, H=1, F0=165.0, F1=195.0, F=5.0),
     "paper": dict(CB=100, TRAN=100, H=1, F0=120.0, F1=145.0, F=5.0),
 }
+#: damping ratio at the middle of the frequency range (mass-proportional damping)
+ZETA = 0.003
 GSI = "method = \"gsi\"\nfree = {free}\nstick = {stick}"
 NONE = "method = \"none\""
 
 
 def deck_text(rom: str, size: str, n_pairs: int, f0: float, n_gsi: int = 40,
-              changes=(), pairs=None) -> str:
+              changes=(), pairs=None, law: str = "normal1d", lug=None,
+              f_lug: float = F_LUG) -> str:
     """The deck of ``rom`` ('rom1' or 'rom2') for a mesh of n_pairs hook pairs, hook
     preload f0 [N, the total over all pairs: n0 = f0 / n_pairs], n_gsi GSI modes (half free,
-    half stick); pairs: :func:`hook_geometry` of the model (the preload's loads; None: no
-    preload loads, the faces pushed apart by n0)."""
+    half stick), contact ``law`` (normal1d or normal2d); pairs: :func:`hook_geometry` of
+    the model (the preload's loads; None: no preload loads, the faces pushed apart by n0);
+    lug: :func:`hook_geometry` of the lug (LUG_V, LUG_C) for the contact interlocking with
+    total preload f_lug [N] (None: the model's lug is tied, no lug contact)."""
+    if law not in LAWS:
+        raise ValueError(f"law must be one of {LAWS}, got {law!r}")
     s = dict(SETTINGS[size])
     text = (HERE / "hooks.toml").read_text()
     im = NONE if rom == "rom1" else GSI.format(free=n_gsi // 2, stick=n_gsi - n_gsi // 2)
-    title = ("ROM_I (every hook DoF)" if rom == "rom1" else
+    title = ("ROM_I (every contact DoF)" if rom == "rom1" else
              f"ROM_II ({n_gsi} GSI modes)")
     n0 = f0 / n_pairs
+    sets = ["HOOK_V", "HOOK_C"] + (["LUG_V", "LUG_C"] if lug is not None else [])
+    preload = preload_loads(pairs, n0) if pairs is not None else ""
+    if lug is not None:
+        preload += "\n" + preload_loads(lug, f_lug / len(lug[0]))
+    s.update(ALPHA=f"{2 * ZETA * 2 * np.pi * (s['F0'] + s['F1']) / 2:.6g}")
     s.update(ROM=title, IM=im, KT=f"{KT_TOTAL / n_pairs:.6g}",
-             KN=f"{KN_TOTAL / n_pairs:.6g}", N0=f"{n0:.6g}",
-             PRELOAD=preload_loads(pairs, n0) if pairs is not None else "")
+             KN=f"{KN_TOTAL / n_pairs:.6g}", N0=f"{n0:.6g}", LAW=law,
+             IFACE="[" + ", ".join(f'"{n}"' for n in sets) + "]",
+             LUG=lug_contacts(law, f_lug / len(lug[0])) if lug is not None else "",
+             PRELOAD=preload)
     for k, v in s.items():
         text = text.replace(f"@{k}@", str(v))
     for old, new in changes:
@@ -64,16 +95,42 @@ def deck_text(rom: str, size: str, n_pairs: int, f0: float, n_gsi: int = 40,
     return text
 
 
+def lug_contacts(law: str, n0: float) -> str:
+    """[[contacts]] tables of the interlocking lug, preload n0 per pair [N]: normal2d one
+    group; normal1d two groups on the same pairs (tangents circumferential and axial), each
+    with half the normal stiffness and preload, so that the stuck lug holds all three
+    directions as the tied one does."""
+    if law == "normal2d":
+        parts = [("lug", "[0.0, 1.0, 0.0]", KN_LUG, n0)]
+    else:
+        parts = [("lug_t", "[0.0, 1.0, 0.0]", KN_LUG / 2, n0 / 2),
+                 ("lug_z", "[0.0, 0.0, 1.0]", KN_LUG / 2, n0 / 2)]
+    return "".join(f"""
+[[contacts]]                        # the interlocking lug, preloaded to stay stuck
+name = "{name}"
+law = "{law}"
+a = "LUG_V"
+b = "LUG_C"
+normal = "radial"
+tangent = {t}
+kt = {KT_LUG:.6g}
+kn = {kn:.6g}
+mu = {MU_LUG:g}
+n0 = {p:.6g}
+""" for name, t, kn, p in parts)
+
+
 def _nset(text: str, name: str) -> np.ndarray:
     block = text.split(f"*NSET, NSET={name}\n", 1)[1].split("*", 1)[0]
     return np.array([int(v) for v in block.replace("\n", ",").split(",") if v.strip()])
 
 
-def hook_geometry(job: Path):
-    """The hook pairs of job.inp: (vane nodes (n,), casing nodes (n,), radial unit normals
-    (n, 3)); HOOK_V and HOOK_C list the pairs in the same order."""
+def hook_geometry(job: Path, sets=("HOOK_V", "HOOK_C")):
+    """The pairs of job.inp's node sets (vane side, casing side; default the hooks): (vane
+    nodes (n,), casing nodes (n,), radial unit normals (n, 3)); the two sets list the pairs
+    in the same order."""
     text = job.with_suffix(".inp").read_text()
-    v, c = _nset(text, "HOOK_V"), _nset(text, "HOOK_C")
+    v, c = _nset(text, sets[0]), _nset(text, sets[1])
     block = text.split("*NODE, NSET=ALL\n", 1)[1].split("*", 1)[0]
     xyz = np.loadtxt(block.splitlines(), delimiter=",")
     pos = xyz[np.searchsorted(xyz[:, 0], v), 1:]
@@ -103,15 +160,23 @@ def preload_loads(pairs, n0: float) -> str:
 F0_DEFAULT = 2000.0
 
 
-def make(out: Path, size: str = "coarse", f0: float = F0_DEFAULT) -> Path:
+def lug_geometry(job: Path):
+    """The lug's pairs (as :func:`hook_geometry`), or None when job.inp's lug is tied."""
+    return (hook_geometry(job, ("LUG_V", "LUG_C"))
+            if "*NSET, NSET=LUG_V\n" in job.with_suffix(".inp").read_text() else None)
+
+
+def make(out: Path, size: str = "coarse", f0: float = F0_DEFAULT, law: str = "normal1d",
+         interlock: str = "contact") -> Path:
     """Generate the model in ``out`` and write rom1.toml, rom2.toml; returns ``out``."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    job = make_hooks(out, size)
+    job = make_hooks(out, size, interlock)
     pairs = hook_geometry(job)
     for rom in ("rom1", "rom2"):
         (out / f"{rom}.toml").write_text(deck_text(rom, size, len(pairs[0]), f0,
-                                                   pairs=pairs))
+                                                   pairs=pairs, law=law,
+                                                   lug=lug_geometry(job)))
     return out
 
 
@@ -120,8 +185,13 @@ def main(argv=None):
     ap.add_argument("--size", default="coarse", choices=sorted(SETTINGS))
     ap.add_argument("--out", type=Path, default=None,
                     help="folder (default results/paper_hooks/<size>)")
+    ap.add_argument("--law", default="normal1d", choices=LAWS,
+                    help="contact law of the hooks and the lug (default normal1d)")
+    ap.add_argument("--interlock", default="contact", choices=INTERLOCKS,
+                    help="the lug: a preloaded contact (default) or tied")
     a = ap.parse_args(argv)
-    out = make(a.out or Path("results/paper_hooks") / a.size, a.size)
+    out = make(a.out or Path("results/paper_hooks") / a.size, a.size, law=a.law,
+               interlock=a.interlock)
     print(f"wrote {out}/hooks.* (ccx) and {out}/rom1.toml, {out}/rom2.toml")
 
 
