@@ -2,13 +2,14 @@
 of N1 sectors, stage 2 of N2, coupled at the flange on their common spatial harmonics.
 
     python cases/paper_flange/paper_flange_mixed.py [--quick] [--sectors N1 N2] [--work DIR]
-                                                    [--f0 1 300] [--spectrum]
+                                                    [--f0 1 300] [--descending] [--spectrum]
 
 Model: the bolted assembly of cases/paper_flange (cases/models/flange.py, ``sectors2``):
 both stages full annulus, steel, ccx writes the matrices at run time. The contact-circle
 nodes of the two faces coincide, so both faces have NZ = a common multiple of N1 and N2
 radial line segments (paper size 50 + 60 sectors, NZ = 300; ``--quick`` 20 + 30 sectors,
-NZ = 60; ``--sectors N1 N2`` any pair, NZ = lcm); the stages share the face nodes on the bolt circle at both stages' bolt angles.
+NZ = 60; ``--sectors N1 N2`` any pair, NZ = lcm); the stages share the face nodes on the
+bolt circle at both stages' bolt angles.
 Excitation: one EO 2 travelling wave per stage (stage 2 clocked), on the mid-airfoil node
 of every blade.
 
@@ -25,7 +26,8 @@ ROMs (decks in the work folder, each runs with ``frirom run``):
 The case prints the index reasoning, Table 1 (sizes), ROM_I's flange energy per spatial
 index at the slipping peak (which indices the solution really uses) and the peaks of every
 ROM_II against ROM_I at a stuck and a slipping F0 (both stages), each row flagged 'match'
-or 'DIFFERS' against the paper's 1 % amplitude / 0.1 % frequency.
+or 'DIFFERS' against the paper's 1 % amplitude / 0.1 % frequency (measured tables and
+times: cases/paper_flange/MIXED.md).
 """
 
 from __future__ import annotations
