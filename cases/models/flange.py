@@ -226,7 +226,7 @@ def write_stage_deck(path, stage: int, n_sectors: int, z_per_sector: int,
                            xyz, elems, sets, material)
 
 
-def assembly_mesh(spec: FlangeSpec, bolt_radii=(0.10,)):
+def assembly_mesh(spec: FlangeSpec, bolt_radii=(0.10,), sectors2: int | None = None):
     """Both stages in one mesh, bolted: at the angle of each sector's BOLT pair, the flange
     face nodes at ``bolt_radii`` (default the inner edge of the arm, r 0.10, z = 0) are
     shared by the two stages (a bolt circle of shared nodes); every other face node stays
@@ -240,11 +240,20 @@ def assembly_mesh(spec: FlangeSpec, bolt_radii=(0.10,)):
     ACTIVE1, ACTIVE2 (mid-airfoil node per blade), BOLT (the shared nodes), HUB (stage 2's
     clamped bore). Stage 1's nodes keep their ids, stage 2's are offset; stage 1's
     elements come first.
+
+    sectors2: stage 2's sector count when it differs from stage 1's (``spec.sectors``);
+    both faces keep the ``spec.pairs`` contact segments, so ``spec.pairs`` must be a
+    multiple of it, and the bolts sit at both stages' bolt angles (the union).
     """
     from scipy.spatial import cKDTree
+    n2 = spec.sectors if sectors2 is None else int(sectors2)
+    if n2 < 1 or spec.pairs % n2:
+        raise ValueError(f"sectors2: the {spec.pairs} contact segments are not a multiple "
+                         f"of stage 2's {n2} sectors")
     i1, x1, e1, s1 = stage_mesh(1, spec.sectors, spec.z_per_sector, spec.coarse)
-    i2, x2, e2, s2 = stage_mesh(2, spec.sectors, spec.z_per_sector, spec.coarse)
-    xb = x1[s1["BOLT"] - 1]
+    i2, x2, e2, s2 = stage_mesh(2, n2, spec.pairs // n2, spec.coarse)
+    xb = np.vstack([x1[s1["BOLT"] - 1], x2[s2["BOLT"] - 1]])
+    xb = xb[np.unique(np.round(xb, 9), axis=0, return_index=True)[1]]
     th = np.arctan2(xb[:, 1], xb[:, 0])
     targets = np.vstack([np.column_stack([r * np.cos(th), r * np.sin(th), 0 * th])
                          for r in bolt_radii])
@@ -267,13 +276,16 @@ def assembly_mesh(spec: FlangeSpec, bolt_radii=(0.10,)):
 
 
 def write_assembly_deck(path, spec: FlangeSpec, n_ref_modes: int = 0,
-                        material=PAPER_STEEL) -> Path:
+                        material=PAPER_STEEL, sectors2: int | None = None) -> Path:
     """``flange.inp``: the bolted assembly (:func:`assembly_mesh`), HUB clamped, steel; an
     optional ``*FREQUENCY`` step of ``n_ref_modes`` modes (ccx's reference eigenvalues in
-    the .dat, joint without contacts: the bolts alone) before the matrix storage."""
-    ids, xyz, elems, sets = assembly_mesh(spec)
-    return _write_hex_deck(path, f"bolted two-stage flange, {spec.sectors} sectors per "
-                           "stage", ids, xyz, elems, sets, material, n_ref_modes)
+    the .dat, joint without contacts: the bolts alone) before the matrix storage.
+    sectors2: stage 2's sector count, if not ``spec.sectors``."""
+    ids, xyz, elems, sets = assembly_mesh(spec, sectors2=sectors2)
+    title = f"bolted two-stage flange, {spec.sectors} sectors per stage"
+    if sectors2 is not None:
+        title = f"bolted two-stage flange, {spec.sectors} + {sectors2} sectors"
+    return _write_hex_deck(path, title, ids, xyz, elems, sets, material, n_ref_modes)
 
 
 # --------------------------------------------------------------------------------------------

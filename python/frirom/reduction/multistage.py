@@ -32,7 +32,8 @@ from .._errors import InputError, SizeError
 from .interface import InterfaceReduction
 
 __all__ = ["RadialSegments", "MultistageInterface", "cylindrical_frame", "fourier_matrix",
-           "fourier_columns", "harmonic_indices", "stage_indices", "radial_line_segments",
+           "fourier_columns", "harmonic_indices", "stage_indices", "shared_indices",
+           "radial_line_segments",
            "ms_basis", "harmonic_content",
            "stage_contact_matrix", "assemble"]
 
@@ -128,6 +129,31 @@ def stage_indices(engine_orders, sector_counts, n_segments, time_harmonics=(1,))
         raise SizeError(f"stage_indices: {len(counts)} sector counts for {len(nzs)} stages")
     g = int(np.gcd.reduce(counts))
     return [harmonic_indices(engine_orders, g, nz, time_harmonics) for nz in nzs]
+
+
+def shared_indices(engine_orders, sector_counts, n_segments: int,
+                   time_harmonics=(1,)) -> np.ndarray:
+    """Harmonic indices (0..NZ/2) that every stage's aliasing family shares.
+
+    For each engine order EO and time harmonic j, stage s of N_s sectors carries the family
+    z N_s +- j EO (:func:`harmonic_indices`); the indices kept are those in the families of
+    all stages at once (for each (EO, j), the intersection over the stages), united over
+    (EO, j). With N_1 = 50, N_2 = 60, EO 2: {2 j} (an index h = k mod N_1 and -k mod N_2
+    needs 2k = 0 mod gcd = 10); with 5 and 6 sectors the Chinese remainder theorem adds the
+    mixed signs, e.g. 8 = -2 mod 5 = 2 mod 6 for j = 1. n_segments: NZ, a common multiple of
+    the sector counts (both faces have NZ radial line segments). This is the set that
+    couples the stages on their common spatial harmonics; the exact set of the tuned
+    assembly is the larger family modulo gcd(N_1, N_2) (:func:`stage_indices`).
+    """
+    counts = [int(c) for c in np.atleast_1d(sector_counts)]
+    if not counts:
+        raise SizeError("shared_indices: no sector count")
+    out = set()
+    for eo in np.atleast_1d(np.asarray(engine_orders, dtype=np.int64)):
+        for j in np.atleast_1d(np.asarray(time_harmonics, dtype=np.int64)):
+            fam = [set(harmonic_indices(eo, n, n_segments, (j,)).tolist()) for n in counts]
+            out |= set.intersection(*fam)
+    return np.array(sorted(out), dtype=np.int64)
 
 
 # --------------------------------------------------------------------------------------------
