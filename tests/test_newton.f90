@@ -4,7 +4,10 @@
 !> piecewise linear curve y = a (1 - |lam|) (a = 1.5: it turns by 113 degrees at lam = 0,
 !> as a contact state switching at one AFT sample can make a harmonic balance curve turn).
 !> And a ratchet, y = a lam with the history moved to every converged point, each point a
-!> corner (as a contact history carried from point to point makes them).
+!> corner (as a contact history carried from point to point makes them); and a ratchet
+!> whose curve turns by 91 degrees at lam = c, where the frozen history's branch behind
+!> the last point is the only one a corrector across the tangent there meets (the paper
+!> flange's ROM_I at F0 = 100 N turned back onto such a branch near its peak).
 module newton_test_system
     use frirom_kinds, only: wp, ip
     use frirom_newton, only: nl_system
@@ -37,7 +40,41 @@ module newton_test_system
         procedure :: eval => ratchet_eval
         procedure :: accept => ratchet_accept
     end type ratchet_curve
+    !> The ratchet's curve ahead turns at lam = c to the slope s2 (91 degrees from slope a,
+    !> lam still rising): y = a lam up to c, a c + s2 (lam - c) beyond.
+    type, extends(ratchet_curve) :: ratchet_corner
+        real(wp) :: c = 0.5_wp, s2 = -1.1_wp/3.0_wp
+    contains
+        procedure :: eval => rcorner_eval
+    end type ratchet_corner
 contains
+    subroutine rcorner_eval(this, y, lam, r, rref, jac, rlam, info, errmsg)
+        class(ratchet_corner), intent(inout) :: this
+        real(wp), intent(in) :: y(:), lam
+        real(wp), intent(out) :: r(:), rref, rlam(:)
+        logical, intent(in) :: jac
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        info = 0
+        if (lam > this%h) then
+            r(1) = y(1) - virgin(lam)
+            rlam(1) = -merge(this%a, this%s2, lam <= this%c)
+        else
+            r(1) = y(1) - virgin(this%h) - this%b*(lam - this%h)
+            rlam(1) = -this%b
+        end if
+        rref = max(abs(y(1)), 1.0_wp)
+        if (jac .and. .false.) errmsg = ''
+    contains
+        real(wp) function virgin(x)
+            real(wp), intent(in) :: x
+            if (x <= this%c) then
+                virgin = this%a*x
+            else
+                virgin = this%a*this%c + this%s2*(x - this%c)
+            end if
+        end function virgin
+    end subroutine rcorner_eval
     !> The hook must see every converged point once, at the converged (y, lam).
     subroutine cc_accept(this, y, lam, info, errmsg)
         class(cubic_curve), intent(inout) :: this
@@ -148,6 +185,7 @@ program test_newton
     type(cubic_curve) :: s
     type(vee_curve) :: v
     type(ratchet_curve) :: r
+    type(ratchet_corner) :: rc
     type(cont_options) :: o
     real(wp) :: y(2), lam, t(3), ds, yout(2, 500), lout(500), tout(3, 500), y1ref
     integer(ip) :: it(500), npts, info, k, iters, nfold
@@ -257,5 +295,30 @@ program test_newton
                'every ratchet point on y = a lam')
     ! steps of ds = 0.05 along (1, a) / |(1, a)|: 0.016 in lam each, about 63, not 500
     call check(npts < 100, 'ratchet: under 100 points (predicting along the chord)')
+    ! the ratchet's corner: the tangent J gives at every point (slope b) is replaced by the
+    ! chord; past lam = c a corrector across the chord meets nothing within 3 steps, and
+    ! the tangent at a predictor past the corner, oriented along the chord, points back
+    ! in lam, where it meets the frozen history's branch y = a h + b (lam - h) 114 degrees
+    ! from the chord. That point lies against the direction of travel: the run must take
+    ! the branch beyond the corner instead and reach lam = 1 (it left through lam_lo).
+    rc%n = 1
+    rc%a = 3.0_wp
+    o = cont_options(lam_end=1.0_wp, ds=0.05_wp, ds_max=0.05_wp, max_points=500, &
+                     tol_r=1.0e-12_wp, tol_x=1.0e-10_wp)
+    y(1) = 0.0_wp
+    lam = 0.0_wp
+    rc%h = 0.0_wp
+    call cont_tangent(rc, y(1:1), lam, o, [0.0_wp, 0.0_wp], 1.0_wp, t(1:2), info, msg)
+    ds = o%ds
+    hf = .true.
+    call cont_run(rc, y(1:1), lam, t(1:2), ds, -0.1_wp, o, yout(1:1, :), lout, tout(1:2, :), &
+                  it, npts, fin, info, msg, hf)
+    print '(a,i0,a,l1,a,es10.2)', 'ratchet corner: ', npts, ' points, finished ', fin, &
+        ', last lam ', lout(max(npts, 1))
+    call check(info == 0 .and. fin .and. lout(npts) == 1.0_wp, &
+               'ratchet corner turned forward: '//trim(msg))
+    call check(all(lout(2:npts) > lout(1:npts - 1)), 'ratchet corner: lam rises monotonically')
+    call check(abs(yout(1, npts) - (rc%a*rc%c + rc%s2*(1.0_wp - rc%c))) < 1.0e-10_wp, &
+               'ratchet corner: the branch beyond the corner followed to lam = 1')
     call check_done('test_newton')
 end program test_newton
