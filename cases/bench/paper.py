@@ -5,6 +5,7 @@ and extrapolated while it is slow: marked "extrap."), the speed-up, and the erro
 ROM_II's peak amplitude and frequency against ROM_I's.
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python cases/bench/paper.py [--quick] [--work DIR]
+        [--case paper_flange|paper_hooks]
 
 Rows come from ``bench_rows(work, quick)`` of cases/paper_flange/paper_flange.py (ROM_II
 with index 2, the paper's, and with the whole EO 2 family) and of the module in
@@ -89,14 +90,16 @@ def main(argv=None):
     ap.add_argument("--quick", action="store_true", help="the coarse models (seconds)")
     ap.add_argument("--work", default=None,
                     help="folder of the cases' models and results (default results/)")
+    ap.add_argument("--case", choices=("paper_flange", "paper_hooks"), default=None,
+                    help="one application only (default both)")
     a = ap.parse_args(argv)
     base = Path(a.work or "results").resolve()
     rows = []
-    provs = providers()
+    provs = {k: f for k, f in providers().items() if a.case in (None, k)}
     for name, fn in provs.items():
         work = base / (name + ("_quick" if a.quick else ""))
         rows += fn(work, a.quick)
-    missing = {"paper_flange", "paper_hooks"} - set(provs)
+    missing = ({a.case} if a.case else {"paper_flange", "paper_hooks"}) - set(provs)
     print(f"paper benchmark ({'quick: coarse models' if a.quick else 'paper size'}), "
           f"OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}"
           + (f"; no bench_rows in cases/{', cases/'.join(sorted(missing))}" if missing else ""))
