@@ -422,10 +422,8 @@ contains
                 ! degrees on the paper_hooks ROM_II). Predict along the chord (secant).
                 cy(1:n) = (y1 - y)/opts%yscale
                 dist = sqrt(sum(cy**2) + ((lam1 - lam)/opts%lscale)**2)
-                frac = 0.5_wp
-                if (ds < 0.05_wp*opts%ds_max) frac = cos(3.0_wp*opts%angle_target)
                 if (dist > 0.0_wp .and. dot_product(cy, t1(1:n)) + &
-                    (lam1 - lam)/opts%lscale*t1(n + 1) < frac*dist) then
+                    (lam1 - lam)/opts%lscale*t1(n + 1) < secant_cos(ds, opts)*dist) then
                     t1(1:n) = cy/dist
                     t1(n + 1) = (lam1 - lam)/opts%lscale/dist
                 end if
@@ -462,6 +460,12 @@ contains
     !> direction: the corrector runs across tc, oriented along t first, then against it.
     !> A point is taken (turned true, tc its direction) only if it lies within 3 ds and
     !> its chord turns by less than 120 degrees from t (never back along the curve).
+    !> Where t is a chord, not the tangent J gives at (y, lam) (a carried contact history:
+    !> J gives the stick tangent and every point is a corner), the tangent at the predictor
+    !> says nothing about a corner while the step is long: a failure there is a step too
+    !> long, halved first (nothing is tried above ds_max / 20); and a point against the
+    !> parameter's direction of travel is the frozen history's branch behind (y, lam), not
+    !> the curve ahead: it is never taken.
     subroutine turn_corner(sys, y, lam, t, ds, opts, y1, lam1, tc, iters, nf, turned, info, &
                            errmsg, have_fact)
         class(nl_system), intent(inout) :: sys
@@ -479,12 +483,21 @@ contains
         real(wp), allocatable :: yp(:), ch(:)
         real(wp) :: lp, dch
         integer(ip) :: n, k, info2
+        logical :: ratchet
         character(len=len(errmsg)) :: msg2
         n = size(y)
         turned = .false.
         iters = 0
         nf = 0
         allocate (yp(n), ch(n + 1))
+        msg2 = ''
+        ! is t the tangent J gives here, or a chord (see cont_run)?
+        call cont_tangent(sys, y, lam, opts, t, 1.0_wp, tc, info2, msg2)
+        ratchet = dot_product(tc, t) < secant_cos(ds, opts)
+        if (info2 /= 0 .or. (ratchet .and. ds >= 0.05_wp*opts%ds_max)) then
+            have_fact = .false.
+            return
+        end if
         yp = y + ds*t(1:n)*opts%yscale
         lp = lam + ds*t(n + 1)*opts%lscale
         msg2 = ''
@@ -505,7 +518,8 @@ contains
             ch(1:n) = (y1 - y)/opts%yscale
             ch(n + 1) = (lam1 - lam)/opts%lscale
             dch = norm2(ch)
-            if (dch <= 3.0_wp*ds .and. dot_product(ch, t) >= -0.5_wp*dch) then
+            if (dch <= 3.0_wp*ds .and. dot_product(ch, t) >= -0.5_wp*dch .and. &
+                .not. (ratchet .and. ch(n + 1)*t(n + 1) < 0.0_wp)) then
                 turned = .true.
                 info = FRIROM_OK
                 return
@@ -513,6 +527,15 @@ contains
         end do
         have_fact = .false.
     end subroutine turn_corner
+
+    !> Cosine below which the tangent J gives at a point is replaced by the chord that
+    !> reached it (60 degrees; 3 angle_target once steps have shrunk below ds_max / 20).
+    pure real(wp) function secant_cos(ds, opts)
+        real(wp), intent(in) :: ds             !! the step (scaled)
+        type(cont_options), intent(in) :: opts
+        secant_cos = 0.5_wp
+        if (ds < 0.05_wp*opts%ds_max) secant_cos = cos(3.0_wp*opts%angle_target)
+    end function secant_cos
 
     !> Factor on the arc-length step after a point: the curve's shape sets it (the angle
     !> between the tangents at the step's ends grows like ds, the predictor-corrector

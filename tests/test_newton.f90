@@ -4,7 +4,10 @@
 !> piecewise linear curve y = a (1 - |lam|) (a = 1.5: it turns by 113 degrees at lam = 0,
 !> as a contact state switching at one AFT sample can make a harmonic balance curve turn).
 !> And a ratchet, y = a lam with the history moved to every converged point, each point a
-!> corner (as a contact history carried from point to point makes them).
+!> corner (as a contact history carried from point to point makes them); and a ratchet
+!> whose curve turns by 91 degrees at lam = c, where the frozen history's branch behind
+!> the last point is the only one a corrector across the tangent there meets (the paper
+!> flange's ROM_I at F0 = 100 N turned back onto such a branch near its peak).
 module newton_test_system
     use frirom_kinds, only: wp, ip
     use frirom_newton, only: nl_system
@@ -31,8 +34,11 @@ module newton_test_system
     !> whose Jacobian (taken on the side lam <= h, as the AFT's stick Jacobian of a
     !> contact left at the friction limit) gives the slope b, while the curve ahead has
     !> slope a (a ratchet: a contact history carried from point to point).
+    !> With c set, the curve ahead turns at lam = c to the slope s2 (s2 = -1.1/3 with a = 3:
+    !> 91 degrees, lam still rising): y = a lam up to c, a c + s2 (lam - c) beyond.
     type, extends(vee_curve) :: ratchet_curve
         real(wp) :: b = 0.1_wp, h = -huge(1.0_wp)   !! slope below h (a: vee_curve's)
+        real(wp) :: c = huge(1.0_wp), s2 = -1.1_wp/3.0_wp
     contains
         procedure :: eval => ratchet_eval
         procedure :: accept => ratchet_accept
@@ -117,14 +123,20 @@ contains
         character(len=*), intent(inout) :: errmsg
         info = 0
         if (lam > this%h) then
-            r(1) = y(1) - this%a*lam
-            rlam(1) = -this%a
+            r(1) = y(1) - virgin(lam)
+            rlam(1) = -merge(this%a, this%s2, lam <= this%c)
         else
-            r(1) = y(1) - this%a*this%h - this%b*(lam - this%h)
+            r(1) = y(1) - virgin(this%h) - this%b*(lam - this%h)
             rlam(1) = -this%b
         end if
         rref = max(abs(y(1)), 1.0_wp)
         if (jac .and. .false.) errmsg = ''
+    contains
+        !> the curve the ratchet follows while lam rises past its history
+        real(wp) function virgin(x)
+            real(wp), intent(in) :: x
+            virgin = this%a*min(x, this%c) + this%s2*max(x - this%c, 0.0_wp)
+        end function virgin
     end subroutine ratchet_eval
     subroutine ratchet_accept(this, y, lam, info, errmsg)
         class(ratchet_curve), intent(inout) :: this
@@ -147,7 +159,7 @@ program test_newton
     implicit none
     type(cubic_curve) :: s
     type(vee_curve) :: v
-    type(ratchet_curve) :: r
+    type(ratchet_curve) :: r, rc
     type(cont_options) :: o
     real(wp) :: y(2), lam, t(3), ds, yout(2, 500), lout(500), tout(3, 500), y1ref
     integer(ip) :: it(500), npts, info, k, iters, nfold
@@ -238,24 +250,45 @@ program test_newton
     ! the ratchet: a corner of 66 degrees at every point (slopes 3 and 0.1); following
     ! the tangent J gives (slope b), every step lands 2.5 ds off its predictor and the next
     ! one shrinks (144 points). From y = 0 at lam = 0 to 1.
-    r%n = 1
-    r%a = 3.0_wp
-    o = cont_options(lam_end=1.0_wp, ds=0.05_wp, ds_max=0.05_wp, max_points=500, &
-                     tol_r=1.0e-12_wp, tol_x=1.0e-10_wp)
-    y(1) = 0.0_wp
-    lam = 0.0_wp
-    r%h = 0.0_wp
-    call cont_tangent(r, y(1:1), lam, o, [0.0_wp, 0.0_wp], 1.0_wp, t(1:2), info, msg)
-    ds = o%ds
-    hf = .true.
-    call cont_run(r, y(1:1), lam, t(1:2), ds, -0.1_wp, o, yout(1:1, :), lout, tout(1:2, :), &
-                  it, npts, fin, info, msg, hf)
-    print '(a,i0,a,l1,a,es10.2)', 'ratchet: ', npts, ' points, finished ', fin, &
-        ', last lam ', lout(max(npts, 1))
+    call run_ratchet(r, 'ratchet')
     call check(info == 0 .and. fin .and. lout(npts) == 1.0_wp, 'ratchet followed: '//trim(msg))
     call check(all(abs(yout(1, 1:npts) - r%a*lout(1:npts)) < 1.0e-10_wp), &
                'every ratchet point on y = a lam')
     ! steps of ds = 0.05 along (1, a) / |(1, a)|: 0.016 in lam each, about 63, not 500
     call check(npts < 100, 'ratchet: under 100 points (predicting along the chord)')
+    ! the ratchet's corner: the tangent J gives at every point (slope b) is replaced by the
+    ! chord; past lam = c a corrector across the chord meets nothing within 3 steps, and
+    ! the tangent at a predictor past the corner, oriented along the chord, points back
+    ! in lam, where it meets the frozen history's branch y = a h + b (lam - h) 114 degrees
+    ! from the chord. That point lies against the direction of travel: the run must take
+    ! the branch beyond the corner instead and reach lam = 1 (it left through lam_lo).
+    rc%c = 0.5_wp
+    call run_ratchet(rc, 'ratchet corner')
+    call check(info == 0 .and. fin .and. lout(npts) == 1.0_wp, &
+               'ratchet corner turned forward: '//trim(msg))
+    call check(all(lout(2:npts) > lout(1:npts - 1)), 'ratchet corner: lam rises monotonically')
+    call check(abs(yout(1, npts) - (rc%a*rc%c + rc%s2*(1.0_wp - rc%c))) < 1.0e-10_wp, &
+               'ratchet corner: the branch beyond the corner followed to lam = 1')
     call check_done('test_newton')
+contains
+    !> cont_run of a ratchet (slope a = 3) from y = 0 at lam = 0 towards lam = 1, steps of
+    !> ds = ds_max = 0.05; the points in yout, lout, tout, it, npts, the end in fin, info, msg.
+    subroutine run_ratchet(rr, label)
+        class(ratchet_curve), intent(inout) :: rr
+        character(len=*), intent(in) :: label
+        rr%n = 1
+        rr%a = 3.0_wp
+        o = cont_options(lam_end=1.0_wp, ds=0.05_wp, ds_max=0.05_wp, max_points=500, &
+                         tol_r=1.0e-12_wp, tol_x=1.0e-10_wp)
+        y(1) = 0.0_wp
+        lam = 0.0_wp
+        rr%h = 0.0_wp
+        call cont_tangent(rr, y(1:1), lam, o, [0.0_wp, 0.0_wp], 1.0_wp, t(1:2), info, msg)
+        ds = o%ds
+        hf = .true.
+        call cont_run(rr, y(1:1), lam, t(1:2), ds, -0.1_wp, o, yout(1:1, :), lout, &
+                      tout(1:2, :), it, npts, fin, info, msg, hf)
+        print '(a,i0,a,l1,a,es10.2)', label//': ', npts, ' points, finished ', fin, &
+            ', last lam ', lout(max(npts, 1))
+    end subroutine run_ratchet
 end program test_newton

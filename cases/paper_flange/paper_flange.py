@@ -554,10 +554,12 @@ def bench_rows(work: Path, quick: bool) -> list[dict]:
 
     Keys: case, member, rom2 ('h=2' or 'family'), fe_dofs, rom1_dofs, rom2_dofs,
     rom1_nonlinear, rom2_nonlinear, reduction_s (ROM_II's CB + MS, when its cache was
-    built), rom1_frf_s, rom1_extrapolated, rom2_frf_s, speedup, peak_amp_err,
-    peak_freq_err (largest over the two stages' peaks, relative), complete (False when
-    the ROM_I or ROM_II FRF stopped before the band's end). The ROM_II FRFs run in
-    this call. ROM_I at paper size: its time is sampled (solve_point at 3 frequencies:
+    built), rom1_frf_s, rom1_extrapolated, rom1_stored, rom2_frf_s, speedup,
+    peak_amp_err, peak_freq_err (largest over the two stages' peaks, relative), complete
+    (False when the ROM_I or ROM_II FRF stopped before the band's end). The ROM_II FRFs
+    run in this call. ROM_I at paper size: a complete FRF stored by ``paper_flange.py
+    family`` gives its peaks and its time (``rom1_stored``: timed in that run, not this
+    one); for a stopped one the time is sampled (solve_point at 3 frequencies:
     seconds per Newton evaluation x the evaluations of the family ROM_II's FRF, which
     follows the same solution path; ``rom1_extrapolated``) and its peaks are those of the
     case's stored run (family.json, from ``paper_flange.py family``; a member without one
@@ -577,9 +579,13 @@ def bench_rows(work: Path, quick: bool) -> list[dict]:
     for f0 in family_of(quick):
         r2 = {rom: sweep(d, f0) for rom, d in two.items()}
         stored = res.get("rom1", {}).get(f"{f0:g}")
+        kept = not quick and stored is not None and stored.get("complete", False)
         if quick or stored is None:
             r1 = sweep(d1, f0)
             t1, extrap = r1["seconds"], False
+        elif kept:
+            # the stored run's whole FRF, timed by `family` (not in this run)
+            r1, t1, extrap = stored, stored["seconds"], False
         else:
             r1 = stored
             band = info["band"]
@@ -596,7 +602,8 @@ def bench_rows(work: Path, quick: bool) -> list[dict]:
                              rom2_nonlinear=s2["nonlinear"],
                              reduction_s=info["t_rom1_reduction"] + d.reduced.build_seconds,
                              rom1_frf_s=t1,
-                             rom1_extrapolated=extrap, rom2_frf_s=r["seconds"],
+                             rom1_extrapolated=extrap, rom1_stored=kept,
+                             rom2_frf_s=r["seconds"],
                              speedup=t1 / max(r["seconds"], 1e-12), peak_amp_err=ea,
                              peak_freq_err=ef,
                              complete=bool(r["complete"] and r1.get("complete", True))))
