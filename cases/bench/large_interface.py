@@ -23,9 +23,12 @@ the 1e-8 target on this model.
 Scaling (issue 10 item 5): ROM_I models of the same kind with 100, 200, 400, 800 contact
 pairs (2, 4, 8, 16 segments per sector; generated like the main one, cached), per size the
 first route's FRF: FE DoFs, points, evaluations, LUs, GMRES iterations, seconds per
-evaluation (and its split), per point and per FRF, the generation time, and the growth
-exponents (least squares, log-log) of the FRF time and of the time per evaluation, with the
-machine load (load averages). Generation on this machine (2 cores shared, load ~6-8): 100
+evaluation (and its split), per point and per FRF (wall and this process's CPU seconds: one
+BLAS thread, so CPU seconds are the work, less sensitive to the load of a shared machine),
+the generation time, and the growth exponents (least squares, log-log) of the FRF time
+(over every size, and over the whole FRFs alone, wall and CPU) and of the time per
+evaluation, with the machine load (load averages). --no-carry runs the build before the
+LU carried between Fortran calls (same process, for before/after numbers). Generation on this machine (2 cores shared, load ~6-8): 100
 pairs 11 s, 200 pairs 28 s, 400 pairs 90 s, 800 pairs 7-13 min (CB of 63 000 + 66 000 FE
 DoFs with 2 550 masters each), so run the 800-pair size once: it is cached. A size whose
 whole FRF would exceed --budget (predicted from the largest whole one by the n^3 law of a
@@ -325,10 +328,11 @@ def scaling(a, sizes, kw, main_row, pairs, spec_for, roms, band, sectors, n_mode
     FRF time is s/point x the points of the largest whole FRF (marked "short"). The growth
     exponents (least squares over the sizes measured so far, printed after each size) are
     on the FRF time and on the time per Newton evaluation (less sensitive to the load and
-    to where a short run stops). Per evaluation, the receptances cost (contact rows)^2 x
-    (ROM_I DoFs) per harmonic and a dense LU (unknowns)^3: with every interface DoF kept in
+    to where a short run stops). Per LU, the receptances cost (contact rows)^2 x (ROM_I
+    DoFs) per harmonic and the dense LU (unknowns)^3: with every interface DoF kept in
     ROM_I both grow about like pairs^3, so the FRF stays under pairs^2 only as far as held
-    LUs and GMRES replace factorisations."""
+    LUs and GMRES (pairs^2 per iteration) replace factorisations; the LU is carried from
+    call to call (batches, peak solves), so an FRF needs fewer LUs as they grow dearer."""
     print(f"\nscaling, route {first_route(a)!r}, ROM_I of the same kind (sectors {sectors}, "
           f"{n_modes} CB modes per stage, {2 * sectors} active nodes x 3; every interface DoF "
           "kept)")
