@@ -427,21 +427,28 @@ contains
     !> matrix-free product (8 (nh+1) nnl nm: projection and back, complex).
     real(wp) function gm_cost(sys)
         type(hbm_condensed), intent(inout) :: sys
-        if (sys%gm_worth <= 0.0_wp) sys%gm_worth = lu_worth(sys%nh, sys%nnl, size(sys%g, 1))
+        real(wp) :: n
+        if (sys%gm_worth <= 0.0_wp) then
+            n = real(sys%n, wp)
+            sys%gm_worth = (2.0_wp/3.0_wp*n**3/LU_SPEEDUP)/(2.0_wp*n**2 + 8.0_wp* &
+                           real(sys%nh + 1, wp)*real(sys%nnl, wp)*real(size(sys%g, 1), wp))
+        end if
         gm_cost = sys%gm_worth
     end function gm_cost
 
-    !> gm_cost's number for nh harmonics, nnl unknowns per coefficient and nm modes.
-    pure real(wp) function lu_worth(nh, nnl, nm)
-        integer(ip), intent(in) :: nh, nnl, nm
+    !> gm_cost's number for nu unknowns, nh harmonics, nnl unknowns per coefficient and nm
+    !> modes, for the carry decision (gm_cost keeps its own expression: its rounding
+    !> decides knife-edge comparisons of the Newton paths, which stay those of before).
+    pure real(wp) function lu_worth(nu, nh, nnl, nm)
+        integer(ip), intent(in) :: nu, nh, nnl, nm
         real(wp) :: n
-        n = real(nnl, wp)*real(2*nh + 1, wp)
+        n = real(nu, wp)
         lu_worth = (2.0_wp/3.0_wp*n**3/LU_SPEEDUP)/(2.0_wp*n**2 + 8.0_wp* &
                    real(nh + 1, wp)*real(nnl, wp)*real(nm, wp))
     end function lu_worth
 
     module procedure cond_lu_holds
-        hold = lu_worth(nh, nnl, nm) >= GN_WORTH_MIN
+        hold = lu_worth(nnl*(2*nh + 1), nh, nnl, nm) >= GN_WORTH_MIN
     end procedure cond_lu_holds
 
     !> Whether sys keeps LUs across runs: modal, direct mode, worth holding.
@@ -449,7 +456,7 @@ contains
         type(hbm_condensed), intent(in) :: sys
         holds = .false.
         if (.not. sys%modal .or. use_krylov(sys)) return
-        holds = cond_lu_holds(sys%nh, sys%nnl, size(sys%g, 1))
+        holds = lu_worth(sys%n, sys%nh, sys%nnl, size(sys%g, 1)) >= GN_WORTH_MIN
     end function holds
 
     module procedure hbm_lu_import
