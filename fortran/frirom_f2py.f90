@@ -122,13 +122,14 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
                         tan0, start_mode, nropt, ropt, niopt, iopt, stability, history, &
                         maxpts, netot, ntim, ys, lams, tans, iters, xo, states, hill_re, &
                         sliders, npts, finished, ds_out, timings, info, msg, tcontact, krylov, &
-                        sparse)
+                        sparse, nlu, lu, lupiv, lustate)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options, cont_options_from, N_RCONT, N_ICONT, RCONT_DS, &
                              RCONT_LAM_LO
     use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
-                          hbm_set_modes_harmonic, hbm_run, HBM_FREQUENCY, HBM_LOAD, N_TIMERS
+                          hbm_set_modes_harmonic, hbm_run, hbm_lu_import, hbm_lu_export, &
+                          HBM_FREQUENCY, HBM_LOAD, N_TIMERS
     implicit none
     character(len=*), intent(in) :: formulation  !! 'condensed' (Eq. 5-9) or 'banded'
     character(len=*), intent(in) :: lam_kind     !! the parameter lam: 'frequency' or 'load'
@@ -179,7 +180,14 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     real(8), intent(out) :: ds_out, timings(ntim)
     integer(4), intent(out) :: info
     character(len=512), intent(out) :: msg
+    !> the LU carried from run to run of the same model (hbm_lu_holds; nlu = 0 or 1 and a
+    !> dummy when it is not): dgetrf factors and pivots, lustate(1) = 1 when valid and
+    !> lustate(2) the GMRES iterations spent on it; read at the start, written at the end
+    integer(4), intent(in) :: nlu
+    real(8), intent(inout) :: lu(nlu, nlu), lustate(2)
+    integer(4), intent(inout) :: lupiv(nlu)
     class(hbm_system), allocatable :: sys
+    logical :: lu_used
     type(cont_options) :: opts
     real(wp), allocatable :: y(:), t(:)
     real(wp) :: lam, dsl
@@ -240,6 +248,7 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
         return
     end if
     sys%carry = history /= 0
+    call hbm_lu_import(sys, lu, lupiv, lustate, lu_used)
     opts = cont_options_from(ropt, iopt)
     opts%max_points = maxpts
     y = y0
@@ -253,6 +262,7 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
         call hbm_run(sys, start_mode, y, lam, t, dsl, ropt(RCONT_LAM_LO), opts, ys, lams, &
                      tans, itl, xo, states, np, fin, linfo, msg, sliders=sliders)
     end if
+    call hbm_lu_export(sys, lu, lupiv, lustate, lu_used)
     npts = np
     iters = itl
     finished = merge(1, 0, fin)
@@ -262,6 +272,18 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     call system_clock(c1)
     timings(N_TIMERS) = real(c1 - c0, 8)/real(rate, 8)
 end subroutine hbm_continue
+
+!> Whether hbm_continue carries the LU from run to run (hold = 1, then pass nlu = n arrays)
+!> for a condensed modal system in direct mode of nnl unknowns per harmonic coefficient,
+!> nh harmonics and nmodes modes (frirom_hbm cond_lu_holds).
+subroutine hbm_lu_holds(nh, nnl, nmodes, hold)
+    use frirom_kinds, only: ip
+    use frirom_hbm, only: cond_lu_holds
+    implicit none
+    integer(4), intent(in) :: nh, nnl, nmodes
+    integer(4), intent(out) :: hold
+    hold = merge(1, 0, cond_lu_holds(int(nh, ip), int(nnl, ip), int(nmodes, ip)))
+end subroutine hbm_lu_holds
 
 !> Value of a named integer constant of this interface, so that Python reads slots, modes
 !> and codes from Fortran instead of typing their numbers: RCONT_*, N_RCONT, ICONT_*,

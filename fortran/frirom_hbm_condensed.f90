@@ -436,6 +436,63 @@ contains
         gm_cost = sys%gm_worth
     end function gm_cost
 
+    !> gm_cost's number for nu unknowns, nh harmonics, nnl unknowns per coefficient and nm
+    !> modes, for the carry decision (gm_cost keeps its own expression: its rounding
+    !> decides knife-edge comparisons of the Newton paths, which stay those of before).
+    pure real(wp) function lu_worth(nu, nh, nnl, nm)
+        integer(ip), intent(in) :: nu, nh, nnl, nm
+        real(wp) :: n
+        n = real(nu, wp)
+        lu_worth = (2.0_wp/3.0_wp*n**3/LU_SPEEDUP)/(2.0_wp*n**2 + 8.0_wp* &
+                   real(nh + 1, wp)*real(nnl, wp)*real(nm, wp))
+    end function lu_worth
+
+    module procedure cond_lu_holds
+        hold = lu_worth(nnl*(2*nh + 1), nh, nnl, nm) >= GN_WORTH_MIN
+    end procedure cond_lu_holds
+
+    !> Whether sys keeps LUs across runs: modal, direct mode, worth holding.
+    logical function holds(sys)
+        type(hbm_condensed), intent(in) :: sys
+        holds = .false.
+        if (.not. sys%modal .or. use_krylov(sys)) return
+        holds = lu_worth(sys%n, sys%nh, sys%nnl, size(sys%g, 1)) >= GN_WORTH_MIN
+    end function holds
+
+    module procedure hbm_lu_import
+        used = .false.
+        select type (sys => sysc)
+        type is (hbm_condensed)
+            if (.not. holds(sys) .or. size(state) < 2) return
+            if (state(1) /= 1.0_wp .or. any(shape(lu) /= sys%n) .or. size(piv) /= sys%n) return
+            if (.not. allocated(sys%jm)) return
+            sys%jm = lu
+            sys%ipiv = piv
+            sys%lu_any = .true.
+            sys%lu_fresh = .false.
+            sys%gm_spent = state(2)
+            used = .true.
+        end select
+    end procedure hbm_lu_import
+
+    module procedure hbm_lu_export
+        new = .false.
+        if (size(state) < 2) return
+        state(1) = 0.0_wp
+        select type (sys => sysc)
+        type is (hbm_condensed)
+            if (.not. holds(sys) .or. .not. sys%lu_any .or. .not. allocated(sys%jm)) return
+            if (any(shape(lu) /= sys%n) .or. size(piv) /= sys%n) return
+            if (sys%timers(N_FACT) > 0.0_wp) then
+                lu = sys%jm
+                piv = sys%ipiv
+                new = .true.
+            end if
+            state(1) = 1.0_wp
+            state(2) = sys%gm_spent
+        end select
+    end procedure hbm_lu_export
+
     !> y = J x: the assembled jcur, or matrix-free (jfree: modal route) as
     !> x + R_h G^T J_loc G x at the Jacobian's frequency, element by element and mode by
     !> mode (R_h = A diag(g) A^H never formed).

@@ -23,9 +23,12 @@ the 1e-8 target on this model.
 Scaling (issue 10 item 5): ROM_I models of the same kind with 100, 200, 400, 800 contact
 pairs (2, 4, 8, 16 segments per sector; generated like the main one, cached), per size the
 first route's FRF: FE DoFs, points, evaluations, LUs, GMRES iterations, seconds per
-evaluation (and its split), per point and per FRF, the generation time, and the growth
-exponents (least squares, log-log) of the FRF time and of the time per evaluation, with the
-machine load (load averages). Generation on this machine (2 cores shared, load ~6-8): 100
+evaluation (and its split), per point and per FRF (wall and this process's CPU seconds: one
+BLAS thread, so CPU seconds are the work, less sensitive to the load of a shared machine),
+the generation time, and the growth exponents (least squares, log-log) of the FRF time
+(over every size, and over the whole FRFs alone, wall and CPU) and of the time per
+evaluation, with the machine load (load averages). --no-carry runs the build before the
+LU carried between Fortran calls (same process, for before/after numbers). Generation on this machine (2 cores shared, load ~6-8): 100
 pairs 11 s, 200 pairs 28 s, 400 pairs 90 s, 800 pairs 7-13 min (CB of 63 000 + 66 000 FE
 DoFs with 2 550 masters each), so run the 800-pair size once: it is cached. A size whose
 whole FRF would exceed --budget (predicted from the largest whole one by the n^3 law of a
@@ -80,6 +83,9 @@ def _parse(argv=None):
     ap.add_argument("--short", type=int, default=12,
                     help="points of the short run of a scaling size whose FRF exceeds "
                          "--budget")
+    ap.add_argument("--no-carry", action="store_true",
+                    help="the build before: no LU carried from one Fortran call to the next "
+                         "(each batch and peak solve factorises its first Jacobian)")
     ap.add_argument("--mem-limit", type=float, default=2.0,
                     help="GB: a route whose estimated matrices exceed it is skipped")
     return ap.parse_args(argv)
@@ -248,11 +254,12 @@ def run_route(name, kw, model, exc, outputs, band, n_eval_frf, ref_kw, a, label)
     if n_eval_frf is None or predicted <= a.budget:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             got = []          # every point with its unknowns and history, for the checks
             res = frf(model, exc, 2 * np.pi * f1, 2 * np.pi * f2, options(kw, model),
                       outputs=outputs, sink=got.append)
             row["frf_s"] = time.perf_counter() - t0
+            row["frf_cpu"] = time.process_time() - c0
         row.update(points=len(res), evals=int(res.timings.get("evaluations", 0)),
                    timings=res.timings,
                    complete=res.complete, pe=per_eval(res.timings), extrap=False,
@@ -321,10 +328,11 @@ def scaling(a, sizes, kw, main_row, pairs, spec_for, roms, band, sectors, n_mode
     FRF time is s/point x the points of the largest whole FRF (marked "short"). The growth
     exponents (least squares over the sizes measured so far, printed after each size) are
     on the FRF time and on the time per Newton evaluation (less sensitive to the load and
-    to where a short run stops). Per evaluation, the receptances cost (contact rows)^2 x
-    (ROM_I DoFs) per harmonic and a dense LU (unknowns)^3: with every interface DoF kept in
+    to where a short run stops). Per LU, the receptances cost (contact rows)^2 x (ROM_I
+    DoFs) per harmonic and the dense LU (unknowns)^3: with every interface DoF kept in
     ROM_I both grow about like pairs^3, so the FRF stays under pairs^2 only as far as held
-    LUs and GMRES replace factorisations."""
+    LUs and GMRES (pairs^2 per iteration) replace factorisations; the LU is carried from
+    call to call (batches, peak solves), so an FRF needs fewer LUs as they grow dearer."""
     print(f"\nscaling, route {first_route(a)!r}, ROM_I of the same kind (sectors {sectors}, "
           f"{n_modes} CB modes per stage, {2 * sectors} active nodes x 3; every interface DoF "
           "kept)")
@@ -334,8 +342,8 @@ def scaling(a, sizes, kw, main_row, pairs, spec_for, roms, band, sectors, n_mode
     print(f"  {_load()} at the start")
     print(f"  {'pairs':>6} {'FE DoFs':>7} {'ROM DoFs':>8} {'unknowns':>8} {'points':>6} "
           f"{'evals':>6} {'LUs':>5} {'GMRES':>6} {'s/eval':>8} {'s/point':>8} {'FRF s':>9}"
-          f"  {'gen. s':>7}")
-    xs, ys, ye = [], [], []
+          f" {'CPU s':>9}  {'gen. s':>7}")
+    xs, ys, ye, xw, yw, cw = [], [], [], [], [], []
     last = None          # (unknowns, FRF s, points) of the largest whole FRF
     for p in sizes:
         if p % sectors or p // sectors < 2:
@@ -354,6 +362,7 @@ def scaling(a, sizes, kw, main_row, pairs, spec_for, roms, band, sectors, n_mode
         whole = last is None or last[1] * (n_u / last[0]) ** 3 <= a.budget
         if p == pairs and main_row.get("points"):
             res_t, npts, t_frf = main_row["timings"], main_row["points"], main_row["frf_s"]
+            c_frf = main_row["frf_cpu"]
             note, whole = "(table above)", True
         else:
             o = options(kw, mp)
@@ -361,13 +370,16 @@ def scaling(a, sizes, kw, main_row, pairs, spec_for, roms, band, sectors, n_mode
                 o = dataclasses.replace(o, max_points=a.short)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                t1 = time.perf_counter()
+                t1, c1 = time.perf_counter(), time.process_time()
                 res = frf(mp, ep, 2 * np.pi * band[0], 2 * np.pi * band[1], o, outputs=op)
-                t_frf = time.perf_counter() - t1
+                t_frf, c_frf = time.perf_counter() - t1, time.process_time() - c1
             res_t, npts, note = res.timings, len(res), ""
+            if not res.complete:
+                note = "INCOMPLETE "
             if not whole:
                 note = f"short: {npts} points x {last[2]} points of the {last[3]}-pair FRF"
                 t_frf = t_frf / npts * last[2]
+                c_frf = c_frf / npts * last[2]
         if whole:
             last = (n_u, t_frf, npts, p)
         n_ev = max(int(res_t["evaluations"]), 1)
@@ -375,16 +387,23 @@ def scaling(a, sizes, kw, main_row, pairs, spec_for, roms, band, sectors, n_mode
         print(f"  {p:6d} {sum(rp['sizes']['fe_dofs']):7d} {mp.n_dof:8d} {n_u:8d} {npts:6d} "
               f"{n_ev:6d} {int(res_t['factorizations']):5d} "
               f"{int(res_t['krylov_iterations']):6d} {s_eval:8.3f} "
-              f"{t_frf / (last[2] if not whole else npts):8.3f} {t_frf:9.1f}  {t_gen:7.1f} "
-              f"{note}")
+              f"{t_frf / (last[2] if not whole else npts):8.3f} {t_frf:9.1f} {c_frf:9.1f}"
+              f"  {t_gen:7.1f} {note}")
         print(f"         split of an evaluation: {fmt_split(per_eval(res_t))}")
         xs.append(p)
         ys.append(t_frf)
         ye.append(s_eval)
+        if whole:
+            xw.append(p)
+            yw.append(t_frf)
+            cw.append(c_frf)
         if len(xs) >= 2 and min(ys) > 0 and min(ye) > 0:
+            whole_fit = (f"whole FRFs only ({xw}) {_exponent(xw, yw):.2f}, their CPU time "
+                         f"{_exponent(xw, cw):.2f}" if len(xw) >= 2
+                         else "whole FRFs only: fewer than 2")
             print(f"         growth exponent over {xs} pairs (least squares, log-log): FRF "
-                  f"time {_exponent(xs, ys):.2f}, time per evaluation {_exponent(xs, ye):.2f}"
-                  f" (target <= 2); {_load()}")
+                  f"time {_exponent(xs, ys):.2f} ({whole_fit}), time per evaluation "
+                  f"{_exponent(xs, ye):.2f} (target <= 2); {_load()}")
         sys.stdout.flush()
 
 
@@ -405,8 +424,11 @@ def main(a):
         return flange.FlangeSpec(sectors=sectors, z_per_sector=p // sectors,
                                  n_modes=n_modes, coarse=quick)
 
+    import frirom._pack
+    frirom._pack.CARRY_LU = not a.no_carry
     print(f"large_interface: OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}, "
-          f"H = {H}, {SAMPLES} samples, work folder {a.work}; {_load()}")
+          f"H = {H}, {SAMPLES} samples, work folder {a.work}; LU carried between calls: "
+          f"{'no (--no-carry: the build before)' if a.no_carry else 'yes'}; {_load()}")
     t0 = time.perf_counter()
     roms = flange.flange_roms(spec_for(pairs), a.work)
     s = roms["sizes"]

@@ -8,7 +8,7 @@ number of the boundary is typed here.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
@@ -177,6 +177,10 @@ def _all_modes(model: Model, H: int, need_diagonal: bool) -> _Modes | str:
     return m
 
 
+#: carry the held LU from call to call (False: each call factorises its first Jacobian,
+#: the behaviour before; cases/bench/large_interface.py --no-carry measures that)
+CARRY_LU = True
+
 #: 'auto' factorises D_h by sparse LU (MUMPS) instead of a band when the band LU would
 #: take more than this many flops per harmonic (n_dof bw^2, bw the RCM half-bandwidth).
 SPARSE_FLOPS = 5e8
@@ -337,6 +341,10 @@ class _Packed:
     #: (n_out, len(out_f)) physical outputs from the rows read (outputs given as a
     #: matrix): X = out_map @ x[out_f]; None: X = x[out_f]
     out_map: np.ndarray | None = None
+    #: the LU hbm_continue carries from call to call of this run (lu (ny, ny), pivots
+    #: (ny,), state (2,)), when Fortran holds one (hbm_lu_holds): shared by the copies
+    #: of this object (the peak solves), filled at the first call
+    lu_hold: list = field(default_factory=list)
 
     @property
     def nc(self) -> int:
@@ -384,6 +392,7 @@ class _Packed:
         iopt = np.empty(len(_ICONT), np.int32)
         iopt[_ICONT_AT] = (o.max_iter, int(o.reuse_jacobian))
         nl = (self.nl + 1).astype(np.int32) if self.nl.size else np.ones(1, np.int32)
+        lu, piv, lust = self._held_lu()
         (kp, ki, kx), (mp, mi, mx), (cp, ci, cx), (gp, gi, gx) = self.K, self.M, self.C, self.G
         res = _kernels.hbm_continue(
             formulation=o.formulation, lam_kind=o.parameter, nsamp=o.n_samples,
@@ -398,11 +407,24 @@ class _Packed:
             stability=int(self.stability), history=int(o.history), maxpts=maxpts,
             netot=max(self.ne_tot, 1), ntim=len(_TIMER_SLOTS), nh=self.H, ndof=self.n_dof,
             nnl=self.nl.size or 1, tcontact=int(self.tcontact),
-            krylov=int(o.krylov), sparse=int(self.sparse))
+            krylov=int(o.krylov), sparse=int(self.sparse), lu=lu, lupiv=piv, lustate=lust)
         r = _CallResult(*res[:-1], msg=res[-1].decode(errors="replace"))
         if r.npts > 0 and self.nw and o.history:
             self.w0 = r.sliders[:self.nw, r.npts - 1].copy()
         return r
+
+    def _held_lu(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The arrays of the LU carried between calls (allocated at the first call), or
+        1 x 1 dummies when Fortran keeps none for this system (small, banded, Krylov mode
+        or factorised receptances)."""
+        if not self.lu_hold:
+            nm = max(self.modes.nmodes, self.modes.hmodes)
+            hold = (CARRY_LU and self.opts.formulation == "condensed" and nm > 0
+                    and not self.opts.krylov and _kernels.hbm_lu_holds(self.H, self.nrow, nm))
+            n = self.ny if hold else 1
+            self.lu_hold.extend([np.zeros((n, n), order="F"), np.zeros(n, np.int32),
+                                 np.zeros(2)])
+        return tuple(self.lu_hold)
 
     def pad_start(self, y, H_from: int) -> np.ndarray:
         """Unknowns of a solution with H_from harmonics, extended or cut to this H."""
