@@ -321,3 +321,48 @@ def test_help_documents_exit_codes(capsys):
     text = capsys.readouterr().out
     for code in ("0 ", "2 ", "3 ", "130"):
         assert f"\n  {code}" in text, code
+
+
+def test_resume_exact_when_the_solver_carries_its_lu(tmp_path):
+    """A large condensed system carries its LU (the GMRES preconditioner) between calls
+    into Fortran; the continuation drops it at every call boundary, where a resume may
+    start, so a run killed and resumed still gives the uninterrupted points bit for bit.
+    Random reduced model (cases/bench/condensed.py): 60 normal1d contacts, 360 modes,
+    840 unknowns, large enough that Fortran holds the LU (checked). Tolerance 0; without
+    the drop the resumed calls would start from a fresh LU where the uninterrupted ones
+    used the carried one, and differ at the GMRES tolerance."""
+    sys.path.insert(0, str(ROOT / "cases" / "bench"))
+    from condensed import F_RES, reduced_model
+
+    from frirom import _kernels
+    from frirom.solver import SolverOptions
+    model, exc = reduced_model(n=360, nc=60, seed=5)
+    assert _kernels.hbm_lu_holds(3, 120, 360) == 1
+    out = np.arange(4)
+    opts = SolverOptions(harmonics=3, samples=64, max_points=34, refine_peak=False,
+                         stability=False)
+    w0, w1 = 2 * np.pi * F_RES * 0.99, 2 * np.pi * F_RES * 1.01
+
+    def writer(path, append=False):
+        return FRFWriter(path, out, ["interface"], 3, append=append)
+    w = writer(tmp_path / "ref.h5")
+    full = frf(model, exc, w0, w1, opts, outputs=out, sink=w.append)
+    w.close(full.complete, full.message)
+    ref = FRF.load(tmp_path / "ref.h5")
+    assert len(ref) == 34 and full.timings["krylov_iterations"] > 0
+    path = tmp_path / "cut.h5"
+    w = writer(path)
+
+    def dying(p):
+        if w._commit[0] == 25:
+            raise Killed
+        w.append(p)
+    with pytest.raises(Killed):
+        frf(model, exc, w0, w1, opts, outputs=out, sink=dying)
+    w.f.close()
+    start = FRFWriter.resume_point(path)
+    assert start["n_points"] == 21
+    w = writer(path, append=True)
+    rest = frf(model, exc, w0, w1, opts, outputs=out, sink=w.append, start=start)
+    w.close(rest.complete, rest.message)
+    _same(FRF.load(path), ref, "resumed with a carried LU")

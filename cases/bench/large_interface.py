@@ -85,7 +85,8 @@ def _parse(argv=None):
                          "--budget")
     ap.add_argument("--no-carry", action="store_true",
                     help="the build before: no LU carried from one Fortran call to the next "
-                         "(each batch and peak solve factorises its first Jacobian)")
+                         "(each peak solve factorises its first Jacobian; a continuation "
+                         "batch always does, so that resume is exact)")
     ap.add_argument("--mem-limit", type=float, default=2.0,
                     help="GB: a route whose estimated matrices exceed it is skipped")
     return ap.parse_args(argv)

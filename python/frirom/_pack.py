@@ -343,7 +343,8 @@ class _Packed:
     out_map: np.ndarray | None = None
     #: the LU hbm_continue carries from call to call of this run (lu (ny, ny), pivots
     #: (ny,), state (2,)), when Fortran holds one (hbm_lu_holds): shared by the copies
-    #: of this object (the peak solves), filled at the first call
+    #: of this object (the peak solves), filled at the first call; forget_lu at every
+    #: continuation call boundary (exact resume)
     lu_hold: list = field(default_factory=list)
 
     @property
@@ -425,6 +426,14 @@ class _Packed:
             self.lu_hold.extend([np.zeros((n, n), order="F"), np.zeros(n, np.int32),
                                  np.zeros(2)])
         return tuple(self.lu_hold)
+
+    def forget_lu(self) -> None:
+        """Make the next call factorise its first Jacobian (the carried LU is marked
+        invalid). The continuation does this at every call boundary, where a resumed run
+        may start, so that a resumed run computes bit for bit the points of the
+        uninterrupted one; the peak solves after the last call keep the carry."""
+        if self.lu_hold:
+            self.lu_hold[2][0] = 0.0
 
     def pad_start(self, y, H_from: int) -> np.ndarray:
         """Unknowns of a solution with H_from harmonics, extended or cut to this H."""

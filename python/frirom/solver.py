@@ -327,6 +327,7 @@ class _Continuation:
         while self.n_before + len(self.points) < o.max_points:
             maxpts = min(o.batch, o.max_points - self.n_before - len(self.points)) + \
                 int(self.pending)
+            self.packed.forget_lu()     # a checkpoint: resume starts here, LU-less
             res = self._call(self.y0, self.start_mode, self.yscale, maxpts)
             t_call = time.perf_counter() - self.t0
             self.t0 = time.perf_counter()
