@@ -55,15 +55,17 @@ def _peak(rom, f0):
     return ph._peak(res), res
 
 
-def test_rom1_stuck_peak_is_the_stick_eigenfrequency(case):
+@pytest.mark.parametrize("law", ["normal1d", "normal2d"])
+def test_rom1_stuck_peak_is_the_stick_eigenfrequency(case, law):
     """With a preload that keeps every hook stuck, ROM_I is linear: its peak lies at the
     first nodal-diameter-2 frequency of the sector with the hooks tied by their stick
-    springs (an eigen-solve of the projected pair, independent of the HBM). Tolerance
-    1e-4: the 0.3 % modal damping shifts the peak by zeta^2 ~ 1e-5, continuation and the
-    peak refinement stay below 1e-5."""
+    springs (an eigen-solve of the projected pair, independent of the HBM; normal2d
+    springs in both tangents, normal1d in the circumferential one). Tolerance 1e-4: the
+    0.3 % modal damping shifts the peak by zeta^2 ~ 1e-5, continuation and the peak
+    refinement stay below 1e-5."""
     import paper_hooks as ph
     import scipy.linalg as sla
-    r1 = ph.Rom(case, "rom1", "coarse")
+    r1 = ph.Rom(case, "rom1", "coarse", law=law)
     (f, a), res = _peak(r1, 1e5)
     assert np.all(res.state_fractions[res.peak(0).index, :, 0] == pytest.approx(1.0))
     red, cs = r1.deck.reduced, r1.deck.cyclic["sector"]
@@ -119,3 +121,20 @@ def test_gsi_error_decreases_with_modes_and_rom2_matches(case):
     assert all(b < a for a, b in zip(df, df[1:])), errs
     assert errs[80][0] < min(errs[n][0] for n in (10, 20, 40)), errs
     assert errs[80][0] < 0.01 and errs[80][1] < 0.001, errs
+
+
+def test_normal2d_hooks_rom2_matches_rom1_with_the_lug_tied(tied):
+    """The paper's 2-D friction on the hooks (normal2d), lug tied, at the preload with the
+    most slip: ROM_I runs through the range (the 2-D cycle closes at the onset of partial
+    slip; it used to stop there: "not closed in 200 periods"), the hooks slip and lift
+    off, and ROM_II's 40 GSI modes are within the issue's targets, 1 % in peak amplitude
+    and 0.1 % in peak frequency (measured -0.34 %, +4.9e-5). With the contact lug, ROM_I
+    normal2d stops before its peak on this mesh (README), so the tied lug is the test."""
+    import paper_hooks as ph
+    r1 = ph.Rom(tied, "rom1", "coarse", law="normal2d")
+    (f1, a1), res = _peak(r1, F0)
+    assert res.state_fractions[:, r1._hooks, 1].max() > 0.3
+    assert res.state_fractions[:, r1._hooks, 2].max() > 0.1
+    (f2, a2), _ = _peak(ph.Rom(tied, "rom2", "coarse", 40, law="normal2d"), F0)
+    assert a2 == pytest.approx(a1, rel=0.01)
+    assert f2 == pytest.approx(f1, rel=0.001)

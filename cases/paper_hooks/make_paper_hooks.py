@@ -11,8 +11,9 @@ filled from the template hooks.toml: ROM_I keeps every hook (and lug) DoF nonlin
 (Craig-Bampton only), ROM_II reduces them by 20 free + 20 full-stick GSI modes. Both reduce
 the cyclic boundary by Tran's interface modes (``boundary_modes``).
 
-The hooks are one contact group of ``--law`` (normal1d: one tangent, circumferential;
-normal2d: friction in the face's plane). The interlocking lug is, with ``--interlock
+The hooks are one contact group of ``--law`` (normal1d, the default: one tangent,
+circumferential; normal2d: friction in the face's plane, the paper's law, whose ROM_I
+stops before the slipping members' peaks: README). The interlocking lug is, with ``--interlock
 contact`` (default), a contact of the same law preloaded by :data:`F_LUG` so that it stays
 stuck (normal1d: two groups on the lug's pairs, one per tangent, circumferential and
 axial, each with half the normal stiffness and preload; normal2d: one group), or, with

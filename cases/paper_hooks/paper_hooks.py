@@ -204,17 +204,31 @@ def sweep(rom: Rom, log=print, what: str = "") -> dict:
     fraction over every point, None when tied), slip (the hooks' slip fraction at the
     peak).
     """
-    res, t = rom.frf()
-    runs = [res]
-    if not res.complete:
-        f_stop = res.omega[-1] / (2 * np.pi)
-        back, tb = rom.frf(reverse=True)
-        t += tb
-        runs.append(back)
-        log(f"{what}: the continuation stopped at {f_stop:.3f} Hz; from the end of the "
-            f"range down, it " + ("reached the start" if back.complete else
-                                  f"stopped at {back.omega[-1] / (2 * np.pi):.3f} Hz"))
-    covered = res.complete or (runs[1].complete or runs[1].omega[-1] <= res.omega[-1])
+    from frirom._errors import ConvergenceError
+    runs, t = [], 0.0
+    for reverse in (False, True):
+        t0 = time.perf_counter()
+        try:
+            r, dt = rom.frf(reverse=reverse)
+        except ConvergenceError as exc:         # Newton found no first point there
+            t += time.perf_counter() - t0
+            log(f"{what}: no first point at the {'end' if reverse else 'start'} of the "
+                f"range ({str(exc)[:120]})")
+            continue
+        t += dt
+        if reverse and runs:
+            log(f"{what}: the continuation stopped at {runs[0].omega[-1] / (2 * np.pi):.3f}"
+                " Hz; from the end of the range down, it " + (
+                    "reached the start" if r.complete else
+                    f"stopped at {r.omega[-1] / (2 * np.pi):.3f} Hz"))
+        runs.append(r)
+        if r.complete:
+            break
+    if not runs:
+        return dict(peak=(np.nan, np.nan), seconds=t, points=0, timings={}, curves=[],
+                    complete=False, two_way=False, lug=None, slip=np.nan)
+    covered = runs[-1].complete or (len(runs) == 2
+                                    and runs[1].omega[-1] <= runs[0].omega[-1])
     best = max(runs, key=lambda r: r.peak(0).amplitude)
     peak = _peak(best)
     lugs = [x for x in (lug_stick(rom, r) for r in runs) if x is not None]
@@ -367,7 +381,7 @@ def plot_family(res, path: Path):
         for x2, y2 in r["curve2"]:
             step = max(1, len(x2) // 40)
             ax.plot(x2[::step], y2[::step], mark, mfc="none", color=col, ms=5)
-        if r["n_gsi"] == res["n_gsi"][0]:        # staggered: the peaks lie close
+        if r["n_gsi"] == res["n_gsi"][0] and np.isfinite(r["a1"]):  # staggered: close
             i = [q["f0"] for q in res["rows"]].index(r["f0"])
             ax.annotate(f"f0 = {r['f0']:g} N", (r["f1"], r["a1"]),
                         textcoords="offset points", xytext=(30, -12 * i - 6), fontsize=8,
@@ -376,7 +390,7 @@ def plot_family(res, path: Path):
     for i, n in enumerate(res["n_gsi"]):
         mark, col = MARKERS[i % len(MARKERS)]
         ax.plot([], [], mark, mfc="none", color=col, label=f"ROM_II ({n} GSI modes)")
-    peaks = [r["f2"] for r in res["rows"]] + [r["f1"] for r in res["rows"]]
+    peaks = [f for r in res["rows"] for f in (r["f1"], r["f2"]) if np.isfinite(f)]
     ax.set_xlim(min(peaks) - 3.0, max(peaks) + 3.0)       # the resonances, not the flanks
     ax.set_xlabel("frequency [Hz]")
     ax.set_ylabel("airfoil amplitude (OUT:y) [m]")
