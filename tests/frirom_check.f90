@@ -7,11 +7,24 @@ module frirom_check
     use frirom_kinds, only: ip
     implicit none
     private
-    public :: check, check_done
+    public :: check, check_done, fixed_seed
 
     integer(ip) :: nfail = 0  !! failed checks so far in this program
 
 contains
+
+    !> Seed random_number with a fixed sequence, so a test program draws the same numbers
+    !> on every run (random_seed() without arguments takes them from the OS: a random
+    !> point may then land on a contact-state switch in one run out of many).
+    subroutine fixed_seed(base)
+        integer, intent(in) :: base            !! any integer; the same base, the same draws
+        integer :: n, i
+        integer, allocatable :: seed(:)
+        call random_seed(size=n)
+        allocate (seed(n))
+        seed = [(base + 7919*i, i=1, n)]
+        call random_seed(put=seed)
+    end subroutine fixed_seed
 
     !> Record one check: when `ok` is false, print what failed and count it.
     subroutine check(ok, what)
