@@ -21,7 +21,7 @@ import pytest
 
 from frirom import contact
 from frirom.model import ContactGroup, Damping, Excitation, Model
-from frirom.solver import SolverOptions, frf
+from frirom.solver import SolverOptions
 from frirom.timeint import TimeContact
 
 from test_verification import _compare_peak, _run
