@@ -58,6 +58,12 @@ def static_loads(red, pairs, n0: float) -> np.ndarray:
     return out
 
 
+def _dofs(red, groups) -> int:
+    """Number of distinct FE DoFs of the contact groups ``groups`` (names)."""
+    return (np.unique(np.concatenate([np.ravel(red.pairs[g].dofs) for g in groups])).size
+            if groups else 0)
+
+
 class Rom:
     """One ROM of the case, built from its deck once; ``set_preload`` changes f0.
 
@@ -66,17 +72,19 @@ class Rom:
     f0) or tied."""
 
     def __init__(self, work: Path, rom: str, size: str, n_gsi: int = 40,
-                 law: str = "normal1d"):
+                 law: str = "normal1d", lug_reduction: str = "own"):
         from frirom.contact import LAWS
         from frirom.deck import load_deck
         self.name = rom
         pairs = mk.hook_geometry(work / "hooks")
         lug = mk.lug_geometry(work / "hooks")
         self.n_pairs = len(pairs[0])
-        tag = "" if law == "normal1d" else f"_{law}"
+        tag = ("" if law == "normal1d" else f"_{law}") + (
+            f"_lug{lug_reduction}" if lug is not None and lug_reduction != "own" else "")
         deck = work / (f"{rom}{tag}.toml" if rom == "rom1" else f"rom2_gsi{n_gsi}{tag}.toml")
         deck.write_text(mk.deck_text(rom, size, self.n_pairs, mk.F0_DEFAULT, n_gsi,
-                                     pairs=pairs, law=law, lug=lug))
+                                     pairs=pairs, law=law, lug=lug,
+                                     lug_reduction=lug_reduction))
         t0 = time.perf_counter()
         self.deck = load_deck(deck)
         self.model = self.deck.model()
@@ -98,15 +106,18 @@ class Rom:
             raise RuntimeError("the hooks' static loads differ from the deck's")
         self.options = self.deck.options()
         self.groups = [c.name for c in self.deck.settings.contacts]
+        spec = self.deck.settings.reduction
+        #: ROM_II's lug coordinates: its own stick modes, or its DoFs kept physical
+        self.lug_dofs = (0 if rom == "rom1" or not spec.separate else spec.separate_stick
+                         or _dofs(red, [g for g in self.groups if g.startswith("lug")]))
         self._hooks = self.groups.index("hooks")
         self._n0 = LAWS[self.model.contacts[self._hooks].law].parameters.index("n0")
         cyc = self.deck.cyclic
         n_b = cyc["sector"].boundary.size
         nm = max(m.omega.size for m in cyc["modes"].values())
         self.sizes = dict(fe=red.n_fe, coords=self.model.n_dof,
-                          contact_dofs=(np.unique(np.concatenate(
-                              [np.ravel(red.pairs[g].dofs) for g in self.groups])).size
-                              if rom == "rom1" else n_gsi),
+                          contact_dofs=(_dofs(red, self.groups) if rom == "rom1" else
+                                        n_gsi + self.lug_dofs),
                           law=self.model.contacts[self._hooks].law,
                           nonlinear=len(self.model.nonlinear_dofs()),
                           contact_pairs=self.model.contacts[self._hooks].n_elem,
@@ -249,14 +260,14 @@ def sweep(rom: Rom, log=print, what: str = "") -> dict:
 
 def run_family(work: Path, size: str = "coarse", f0s=F0_FAMILY, n_gsi=(40,),
                rom1: str = "full", log=print, law: str = "normal1d",
-               interlock: str = "contact") -> dict:
+               interlock: str = "contact", lug: str = "own") -> dict:
     """ROM_I and a ROM_II per GSI mode count in n_gsi over the preloads f0s; returns the
     sizes and one row per f0 and mode count."""
     work = Path(work)
     n_gsi = tuple(np.atleast_1d(n_gsi).tolist())
     mk.make(work, size, law=law, interlock=interlock)
     r1 = Rom(work, "rom1", size, law=law)
-    r2s = {n: Rom(work, "rom2", size, n, law=law) for n in n_gsi}
+    r2s = {n: Rom(work, "rom2", size, n, law=law, lug_reduction=lug) for n in n_gsi}
     rows = []
     for f0 in f0s:
         s2s = {}
@@ -435,9 +446,13 @@ def main(argv=None):
     ap.add_argument("--rom1", choices=("full", "sample"), default="full")
     ap.add_argument("--law", choices=mk.LAWS, default="normal1d")
     ap.add_argument("--interlock", choices=mk.INTERLOCKS, default="contact")
+    ap.add_argument("--lug", choices=mk.LUG_REDUCTIONS, default="own",
+                    help="ROM_II's contact lug: its own full-stick GSI modes (default), "
+                         "kept physical, or shared with the hooks' GSI basis")
     a = ap.parse_args(argv)
     work = a.work or Path("results/paper_hooks") / a.size
-    res = run_family(work, a.size, a.f0, a.gsi, a.rom1, law=a.law, interlock=a.interlock)
+    res = run_family(work, a.size, a.f0, a.gsi, a.rom1, law=a.law, interlock=a.interlock,
+                     lug=a.lug)
     print()
     print(sizes_table(res))
     print(family_table(res))

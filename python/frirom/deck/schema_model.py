@@ -125,7 +125,8 @@ def parse_reduction(ctx: Context, red: dict) -> tuple:
     im = table(ctx, red, pre, required=False)
     method = string(ctx, im, "method", f"{pre}.method", default="none",
                     choices=("none", "gsi", "ms"))
-    allowed = {"none": {"method"}, "gsi": {"method", "free", "stick", "per_side"},
+    allowed = {"none": {"method"}, "gsi": {"method", "free", "stick", "per_side",
+                                                 "separate", "separate_stick"},
                "ms": {"method", "sectors", "engine_orders", "time_harmonics",
                       "harmonic_indices", "axis", "origin"}}[method]
     im, modes_auto = parse_modes_auto(ctx, im, method)
@@ -138,6 +139,20 @@ def parse_reduction(ctx: Context, red: dict) -> tuple:
         if kw["free"] + kw["stick"] == 0:
             raise ctx.error(f"{pre}.free", "free + stick >= 1 GSI modes")
         kw["per_side"] = boolean(ctx, im, "per_side", f"{pre}.per_side", False)
+        sep = names(ctx, im, "separate", f"{pre}.separate", required=False)
+        up = {s.upper() for s in iface}
+        if any(s.upper() not in up for s in sep):
+            raise ctx.error(f"{pre}.separate", "node sets of reduction.interface (a joint "
+                            "of its own, outside the span of the GSI modes)", sep)
+        if sep and {s.upper() for s in sep} >= up:
+            raise ctx.error(f"{pre}.separate", "some interface sets left to the GSI modes "
+                            "(with every set separate, use method = 'none')", sep)
+        kw["separate"] = tuple(sep)
+        kw["separate_stick"] = number(ctx, im, "separate_stick", f"{pre}.separate_stick",
+                                      default=0, integer=True, minimum=0)
+        if kw["separate_stick"] and not sep:
+            raise ctx.error(f"{pre}.separate_stick", "with separate = [node sets]",
+                            kw["separate_stick"])
     axis = vector(ctx, red, "axis", "reduction.axis", (0.0, 0.0, 1.0))
     origin = vector(ctx, red, "origin", "reduction.origin", (0.0, 0.0, 0.0), nonzero=False)
     kw["axis"], kw["origin"] = axis, origin

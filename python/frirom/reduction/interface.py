@@ -305,7 +305,8 @@ def gsi_basis(K, M, interface, active=(), pairs: ContactPairs | None = None,
 
     K, M: (n, n) matrices (sparse or dense); interface: (n_i,) model DoFs to reduce; active:
     other master DoFs (kept physical, but part of the CC eigenproblem); pairs: the contact
-    elements (needed when n_stick > 0; their DoFs must be interface DoFs); groups: optional
+    elements, all tied for the full-stick modes (needed when n_stick > 0; their DoFs must be
+    interface DoFs, or active ones: a joint kept physical); groups: optional
     list of index arrays into ``interface`` (e.g. side A and side B of a joint, Eq. 14 per
     component): each group gets its own orthonormal modes, n_free + n_stick per group.
 
@@ -331,10 +332,10 @@ def gsi_basis(K, M, interface, active=(), pairs: ContactPairs | None = None,
     if n_stick > 0:
         if pairs is None:
             raise InputError("gsi_basis: n_stick > 0 needs the contact pairs")
-        outside = np.setdiff1d(pairs.dofs, i)
+        outside = np.setdiff1d(pairs.dofs, masters)
         if outside.size:
             raise InputError(f"gsi_basis: contact DoFs {outside[:5].tolist()}... are not "
-                             "interface DoFs")
+                             "interface DoFs (nor active ones)")
         Kstick = sp.csr_matrix(K) + stick_stiffness(pairs, n)
     basis = np.zeros((i.size, 0))
     info = {"eig_free": None, "eig_stick": None, "groups": []}

@@ -124,6 +124,8 @@ class ReductionSpec:
     free: int = 0
     stick: int = 0
     per_side: bool = False
+    separate: tuple = ()                 # gsi: interface sets of a joint of their own,
+    separate_stick: int = 0              # reduced by that many stick modes (0: physical)
     sectors: int | None = None
     engine_orders: tuple = ()
     time_harmonics: tuple = (1,)
@@ -434,7 +436,7 @@ def rom_key(source: FESource, spec: ReductionSpec, pairs: list) -> str:
             for chunk in iter(lambda: fh.read(1 << 22), b""):
                 h.update(chunk)
     cfg = {k: v for k, v in asdict(spec).items() if k != "cache"}
-    stick = spec.method == "gsi" and spec.stick > 0
+    stick = spec.method == "gsi" and spec.stick + spec.separate_stick > 0
     pc = [{k: v for k, v in asdict(p).items()
            if k != "key" and (stick or k not in ("kt", "kn"))} for p in pairs]
     h.update(json.dumps([source.options, cfg, pc], sort_keys=True, default=str).encode())
@@ -577,24 +579,39 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
         if spec.stick and rot:
             raise InputError(f"{pre}.stick: full-stick modes with contacts to the next "
                              "sector (b_sector = 1) are not implemented; use free modes")
-        if spec.stick:
+        if (spec.stick or spec.separate_stick) and pairs0 and not rot:
             if len({p.n_dir for p in pairs0.values()}) > 1:
                 raise InputError(f"{pre}.stick: all contacts must have the same number of "
                                  "local directions for the full-stick modes")
             allp = ContactPairs(*(np.vstack([getattr(p, k) for p in pairs0.values()])
                                   for k in ("dofs_a", "dofs_b", "frames", "stiffness")))
+        # a joint of its own (spec.separate): masters of the CC eigenproblem beside the
+        # active ones, not in the span of the GSI modes of the rest; kept physical, or
+        # reduced by its own full-stick modes (below)
+        phys = (pos[model.dof_indices(list(spec.separate))] if spec.separate
+                else np.zeros(0, np.int64))
+        iface_r, act_r = np.setdiff1d(iface0, phys), np.union1d(act0, phys)
         groups = None
         if spec.per_side and pairs0:
-            side_a = np.isin(iface0, np.concatenate([p.dofs_a.ravel()
-                                                     for p in pairs0.values()]))
+            side_a = np.isin(iface_r, np.concatenate([p.dofs_a.ravel()
+                                                      for p in pairs0.values()]))
             groups = [g for g in (np.nonzero(side_a)[0], np.nonzero(~side_a)[0]) if g.size]
         try:
-            basis, _ = gsi_basis(K0, M0, iface0, act0, allp, spec.free, spec.stick,
+            basis, _ = gsi_basis(K0, M0, iface_r, act_r, allp, spec.free, spec.stick,
                                  groups=groups)
         except InputError as exc:
             raise InputError(f"{pre}: {exc}") from None
-        iface_r = iface0
         mode_labels = [f"gsi {j + 1}" for j in range(basis.shape[1])]
+        if spec.separate_stick and phys.size:
+            # the separate joint's own full-stick GSI modes (every contact tied), the
+            # other interface DoFs now among the CC masters
+            try:
+                sep, _ = gsi_basis(K0, M0, phys, np.union1d(act0, iface_r), allp, 0,
+                                   spec.separate_stick)
+            except InputError as exc:
+                raise InputError(f"{pre}.separate_stick: {exc}") from None
+            basis, iface_r = block_diag(basis, sep), np.concatenate([iface_r, phys])
+            mode_labels += [f"gsi separate {j + 1}" for j in range(sep.shape[1])]
     else:
         # one MS basis per interface node set (a stage's face): the radial line segments
         # of one call over two coincident faces would mix the stages' nodes

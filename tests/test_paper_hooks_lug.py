@@ -1,0 +1,119 @@
+"""ROM_II of the vane with hooks (cases/paper_hooks) with the interlocking lug as a joint
+of its own: the hooks reduced by their GSI modes, the lug by its own full-stick GSI modes
+(``[reduction.interface_modes] separate``, ``separate_stick``) or kept physical; and the
+deck's checks of those keys.
+
+The case's tests need ccx (coarse mesh, about 15 s: slow); the deck checks use the small
+block model of tests/test_reduction_deck.py.
+"""
+
+from __future__ import annotations
+
+import shutil
+import sys
+import warnings
+from pathlib import Path
+
+import pytest
+
+from frirom._errors import InputError
+from frirom.deck import load_deck
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "cases" / "paper_hooks"))
+sys.path.insert(0, str(ROOT / "tests"))
+
+needs_ccx = pytest.mark.skipif(shutil.which("ccx") is None, reason="needs ccx")
+
+#: the preload with the most slip in the coarse family (the hooks slip over 40 % of the
+#: cycle at the peak), where the shared basis missed
+F0 = 1000.0
+
+
+@pytest.fixture(scope="module")
+def case(tmp_path_factory):
+    import make_paper_hooks as mk
+    work = tmp_path_factory.mktemp("hooks_lug")
+    mk.make(work, "coarse")
+    return work
+
+
+def _peak(rom, f0=F0):
+    import paper_hooks as ph
+    rom.set_preload(f0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")          # an early stop is a failure here
+        res, _ = rom.frf()
+    assert res.complete
+    return ph._peak(res), res
+
+
+@pytest.mark.slow
+@needs_ccx
+def test_hooks_gsi_error_decreases_and_40_modes_match_with_the_lug_apart(case):
+    """The lug apart from the hooks' basis (its own 12 full-stick GSI modes), ROM_II
+    against ROM_I at the preload with the most slip: the errors in peak amplitude and in
+    peak frequency both fall with every step 10 -> 20 -> 40 -> 80 hook GSI modes (the
+    lug's coordinates fixed, so the hooks' basis alone changes; measured 1.9 %, 0.76 %,
+    0.10 %, 0.009 % and 4.6e-4, 3.0e-4, 2.4e-5, 5.8e-6), the paper's 40 modes are within
+    the issue's targets (1 % / 0.1 %), and the lug stays stuck at every point. The lug's
+    own modes against the lug kept physical (48 DoFs) with the same 40 hook modes: within
+    1e-3 in peak amplitude and 1e-5 in frequency (measured 2e-5, 8e-7): 12 modes carry the
+    stuck lug (six rigid motions per face)."""
+    import paper_hooks as ph
+    (f1, a1), _ = _peak(ph.Rom(case, "rom1", "coarse"))
+    errs, lugs = {}, {}
+    for n in (10, 20, 40, 80):
+        r2 = ph.Rom(case, "rom2", "coarse", n)
+        assert r2.sizes["contact_dofs"] == n + 12
+        (f2, a2), res = _peak(r2)
+        errs[n] = (abs(a2 / a1 - 1), abs(f2 / f1 - 1))
+        lugs[n] = ph.lug_stick(r2, res)
+    for k in (0, 1):
+        e = [errs[n][k] for n in (10, 20, 40, 80)]
+        assert all(b < a for a, b in zip(e, e[1:])), errs
+    assert errs[40][0] < 0.01 and errs[40][1] < 0.001, errs
+    assert all(v == 1.0 for v in lugs.values()), lugs
+    rp = ph.Rom(case, "rom2", "coarse", 40, lug_reduction="physical")
+    assert rp.sizes["contact_dofs"] == 40 + 48
+    (fp, ap), _ = _peak(rp)
+    (fo, ao), _ = _peak(ph.Rom(case, "rom2", "coarse", 40))
+    assert ao == pytest.approx(ap, rel=1e-3)
+    assert fo == pytest.approx(fp, rel=1e-5)
+
+
+@pytest.fixture(scope="module")
+def block_dir(tmp_path_factory):
+    if shutil.which("ccx") is None:
+        pytest.skip("ccx not installed")
+    sys.path.insert(0, str(ROOT / "cases" / "models"))
+    import block
+    out = tmp_path_factory.mktemp("sepblock")
+    block.run_ccx(block.write_block_deck(out / "block.inp", 10, 3, 3, n_ref_modes=0))
+    return out
+
+
+BAD_SEPARATE = [
+    ('stick = 6', 'stick = 6\nseparate = ["ACTIVE"]',
+     "reduction.interface_modes.separate: expected node sets of reduction.interface"),
+    ('stick = 6', 'stick = 6\nseparate = ["IFACE"]',
+     "reduction.interface_modes.separate: expected some interface sets left"),
+    ('stick = 6', 'stick = 6\nseparate_stick = 4',
+     "reduction.interface_modes.separate_stick: expected with separate"),
+    ('stick = 6', 'stick = 6\nseparate_stick = -1',
+     "reduction.interface_modes.separate_stick: expected"),
+]
+
+
+@pytest.mark.parametrize("old, new, expected", BAD_SEPARATE)
+def test_separate_keys_are_checked(block_dir, old, new, expected):
+    """A joint of its own must be interface sets, not all of them, and its stick-mode
+    count needs the sets: each bad deck names the key."""
+    from test_reduction_deck import GSI_DECK
+    good = GSI_DECK.format(kt="2.0e8", h=3, mu=0.5)
+    assert old in good
+    deck = block_dir / "bad.toml"
+    deck.write_text(good.replace(old, new))
+    with pytest.raises(InputError) as exc:
+        load_deck(deck)
+    assert expected in str(exc.value) and "bad.toml" in str(exc.value), str(exc.value)
