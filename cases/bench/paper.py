@@ -69,6 +69,47 @@ def print_table(rows: list) -> None:
               + ("" if r.get("complete", True) else "  INCOMPLETE (an FRF stopped early)"))
 
 
+#: the Fortran timers of a FRF (frirom.results.FRF.timings), in the profile's order
+PARTS = ("aft", "assembly", "receptance", "factorization", "solve")
+
+
+def print_profile(rows: list) -> None:
+    """Where each FRF's time goes, for rows that carry a ``profile`` ({ROM: (seconds,
+    points, FRF.timings summed over its sweeps)}): points, evaluations (residuals, with or
+    without Jacobian) per point, ms per evaluation, and the shares of the AFT with the
+    projections G x and G^T f (aft), the contact Jacobian's projection and J's assembly
+    (assembly), the receptances, the LUs, the solves, the rest of the Fortran and Python
+    (per batch: the points' post-processing). Last column: the speed-up ROM_II would have
+    if only its AFT remained (ROM_I's FRF time / ROM_II's AFT time): the AFT floor."""
+    prof = [r for r in rows if r.get("profile")]
+    if not prof:
+        return
+    print(f"{'case':<7} {'member':<16} {'ROM':<12} {'s':>7} {'points':>6} {'ev/pt':>6} "
+          f"{'ms/ev':>6} " + " ".join(f"{k[:6]:>6}" for k in PARTS)
+          + f" {'F rest':>6} {'Python':>6} {'AFT floor':>9}")
+    seen = set()
+    for r in prof:
+        aft2 = r["profile"]["ROM_II"][2].get("aft", 0.0)
+        for rom, (t, pts, tim) in r["profile"].items():
+            floor = (f"{r['rom1_frf_s'] / aft2:8.0f}x" if rom == "ROM_II" and aft2 > 0
+                     else "")
+            rom = rom if rom == "ROM_I" else f"{rom} {r.get('rom2', '')}".strip()
+            if not tim or not pts or (r["case"], r["member"], rom) in seen:
+                continue
+            seen.add((r["case"], r["member"], rom))    # ROM_I once per member
+            ev = tim.get("evaluations", 0.0)
+            shares = [tim.get(k, 0.0) / t for k in PARTS]
+            rest = tim.get("fortran_total", 0.0) / t - sum(shares)
+            print(f"{r['case']:<7} {r['member']:<16} {rom:<12} {t:7.2f} {pts:6d} "
+                  f"{ev / pts:6.1f} {1e3 * t / max(ev, 1):6.2f} "
+                  + " ".join(f"{100 * x:5.0f}%" for x in shares)
+                  + f" {100 * rest:5.0f}% {100 * (1 - tim.get('fortran_total', 0.0) / t):5.0f}%"
+                  + f" {floor:>9}")
+    print("shares of each FRF's time: aft (the AFT of every contact element, with G x and "
+          "G^T f), assembly (G^T J_loc G and J), receptances, LUs, solves, the rest of the "
+          "Fortran, Python; AFT floor: ROM_I's FRF time / ROM_II's AFT time")
+
+
 def summary(rows: list) -> str:
     """The last line: median speed-up per case, worst errors per case and ROM_II kind."""
     parts, errs = [], []
@@ -111,6 +152,7 @@ def main(argv=None):
     print("extrap.: ROM_I sampled by solve_point, FRF time = s/evaluation x the evaluations "
           "of the (exact) family ROM_II's FRF; stored: ROM_I's whole FRF as timed by the "
           "case's own run (paper_flange.py family); errors: largest over the outputs' peaks")
+    print_profile(rows)
     print(summary(rows))
 
 
