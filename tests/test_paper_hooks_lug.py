@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import shutil
 import sys
-import warnings
 from pathlib import Path
 
 import pytest
@@ -25,27 +24,9 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 needs_ccx = pytest.mark.skipif(shutil.which("ccx") is None, reason="needs ccx")
 
-#: the preload with the most slip in the coarse family (the hooks slip over 40 % of the
-#: cycle at the peak), where the shared basis missed
-F0 = 1000.0
-
-
-@pytest.fixture(scope="module")
-def case(tmp_path_factory):
-    import make_paper_hooks as mk
-    work = tmp_path_factory.mktemp("hooks_lug")
-    mk.make(work, "coarse")
-    return work
-
-
-def _peak(rom, f0=F0):
-    import paper_hooks as ph
-    rom.set_preload(f0)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")          # an early stop is a failure here
-        res, _ = rom.frf()
-    assert res.complete
-    return ph._peak(res), res
+# the coarse case (fixture) and a complete FRF's peak, as in test_paper_hooks (F0 = 1 000 N:
+# the preload with the most slip, where the shared basis missed)
+from test_paper_hooks import F0, _peak, case  # noqa: E402,F401
 
 
 @pytest.mark.slow
@@ -61,12 +42,12 @@ def test_hooks_gsi_error_decreases_and_40_modes_match_with_the_lug_apart(case):
     1e-3 in peak amplitude and 1e-5 in frequency (measured 2e-5, 8e-7): 12 modes carry the
     stuck lug (six rigid motions per face)."""
     import paper_hooks as ph
-    (f1, a1), _ = _peak(ph.Rom(case, "rom1", "coarse"))
+    (f1, a1), _ = _peak(ph.Rom(case, "rom1", "coarse"), F0)
     errs, lugs = {}, {}
     for n in (10, 20, 40, 80):
         r2 = ph.Rom(case, "rom2", "coarse", n)
         assert r2.sizes["contact_dofs"] == n + 12
-        (f2, a2), res = _peak(r2)
+        (f2, a2), res = _peak(r2, F0)
         errs[n] = (abs(a2 / a1 - 1), abs(f2 / f1 - 1))
         lugs[n] = ph.lug_stick(r2, res)
     for k in (0, 1):
@@ -76,8 +57,8 @@ def test_hooks_gsi_error_decreases_and_40_modes_match_with_the_lug_apart(case):
     assert all(v == 1.0 for v in lugs.values()), lugs
     rp = ph.Rom(case, "rom2", "coarse", 40, lug_reduction="physical")
     assert rp.sizes["contact_dofs"] == 40 + 48
-    (fp, ap), _ = _peak(rp)
-    (fo, ao), _ = _peak(ph.Rom(case, "rom2", "coarse", 40))
+    (fp, ap), _ = _peak(rp, F0)
+    (fo, ao), _ = _peak(ph.Rom(case, "rom2", "coarse", 40), F0)
     assert ao == pytest.approx(ap, rel=1e-3)
     assert fo == pytest.approx(fp, rel=1e-5)
 
