@@ -25,6 +25,10 @@ submodule (frirom_hbm) frirom_hbm_condensed
     integer(ip), parameter :: GN_MINIT = 4
     !> GMRES iterations on a fresh single-precision LU before J is factorised in double
     integer(ip), parameter :: GS_MAXIT = 12
+    !> Woodbury correction of a single LU: at most WB_PAIRS (mode, harmonic) pairs, those
+    !> above WB_FLOOR times the most sensitive
+    integer(ip), parameter :: WB_PAIRS = 96
+    real(wp), parameter :: WB_FLOOR = 1.0e-4_wp
 
 contains
 
@@ -380,6 +384,8 @@ contains
             call sgetrf(n, n, sys%jms, n, sys%ipiv, linfo)
             ! J (at the LU's frequency gj and contact state) applied matrix-free
             sys%jfree = .true.
+            sys%lu_single = .true.
+            if (linfo == 0) call wb_build(sys)
         else
             call dgetrf(n, n, sys%jm, n, sys%ipiv, linfo)
         end if
@@ -448,6 +454,7 @@ contains
         end if
         if (this%lu_single .and. .not. this%lu_now) then
             ! a chord step (Jacobian reused) with the LU of an older J, as a double one
+            call wb_prepare(this)
             call lu_apply(this, b)
             this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
             return
@@ -516,6 +523,7 @@ contains
             ! state(1) = 2: a single-precision LU (exact in lu)
             sys%lu_single = state(1) == 2.0_wp
             sys%lu_now = .false.
+            sys%wb_ok = .false.
             if (sys%lu_single) then
                 sys%jms = real(lu, real32)
             else
@@ -558,9 +566,9 @@ contains
         type(hbm_condensed), intent(in) :: sys
         real(wp), intent(in) :: x(:)
         real(wp), intent(out) :: y(:)
-        real(wp), allocatable :: xv(:, :), f(:, :), xl(:, :), fl(:), y2(:, :), vr(:, :)
+        real(wp), allocatable :: xv(:, :), f(:, :), y2(:, :), vr(:, :)
         complex(wp), allocatable :: fc(:), v(:, :), b1(:, :)
-        integer(ip) :: n, nu, nc, g, e, d, r, k, h, nm
+        integer(ip) :: n, nu, nc, h, nm
         n = sys%n
         if (.not. sys%jfree) then
             call dgemm('N', 'N', n, 1, n, 1.0_wp, sys%jcur, n, x, n, 0.0_wp, y, n)
@@ -570,29 +578,7 @@ contains
         nc = sys%nc
         xv = reshape(x, [nu, nc])
         allocate (f(nu, nc), y2(nu, nc), fc(nu), v(size(sys%gj, 1), 1), b1(nu, 1))
-        f = 0.0_wp
-        do g = 1, size(sys%cs%grp)
-            associate (gr => sys%cs%grp(g), gg => sys%cs%g)
-                allocate (xl(nc, gr%ndir), fl(nc*gr%ndir))
-                do e = 1, gr%ne
-                    do d = 1, gr%ndir
-                        r = gr%row0 + (e - 1)*gr%ndir + d
-                        xl(:, d) = 0.0_wp
-                        do k = gg%p(r), gg%p(r + 1) - 1
-                            xl(:, d) = xl(:, d) + gg%x(k)*xv(gg%i(k), :)
-                        end do
-                    end do
-                    fl = matmul(gr%jac(:, :, e), reshape(xl, [nc*gr%ndir]))
-                    do d = 1, gr%ndir
-                        r = gr%row0 + (e - 1)*gr%ndir + d
-                        do k = gg%p(r), gg%p(r + 1) - 1
-                            f(gg%i(k), :) = f(gg%i(k), :) + gg%x(k)*fl(1 + nc*(d - 1):nc*d)
-                        end do
-                    end do
-                end do
-                deallocate (xl, fl)
-            end associate
-        end do
+        call kmul(sys, xv, f, .false.)
         if (allocated(sys%phr)) then
             ! real modes, the same for every harmonic: all harmonics in two products (the
             ! modes are read twice, not twice per harmonic); A^T commutes with harm_col
@@ -617,17 +603,166 @@ contains
         y = x + reshape(y2, [n])
     end subroutine jmul
 
+    !> f = K x (trans: K^T x) for K = dF_c/dU = G^T J_e G element by element, x and f
+    !> (nu, nc) by harmonic coefficient.
+    subroutine kmul(sys, xv, f, trans)
+        type(hbm_condensed), intent(in) :: sys
+        real(wp), intent(in) :: xv(:, :)
+        real(wp), intent(out) :: f(:, :)
+        logical, intent(in) :: trans
+        real(wp), allocatable :: xl(:, :), fl(:)
+        integer(ip) :: nc, g, e, d, r, k
+        nc = sys%nc
+        f = 0.0_wp
+        do g = 1, size(sys%cs%grp)
+            associate (gr => sys%cs%grp(g), gg => sys%cs%g)
+                allocate (xl(nc, gr%ndir), fl(nc*gr%ndir))
+                do e = 1, gr%ne
+                    do d = 1, gr%ndir
+                        r = gr%row0 + (e - 1)*gr%ndir + d
+                        xl(:, d) = 0.0_wp
+                        do k = gg%p(r), gg%p(r + 1) - 1
+                            xl(:, d) = xl(:, d) + gg%x(k)*xv(gg%i(k), :)
+                        end do
+                    end do
+                    if (trans) then
+                        fl = matmul(reshape(xl, [nc*gr%ndir]), gr%jac(:, :, e))
+                    else
+                        fl = matmul(gr%jac(:, :, e), reshape(xl, [nc*gr%ndir]))
+                    end if
+                    do d = 1, gr%ndir
+                        r = gr%row0 + (e - 1)*gr%ndir + d
+                        do k = gg%p(r), gg%p(r + 1) - 1
+                            f(gg%i(k), :) = f(gg%i(k), :) + gg%x(k)*fl(1 + nc*(d - 1):nc*d)
+                        end do
+                    end do
+                end do
+                deallocate (xl, fl)
+            end associate
+        end do
+    end subroutine kmul
+
+    !> The Woodbury data of a fresh single LU (real modes): the WB_PAIRS (mode, harmonic
+    !> >= 1) pairs whose factor moves most with w at the LU's w (|dg| |phi|^2), their U,
+    !> LU^-1 U, U^T K and its product (see hbm_condensed%wb_ok). Only a preconditioner.
+    subroutine wb_build(sys)
+        type(hbm_condensed), intent(inout) :: sys
+        real(wp), allocatable :: sens(:, :), nphi(:), xv(:, :), f(:, :)
+        real(real32), allocatable :: ws(:, :)
+        integer(ip) :: nu, nc, nm, np, k, h, r, c, q, loc(2), linfo, n
+        real(wp) :: smax, hw
+        sys%wb_ok = .false.
+        sys%wb_at = -1.0_wp
+        if (.not. allocated(sys%phr) .or. sys%nh < 1) return
+        nu = sys%nnl
+        nc = sys%nc
+        n = sys%n
+        nm = size(sys%gj, 1)
+        allocate (sens(nm, sys%nh), nphi(nm))
+        do r = 1, nm
+            nphi(r) = sum(sys%phr(1:nu, r)**2)
+        end do
+        do h = 1, sys%nh
+            hw = h*sys%wj
+            sens(:, h) = abs(sys%gj(:, h)**2*cmplx(-2.0_wp*h*hw, 2.0_wp*sys%zm(:, h)* &
+                                                   sys%wm(:, h)*h, wp))*sys%wj*nphi
+        end do
+        smax = maxval(sens)
+        if (.not. smax > 0.0_wp) return
+        np = min(WB_PAIRS, nm*sys%nh)
+        if (allocated(sys%wbm)) deallocate (sys%wbm, sys%wbh, sys%wbg, sys%wbw, sys%wbv, &
+                                            sys%wbs, sys%wbl, sys%wbp)
+        allocate (sys%wbm(np), sys%wbh(np), sys%wbg(np))
+        k = 0
+        do while (k < np)
+            loc = maxloc(sens)
+            if (.not. sens(loc(1), loc(2)) > WB_FLOOR*smax) exit
+            k = k + 1
+            sys%wbm(k) = loc(1)
+            sys%wbh(k) = loc(2)
+            sys%wbg(k) = sys%gj(loc(1), loc(2))
+            sens(loc(1), loc(2)) = -1.0_wp
+        end do
+        np = k
+        if (np == 0) return
+        allocate (sys%wbw(n, 2*np), sys%wbv(2*np, n), sys%wbs(2*np, 2*np), &
+                  sys%wbl(2*np, 2*np), sys%wbp(2*np), xv(nu, nc), f(nu, nc))
+        sys%wbw = 0.0_wp
+        do k = 1, np
+            do q = 0, 1
+                c = 2*sys%wbh(k) + q
+                sys%wbw(nu*(c - 1) + 1:nu*c, 2*k - 1 + q) = sys%phr(1:nu, sys%wbm(k))
+                ! row of V: (K^T U_k)^T
+                xv = 0.0_wp
+                xv(:, c) = sys%phr(1:nu, sys%wbm(k))
+                call kmul(sys, xv, f, .true.)
+                sys%wbv(2*k - 1 + q, :) = reshape(f, [n])
+            end do
+        end do
+        ws = real(sys%wbw, real32)
+        call sgetrs('N', n, 2*np, sys%jms, n, sys%ipiv, ws, n, linfo)
+        sys%wbw = real(ws, wp)
+        call dgemm('N', 'N', 2*np, 2*np, n, 1.0_wp, sys%wbv, 2*np, sys%wbw, n, 0.0_wp, &
+                   sys%wbs, 2*np)
+        sys%wb_ok = linfo == 0
+    end subroutine wb_build
+
+    !> The small LU of I + D wbs for the factors at the J's w (gj), D the change since the
+    !> LU in the real harmonic form ([dr di; -di dr] per pair).
+    subroutine wb_prepare(sys)
+        type(hbm_condensed), intent(inout) :: sys
+        integer(ip) :: k, m, i, linfo
+        complex(wp) :: d
+        real(wp) :: dr, di
+        if (.not. (sys%wb_ok .and. sys%lu_single) .or. sys%wb_at == sys%wj) return
+        m = size(sys%wbs, 1)
+        do k = 1, m/2
+            d = sys%gj(sys%wbm(k), sys%wbh(k)) - sys%wbg(k)
+            dr = real(d, wp)
+            di = aimag(d)
+            i = 2*k - 1
+            sys%wbl(i, :) = dr*sys%wbs(i, :) + di*sys%wbs(i + 1, :)
+            sys%wbl(i + 1, :) = -di*sys%wbs(i, :) + dr*sys%wbs(i + 1, :)
+        end do
+        do i = 1, m
+            sys%wbl(i, i) = sys%wbl(i, i) + 1.0_wp
+        end do
+        call dgetrf(m, m, sys%wbl, m, sys%wbp, linfo)
+        if (linfo /= 0) then
+            sys%wb_ok = .false.
+            return
+        end if
+        sys%wb_at = sys%wj
+    end subroutine wb_prepare
+
     !> w := M^-1 w for the LU held (jms single precision, or jm), all columns at once.
     subroutine lu_apply(sys, w)
         type(hbm_condensed), intent(in) :: sys
         real(wp), intent(inout) :: w(:, :)
         real(real32), allocatable :: ws(:, :)
-        integer(ip) :: n, linfo
+        real(wp), allocatable :: t(:, :), t2(:, :)
+        complex(wp) :: d
+        integer(ip) :: n, linfo, m, k
         n = sys%n
         if (sys%lu_single) then
             ws = real(w, real32)
             call sgetrs('N', n, size(w, 2), sys%jms, n, sys%ipiv, ws, n, linfo)
             w = real(ws, wp)
+            if (sys%wb_ok .and. sys%wb_at == sys%wj) then
+                ! w -= W (I + D S)^-1 D V w
+                m = size(sys%wbs, 1)
+                allocate (t(m, size(w, 2)), t2(m, size(w, 2)))
+                call dgemm('N', 'N', m, size(w, 2), n, 1.0_wp, sys%wbv, m, w, size(w, 1), &
+                           0.0_wp, t, m)
+                do k = 1, m/2
+                    d = sys%gj(sys%wbm(k), sys%wbh(k)) - sys%wbg(k)
+                    t2(2*k - 1, :) = real(d, wp)*t(2*k - 1, :) + aimag(d)*t(2*k, :)
+                    t2(2*k, :) = -aimag(d)*t(2*k - 1, :) + real(d, wp)*t(2*k, :)
+                end do
+                call dgetrs('N', m, size(w, 2), sys%wbl, m, sys%wbp, t2, m, linfo)
+                call dgemm('N', 'N', n, size(w, 2), m, -1.0_wp, sys%wbw, n, t2, m, 1.0_wp, &
+                           w, size(w, 1))
+            end if
         else
             call dgetrs('N', n, size(w, 2), sys%jm, n, sys%ipiv, w, size(w, 1), linfo)
         end if
@@ -670,6 +805,7 @@ contains
             bn(c) = norm2(b(:, c))
         end do
         done = bn == 0.0_wp
+        call wb_prepare(sys)
         x = b
         call lu_apply(sys, x)
         do
