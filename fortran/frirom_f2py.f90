@@ -181,8 +181,9 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     integer(4), intent(out) :: info
     character(len=512), intent(out) :: msg
     !> the LU carried from run to run of the same model (hbm_lu_holds; nlu = 0 or 1 and a
-    !> dummy when it is not): dgetrf factors and pivots, lustate(1) = 1 when valid and
-    !> lustate(2) the GMRES iterations spent on it; read at the start, written at the end
+    !> dummy when it is not): dgetrf (lustate(1) = 1) or sgetrf (2) factors and pivots,
+    !> lustate(1) = 0 when invalid, lustate(2) the GMRES iterations spent on it; read at
+    !> the start, written at the end
     integer(4), intent(in) :: nlu
     real(8), intent(inout) :: lu(nlu, nlu), lustate(2)
     integer(4), intent(inout) :: lupiv(nlu)

@@ -23,6 +23,12 @@ submodule (frirom_hbm) frirom_hbm_condensed
     !> path stays the one of the LUs). Deterministic: sizes and counts only.
     real(wp), parameter :: GN_TOL = 1.0e-8_wp, LU_SPEEDUP = 10.0_wp, GN_WORTH_MIN = 12.0_wp
     integer(ip), parameter :: GN_MINIT = 4
+    !> GMRES iterations on a fresh single-precision LU before J is factorised in double
+    integer(ip), parameter :: GS_MAXIT = 12
+    !> Woodbury correction of a single LU: at most WB_PAIRS (mode, harmonic) pairs, those
+    !> above WB_FLOOR times the most sensitive
+    integer(ip), parameter :: WB_PAIRS = 96
+    real(wp), parameter :: WB_FLOOR = 1.0e-4_wp
 
 contains
 
@@ -158,6 +164,7 @@ contains
                 ! J for products only, the LU stays: the next solve by GMRES (cond_solve)
                 this%jfree = .true.
                 this%gm_next = .true.
+                this%lu_now = .false.
                 return
             end if
             if (use_krylov(this)) then
@@ -347,18 +354,43 @@ contains
         end do
     end subroutine jac_dense
 
-    !> LU of J (jm := jcur first in Krylov mode).
-    subroutine cond_factor(sys, info, errmsg)
+    !> LU of J (jm := jcur first in Krylov mode). Systems that hold their LU
+    !> (cond_lu_holds) factorise a single-precision copy into jms: half the flops of the LU
+    !> and half the memory traffic of each triangular solve; it only preconditions GMRES
+    !> (cond_solve) and jm keeps J for a double LU (double) if that GMRES stalls.
+    subroutine cond_factor(sys, info, errmsg, double)
         type(hbm_condensed), intent(inout) :: sys
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
-        integer(ip) :: n, linfo
+        logical, intent(in), optional :: double
+        integer(ip) :: n, linfo, stat
         real(wp) :: t0
+        logical :: single
         info = FRIROM_OK
         n = sys%n
         t0 = wtime()
         if (use_krylov(sys)) sys%jm = sys%jcur
-        call dgetrf(n, n, sys%jm, n, sys%ipiv, linfo)
+        single = holds(sys)
+        if (present(double)) single = single .and. .not. double
+        if (single .and. .not. allocated(sys%jms)) then
+            allocate (sys%jms(n, n), stat=stat)
+            if (stat /= 0) then
+                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: single LU')
+                return
+            end if
+        end if
+        if (single) then
+            sys%jms = real(sys%jm, real32)
+            call sgetrf(n, n, sys%jms, n, sys%ipiv, linfo)
+            ! J (at the LU's frequency gj and contact state) applied matrix-free
+            sys%jfree = .true.
+            sys%lu_single = .true.
+            if (linfo == 0) call wb_build(sys)
+        else
+            call dgetrf(n, n, sys%jm, n, sys%ipiv, linfo)
+        end if
+        sys%lu_single = single
+        sys%lu_now = linfo == 0
         sys%timers(T_FACT) = sys%timers(T_FACT) + wtime() - t0
         sys%timers(N_FACT) = sys%timers(N_FACT) + 1
         sys%lu_fresh = linfo == 0
@@ -366,8 +398,8 @@ contains
         sys%gm_spent = 0.0_wp
         sys%refresh = .false.
         if (linfo > 0) then
-            call set_status(info, FRIROM_ERR_SINGULAR, errmsg, 'condensed Jacobian: dgetrf '// &
-                            'zero pivot')
+            call set_status(info, FRIROM_ERR_SINGULAR, errmsg, 'condensed Jacobian: '// &
+                            merge('sgetrf', 'dgetrf', single)//' zero pivot')
         else if (linfo < 0) then
             call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'dgetrf: illegal argument')
         end if
@@ -383,38 +415,59 @@ contains
         direct_gm = this%gm_next
         this%gm_next = .false.
         j = 1
-        if (krylov .or. direct_gm) then
+        if (direct_gm) then
+            ! every column at once (one pass over the LU per iteration for all of them)
+            call gmres(this, b, its, ok, GN_TOL, max(GN_MINIT, int(gm_cost(this)/3.0_wp, ip)))
+            this%gm_spent = this%gm_spent + its
+            this%timers(N_KRYLOV) = this%timers(N_KRYLOV) + its
+            if (.not. ok) then
+                ! too slow: factorise this J, solve below
+                this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
+                call modal_rmat(this)
+                this%jfree = .false.
+                this%refresh = .true.
+                call cond_jacobian(this, info, errmsg)
+                if (info /= 0) return
+                t0 = wtime()
+            end if
+        else if (krylov) then
             ok = .true.
             do j = 1, size(b, 2)
-                if (direct_gm) then
-                    call gmres(this, b(:, j), its, ok, GN_TOL, &
-                               max(GN_MINIT, int(gm_cost(this)/3.0_wp, ip)))
-                    this%gm_spent = this%gm_spent + its
-                else
-                    call gmres(this, b(:, j), its, ok)
-                end if
+                call gmres(this, b(:, j:j), its, ok)
                 this%timers(N_KRYLOV) = this%timers(N_KRYLOV) + its
                 ! a preconditioner that needs many iterations is renewed at the next J
-                if (krylov .and. its > GM_REFRESH) this%refresh = .true.
+                if (its > GM_REFRESH) this%refresh = .true.
                 if (ok) cycle
                 ! too slow: factorise this J and solve the remaining columns directly
                 this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
-                if (this%jfree) then
-                    call modal_rmat(this)
-                    this%jfree = .false.
-                    this%refresh = .true.
-                    call cond_jacobian(this, info, errmsg)
-                else
-                    call cond_factor(this, info, errmsg)
-                end if
+                call cond_factor(this, info, errmsg)
                 if (info /= 0) return
                 t0 = wtime()
                 exit
             end do
-            if (ok) then
-                this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
-                return
-            end if
+        else
+            ok = .false.
+        end if
+        if (ok) then
+            this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
+            return
+        end if
+        if (this%lu_single .and. .not. this%lu_now) then
+            ! a chord step (Jacobian reused) with the LU of an older J, as a double one
+            call wb_prepare(this)
+            call lu_apply(this, b)
+            this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
+            return
+        else if (this%lu_single) then
+            ! the J of the LU (matrix-free) by GMRES on its single-precision LU
+            call gmres(this, b(:, j:), its, ok, GM_TOL, GS_MAXIT)
+            this%timers(N_KRYLOV) = this%timers(N_KRYLOV) + its
+            this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
+            if (ok) return
+            ! J too ill-conditioned for single precision: the double LU of the J in jm
+            call cond_factor(this, info, errmsg, double=.true.)
+            if (info /= 0) return
+            t0 = wtime()
         end if
         call dgetrs('N', this%n, size(b, 2) - j + 1, this%jm, this%n, this%ipiv, b(:, j:), &
                     size(b, 1), linfo)
@@ -464,9 +517,18 @@ contains
         select type (sys => sysc)
         type is (hbm_condensed)
             if (.not. holds(sys) .or. size(state) < 2) return
-            if (state(1) /= 1.0_wp .or. any(shape(lu) /= sys%n) .or. size(piv) /= sys%n) return
+            if (all(state(1) /= [1.0_wp, 2.0_wp]) .or. any(shape(lu) /= sys%n) .or. &
+                size(piv) /= sys%n) return
             if (.not. allocated(sys%jm)) return
-            sys%jm = lu
+            ! state(1) = 2: a single-precision LU (exact in lu)
+            sys%lu_single = state(1) == 2.0_wp
+            sys%lu_now = .false.
+            sys%wb_ok = .false.
+            if (sys%lu_single) then
+                sys%jms = real(lu, real32)
+            else
+                sys%jm = lu
+            end if
             sys%ipiv = piv
             sys%lu_any = .true.
             sys%lu_fresh = .false.
@@ -484,11 +546,15 @@ contains
             if (.not. holds(sys) .or. .not. sys%lu_any .or. .not. allocated(sys%jm)) return
             if (any(shape(lu) /= sys%n) .or. size(piv) /= sys%n) return
             if (sys%timers(N_FACT) > 0.0_wp) then
-                lu = sys%jm
+                if (sys%lu_single) then
+                    lu = real(sys%jms, wp)
+                else
+                    lu = sys%jm
+                end if
                 piv = sys%ipiv
                 new = .true.
             end if
-            state(1) = 1.0_wp
+            state(1) = merge(2.0_wp, 1.0_wp, sys%lu_single)
             state(2) = sys%gm_spent
         end select
     end procedure hbm_lu_export
@@ -500,9 +566,9 @@ contains
         type(hbm_condensed), intent(in) :: sys
         real(wp), intent(in) :: x(:)
         real(wp), intent(out) :: y(:)
-        real(wp), allocatable :: xv(:, :), f(:, :), xl(:, :), fl(:), y2(:, :), vr(:, :)
+        real(wp), allocatable :: xv(:, :), f(:, :), y2(:, :), vr(:, :)
         complex(wp), allocatable :: fc(:), v(:, :), b1(:, :)
-        integer(ip) :: n, nu, nc, g, e, d, r, k, h, nm
+        integer(ip) :: n, nu, nc, h, nm
         n = sys%n
         if (.not. sys%jfree) then
             call dgemm('N', 'N', n, 1, n, 1.0_wp, sys%jcur, n, x, n, 0.0_wp, y, n)
@@ -512,29 +578,7 @@ contains
         nc = sys%nc
         xv = reshape(x, [nu, nc])
         allocate (f(nu, nc), y2(nu, nc), fc(nu), v(size(sys%gj, 1), 1), b1(nu, 1))
-        f = 0.0_wp
-        do g = 1, size(sys%cs%grp)
-            associate (gr => sys%cs%grp(g), gg => sys%cs%g)
-                allocate (xl(nc, gr%ndir), fl(nc*gr%ndir))
-                do e = 1, gr%ne
-                    do d = 1, gr%ndir
-                        r = gr%row0 + (e - 1)*gr%ndir + d
-                        xl(:, d) = 0.0_wp
-                        do k = gg%p(r), gg%p(r + 1) - 1
-                            xl(:, d) = xl(:, d) + gg%x(k)*xv(gg%i(k), :)
-                        end do
-                    end do
-                    fl = matmul(gr%jac(:, :, e), reshape(xl, [nc*gr%ndir]))
-                    do d = 1, gr%ndir
-                        r = gr%row0 + (e - 1)*gr%ndir + d
-                        do k = gg%p(r), gg%p(r + 1) - 1
-                            f(gg%i(k), :) = f(gg%i(k), :) + gg%x(k)*fl(1 + nc*(d - 1):nc*d)
-                        end do
-                    end do
-                end do
-                deallocate (xl, fl)
-            end associate
-        end do
+        call kmul(sys, xv, f, .false.)
         if (allocated(sys%phr)) then
             ! real modes, the same for every harmonic: all harmonics in two products (the
             ! modes are read twice, not twice per harmonic); A^T commutes with harm_col
@@ -559,88 +603,291 @@ contains
         y = x + reshape(y2, [n])
     end subroutine jmul
 
-    !> b := J^-1 b by restarted GMRES on jcur, right-preconditioned by the LU in jm (from
-    !> an earlier J), from the preconditioned start x0 = LU^-1 b, to a residual of GM_TOL
-    !> |b| (or tol |b|); ok false (b unchanged) when GM_MAXIT (or maxit) iterations do not
-    !> get there.
+    !> f = K x (trans: K^T x) for K = dF_c/dU = G^T J_e G element by element, x and f
+    !> (nu, nc) by harmonic coefficient.
+    subroutine kmul(sys, xv, f, trans)
+        type(hbm_condensed), intent(in) :: sys
+        real(wp), intent(in) :: xv(:, :)
+        real(wp), intent(out) :: f(:, :)
+        logical, intent(in) :: trans
+        real(wp), allocatable :: xl(:, :), fl(:)
+        integer(ip) :: nc, g, e, d, r, k
+        nc = sys%nc
+        f = 0.0_wp
+        do g = 1, size(sys%cs%grp)
+            associate (gr => sys%cs%grp(g), gg => sys%cs%g)
+                allocate (xl(nc, gr%ndir), fl(nc*gr%ndir))
+                do e = 1, gr%ne
+                    do d = 1, gr%ndir
+                        r = gr%row0 + (e - 1)*gr%ndir + d
+                        xl(:, d) = 0.0_wp
+                        do k = gg%p(r), gg%p(r + 1) - 1
+                            xl(:, d) = xl(:, d) + gg%x(k)*xv(gg%i(k), :)
+                        end do
+                    end do
+                    if (trans) then
+                        fl = matmul(reshape(xl, [nc*gr%ndir]), gr%jac(:, :, e))
+                    else
+                        fl = matmul(gr%jac(:, :, e), reshape(xl, [nc*gr%ndir]))
+                    end if
+                    do d = 1, gr%ndir
+                        r = gr%row0 + (e - 1)*gr%ndir + d
+                        do k = gg%p(r), gg%p(r + 1) - 1
+                            f(gg%i(k), :) = f(gg%i(k), :) + gg%x(k)*fl(1 + nc*(d - 1):nc*d)
+                        end do
+                    end do
+                end do
+                deallocate (xl, fl)
+            end associate
+        end do
+    end subroutine kmul
+
+    !> The Woodbury data of a fresh single LU (real modes): the WB_PAIRS (mode, harmonic
+    !> >= 1) pairs whose factor moves most with w at the LU's w (|dg| |phi|^2), their U,
+    !> LU^-1 U, U^T K and its product (see hbm_condensed%wb_ok). Only a preconditioner.
+    subroutine wb_build(sys)
+        type(hbm_condensed), intent(inout) :: sys
+        real(wp), allocatable :: sens(:, :), nphi(:), xv(:, :), f(:, :)
+        real(real32), allocatable :: ws(:, :)
+        integer(ip) :: nu, nc, nm, np, k, h, r, c, q, loc(2), linfo, n
+        real(wp) :: smax, hw
+        sys%wb_ok = .false.
+        sys%wb_at = -1.0_wp
+        if (.not. allocated(sys%phr) .or. sys%nh < 1) return
+        nu = sys%nnl
+        nc = sys%nc
+        n = sys%n
+        nm = size(sys%gj, 1)
+        allocate (sens(nm, sys%nh), nphi(nm))
+        do r = 1, nm
+            nphi(r) = sum(sys%phr(1:nu, r)**2)
+        end do
+        do h = 1, sys%nh
+            hw = h*sys%wj
+            sens(:, h) = abs(sys%gj(:, h)**2*cmplx(-2.0_wp*h*hw, 2.0_wp*sys%zm(:, h)* &
+                                                   sys%wm(:, h)*h, wp))*sys%wj*nphi
+        end do
+        smax = maxval(sens)
+        if (.not. smax > 0.0_wp) return
+        np = min(WB_PAIRS, nm*sys%nh)
+        if (allocated(sys%wbm)) deallocate (sys%wbm, sys%wbh, sys%wbg, sys%wbw, sys%wbv, &
+                                            sys%wbs, sys%wbl, sys%wbp)
+        allocate (sys%wbm(np), sys%wbh(np), sys%wbg(np))
+        k = 0
+        do while (k < np)
+            loc = maxloc(sens)
+            if (.not. sens(loc(1), loc(2)) > WB_FLOOR*smax) exit
+            k = k + 1
+            sys%wbm(k) = loc(1)
+            sys%wbh(k) = loc(2)
+            sys%wbg(k) = sys%gj(loc(1), loc(2))
+            sens(loc(1), loc(2)) = -1.0_wp
+        end do
+        np = k
+        if (np == 0) return
+        allocate (sys%wbw(n, 2*np), sys%wbv(2*np, n), sys%wbs(2*np, 2*np), &
+                  sys%wbl(2*np, 2*np), sys%wbp(2*np), xv(nu, nc), f(nu, nc))
+        sys%wbw = 0.0_wp
+        do k = 1, np
+            do q = 0, 1
+                c = 2*sys%wbh(k) + q
+                sys%wbw(nu*(c - 1) + 1:nu*c, 2*k - 1 + q) = sys%phr(1:nu, sys%wbm(k))
+                ! row of V: (K^T U_k)^T
+                xv = 0.0_wp
+                xv(:, c) = sys%phr(1:nu, sys%wbm(k))
+                call kmul(sys, xv, f, .true.)
+                sys%wbv(2*k - 1 + q, :) = reshape(f, [n])
+            end do
+        end do
+        ws = real(sys%wbw, real32)
+        call sgetrs('N', n, 2*np, sys%jms, n, sys%ipiv, ws, n, linfo)
+        sys%wbw = real(ws, wp)
+        call dgemm('N', 'N', 2*np, 2*np, n, 1.0_wp, sys%wbv, 2*np, sys%wbw, n, 0.0_wp, &
+                   sys%wbs, 2*np)
+        sys%wb_ok = linfo == 0
+    end subroutine wb_build
+
+    !> The small LU of I + D wbs for the factors at the J's w (gj), D the change since the
+    !> LU in the real harmonic form ([dr di; -di dr] per pair).
+    subroutine wb_prepare(sys)
+        type(hbm_condensed), intent(inout) :: sys
+        integer(ip) :: k, m, i, linfo
+        complex(wp) :: d
+        real(wp) :: dr, di
+        if (.not. (sys%wb_ok .and. sys%lu_single) .or. sys%wb_at == sys%wj) return
+        m = size(sys%wbs, 1)
+        do k = 1, m/2
+            d = sys%gj(sys%wbm(k), sys%wbh(k)) - sys%wbg(k)
+            dr = real(d, wp)
+            di = aimag(d)
+            i = 2*k - 1
+            sys%wbl(i, :) = dr*sys%wbs(i, :) + di*sys%wbs(i + 1, :)
+            sys%wbl(i + 1, :) = -di*sys%wbs(i, :) + dr*sys%wbs(i + 1, :)
+        end do
+        do i = 1, m
+            sys%wbl(i, i) = sys%wbl(i, i) + 1.0_wp
+        end do
+        call dgetrf(m, m, sys%wbl, m, sys%wbp, linfo)
+        if (linfo /= 0) then
+            sys%wb_ok = .false.
+            return
+        end if
+        sys%wb_at = sys%wj
+    end subroutine wb_prepare
+
+    !> w := M^-1 w for the LU held (jms single precision, or jm), all columns at once.
+    subroutine lu_apply(sys, w)
+        type(hbm_condensed), intent(in) :: sys
+        real(wp), intent(inout) :: w(:, :)
+        real(real32), allocatable :: ws(:, :)
+        real(wp), allocatable :: t(:, :), t2(:, :)
+        complex(wp) :: d
+        integer(ip) :: n, linfo, m, k
+        n = sys%n
+        if (sys%lu_single) then
+            ws = real(w, real32)
+            call sgetrs('N', n, size(w, 2), sys%jms, n, sys%ipiv, ws, n, linfo)
+            w = real(ws, wp)
+            if (sys%wb_ok .and. sys%wb_at == sys%wj) then
+                ! w -= W (I + D S)^-1 D V w
+                m = size(sys%wbs, 1)
+                allocate (t(m, size(w, 2)), t2(m, size(w, 2)))
+                call dgemm('N', 'N', m, size(w, 2), n, 1.0_wp, sys%wbv, m, w, size(w, 1), &
+                           0.0_wp, t, m)
+                do k = 1, m/2
+                    d = sys%gj(sys%wbm(k), sys%wbh(k)) - sys%wbg(k)
+                    t2(2*k - 1, :) = real(d, wp)*t(2*k - 1, :) + aimag(d)*t(2*k, :)
+                    t2(2*k, :) = -aimag(d)*t(2*k - 1, :) + real(d, wp)*t(2*k, :)
+                end do
+                call dgetrs('N', m, size(w, 2), sys%wbl, m, sys%wbp, t2, m, linfo)
+                call dgemm('N', 'N', n, size(w, 2), m, -1.0_wp, sys%wbw, n, t2, m, 1.0_wp, &
+                           w, size(w, 1))
+            end if
+        else
+            call dgetrs('N', n, size(w, 2), sys%jm, n, sys%ipiv, w, size(w, 1), linfo)
+        end if
+    end subroutine lu_apply
+
+    !> b := J^-1 b, column by column, by restarted flexible GMRES on jcur (or J matrix-free),
+    !> right-preconditioned by the LU held (lu_apply, from an earlier J or in single
+    !> precision: the preconditioned directions Z are kept, so x = x0 + Z y is exact for
+    !> an inexact M), from x0 = M^-1 b, to a residual of GM_TOL |b| (or tol |b|). The
+    !> columns iterate in lockstep: one lu_apply per iteration for all of them. its: the
+    !> iterations summed over the columns; ok false (b unchanged) when a column needs
+    !> more than GM_MAXIT (or maxit).
     subroutine gmres(sys, b, its, ok, tol, maxit)
         type(hbm_condensed), intent(inout) :: sys
-        real(wp), intent(inout) :: b(:)
+        real(wp), intent(inout) :: b(:, :)
         integer(ip), intent(out) :: its
         logical, intent(out) :: ok
         real(wp), intent(in), optional :: tol
         integer(ip), intent(in), optional :: maxit
         integer(ip), parameter :: m = 30
-        real(wp), allocatable :: v(:, :), hh(:, :), cs(:), sn(:), gv(:), x(:), r(:), w(:, :)
-        real(wp) :: beta, bn, tmp, rtol
-        integer(ip) :: n, j, i, k, linfo, itmax
+        real(wp), allocatable :: v(:, :, :), z(:, :, :), hh(:, :, :), cs(:, :), sn(:, :), &
+                                 gv(:, :), x(:, :), r(:), w(:, :), bn(:)
+        real(wp) :: beta, tmp, rtol
+        integer(ip) :: n, nb, c, q, na, j, i, itmax
+        integer(ip), allocatable :: itc(:), kk(:), ac(:)
+        logical, allocatable :: done(:), act(:)
         n = sys%n
+        nb = size(b, 2)
         rtol = GM_TOL
         if (present(tol)) rtol = tol
         itmax = GM_MAXIT
         if (present(maxit)) itmax = maxit
-        allocate (v(n, m + 1), hh(m + 1, m), cs(m), sn(m), gv(m + 1), x(n), r(n), w(n, 1))
+        allocate (v(n, m + 1, nb), z(n, m, nb), hh(m + 1, m, nb), cs(m, nb), sn(m, nb), &
+                  gv(m + 1, nb), r(n), w(n, nb), bn(nb), itc(nb), kk(nb), ac(nb), &
+                  done(nb), act(nb))
         its = 0
         ok = .false.
-        bn = norm2(b)
-        if (bn == 0.0_wp) then
-            ok = .true.
-            return
-        end if
-        w(:, 1) = b
-        call dgetrs('N', n, 1, sys%jm, n, sys%ipiv, w, n, linfo)
-        x = w(:, 1)
-        do
-            ! r = b - J x
-            call jmul(sys, x, r)
-            r = b - r
-            beta = norm2(r)
-            if (beta <= rtol*bn) exit
-            if (its >= itmax) return
-            v(:, 1) = r/beta
-            gv = 0.0_wp
-            gv(1) = beta
-            k = 0
-            do j = 1, m
-                its = its + 1
-                k = j
-                ! w = J LU^-1 v_j, orthogonalised (modified Gram-Schmidt)
-                w(:, 1) = v(:, j)
-                call dgetrs('N', n, 1, sys%jm, n, sys%ipiv, w, n, linfo)
-                call jmul(sys, w(:, 1), v(:, j + 1))
-                do i = 1, j
-                    hh(i, j) = dot_product(v(:, i), v(:, j + 1))
-                    v(:, j + 1) = v(:, j + 1) - hh(i, j)*v(:, i)
-                end do
-                hh(j + 1, j) = norm2(v(:, j + 1))
-                if (hh(j + 1, j) > 0.0_wp) v(:, j + 1) = v(:, j + 1)/hh(j + 1, j)
-                do i = 1, j - 1
-                    tmp = cs(i)*hh(i, j) + sn(i)*hh(i + 1, j)
-                    hh(i + 1, j) = -sn(i)*hh(i, j) + cs(i)*hh(i + 1, j)
-                    hh(i, j) = tmp
-                end do
-                tmp = hypot(hh(j, j), hh(j + 1, j))
-                if (tmp == 0.0_wp) then
-                    ! breakdown: column j adds nothing; solve with the first j - 1
-                    k = j - 1
-                    exit
-                end if
-                cs(j) = hh(j, j)/tmp
-                sn(j) = hh(j + 1, j)/tmp
-                hh(j, j) = tmp
-                hh(j + 1, j) = 0.0_wp
-                gv(j + 1) = -sn(j)*gv(j)
-                gv(j) = cs(j)*gv(j)
-                if (abs(gv(j + 1)) <= 0.1_wp*rtol*bn .or. its >= itmax) exit
-            end do
-            ! x += LU^-1 V y, H y = g (upper triangular)
-            do i = k, 1, -1
-                gv(i) = (gv(i) - dot_product(hh(i, i + 1:k), gv(i + 1:k)))/hh(i, i)
-            end do
-            call dgemm('N', 'N', n, 1, k, 1.0_wp, v, n, gv, k, 0.0_wp, w, n)
-            call dgetrs('N', n, 1, sys%jm, n, sys%ipiv, w, n, linfo)
-            x = x + w(:, 1)
+        itc = 0
+        do c = 1, nb
+            bn(c) = norm2(b(:, c))
         end do
+        done = bn == 0.0_wp
+        call wb_prepare(sys)
+        x = b
+        call lu_apply(sys, x)
+        do
+            ! r = b - J x per open column
+            act = .false.
+            do c = 1, nb
+                if (done(c)) cycle
+                call jmul(sys, x(:, c), r)
+                r = b(:, c) - r
+                beta = norm2(r)
+                if (beta <= rtol*bn(c)) then
+                    done(c) = .true.
+                    cycle
+                end if
+                if (itc(c) >= itmax) then
+                    its = sum(itc)
+                    return
+                end if
+                v(:, 1, c) = r/beta
+                gv(:, c) = 0.0_wp
+                gv(1, c) = beta
+                act(c) = .true.
+            end do
+            if (all(done)) exit
+            kk = 0
+            do j = 1, m
+                na = 0
+                do c = 1, nb
+                    if (.not. act(c)) cycle
+                    na = na + 1
+                    ac(na) = c
+                    w(:, na) = v(:, j, c)
+                end do
+                if (na == 0) exit
+                call lu_apply(sys, w(:, 1:na))
+                do q = 1, na
+                    c = ac(q)
+                    itc(c) = itc(c) + 1
+                    kk(c) = j
+                    ! v_j+1 = J M^-1 v_j, orthogonalised (modified Gram-Schmidt)
+                    z(:, j, c) = w(:, q)
+                    call jmul(sys, z(:, j, c), v(:, j + 1, c))
+                    do i = 1, j
+                        hh(i, j, c) = dot_product(v(:, i, c), v(:, j + 1, c))
+                        v(:, j + 1, c) = v(:, j + 1, c) - hh(i, j, c)*v(:, i, c)
+                    end do
+                    hh(j + 1, j, c) = norm2(v(:, j + 1, c))
+                    if (hh(j + 1, j, c) > 0.0_wp) v(:, j + 1, c) = v(:, j + 1, c)/hh(j + 1, j, c)
+                    do i = 1, j - 1
+                        tmp = cs(i, c)*hh(i, j, c) + sn(i, c)*hh(i + 1, j, c)
+                        hh(i + 1, j, c) = -sn(i, c)*hh(i, j, c) + cs(i, c)*hh(i + 1, j, c)
+                        hh(i, j, c) = tmp
+                    end do
+                    tmp = hypot(hh(j, j, c), hh(j + 1, j, c))
+                    if (tmp == 0.0_wp) then
+                        ! breakdown: column j adds nothing; solve with the first j - 1
+                        kk(c) = j - 1
+                        act(c) = .false.
+                        cycle
+                    end if
+                    cs(j, c) = hh(j, j, c)/tmp
+                    sn(j, c) = hh(j + 1, j, c)/tmp
+                    hh(j, j, c) = tmp
+                    hh(j + 1, j, c) = 0.0_wp
+                    gv(j + 1, c) = -sn(j, c)*gv(j, c)
+                    gv(j, c) = cs(j, c)*gv(j, c)
+                    if (abs(gv(j + 1, c)) <= 0.1_wp*rtol*bn(c) .or. itc(c) >= itmax) &
+                        act(c) = .false.
+                end do
+            end do
+            ! x += Z y, H y = g (upper triangular)
+            do c = 1, nb
+                if (done(c) .or. kk(c) == 0) cycle
+                do i = kk(c), 1, -1
+                    gv(i, c) = (gv(i, c) - dot_product(hh(i, i + 1:kk(c), c), &
+                                                       gv(i + 1:kk(c), c)))/hh(i, i, c)
+                end do
+                call dgemv('N', n, kk(c), 1.0_wp, z(:, :, c), n, gv(:, c), 1, 1.0_wp, &
+                           x(:, c), 1)
+            end do
+        end do
+        its = sum(itc)
         b = x
         ok = .true.
     end subroutine gmres

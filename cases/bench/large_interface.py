@@ -38,7 +38,8 @@ per point x the points of the largest whole FRF (marked "short").
     OPENBLAS_NUM_THREADS=1 .venv/bin/python cases/bench/large_interface.py [--quick]
         [--pairs 200] [--threads 1] [--route "name:key=value,..."] [--budget 600]
 
-Last line: seconds for the ROM_I FRF and for the ROM_II FRF (first route).
+Last lines: the scaling's CPU growth exponent over its whole FRFs (when run), seconds for
+the ROM_I FRF and for the ROM_II FRF (first route).
 """
 
 from __future__ import annotations
@@ -333,7 +334,8 @@ def scaling(a, sizes, kw, main_row, pairs, spec_for, roms, band, sectors, n_mode
     DoFs) per harmonic and the dense LU (unknowns)^3: with every interface DoF kept in
     ROM_I both grow about like pairs^3, so the FRF stays under pairs^2 only as far as held
     LUs and GMRES (pairs^2 per iteration) replace factorisations; the LU is carried from
-    call to call (batches, peak solves), so an FRF needs fewer LUs as they grow dearer."""
+    call to call (batches, peak solves), so an FRF needs fewer LUs as they grow dearer.
+    Returns the line of the CPU exponent over the whole FRFs, for the benchmark's end."""
     print(f"\nscaling, route {first_route(a)!r}, ROM_I of the same kind (sectors {sectors}, "
           f"{n_modes} CB modes per stage, {2 * sectors} active nodes x 3; every interface DoF "
           "kept)")
@@ -406,6 +408,10 @@ def scaling(a, sizes, kw, main_row, pairs, spec_for, roms, band, sectors, n_mode
                   f"time {_exponent(xs, ys):.2f} ({whole_fit}), time per evaluation "
                   f"{_exponent(xs, ye):.2f} (target <= 2); {_load()}")
         sys.stdout.flush()
+    if len(xw) >= 2:
+        return (f"CPU exponent over whole FRFs ({xw} pairs): {_exponent(xw, cw):.2f} "
+                "(target <= 2)")
+    return "CPU exponent: fewer than 2 whole FRFs"
 
 
 def first_route(a):
@@ -490,10 +496,13 @@ def main(a):
     scal = [int(v) for v in a.scaling.split(",") if v.strip()] if a.scaling else []
     if quick and a.scaling == SCALING:
         scal = [16, 32]
+    grow = None
     if scal:
-        scaling(a, scal, rts[first], rows.get((first, "ROM_I"), {}), pairs, spec_for, roms,
-                band, sectors, n_modes)
+        grow = scaling(a, scal, rts[first], rows.get((first, "ROM_I"), {}), pairs, spec_for,
+                       roms, band, sectors, n_modes)
     print(f"\ntotal benchmark time {time.perf_counter() - t_start:.0f} s; {_load()}")
+    if grow:
+        print(f"scaling: {grow}")
     r1, r2 = rows[(first, "ROM_I")], rows[(first, "ROM_II")]
 
     def sec(r):
