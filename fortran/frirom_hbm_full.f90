@@ -51,6 +51,8 @@ contains
         ndx = norm2(this%rd)
         nfe = norm2(this%fe0 + s*this%fe1)
         rref = max(nfe, ndx, norm2(this%fd))
+        ! the rest forces, left out of fd and fe0 (contact_set), stay in the reference
+        if (allocated(this%cs%c0)) rref = max(rref, norm2(this%cs%c0))
         this%rd = this%rd + this%fd - this%fe0 - s*this%fe1
         if (this%mode == HBM_LOAD) dl = -this%fe1
         do i = 1, this%ndof
