@@ -98,6 +98,7 @@ module frirom_aft
         logical, allocatable :: stepped(:)           !! (nbatch) period started from a step
         logical, allocatable :: accelerated(:)       !! (nbatch) a step was accepted
         integer(ip), allocatable :: hold(:)          !! (nbatch) plain periods before a step
+        real(wp), allocatable :: damp(:)             !! (nbatch) fraction of the step taken
     end type aft_plan
 
     ! The two entry points are generic names over separate module procedures: gfortran 12
@@ -321,7 +322,8 @@ contains
                   plan%events(nsamp))
         allocate (plan%dw(2, 3*nc), plan%dw0(2, 3*nc), plan%dft(2, 3*nc))
         allocate (plan%wplain(nb, 2), plan%res_base(nb), &
-                  plan%res_last(nb), plan%stepped(nb), plan%accelerated(nb), plan%hold(nb))
+                  plan%res_last(nb), plan%stepped(nb), plan%accelerated(nb), plan%hold(nb), &
+                  plan%damp(nb))
     end subroutine aft_plan_create
 
     !> Release the plans and work arrays (a destroyed or never created plan is fine).
@@ -335,6 +337,7 @@ contains
         if (allocated(plan%tangent)) deallocate (plan%tangent, plan%follow)
         if (allocated(plan%dw)) deallocate (plan%dw, plan%dw0, plan%dft)
         if (allocated(plan%wplain)) deallocate (plan%wplain, plan%res_base, plan%res_last, &
-                                                plan%stepped, plan%accelerated, plan%hold)
+                                                plan%stepped, plan%accelerated, plan%hold, &
+                                                plan%damp)
     end subroutine aft_plan_destroy
 end module frirom_aft
