@@ -74,7 +74,7 @@ contains
     end function use_krylov
 
     module procedure cond_eval
-        real(wp) :: w, s, nx, nxe, nhf, nrc
+        real(wp) :: w, s, nx, nxe, nhf, nrc, nxd, nhd
         integer(ip) :: nnl, nc, h, n, nm
         complex(wp), allocatable :: fc(:), z(:), dz(:), rh(:), xe(:), v(:), x3(:, :), b3(:, :)
         real(wp), allocatable :: r2(:, :), rl2(:, :)   !! (nnl, nc) r and rlam by harmonic
@@ -98,6 +98,8 @@ contains
         end if
         nxe = 0.0_wp
         nhf = 0.0_wp
+        nxd = 0.0_wp
+        nhd = 0.0_wp
         nx = norm2(y)
         nrc = 0.0_wp
         if (allocated(this%cs%c0)) then
@@ -140,6 +142,10 @@ contains
             end if
             nhf = nhf + sum(abs(rh)**2)
             nxe = nxe + sum(abs(xe)**2)
+            if (h > 0) then
+                nhd = nhd + sum(abs(rh)**2)
+                nxd = nxd + sum(abs(xe)**2)
+            end if
             rh = rh - xe + harm_col(this%xd, h)
             call harm_set(r2, h, rh)
             ! dR/dlam (into xe)
@@ -164,6 +170,8 @@ contains
         r = reshape(r2, [n])
         rlam = reshape(rl2, [n])
         rref = max(sqrt(nxe), nx, sqrt(nhf), nrc)
+        ! harmonics 1..H alone (hbm_rnorm)
+        this%rref_dyn = max(sqrt(nxd), norm2(y(nnl + 1:)), sqrt(nhd))
         if (.not. jac) return
         if (this%modal) then
             this%gj = this%g
