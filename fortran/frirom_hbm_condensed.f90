@@ -170,7 +170,7 @@ contains
         r = reshape(r2, [n])
         rlam = reshape(rl2, [n])
         rref = max(sqrt(nxe), nx, sqrt(nhf), nrc)
-        ! harmonics 1..H alone (hbm_rnorm)
+        ! harmonics 1..H alone (hbm_roundoff)
         this%rref_dyn = max(sqrt(nxd), norm2(y(nnl + 1:)), sqrt(nhd))
         if (.not. jac) return
         if (this%modal) then

@@ -51,7 +51,7 @@ contains
         ndx = norm2(this%rd)
         nfe = norm2(this%fe0 + s*this%fe1)
         rref = max(nfe, ndx, norm2(this%fd))
-        ! harmonics 1..H alone (hbm_rnorm)
+        ! harmonics 1..H alone (hbm_roundoff)
         this%rref_dyn = max(norm2(this%fe0(:, 2:) + s*this%fe1(:, 2:)), norm2(this%rd(:, 2:)), &
                             norm2(this%fd(:, 2:)))
         ! the rest forces, left out of fd and fe0 (contact_set), stay in the reference

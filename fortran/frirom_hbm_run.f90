@@ -10,17 +10,18 @@ submodule (frirom_hbm) frirom_hbm_run
 
 contains
 
-    module procedure hbm_rnorm
-        real(wp) :: r0, rd
-        integer(ip) :: n0
-        rn = norm2(r)/max(rref, tiny(1.0_wp))
-        if (this%rref_dyn < 0.0_wp) return
+    module procedure hbm_roundoff
+        real(wp) :: r0, rd, tiny_r
+        tiny_r = 100.0_wp*epsilon(1.0_wp)
+        if (this%rref_dyn < 0.0_wp) then
+            yes = norm2(r) <= tiny_r*rref
+            return
+        end if
         select type (this)
         type is (hbm_condensed)
             ! harmonic by harmonic, nnl unknowns each: harmonic 0 first
-            n0 = this%nnl
-            r0 = norm2(r(1:n0))
-            rd = norm2(r(n0 + 1:))
+            r0 = norm2(r(1:this%nnl))
+            rd = norm2(r(this%nnl + 1:))
         class default
             ! DoF by DoF, nc harmonics each: harmonic 0 first
             associate (rr => reshape(r, [this%nc, size(r)/this%nc]))
@@ -28,8 +29,8 @@ contains
                 rd = norm2(rr(2:, :))
             end associate
         end select
-        rn = hypot(r0/max(rref, tiny(1.0_wp)), rd/max(this%rref_dyn, tiny(1.0_wp)))
-    end procedure hbm_rnorm
+        yes = r0 <= tiny_r*rref .and. rd <= tiny_r*this%rref_dyn
+    end procedure hbm_roundoff
 
     module procedure hbm_setup
         integer(ip) :: nc, ng, g, nrows, row, ip0, iw0, npar, nsl, ne, nd, i, k, ncol, nnl

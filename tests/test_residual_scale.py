@@ -1,14 +1,14 @@
-"""Newton's residual scale with a large static preload (frirom_hbm hbm_rnorm).
+"""Newton's round-off acceptance with a large static preload (frirom_hbm hbm_roundoff).
 
 A body on a soft mount (12 N/m, as the paper_hooks vane) carries a stuck, heavily
 preloaded contact (1 MN, 2e11 N/m: the interlocking lug) and a lightly preloaded one that
-slips (10 N). The condensed residual is in metres: its harmonic-0 reference holds the
-preload's image through the soft mount (1e6 / 12 ~ 6e4 m), while the vibration is ~1e-5 m.
-Measured against that one reference, the vibration harmonics were accepted at
-|R| / rref <= 100 eps, i.e. at ~1e-9 m: the FRF's points lay up to 7.8e-6 (of the largest
-unknown) from the solution and the condensed peak was 18 % above the banded one. Measured
-against their own reference they are converged like the banded formulation's (whose
-residual is in newtons).
+slips (10 N). The condensed residual is in metres: its reference holds the preload's image
+through the soft mount (1e6 / 12 ~ 6e4 m), while the vibration is ~1e-5 m. Newton accepts a
+point whatever its last update once the residual is at round-off; measured against that one
+reference, the vibration harmonics passed at ~1e-9 m, far above their round-off, and the
+FRF's points lay up to 7.8e-6 (of the largest unknown) from the solution. Tested block by
+block (harmonic 0 against the whole reference, harmonics 1..H against theirs), the points
+are converged like the banded formulation's (whose residual is in newtons).
 """
 
 import dataclasses
@@ -55,8 +55,9 @@ def _run(model, formulation):
 
 def test_condensed_points_converged_under_a_large_preload(model):
     """Every third condensed FRF point against the point re-solved from it with
-    tol_residual 1e-14 / tol_update 1e-13: within 1e-7 of the largest unknown (measured
-    3.4e-9 over all points; 7.8e-6 with the single reference)."""
+    tol_residual 1e-14 / tol_update 1e-13: within 1e-7 of the largest unknown (the update
+    tolerance 1e-8 with a margin; measured 1.2e-8 over all points, 7.8e-6 with the single
+    reference)."""
     m, ex = model
     r, opt = _run(model, "condensed")
     tight = dataclasses.replace(opt, tol_residual=1e-14, tol_update=1e-13, max_iter=80)
@@ -69,10 +70,12 @@ def test_condensed_points_converged_under_a_large_preload(model):
 
 def test_condensed_peak_equals_banded_under_a_large_preload(model):
     """The two formulations (residual in metres at the contact DoFs, in newtons at every
-    DoF) give the same peak: within 1e-5 in amplitude and frequency (measured 5e-8 and
-    2e-7, the points' spacing; with the single reference 18 % and 3.4e-4)."""
+    DoF) give the same peak of the stuck lug's tangential motion (output DoF 0, 3e-9 m:
+    1e-4 of the unknowns' scale, where the update tolerance 1e-8 allows ~1e-4): within
+    1e-3 in amplitude and 1e-5 in frequency (measured 6.6e-5 and 1.5e-6; with the single
+    reference 18 % and 3.4e-4)."""
     rc, _ = _run(model, "condensed")
     rb, _ = _run(model, "banded")
     pc, pb = rc.peak(0), rb.peak(0)
-    assert pc.amplitude == pytest.approx(pb.amplitude, rel=1e-5)
-    assert pc.omega == pytest.approx(pb.omega, rel=1e-5)
+    assert pc.amplitude == pytest.approx(pb.amplitude, rel=1e-3, abs=0.0)
+    assert pc.omega == pytest.approx(pb.omega, rel=1e-5, abs=0.0)
