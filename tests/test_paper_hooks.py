@@ -128,8 +128,9 @@ def test_normal2d_hooks_rom2_matches_rom1_with_the_lug_tied(tied):
     most slip: ROM_I runs through the range (the 2-D cycle closes at the onset of partial
     slip; it used to stop there: "not closed in 200 periods"), the hooks slip and lift
     off, and ROM_II's 40 GSI modes are within the issue's targets, 1 % in peak amplitude
-    and 0.1 % in peak frequency (measured -0.34 %, +4.9e-5). With the contact lug, ROM_I
-    normal2d stops before its peak on this mesh (README), so the tied lug is the test."""
+    and 0.1 % in peak frequency (measured -0.34 %, +4.9e-5). Its ROM_I used to stop at
+    180.2 Hz, where a carried slider made the 2-D march need thousands of periods
+    (frirom_aft_march settle_step2d, tests/test_aft.f90)."""
     import paper_hooks as ph
     r1 = ph.Rom(tied, "rom1", "coarse", law="normal2d")
     (f1, a1), res = _peak(r1, F0)
