@@ -46,7 +46,7 @@ module frirom_aft
 
     public :: aft_plan, aft_plan_create, aft_plan_destroy, aft_eval, aft_time
     public :: LAW_JENKINS, LAW_NORMAL1D, LAW_NORMAL2D, LAW_CUBIC, LAW_CODES
-    public :: law_info, law_check, law_ndir, law_npar, law_nslider
+    public :: law_info, law_check, law_ndir, law_npar, law_nslider, law_rest_force
 
     ! The contact-law table: the one source of the codes and sizes (the Python package
     ! checks its own table, with the names of directions and parameters, against it).
@@ -98,6 +98,7 @@ module frirom_aft
         logical, allocatable :: stepped(:)           !! (nbatch) period started from a step
         logical, allocatable :: accelerated(:)       !! (nbatch) a step was accepted
         integer(ip), allocatable :: hold(:)          !! (nbatch) plain periods before a step
+        real(wp), allocatable :: damp(:)             !! (nbatch) fraction of the step taken
     end type aft_plan
 
     ! The two entry points are generic names over separate module procedures: gfortran 12
@@ -119,9 +120,11 @@ module frirom_aft
         !> ends, after the last sample). A continuation passes slider back as the next
         !> point's w0, so that a contact entering stick-all-cycle keeps the slider where it
         !> last slipped (the stuck state is not unique; history decides it) instead of
-        !> jumping back to w0.
+        !> jumping back to w0. relative: f less the force at rest (law_rest_force: the
+        !> normal preload on harmonic 0), its samples computed as kn v (-n0 open), not as
+        !> (n0 + kn v) - n0: no rounding of the size eps n0 (a large preload).
         module subroutine aft_forces(plan, law, x, params, w0, f, info, errmsg, jac, periods, &
-                                     states, tol, max_periods, index_base, slider)
+                                     states, tol, max_periods, index_base, slider, relative)
             type(aft_plan), intent(inout) :: plan
             integer(ip), intent(in) :: law                !! LAW_*
             real(wp), intent(in) :: x(:, :, :)            !! (2H+1, ndir, ne), m
@@ -137,6 +140,7 @@ module frirom_aft
             integer(ip), intent(in), optional :: max_periods  !! (200)
             integer(ip), intent(in), optional :: index_base   !! element numbering in messages
             real(wp), intent(out), optional :: slider(:, :)   !! (nslider, ne), m
+            logical, intent(in), optional :: relative         !! (.false.)
         end subroutine aft_forces
     end interface aft_eval
 
@@ -251,6 +255,18 @@ contains
     end function law_list
 
     !> Number of directions of a law (0 for an unknown code).
+    !> The local force f(ndir) of one element at rest (zero relative displacement): the
+    !> normal preload max(n0, 0) of normal1d / normal2d on their normal direction (the
+    !> last), zero otherwise (Jenkins' fn0 has no normal direction; the tangential force
+    !> at rest depends on the slider, and is left in the harmonics).
+    pure subroutine law_rest_force(law, p, f)
+        integer(ip), intent(in) :: law
+        real(wp), intent(in) :: p(:)        !! (npar) the element's parameters
+        real(wp), intent(out) :: f(:)       !! (ndir) N
+        f = 0.0_wp
+        if (law == LAW_NORMAL1D .or. law == LAW_NORMAL2D) f(size(f)) = max(p(4), 0.0_wp)
+    end subroutine law_rest_force
+
     pure integer(ip) function law_ndir(law)
         integer(ip), intent(in) :: law
         law_ndir = 0
@@ -306,7 +322,8 @@ contains
                   plan%events(nsamp))
         allocate (plan%dw(2, 3*nc), plan%dw0(2, 3*nc), plan%dft(2, 3*nc))
         allocate (plan%wplain(nb, 2), plan%res_base(nb), &
-                  plan%res_last(nb), plan%stepped(nb), plan%accelerated(nb), plan%hold(nb))
+                  plan%res_last(nb), plan%stepped(nb), plan%accelerated(nb), plan%hold(nb), &
+                  plan%damp(nb))
     end subroutine aft_plan_create
 
     !> Release the plans and work arrays (a destroyed or never created plan is fine).
@@ -320,6 +337,7 @@ contains
         if (allocated(plan%tangent)) deallocate (plan%tangent, plan%follow)
         if (allocated(plan%dw)) deallocate (plan%dw, plan%dw0, plan%dft)
         if (allocated(plan%wplain)) deallocate (plan%wplain, plan%res_base, plan%res_last, &
-                                                plan%stepped, plan%accelerated, plan%hold)
+                                                plan%stepped, plan%accelerated, plan%hold, &
+                                                plan%damp)
     end subroutine aft_plan_destroy
 end module frirom_aft

@@ -13,7 +13,7 @@ contains
     module procedure aft_forces
         integer(ip) :: ne, nd, nc, nb, e0, m, j, e, d, s, np, nper, nfail, base, mp
         real(wp) :: tl
-        logical :: want_jac
+        logical :: want_jac, rel
         character(len=200) :: buf
 
         call check_call(plan, law, x, params, w0, f, info, errmsg, jac, periods, states, &
@@ -21,6 +21,9 @@ contains
         if (info /= FRIROM_OK) return
         call defaults(tol, max_periods, index_base, tl, mp, base)
         want_jac = present(jac)
+        rel = .false.
+        if (present(relative)) rel = relative .and. (law == LAW_NORMAL1D .or. &
+                                                     law == LAW_NORMAL2D)
         nd = NDIR_OF(law)
         ne = size(x, 3)
         nc = plan%fp%ncoef
@@ -46,6 +49,7 @@ contains
                     slider(1:NSLIDER_OF(law), e) = plan%w(j, 1:NSLIDER_OF(law))
             end do
             if (want_jac) call fill_series(plan, law, m)
+            if (rel) call relative_normal(m)
             do s = 1, np
                 call exec_r2c(plan%fp, s)
             end do
@@ -59,6 +63,23 @@ contains
             end do
         end do
         if (nfail /= 0) call set_status(info, FRIROM_ERR_NOCLOSE, errmsg, trim(buf))
+
+    contains
+
+        !> The normal force samples of the batch's mb elements less their force at rest
+        !> max(n0, 0): kn v where closed, -n0 open (the march's max(n0 + kn v, 0) - n0,
+        !> without the rounding of n0 + kn v).
+        subroutine relative_normal(mb)
+            integer(ip), intent(in) :: mb
+            integer(ip) :: jj
+            associate (rin => plan%fp%rin, rout => plan%fp%rout, par => plan%par)
+                do jj = 1, mb
+                    if (par(jj, 4) <= 0.0_wp) cycle
+                    rout(jj, :, nd) = merge(-par(jj, 4), par(jj, 2)*rin(jj, :, nd), &
+                                            plan%state(jj, :) == STATE_LIFTOFF)
+                end do
+            end associate
+        end subroutine relative_normal
     end procedure aft_forces
 
     module procedure aft_histories

@@ -73,6 +73,7 @@ contains
             plan%stepped(1:m) = .false.
             plan%accelerated(1:m) = .false.
             plan%hold(1:m) = 0
+            plan%damp(1:m) = 1.0_wp
             do nper = 1, max_periods
                 plan%wstart(1:m, :) = w
                 select case (law)
@@ -139,6 +140,7 @@ contains
         !> smallest det(I - M) a step is taken with
         real(wp), parameter :: DET_MIN = 1.0e-8_wp
         integer(ip), parameter :: HOLD = 2
+        real(wp), parameter :: DAMP_MIN = 2.0_wp**(-12)
         real(wp) :: res, mm(2, 2), a(2, 2), det, g(2)
         logical :: opened, try
         associate (w => plan%w(j, 1:2), ws => plan%wstart(j, 1:2))
@@ -150,8 +152,10 @@ contains
                     w = plan%wplain(j, :)
                     plan%res_last(j) = plan%res_base(j)
                     plan%hold(j) = HOLD
+                    plan%damp(j) = max(0.5_wp*plan%damp(j), DAMP_MIN)
                     return
                 end if
+                plan%damp(j) = min(2.0_wp*plan%damp(j), 1.0_wp)
                 try = .true.
             end if
             if (res <= tolj) then
@@ -173,8 +177,8 @@ contains
             g = w - ws
             plan%wplain(j, :) = w
             plan%res_base(j) = res
-            w(1) = ws(1) + (a(2, 2)*g(1) - a(1, 2)*g(2))/det
-            w(2) = ws(2) + (a(1, 1)*g(2) - a(2, 1)*g(1))/det
+            w(1) = ws(1) + plan%damp(j)*(a(2, 2)*g(1) - a(1, 2)*g(2))/det
+            w(2) = ws(2) + plan%damp(j)*(a(1, 1)*g(2) - a(2, 1)*g(1))/det
             plan%stepped(j) = .true.
             plan%accelerated(j) = .true.
         end associate

@@ -84,15 +84,15 @@ contains
                     allocate (wnew, mold=gr%w0)
                     wnew = gr%w0
                     call aft_eval(plan, gr%law, gr%x, gr%params, gr%w0, gr%f, info, errmsg, &
-                                  states=gr%states, slider=wnew)
+                                  states=gr%states, slider=wnew, relative=.true.)
                     if (info == 0) gr%w0 = wnew
                     deallocate (wnew)
                 else if (jac) then
                     call aft_eval(plan, gr%law, gr%x, gr%params, gr%w0, gr%f, info, errmsg, &
-                                  jac=gr%jac, states=gr%states)
+                                  jac=gr%jac, states=gr%states, relative=.true.)
                 else
                     call aft_eval(plan, gr%law, gr%x, gr%params, gr%w0, gr%f, info, errmsg, &
-                                  states=gr%states)
+                                  states=gr%states, relative=.true.)
                 end if
                 if (info /= 0) return
                 do e = 1, gr%ne

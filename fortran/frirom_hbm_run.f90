@@ -5,10 +5,32 @@ submodule (frirom_hbm) frirom_hbm_run
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, FRIROM_ERR_ALLOC, &
                              FRIROM_ERR_MODEL, FRIROM_ERR_LAW, set_status
     use frirom_newton, only: newton_correct, cont_tangent, cont_run
-    use frirom_aft, only: aft_plan_create, law_ndir, law_npar, law_nslider
+    use frirom_aft, only: aft_plan_create, law_ndir, law_npar, law_nslider, law_rest_force
     implicit none
 
 contains
+
+    module procedure hbm_roundoff
+        real(wp) :: r0, rd, tiny_r
+        tiny_r = 100.0_wp*epsilon(1.0_wp)
+        if (this%rref_dyn < 0.0_wp) then
+            yes = norm2(r) <= tiny_r*rref
+            return
+        end if
+        select type (this)
+        type is (hbm_condensed)
+            ! harmonic by harmonic, nnl unknowns each: harmonic 0 first
+            r0 = norm2(r(1:this%nnl))
+            rd = norm2(r(this%nnl + 1:))
+        class default
+            ! DoF by DoF, nc harmonics each: harmonic 0 first
+            associate (rr => reshape(r, [this%nc, size(r)/this%nc]))
+                r0 = norm2(rr(1, :))
+                rd = norm2(rr(2:, :))
+            end associate
+        end select
+        yes = r0 <= tiny_r*rref .and. rd <= tiny_r*this%rref_dyn
+    end procedure hbm_roundoff
 
     module procedure hbm_setup
         integer(ip) :: nc, ng, g, nrows, row, ip0, iw0, npar, nsl, ne, nd, i, k, ncol, nnl
@@ -184,6 +206,7 @@ contains
         end do
         call aft_plan_create(sys%plan, nh, nsamp, info, errmsg)
         if (info /= 0) return
+        call rest_shift(sys)
         ! contact couplings widen the band of the full formulation
         do g = 1, ng
             associate (gr => sys%cs%grp(g), gg => sys%cs%g)
@@ -202,6 +225,48 @@ contains
         end select
 
     contains
+
+        !> fe0's harmonic 0 less the image in the DoFs of c0 = G^T f_rest over G's columns
+        !> (T^T c0 condensed, c0 full): the contact forces are relative to rest
+        !> (contact_set); nothing when no element has a force at rest.
+        subroutine rest_shift(s)
+            class(hbm_system), intent(inout) :: s
+            real(wp), allocatable :: fr(:), c0(:), cdof(:)
+            integer(ip) :: gg, e, d, r, kk, j
+            allocate (c0(s%cs%g%ncol))
+            c0 = 0.0_wp
+            do gg = 1, size(s%cs%grp)
+                associate (gr => s%cs%grp(gg), gm => s%cs%g)
+                    allocate (fr(gr%ndir))
+                    do e = 1, gr%ne
+                        call law_rest_force(gr%law, gr%params(:, e), fr)
+                        do d = 1, gr%ndir
+                            if (fr(d) == 0.0_wp) cycle
+                            r = gr%row0 + (e - 1)*gr%ndir + d
+                            do kk = gm%p(r), gm%p(r + 1) - 1
+                                c0(gm%i(kk)) = c0(gm%i(kk)) + gm%x(kk)*fr(d)
+                            end do
+                        end do
+                    end do
+                    deallocate (fr)
+                end associate
+            end do
+            if (all(c0 == 0.0_wp)) return
+            s%cs%c0 = c0
+            select type (s)
+            type is (hbm_condensed)
+                allocate (cdof(s%ndof))
+                cdof = 0.0_wp
+                do j = 1, s%t%nrow
+                    do kk = s%t%p(j), s%t%p(j + 1) - 1
+                        cdof(s%t%i(kk)) = cdof(s%t%i(kk)) + s%t%x(kk)*c0(j)
+                    end do
+                end do
+                s%fe0(:, 1) = s%fe0(:, 1) - cdof
+            class default
+                s%fe0(:, 1) = s%fe0(:, 1) - c0
+            end select
+        end subroutine rest_shift
 
         pure function pattern_bw(a) result(bw)
             type(csr_matrix), intent(in) :: a

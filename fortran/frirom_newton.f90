@@ -39,6 +39,7 @@ module frirom_newton
         procedure(eval_iface), deferred :: eval
         procedure(solve_iface), deferred :: solve
         procedure :: accept => nl_accept
+        procedure :: roundoff => nl_roundoff
     end type nl_system
 
     abstract interface
@@ -129,6 +130,20 @@ contains
         if (.false.) errmsg = ''
         if (.false.) this%n = size(y) + int(lam)
     end subroutine nl_accept
+
+    !> Whether the residual r (rref from the same eval) is at the round-off level of its
+    !> terms, where Newton accepts a point whatever its last update (a near-singular J,
+    !> e.g. gross slip, can keep the update above tol_x there): ||r|| <= 100 eps rref. A
+    !> system whose residual falls into blocks of very different scales (a static preload
+    !> at harmonic 0, the vibration harmonics) overrides it with a test per block.
+    function nl_roundoff(this, r, rref) result(yes)
+        class(nl_system), intent(in) :: this
+        real(wp), intent(in) :: r(:)        !! (n) residual
+        real(wp), intent(in) :: rref        !! its reference magnitude
+        logical :: yes
+        yes = norm2(r) <= 100.0_wp*epsilon(1.0_wp)*rref
+        if (.false.) yes = this%n < 0
+    end function nl_roundoff
 
     !> Bordered Newton corrector: solve R(y, lam) = 0 together with the linear constraint
     !> cy.(y - yp)/yscale + cl (lam - lp)/lscale = 0 (cy = 0, cl = 1 fixes lam = lp;
@@ -228,7 +243,7 @@ contains
             ! converged: residual and update small; or the residual at round-off level
             ! (near-singular J, e.g. gross slip, can keep the update above tol_x there)
             if (rn <= opts%tol_r .and. abs(g) <= max(opts%tol_x, 1.0e-12_wp) .and. &
-                (dxn <= opts%tol_x .or. rn <= 100.0_wp*epsilon(1.0_wp))) return
+                (dxn <= opts%tol_x .or. sys%roundoff(r, rref))) return
         end do
         if (rn <= opts%tol_stall .and. abs(g) <= max(opts%tol_x, 1.0e-12_wp)) return
         call set_status(info, FRIROM_ERR_NOCONV, errmsg, 'newton_correct: no convergence')

@@ -128,8 +128,9 @@ def test_normal2d_hooks_rom2_matches_rom1_with_the_lug_tied(tied):
     most slip: ROM_I runs through the range (the 2-D cycle closes at the onset of partial
     slip; it used to stop there: "not closed in 200 periods"), the hooks slip and lift
     off, and ROM_II's 40 GSI modes are within the issue's targets, 1 % in peak amplitude
-    and 0.1 % in peak frequency (measured -0.34 %, +4.9e-5). With the contact lug, ROM_I
-    normal2d stops before its peak on this mesh (README), so the tied lug is the test."""
+    and 0.1 % in peak frequency (measured -0.34 %, +4.9e-5). Its ROM_I used to stop at
+    180.2 Hz, where a carried slider made the 2-D march need thousands of periods
+    (frirom_aft_march settle_step2d, tests/test_aft.f90)."""
     import paper_hooks as ph
     r1 = ph.Rom(tied, "rom1", "coarse", law="normal2d")
     (f1, a1), res = _peak(r1, F0)
@@ -138,3 +139,36 @@ def test_normal2d_hooks_rom2_matches_rom1_with_the_lug_tied(tied):
     (f2, a2), _ = _peak(ph.Rom(tied, "rom2", "coarse", 40, law="normal2d"), F0)
     assert a2 == pytest.approx(a1, rel=0.01)
     assert f2 == pytest.approx(f1, rel=0.001)
+
+
+def test_rom1_first_point_does_not_depend_on_the_stuck_lug_preload(case):
+    """The lug stays stuck, so its preload P only adds a constant force that its static
+    load balances: ROM_I's first point (f0 = 300 N, hooks slipping) is the same for
+    P = 100 kN, 300 kN and 1 MN. The static load over the vane's 12 N/m soft mount used to
+    appear at the contact DoFs as T D_0^-1 f_e ~ 1e5 m, cancelled by the contact term to
+    rounding: a floor of ~1e-11 m on unknowns of 6e-8 m (measured 2.3e-4 and 4.5e-4
+    relative). With the forces relative to rest (frirom_hbm contact_set) nothing large
+    cancels; what differs is Newton's stop (tol_update 1e-8 of the deck, converging
+    quadratically: measured 5e-12): tolerance 1e-9."""
+    import make_paper_hooks as mk
+    import paper_hooks as ph
+    from frirom.contact import LAWS
+    from frirom.solver import solve_point
+    rom = ph.Rom(case, "rom1", "coarse")
+    rom.set_preload(300.0)
+    lug = mk.lug_geometry(case / "hooks")
+    unit = ph.static_loads(rom.deck.reduced, lug, 1.0)       # per N of n0 on every pair
+    other = rom.excitation.F[:, 0] - unit * (mk.F_LUG / len(lug[0]))
+    groups = [i for i, g in enumerate(rom.groups) if g.startswith("lug")]
+    y = {}
+    for p in (1e5, 3e5, 1e6):
+        for i in groups:                 # normal1d: two groups share each pair's preload
+            c = rom.model.contacts[i]
+            c.params[:, LAWS[c.law].parameters.index("n0")] = p / len(lug[0]) / len(groups)
+        rom.excitation.F[:, 0] = other + unit * (p / len(lug[0]))
+        pt = solve_point(rom.model, rom.excitation, rom.deck.omega_start, rom.options,
+                         outputs=rom.deck.outputs)
+        assert pt.state_fractions[groups, 0].min() == 1.0     # the lug sticks
+        y[p] = pt.unknowns
+    for p in (3e5, 1e6):
+        assert np.abs(y[p] - y[1e5]).max() < 1e-9 * np.abs(y[1e5]).max(), p
