@@ -91,6 +91,8 @@ module frirom_aft
         real(wp), allocatable :: anchor_dtv(:)       !! (nbatch) its d ft / dv
         real(wp), allocatable :: dw(:, :), dw0(:, :) !! (2, 3(2H+1)) 2-D slider tangent
         real(wp), allocatable :: dft(:, :)           !! (2, 3(2H+1)) 2-D force tangent
+        real(wp), allocatable :: jw(:, :)            !! (2H+1, 3) 1-D Jacobian rows g, ru, rv
+        real(wp), allocatable :: jt(:, :)            !! (0:2H, 6) 1-D Jacobian trig sums
         ! 2-D slider fixed point: Newton steps between periods (frirom_aft_march)
         real(wp), allocatable :: wplain(:, :)        !! (nbatch, 2) plain march from the base
         real(wp), allocatable :: res_base(:)         !! (nbatch) mismatch of the base period
@@ -304,7 +306,8 @@ contains
         allocate (plan%w(nb, 2), plan%wstart(nb, 2), plan%scale(nb), plan%closed_at(nb))
         allocate (plan%anchor(nb), plan%anchor_state(nb), plan%anchor_dtv(nb), &
                   plan%events(nsamp))
-        allocate (plan%dw(2, 3*nc), plan%dw0(2, 3*nc), plan%dft(2, 3*nc))
+        allocate (plan%dw(2, 3*nc), plan%dw0(2, 3*nc), plan%dft(2, 3*nc), plan%jw(nc, 3), &
+                  plan%jt(0:2*nharm, 6))
         allocate (plan%wplain(nb, 2), plan%res_base(nb), &
                   plan%res_last(nb), plan%stepped(nb), plan%accelerated(nb), plan%hold(nb))
     end subroutine aft_plan_create
@@ -318,7 +321,7 @@ contains
         if (allocated(plan%anchor)) deallocate (plan%anchor, plan%anchor_state, plan%anchor_dtv, &
                                                    plan%events)
         if (allocated(plan%tangent)) deallocate (plan%tangent, plan%follow)
-        if (allocated(plan%dw)) deallocate (plan%dw, plan%dw0, plan%dft)
+        if (allocated(plan%dw)) deallocate (plan%dw, plan%dw0, plan%dft, plan%jw, plan%jt)
         if (allocated(plan%wplain)) deallocate (plan%wplain, plan%res_base, plan%res_last, &
                                                 plan%stepped, plan%accelerated, plan%hold)
     end subroutine aft_plan_destroy

@@ -4,14 +4,14 @@ submodule (frirom_aft) frirom_aft_eval
     use frirom_status, only: FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, &
                              FRIROM_ERR_NONFINITE, FRIROM_ERR_NOCLOSE, set_status, &
                              frirom_status_message
-    use frirom_fourier, only: exec_r2c, harmonics_of
+    use frirom_fourier, only: exec_r2c, harmonics_of, analyse_direct
     use frirom_contact, only: STATE_STICK, STATE_SLIP, STATE_LIFTOFF
     implicit none
 
 contains
 
     module procedure aft_forces
-        integer(ip) :: ne, nd, nc, nb, e0, m, j, e, d, s, np, nper, nfail, base, mp
+        integer(ip) :: ne, nd, nc, nb, e0, m, j, e, s, np, nper, nfail, base, mp
         real(wp) :: tl
         logical :: want_jac
         character(len=200) :: buf
@@ -45,15 +45,24 @@ contains
                 if (present(slider) .and. NSLIDER_OF(law) > 0) &
                     slider(1:NSLIDER_OF(law), e) = plan%w(j, 1:NSLIDER_OF(law))
             end do
-            if (want_jac) call fill_series(plan, law, m)
+            ! the series slots are read by the 2-D law's Jacobian only (the 1-D one scans the
+            ! states, the cubic reads its march's derivative)
+            if (want_jac .and. law == LAW_NORMAL2D) call fill_series(plan, law, m)
             do s = 1, np
-                call exec_r2c(plan%fp, s)
+                if (plan%fp%direct) then
+                    call analyse_direct(plan%fp, s, m)
+                    do j = 1, m
+                        f(:, s, e0 + j - 1) = plan%fp%coef(j, :)
+                    end do
+                else
+                    call exec_r2c(plan%fp, s)
+                    do j = 1, m
+                        call harmonics_of(plan%fp, s, j, f(:, s, e0 + j - 1))
+                    end do
+                end if
             end do
             do j = 1, m
                 e = e0 + j - 1
-                do d = 1, nd
-                    call harmonics_of(plan%fp, d, j, f(:, d, e))
-                end do
                 if (want_jac) call element_jacobian(plan, law, j, params(:, e), w0(:, e), tl, &
                                                     mp, jac(:, :, e))
             end do
