@@ -85,7 +85,7 @@ module frirom_aft
         real(wp), allocatable :: w(:, :), wstart(:, :)  !! (nbatch, 2) slider positions
         real(wp), allocatable :: scale(:)            !! (nbatch) closure scale
         integer(ip), allocatable :: closed_at(:)     !! (nbatch) period the cycle closed in
-        integer(ip), allocatable :: events(:)        !! (N) slip/lift-off samples of one element
+        integer(ip), allocatable :: events(:)        !! (N+1) run starts of one element
         integer(ip), allocatable :: anchor(:)        !! (nbatch) last slip/lift-off sample
         integer(ip), allocatable :: anchor_state(:)  !! (nbatch) its state
         real(wp), allocatable :: anchor_dtv(:)       !! (nbatch) its d ft / dv
@@ -305,7 +305,7 @@ contains
                   plan%follow(nb, nsamp, 2))
         allocate (plan%w(nb, 2), plan%wstart(nb, 2), plan%scale(nb), plan%closed_at(nb))
         allocate (plan%anchor(nb), plan%anchor_state(nb), plan%anchor_dtv(nb), &
-                  plan%events(nsamp))
+                  plan%events(nsamp + 1))
         allocate (plan%dw(2, 3*nc), plan%dw0(2, 3*nc), plan%dft(2, 3*nc), plan%jw(nc, 3), &
                   plan%jt(0:2*nharm, 6))
         allocate (plan%wplain(nb, 2), plan%res_base(nb), &

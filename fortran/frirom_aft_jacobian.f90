@@ -63,7 +63,7 @@ contains
         real(wp), intent(in) :: kt
         logical, intent(in) :: normal
         real(wp), intent(inout) :: jac(:, :)  !! (nd nc, nd nc)
-        integer(ip) :: n, nc, nh, k, k0, a, last, first_end, sk
+        integer(ip) :: n, nc, nh, k, k0, a, last, first_end, r, nrun
         logical :: any_event
         real(wp) :: kn
         n = plan%fp%nsamp
@@ -85,15 +85,10 @@ contains
             any_event = .false.
             last = 0
             first_end = 0
-            k0 = 1
-            do k = 1, n + 1
-                if (k <= n) then
-                    sk = st(j, k)
-                    if (sk == st(j, k0)) then
-                        if (.not. (normal .and. sk == STATE_SLIP)) cycle
-                        if (dtvs(k) == dtvs(k0)) cycle
-                    end if
-                end if
+            call run_starts(st(j, :), dtvs, normal, plan%events, nrun)
+            do r = 1, nrun
+                k0 = plan%events(r)
+                k = plan%events(r + 1)
                 select case (st(j, k0))
                 case (STATE_STICK)
                     call add_run(kt, k0, k - 1, ctu, stu)
@@ -116,7 +111,6 @@ contains
                     any_event = .true.
                     last = k - 1
                 end select
-                k0 = k
             end do
             call toeplitz_add(nh, n, ctu, stu, jac, 0_ip, 0_ip)
             if (normal) then
@@ -138,6 +132,31 @@ contains
             if (first_end > 0) call stick_segment(last, mod(last, n) + 1, first_end)
         end associate
     contains
+        !> Starts of the runs of equal state (slip runs of the normal law also of equal
+        !> d ft/dv, i.e. slip sign): starts(1:nrun), starts(nrun + 1) = N + 1. A tight
+        !> loop without calls, so the scan keeps its operands in registers.
+        pure subroutine run_starts(s, dtv, normal, starts, nrun)
+            integer(ip), intent(in) :: s(:)       !! (N) states
+            real(wp), intent(in) :: dtv(:)        !! (N) d ft/dv
+            logical, intent(in) :: normal
+            integer(ip), intent(out) :: starts(:) !! (N+1)
+            integer(ip), intent(out) :: nrun
+            integer(ip) :: k, slip_code
+            logical :: new_run
+            ! runs are maximal, so comparing with the previous sample is comparing with the
+            ! run's first; slip_code: a state no sample has when the law has no slip sign
+            slip_code = merge(STATE_SLIP, -1_ip, normal)
+            nrun = 1
+            starts(1) = 1
+            do k = 2, size(s)
+                new_run = s(k) /= s(k - 1) .or. (s(k) == slip_code .and. dtv(k) /= dtv(k - 1))
+                if (.not. new_run) cycle
+                nrun = nrun + 1
+                starts(nrun) = k
+            end do
+            starts(nrun + 1) = size(s) + 1
+        end subroutine run_starts
+
         !> jac -= kt g (ru, rv): stick samples i1..i2 (cyclic) anchored at sample a.
         subroutine stick_segment(a, i1, i2)
             integer(ip), intent(in) :: a, i1, i2

@@ -64,8 +64,10 @@ contains
             end do
             do j = 1, m
                 plan%scale(j) = max(tiny(1.0_wp), maxval(abs(w(j, 1:ns))))
-                do d = 1, NDIR_OF(law)
-                    plan%scale(j) = max(plan%scale(j), maxval(abs(rin(j, :, d))))
+            end do
+            do d = 1, NDIR_OF(law)      ! sample by sample over the batch (contiguous)
+                do i = 1, plan%fp%nsamp
+                    plan%scale(1:m) = max(plan%scale(1:m), abs(rin(1:m, i, d)))
                 end do
             end do
             ! where the sliders follow the contact point while it is open: fixed in u and v,
