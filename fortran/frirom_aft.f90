@@ -3,8 +3,10 @@
 !> Jacobian d(force harmonics)/d(displacement harmonics), one block per element.
 !>
 !> Method, per batch of elements: displacements to time samples by batched inverse real
-!> FFTs; the law is marched (frirom_contact) period after period until the slider returns
-!> to where it started (the cycle closes); forces back to harmonics by batched real FFTs.
+!> FFTs (up to H = DIRECT_MAX_HARM by one matrix product with the basis table instead:
+!> frirom_fourier synth_direct); the law is marched (frirom_contact) period after period
+!> until the slider returns to where it started (the cycle closes); forces back to
+!> harmonics by batched real FFTs (or the table's product, analyse_direct).
 !> The Jacobian never touches O(N H^2) work: a force that depends on the same-sample
 !> displacement with a coefficient c_k contributes the matrix of multiplication by c,
 !> built from the 4H+1 trigonometric sums of c; c is constant over runs of samples
@@ -23,8 +25,10 @@
 !>
 !> Cost per element: O(N) marching per period (usually 2 periods from a cold slider, about
 !> 5 for the 2-D law near the onset of partial slip),
-!> one inverse and one forward real FFT of length N per direction, and for the Jacobian
-!> an O(N) scan plus O(H^2) per run and per stick segment.
+!> one inverse and one forward real FFT of length N per direction (O(N (2H+1)) by the
+!> table at small H), and for the Jacobian an O(N) scan plus O(H^2) per run and per
+!> stick segment. The 1-D laws allocate nothing per element: their work arrays live in
+!> the plan.
 !>
 !> Choice of N: N >= 2H+1 is required. Friction forces are continuous with kinks, and
 !> the march locates lift-off and re-contact between samples (frirom_contact), so the
