@@ -3,8 +3,10 @@
 !> Jacobian d(force harmonics)/d(displacement harmonics), one block per element.
 !>
 !> Method, per batch of elements: displacements to time samples by batched inverse real
-!> FFTs; the law is marched (frirom_contact) period after period until the slider returns
-!> to where it started (the cycle closes); forces back to harmonics by batched real FFTs.
+!> FFTs (up to H = DIRECT_MAX_HARM by one matrix product with the basis table instead:
+!> frirom_fourier synth_direct); the law is marched (frirom_contact) period after period
+!> until the slider returns to where it started (the cycle closes); forces back to
+!> harmonics by batched real FFTs (or the table's product, analyse_direct).
 !> The Jacobian never touches O(N H^2) work: a force that depends on the same-sample
 !> displacement with a coefficient c_k contributes the matrix of multiplication by c,
 !> built from the 4H+1 trigonometric sums of c; c is constant over runs of samples
@@ -23,8 +25,10 @@
 !>
 !> Cost per element: O(N) marching per period (usually 2 periods from a cold slider, about
 !> 5 for the 2-D law near the onset of partial slip),
-!> one inverse and one forward real FFT of length N per direction, and for the Jacobian
-!> an O(N) scan plus O(H^2) per run and per stick segment.
+!> one inverse and one forward real FFT of length N per direction (O(N (2H+1)) by the
+!> table at small H), and for the Jacobian an O(N) scan plus O(H^2) per run and per
+!> stick segment. The 1-D laws allocate nothing per element: their work arrays live in
+!> the plan.
 !>
 !> Choice of N: N >= 2H+1 is required. Friction forces are continuous with kinks, and
 !> the march locates lift-off and re-contact between samples (frirom_contact), so the
@@ -85,12 +89,14 @@ module frirom_aft
         real(wp), allocatable :: w(:, :), wstart(:, :)  !! (nbatch, 2) slider positions
         real(wp), allocatable :: scale(:)            !! (nbatch) closure scale
         integer(ip), allocatable :: closed_at(:)     !! (nbatch) period the cycle closed in
-        integer(ip), allocatable :: events(:)        !! (N) slip/lift-off samples of one element
+        integer(ip), allocatable :: events(:)        !! (N+1) run starts of one element
         integer(ip), allocatable :: anchor(:)        !! (nbatch) last slip/lift-off sample
         integer(ip), allocatable :: anchor_state(:)  !! (nbatch) its state
         real(wp), allocatable :: anchor_dtv(:)       !! (nbatch) its d ft / dv
         real(wp), allocatable :: dw(:, :), dw0(:, :) !! (2, 3(2H+1)) 2-D slider tangent
         real(wp), allocatable :: dft(:, :)           !! (2, 3(2H+1)) 2-D force tangent
+        real(wp), allocatable :: jw(:, :)            !! (2H+1, 3) 1-D Jacobian rows g, ru, rv
+        real(wp), allocatable :: jt(:, :)            !! (0:2H, 6) 1-D Jacobian trig sums
         ! 2-D slider fixed point: Newton steps between periods (frirom_aft_march)
         real(wp), allocatable :: wplain(:, :)        !! (nbatch, 2) plain march from the base
         real(wp), allocatable :: res_base(:)         !! (nbatch) mismatch of the base period
@@ -319,8 +325,9 @@ contains
                   plan%follow(nb, nsamp, 2))
         allocate (plan%w(nb, 2), plan%wstart(nb, 2), plan%scale(nb), plan%closed_at(nb))
         allocate (plan%anchor(nb), plan%anchor_state(nb), plan%anchor_dtv(nb), &
-                  plan%events(nsamp))
-        allocate (plan%dw(2, 3*nc), plan%dw0(2, 3*nc), plan%dft(2, 3*nc))
+                  plan%events(nsamp + 1))
+        allocate (plan%dw(2, 3*nc), plan%dw0(2, 3*nc), plan%dft(2, 3*nc), plan%jw(nc, 3), &
+                  plan%jt(0:2*nharm, 6))
         allocate (plan%wplain(nb, 2), plan%res_base(nb), &
                   plan%res_last(nb), plan%stepped(nb), plan%accelerated(nb), plan%hold(nb), &
                   plan%damp(nb))
@@ -335,7 +342,7 @@ contains
         if (allocated(plan%anchor)) deallocate (plan%anchor, plan%anchor_state, plan%anchor_dtv, &
                                                    plan%events)
         if (allocated(plan%tangent)) deallocate (plan%tangent, plan%follow)
-        if (allocated(plan%dw)) deallocate (plan%dw, plan%dw0, plan%dft)
+        if (allocated(plan%dw)) deallocate (plan%dw, plan%dw0, plan%dft, plan%jw, plan%jt)
         if (allocated(plan%wplain)) deallocate (plan%wplain, plan%res_base, plan%res_last, &
                                                 plan%stepped, plan%accelerated, plan%hold, &
                                                 plan%damp)

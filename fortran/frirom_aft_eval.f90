@@ -4,14 +4,14 @@ submodule (frirom_aft) frirom_aft_eval
     use frirom_status, only: FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, &
                              FRIROM_ERR_NONFINITE, FRIROM_ERR_NOCLOSE, set_status, &
                              frirom_status_message
-    use frirom_fourier, only: exec_r2c, harmonics_of
+    use frirom_fourier, only: exec_r2c, harmonics_of, analyse_direct
     use frirom_contact, only: STATE_STICK, STATE_SLIP, STATE_LIFTOFF
     implicit none
 
 contains
 
     module procedure aft_forces
-        integer(ip) :: ne, nd, nc, nb, e0, m, j, e, d, s, np, nper, nfail, base, mp
+        integer(ip) :: ne, nd, nc, nb, e0, m, j, e, s, np, nper, nfail, base, mp
         real(wp) :: tl
         logical :: want_jac, rel
         character(len=200) :: buf
@@ -44,20 +44,29 @@ contains
                         mp, ' periods'
                 end if
                 if (present(periods)) periods(e) = min(nper, mp)
-                if (present(states)) call state_fractions(plan%state(j, :), states(:, e))
                 if (present(slider) .and. NSLIDER_OF(law) > 0) &
                     slider(1:NSLIDER_OF(law), e) = plan%w(j, 1:NSLIDER_OF(law))
             end do
-            if (want_jac) call fill_series(plan, law, m)
+            if (present(states)) call state_fractions(plan%state, m, states(:, e0:e0 + m - 1))
+            ! the series slots are read by the 2-D law's Jacobian only (the 1-D one scans the
+            ! states, the cubic reads its march's derivative)
+            if (want_jac .and. law == LAW_NORMAL2D) call fill_series(plan, law, m)
             if (rel) call relative_normal(m)
             do s = 1, np
-                call exec_r2c(plan%fp, s)
+                if (plan%fp%direct) then
+                    call analyse_direct(plan%fp, s, m)
+                    do j = 1, m
+                        f(:, s, e0 + j - 1) = plan%fp%coef(j, :)
+                    end do
+                else
+                    call exec_r2c(plan%fp, s)
+                    do j = 1, m
+                        call harmonics_of(plan%fp, s, j, f(:, s, e0 + j - 1))
+                    end do
+                end if
             end do
             do j = 1, m
                 e = e0 + j - 1
-                do d = 1, nd
-                    call harmonics_of(plan%fp, d, j, f(:, d, e))
-                end do
                 if (want_jac) call element_jacobian(plan, law, j, params(:, e), w0(:, e), tl, &
                                                     mp, jac(:, :, e))
             end do
@@ -247,12 +256,30 @@ contains
         end select
     end subroutine check_params
 
-    !> Fractions of the samples of one element in each contact state.
-    pure subroutine state_fractions(st, frac)
-        integer(ip), intent(in) :: st(:)
-        real(wp), intent(out) :: frac(3)  !! stick, slip, lift-off
-        frac(1) = real(count(st == STATE_STICK), wp)/real(size(st), wp)
-        frac(2) = real(count(st == STATE_SLIP), wp)/real(size(st), wp)
-        frac(3) = real(count(st == STATE_LIFTOFF), wp)/real(size(st), wp)
+    !> Fractions of the samples of the first m elements of a batch in each contact state,
+    !> counted sample by sample over the batch (contiguous, vectorised).
+    pure subroutine state_fractions(st, m, frac)
+        integer(ip), intent(in) :: st(:, :)   !! (nbatch, N) STATE_* of the batch
+        integer(ip), intent(in) :: m
+        real(wp), intent(out) :: frac(:, :)   !! (3, m) stick, slip, lift-off
+        integer(ip), parameter :: CHUNK = 64
+        integer(ip) :: k, j, j0, jm, n, nstick(CHUNK), nslip(CHUNK)
+        n = size(st, 2)
+        do j0 = 0, m - 1, CHUNK
+            jm = min(CHUNK, m - j0)
+            nstick(1:jm) = 0
+            nslip(1:jm) = 0
+            do k = 1, n
+                do j = 1, jm
+                    nstick(j) = nstick(j) + merge(1_ip, 0_ip, st(j0 + j, k) == STATE_STICK)
+                    nslip(j) = nslip(j) + merge(1_ip, 0_ip, st(j0 + j, k) == STATE_SLIP)
+                end do
+            end do
+            do j = 1, jm     ! every sample is in one of the three states
+                frac(1, j0 + j) = real(nstick(j), wp)/real(n, wp)
+                frac(2, j0 + j) = real(nslip(j), wp)/real(n, wp)
+                frac(3, j0 + j) = real(n - nstick(j) - nslip(j), wp)/real(n, wp)
+            end do
+        end do
     end subroutine state_fractions
 end submodule frirom_aft_eval

@@ -63,50 +63,61 @@ contains
         real(wp), intent(in) :: kt
         logical, intent(in) :: normal
         real(wp), intent(inout) :: jac(:, :)  !! (nd nc, nd nc)
-        integer(ip) :: n, nc, nh, k, k0, a, nev, i, i1, i2, c
-        real(wp) :: g(plan%fp%ncoef), ru(plan%fp%ncoef), rv(plan%fp%ncoef), kn
-        real(wp), dimension(0:2*plan%fp%nharm) :: ctu, stu, ctv, stv, cnv, snv
+        integer(ip) :: n, nc, nh, k, k0, a, last, first_end, r, nrun
+        logical :: any_event
+        real(wp) :: kn
         n = plan%fp%nsamp
         nc = plan%fp%ncoef
         nh = plan%fp%nharm
         kn = plan%par(j, 2)
-        ctu = 0.0_wp; stu = 0.0_wp; ctv = 0.0_wp; stv = 0.0_wp; cnv = 0.0_wp; snv = 0.0_wp
-        associate (st => plan%state, bas => plan%fp%basis, ev => plan%events, &
-                   dtvs => plan%fp%rout(j, :, 4))
+        ! work arrays of the plan (no allocation per element)
+        associate (st => plan%state, dtvs => plan%fp%rout(j, :, 4), &
+                   ru => plan%jw(:, 2), rv => plan%jw(:, 3), ctu => plan%jt(:, 1), &
+                   stu => plan%jt(:, 2), ctv => plan%jt(:, 3), stv => plan%jt(:, 4), &
+                   cnv => plan%jt(:, 5), snv => plan%jt(:, 6))
+            plan%jt = 0.0_wp
             ! One pass: runs of equal state (and slip sign) give the trig sums of the
-            ! same-sample series kt [stick], d ft/dv [slip], kn [contact]; events are the
-            ! slip and lift-off samples that anchor the following stick segments.
-            nev = 0
-            k0 = 1
-            do k = 1, n + 1
-                if (k <= n) then
-                    if (st(j, k) /= STATE_STICK) then
-                        nev = nev + 1
-                        ev(nev) = k
-                    end if
-                    if (st(j, k) == st(j, k0)) then
-                        if (.not. (normal .and. st(j, k) == STATE_SLIP)) cycle
-                        if (dtvs(k) == dtvs(k0)) cycle
-                    end if
-                end if
+            ! same-sample series kt [stick], d ft/dv [slip], kn [contact]. A stick run
+            ! [k0, k-1] is a segment anchored at the slip or lift-off sample k0-1 before it;
+            ! the run from sample 1 is anchored at the period's last such sample (the cycle
+            ! is closed) and joins the run that ends at N: it is added last, when that
+            ! anchor is known.
+            any_event = .false.
+            last = 0
+            first_end = 0
+            call run_starts(st(j, :), dtvs, normal, plan%events, nrun)
+            do r = 1, nrun
+                k0 = plan%events(r)
+                k = plan%events(r + 1)
                 select case (st(j, k0))
                 case (STATE_STICK)
                     call add_run(kt, k0, k - 1, ctu, stu)
                     if (normal) call add_run(kn, k0, k - 1, cnv, snv)
+                    if (k0 == 1) then
+                        first_end = k - 1
+                    else if (k - 1 < n .or. first_end == 0) then
+                        call stick_segment(k0 - 1, k0, k - 1)
+                    else
+                        last = k0 - 1        ! the run up to N: joins the first one
+                    end if
                 case (STATE_SLIP)
+                    any_event = .true.
+                    last = k - 1
                     if (normal) then
                         call add_run(dtvs(k0), k0, k - 1, ctv, stv)
                         call add_run(kn, k0, k - 1, cnv, snv)
                     end if
+                case default
+                    any_event = .true.
+                    last = k - 1
                 end select
-                k0 = k
             end do
             call toeplitz_add(nh, n, ctu, stu, jac, 0_ip, 0_ip)
             if (normal) then
                 call toeplitz_add(nh, n, ctv, stv, jac, 0_ip, nc)
                 call toeplitz_add(nh, n, cnv, snv, jac, nc, nc)
             end if
-            if (nev == 0) then
+            if (.not. any_event) then
                 ! Stuck all cycle. If the slider moved while the march settled, every
                 ! sample is anchored there: the whole-period sum of P is the mean row.
                 a = plan%anchor(j)
@@ -117,19 +128,43 @@ contains
                 if (normal) jac(1, nc + 1:2*nc) = jac(1, nc + 1:2*nc) - kt*rv
                 return
             end if
-            do i = 1, nev
-                ! stick segment after event a, up to the next event (cyclic)
-                a = ev(i)
-                i1 = mod(a, n) + 1
-                if (i < nev) then
-                    i2 = ev(i + 1) - 1
-                else
-                    i2 = ev(1) - 1
-                    if (i2 == 0) i2 = n
-                end if
-                if ((i < nev .and. i2 < i1) .or. (i == nev .and. i1 == ev(1))) cycle
+            ! the segment through sample 1 (wrapping from the run that ends at N, if any)
+            if (first_end > 0) call stick_segment(last, mod(last, n) + 1, first_end)
+        end associate
+    contains
+        !> Starts of the runs of equal state (slip runs of the normal law also of equal
+        !> d ft/dv, i.e. slip sign): starts(1:nrun), starts(nrun + 1) = N + 1. A tight
+        !> loop without calls, so the scan keeps its operands in registers.
+        pure subroutine run_starts(s, dtv, normal, starts, nrun)
+            integer(ip), intent(in) :: s(:)       !! (N) states
+            real(wp), intent(in) :: dtv(:)        !! (N) d ft/dv
+            logical, intent(in) :: normal
+            integer(ip), intent(out) :: starts(:) !! (N+1)
+            integer(ip), intent(out) :: nrun
+            integer(ip) :: k, slip_code
+            logical :: new_run
+            ! runs are maximal, so comparing with the previous sample is comparing with the
+            ! run's first; slip_code: a state no sample has when the law has no slip sign
+            slip_code = merge(STATE_SLIP, -1_ip, normal)
+            nrun = 1
+            starts(1) = 1
+            do k = 2, size(s)
+                new_run = s(k) /= s(k - 1) .or. (s(k) == slip_code .and. dtv(k) /= dtv(k - 1))
+                if (.not. new_run) cycle
+                nrun = nrun + 1
+                starts(nrun) = k
+            end do
+            starts(nrun + 1) = size(s) + 1
+        end subroutine run_starts
+
+        !> jac -= kt g (ru, rv): stick samples i1..i2 (cyclic) anchored at sample a.
+        subroutine stick_segment(a, i1, i2)
+            integer(ip), intent(in) :: a, i1, i2
+            integer(ip) :: c
+            associate (g => plan%jw(:, 1), ru => plan%jw(:, 2), rv => plan%jw(:, 3))
                 call segment_sum(plan%fp, i1, i2, g)
-                call anchor_rows(plan, j, a, st(j, a), dtvs(a), kt, normal, ru, rv)
+                call anchor_rows(plan, j, a, plan%state(j, a), plan%fp%rout(j, a, 4), kt, &
+                                 normal, ru, rv)
                 do c = 1, nc
                     jac(1:nc, c) = jac(1:nc, c) - kt*ru(c)*g
                 end do
@@ -138,9 +173,9 @@ contains
                         jac(1:nc, nc + c) = jac(1:nc, nc + c) - kt*rv(c)*g
                     end do
                 end if
-            end do
-        end associate
-    contains
+            end associate
+        end subroutine stick_segment
+
         !> C_m, S_m += value * sums of cos(m tau), sin(m tau) over samples k1..k2.
         pure subroutine add_run(value, k1, k2, cm, sm)
             real(wp), intent(in) :: value

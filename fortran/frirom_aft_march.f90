@@ -3,7 +3,7 @@
 !> The hot path of frirom: the march and its per-period bookkeeping stay in this one
 !> submodule so that the compiler sees them together.
 submodule (frirom_aft) frirom_aft_march
-    use frirom_fourier, only: clear_input, load_harmonics, exec_c2r
+    use frirom_fourier, only: clear_input, load_harmonics, exec_c2r, synth_direct
     use frirom_contact, only: STATE_STICK, STATE_SLIP, STATE_LIFTOFF, jenkins_march, &
                               friction1d_march, friction2d_march, cubic_spring, &
                               recontact_follow
@@ -14,6 +14,13 @@ contains
     module procedure time_batch
         integer(ip) :: d, j
         do d = 1, NDIR_OF(law)
+            if (plan%fp%direct) then
+                do j = 1, m
+                    plan%fp%coef(j, :) = x(:, d, e0 + j - 1)
+                end do
+                call synth_direct(plan%fp, d, m)
+                cycle
+            end if
             call clear_input(plan%fp, d)
             do j = 1, m
                 call load_harmonics(plan%fp, d, j, x(:, d, e0 + j - 1))
@@ -57,8 +64,10 @@ contains
             end do
             do j = 1, m
                 plan%scale(j) = max(tiny(1.0_wp), maxval(abs(w(j, 1:ns))))
-                do d = 1, NDIR_OF(law)
-                    plan%scale(j) = max(plan%scale(j), maxval(abs(rin(j, :, d))))
+            end do
+            do d = 1, NDIR_OF(law)      ! sample by sample over the batch (contiguous)
+                do i = 1, plan%fp%nsamp
+                    plan%scale(1:m) = max(plan%scale(1:m), abs(rin(1:m, i, d)))
                 end do
             end do
             ! where the sliders follow the contact point while it is open: fixed in u and v,
@@ -68,6 +77,15 @@ contains
                     call recontact_follow(rin(1:m, :, d), rin(1:m, :, NDIR_OF(law)), par(:, 2), &
                                           par(:, 4), uf(:, :, d))
                 end do
+            end if
+            if (law == LAW_NORMAL1D .and. m < plan%fp%nbatch) then
+                ! a short last batch: its unused lanes march an element at rest, so that the
+                ! march runs over the whole (contiguous) batch arrays
+                plan%par(m + 1:, :) = 0.0_wp
+                plan%par(m + 1:, 1) = 1.0_wp
+                plan%follow(m + 1:, :, 1) = 0.0_wp
+                rin(m + 1:, :, 2) = 0.0_wp
+                plan%w(m + 1:, 1) = 0.0_wp
             end if
             plan%closed_at(1:m) = max_periods + 1
             plan%stepped(1:m) = .false.
@@ -81,9 +99,11 @@ contains
                     call jenkins_march(rin(1:m, :, 1), par(:, 1), par(:, 2), par(:, 3), w(:, 1), &
                                        rout(1:m, :, 1), st)
                 case (LAW_NORMAL1D)
-                    call friction1d_march(uf(:, :, 1), rin(1:m, :, 2), par(:, 1), par(:, 2), &
-                                          par(:, 3), par(:, 4), w(:, 1), rout(1:m, :, 1), &
-                                          rout(1:m, :, 2), st, rout(1:m, :, 4))
+                    ! the whole batch, contiguous (lanes m+1.. hold the inert tail set above)
+                    call friction1d_march(plan%follow(:, :, 1), rin(:, :, 2), plan%par(:, 1), &
+                                          plan%par(:, 2), plan%par(:, 3), plan%par(:, 4), &
+                                          plan%w(:, 1), rout(:, :, 1), rout(:, :, 2), &
+                                          plan%state, rout(:, :, 4))
                 case (LAW_NORMAL2D)
                     call friction2d_march(uf(:, :, 1), uf(:, :, 2), rin(1:m, :, 3), &
                                           par(:, 1), par(:, 2), par(:, 3), par(:, 4), w, &

@@ -12,6 +12,7 @@
 module frirom_fourier
     use, intrinsic :: iso_c_binding
     use frirom_kinds, only: wp, ip
+    use frirom_lapack, only: dgemm
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_SAMPLES, FRIROM_ERR_PARAM, &
                              FRIROM_ERR_FFTW, FRIROM_ERR_ALLOC, set_status
     implicit none
@@ -21,7 +22,13 @@ module frirom_fourier
     public :: fourier_plan, fourier_plan_create, fourier_plan_destroy
     public :: clear_input, load_harmonics, exec_c2r, exec_r2c, harmonics_of, trig_sums, &
               toeplitz_add
-    public :: segment_sum, run_trig_sums
+    public :: segment_sum, run_trig_sums, synth_direct, analyse_direct
+
+    !> Harmonics up to which the AFT transforms by the trigonometric tables (O(N (2H+1)) per
+    !> signal, vectorised over the batch) instead of FFTW (O(N log N) with per-call overhead
+    !> and all N/2 harmonics): faster at the few harmonics friction models use
+    !> (cases/bench/aft.py, H = 1-7).
+    integer(ip), parameter, public :: DIRECT_MAX_HARM = 8
 
     !> Batched real FFTs of length N plus the trigonometric tables of H harmonics.
     type :: fourier_plan
@@ -43,6 +50,8 @@ module frirom_fourier
         real(wp), allocatable :: weight(:)     !! (2H+1): 1/N for a0, 2/N for the others
         real(wp), allocatable :: prefix(:, :)  !! (4H+1, 0:N): running sums over the samples of
                                                !! [1, cos tau, sin tau, .., cos 2H tau, sin 2H tau]
+        logical :: direct = .false.            !! transform by the tables (H <= DIRECT_MAX_HARM)
+        real(wp), allocatable :: coef(:, :)    !! (nbatch, 2H+1) one slot's harmonics, batch-major
     end type fourier_plan
 
 contains
@@ -133,6 +142,8 @@ contains
         plan%cin = (0.0_wp, 0.0_wp)
         plan%cout = (0.0_wp, 0.0_wp)
 
+        plan%direct = nharm <= DIRECT_MAX_HARM
+        allocate (plan%coef(plan%nbatch, nc))
         allocate (plan%basis(nsamp, nc), plan%weight(nc), plan%prefix(4*nharm + 1, 0:nsamp), &
                   stat=stat)
         if (stat /= 0) then
@@ -200,6 +211,7 @@ contains
         plan%m_cout = c_null_ptr
         nullify (plan%rin, plan%cin, plan%rout, plan%cout)
         if (allocated(plan%basis)) deallocate (plan%basis)
+        if (allocated(plan%coef)) deallocate (plan%coef)
         if (allocated(plan%weight)) deallocate (plan%weight)
         if (allocated(plan%prefix)) deallocate (plan%prefix)
         plan%nharm = -1
@@ -220,6 +232,31 @@ contains
             plan%cin(col, h + 1, slot) = cmplx(0.5_wp*xh(2*h), -0.5_wp*xh(2*h + 1), wp)
         end do
     end subroutine load_harmonics
+
+    !> Harmonics -> time samples of the first m signals of input slot `slot` by the basis
+    !> table: rin(j, k) = sum_c coef(j, c) basis(k, c), coef(1:m, :) filled by the caller
+    !> (row j: [a0, a1, b1, ..] of signal j). Same result as load_harmonics + exec_c2r to
+    !> rounding; no FFTW call and no clearing.
+    subroutine synth_direct(plan, slot, m)
+        type(fourier_plan), intent(inout) :: plan
+        integer(ip), intent(in) :: slot, m
+        call dgemm('N', 'T', m, plan%nsamp, plan%ncoef, 1.0_wp, plan%coef, plan%nbatch, &
+                   plan%basis, plan%nsamp, 0.0_wp, plan%rin(:, :, slot), plan%nbatch)
+    end subroutine synth_direct
+
+    !> Time samples -> harmonics of the first m signals of output slot `slot` by the basis
+    !> table: coef(j, c) = weight(c) sum_k rout(j, k) basis(k, c) (the exact DFT of the
+    !> retained harmonics; exec_r2c + harmonics_of give the same to rounding).
+    subroutine analyse_direct(plan, slot, m)
+        type(fourier_plan), intent(inout) :: plan
+        integer(ip), intent(in) :: slot, m
+        integer(ip) :: c
+        call dgemm('N', 'N', m, plan%ncoef, plan%nsamp, 1.0_wp, plan%rout(:, :, slot), &
+                   plan%nbatch, plan%basis, plan%nsamp, 0.0_wp, plan%coef, plan%nbatch)
+        do c = 1, plan%ncoef
+            plan%coef(1:m, c) = plan%weight(c)*plan%coef(1:m, c)
+        end do
+    end subroutine analyse_direct
 
     !> Zero the spectra of input slot `slot` before load_harmonics fills a new batch.
     pure subroutine clear_input(plan, slot)

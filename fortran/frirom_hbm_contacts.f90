@@ -62,24 +62,41 @@ contains
     end procedure csr_set
 
     module procedure contact_eval
-        integer(ip) :: g, e, d, row, k
+        integer(ip) :: g, e, d, row, k, c, nc, nrg, ns
+        real(wp) :: acc
         real(wp), allocatable :: wnew(:, :)
         logical :: upd
         info = FRIROM_OK
         upd = .false.
         if (present(carry)) upd = carry
+        nc = cs%nc
         fd = 0.0_wp
         do g = 1, size(cs%grp)
             associate (gr => cs%grp(g), gg => cs%g)
-                do e = 1, gr%ne
-                    do d = 1, gr%ndir
-                        row = gr%row0 + (e - 1)*gr%ndir + d
-                        gr%x(:, d, e) = 0.0_wp
-                        do k = gg%p(row), gg%p(row + 1) - 1
-                            gr%x(:, d, e) = gr%x(:, d, e) + gg%x(k)*xd(gg%i(k), :)
+                if (gr%gx_mode == 0) call choose_gx(gr, gg, nc)
+                nrg = gr%ne*gr%ndir
+                if (gr%gx_mode == 2) then
+                    ! x(c, r) = sum_s xd(col_s, c) G(r, col_s): one product
+                    ns = size(gr%gcols)
+                    do c = 1, nc
+                        gr%gxs(:, c) = xd(gr%gcols, c)
+                    end do
+                    call dgemm('T', 'N', nc, nrg, ns, 1.0_wp, gr%gxs, ns, gr%gt, ns, 0.0_wp, &
+                               gr%x, nc)
+                else
+                    do e = 1, gr%ne
+                        do d = 1, gr%ndir
+                            row = gr%row0 + (e - 1)*gr%ndir + d
+                            do c = 1, nc        ! one accumulator per coefficient
+                                acc = 0.0_wp
+                                do k = gg%p(row), gg%p(row + 1) - 1
+                                    acc = acc + gg%x(k)*xd(gg%i(k), c)
+                                end do
+                                gr%x(c, d, e) = acc
+                            end do
                         end do
                     end do
-                end do
+                end if
                 if (upd) then
                     allocate (wnew, mold=gr%w0)
                     wnew = gr%w0
@@ -95,14 +112,23 @@ contains
                                   states=gr%states, relative=.true.)
                 end if
                 if (info /= 0) return
-                do e = 1, gr%ne
-                    do d = 1, gr%ndir
-                        row = gr%row0 + (e - 1)*gr%ndir + d
-                        do k = gg%p(row), gg%p(row + 1) - 1
-                            fd(gg%i(k), :) = fd(gg%i(k), :) + gg%x(k)*gr%f(:, d, e)
+                if (gr%gx_mode == 2) then
+                    ! fd(col_s, c) += sum_r G(r, col_s) f(c, r)
+                    call dgemm('N', 'T', ns, nc, nrg, 1.0_wp, gr%gt, ns, gr%f, nc, 0.0_wp, &
+                               gr%gxs, ns)
+                    do c = 1, nc
+                        fd(gr%gcols, c) = fd(gr%gcols, c) + gr%gxs(:, c)
+                    end do
+                else
+                    do e = 1, gr%ne
+                        do d = 1, gr%ndir
+                            row = gr%row0 + (e - 1)*gr%ndir + d
+                            do k = gg%p(row), gg%p(row + 1) - 1
+                                fd(gg%i(k), :) = fd(gg%i(k), :) + gg%x(k)*gr%f(:, d, e)
+                            end do
                         end do
                     end do
-                end do
+                end if
             end associate
         end do
     end procedure contact_eval
@@ -164,6 +190,49 @@ contains
         if (.not. ok) call set_status(info, FRIROM_ERR_MODEL, errmsg, &
                                       'contact_assemble: entry outside the band')
     end procedure contact_assemble
+
+    !> How contact_eval maps the group's rows of G (once per contact set; G is fixed):
+    !> by matrix products over the ns columns the group reads when its rows are dense over
+    !> them (ns (ne ndir) <= 2 nnz: GSI coordinates), else by the sparse rows. The
+    !> products sum in another order than the rows: same results to rounding.
+    subroutine choose_gx(gr, gg, nc)
+        type(contact_group), intent(inout) :: gr
+        type(csr_matrix), intent(in) :: gg
+        integer(ip), intent(in) :: nc
+        integer(ip), allocatable :: pos(:)
+        integer(ip) :: k, r, ns, nrg, k1, k2, stat
+        gr%gx_mode = 1
+        nrg = gr%ne*gr%ndir
+        k1 = gg%p(gr%row0 + 1)
+        k2 = gg%p(gr%row0 + nrg + 1) - 1
+        if (k2 < k1) return
+        allocate (pos(gg%ncol), stat=stat)
+        if (stat /= 0) return
+        pos = 0
+        pos(gg%i(k1:k2)) = 1
+        ns = count(pos /= 0)
+        if (real(ns, wp)*real(nrg, wp) > 2.0_wp*real(k2 - k1 + 1, wp)) return
+        allocate (gr%gcols(ns), gr%gt(ns, nrg), gr%gxs(ns, nc), stat=stat)
+        if (stat /= 0) then
+            if (allocated(gr%gcols)) deallocate (gr%gcols)
+            if (allocated(gr%gt)) deallocate (gr%gt)
+            return
+        end if
+        ns = 0
+        do k = 1, gg%ncol
+            if (pos(k) == 0) cycle
+            ns = ns + 1
+            pos(k) = ns
+            gr%gcols(ns) = k
+        end do
+        gr%gt = 0.0_wp
+        do r = 1, nrg
+            do k = gg%p(gr%row0 + r), gg%p(gr%row0 + r + 1) - 1
+                gr%gt(pos(gg%i(k)), r) = gr%gt(pos(gg%i(k)), r) + gg%x(k)
+            end do
+        end do
+        gr%gx_mode = 2
+    end subroutine choose_gx
 
     !> kd += G_g^T J_loc G_g of one contact group by matrix products when its rows are
     !> dense over the columns they read (an interface reduced to a few generalised DoFs):

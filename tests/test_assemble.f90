@@ -4,10 +4,13 @@
 !> and random local Jacobians: dense columns (all of them, or a scattered subset with a
 !> column map and a wider harmonic stride), and sparse rows (where the loops are kept).
 !> Tolerance 1e-12 relative: the same sums in another order, ~50 terms of size ~1.
+!> The same for contact_eval's G x and G^T f (matrix products over a dense group's columns
+!> against the sparse rows, gx_mode = 1), through a cubic spring's AFT.
 program test_assemble
     use frirom_kinds, only: wp, ip
     use frirom_check, only: check, check_done
-    use frirom_hbm, only: contact_set, contact_assemble
+    use frirom_hbm, only: contact_set, contact_assemble, contact_eval
+    use frirom_aft, only: aft_plan, aft_plan_create, LAW_CUBIC
     implicit none
     call compare('dense, 40 columns, normal1d, H = 1', ne=30, nd=2, nh=1, ncol=40, &
                  per_row=40, stride=0)
@@ -80,7 +83,49 @@ contains
         print '(a,a,es10.2)', name, ': max |products - loops| / max |loops| =', &
             maxval(abs(k1 - k2))/maxval(abs(k2))
         call check(maxval(abs(k1 - k2)) <= 1.0e-12_wp*maxval(abs(k2)), name)
+        call compare_eval(cs, name, per_row > 3)
     end subroutine compare
+
+    !> contact_eval of the set as chosen (products when expect_dense) against the sparse
+    !> rows: the local displacements and the forces on the columns, 1e-12 relative.
+    subroutine compare_eval(cs, name, expect_dense)
+        type(contact_set), intent(inout) :: cs
+        character(len=*), intent(in) :: name
+        logical, intent(in) :: expect_dense
+        type(contact_set) :: loops
+        type(aft_plan) :: plan
+        real(wp), allocatable :: xd(:, :), f1(:, :), f2(:, :)
+        integer(ip) :: nc, ne, nd, info
+        character(len=200) :: msg
+        nc = cs%nc
+        ne = cs%grp(1)%ne
+        nd = cs%grp(1)%ndir
+        cs%grp(1)%law = LAW_CUBIC
+        allocate (cs%grp(1)%params(2, nd*ne))
+        cs%grp(1)%params(1, :) = 1.0e3_wp   ! k1, N/m
+        cs%grp(1)%params(2, :) = 5.0e2_wp   ! k3, N/m^3
+        allocate (cs%grp(1)%w0(0, nd*ne), cs%grp(1)%x(nc, 1, nd*ne), &
+                  cs%grp(1)%f(nc, 1, nd*ne), cs%grp(1)%states(3, nd*ne))
+        cs%grp(1)%ne = nd*ne   ! one cubic spring per row of G
+        cs%grp(1)%ndir = 1
+        loops = cs
+        loops%grp(1)%gx_mode = 1
+        allocate (xd(cs%g%ncol, nc), f1(cs%g%ncol, nc), f2(cs%g%ncol, nc))
+        call random_number(xd)
+        xd = 1.0e-2_wp*(xd - 0.5_wp)
+        call aft_plan_create(plan, (nc - 1)/2, 4*nc, info, msg)
+        call check(info == 0, name//': plan: '//trim(msg))
+        call contact_eval(cs, plan, xd, f1, .false., info, msg)
+        call check(info == 0, name//': contact_eval: '//trim(msg))
+        call check((cs%grp(1)%gx_mode == 2) .eqv. expect_dense, name//': G x by products')
+        call contact_eval(loops, plan, xd, f2, .false., info, msg)
+        call check(info == 0, name//': contact_eval (rows): '//trim(msg))
+        print '(a,a,es10.2)', name, ': contact_eval max |products - rows| / max |rows| =', &
+            maxval(abs(f1 - f2))/maxval(abs(f2))
+        call check(maxval(abs(cs%grp(1)%x - loops%grp(1)%x)) <= &
+                   1.0e-12_wp*maxval(abs(loops%grp(1)%x)), name//': G x')
+        call check(maxval(abs(f1 - f2)) <= 1.0e-12_wp*maxval(abs(f2)), name//': G^T f')
+    end subroutine compare_eval
 
     !> Indices of the m smallest entries of u, ascending by index (a random m-subset).
     function sort_idx(u, m) result(idx)

@@ -13,7 +13,10 @@ max_periods is raised to 5 000 here so that a plain march closes too) and the ti
 forces + Jacobian. Run it with an older build to compare (the march of that build is
 the reference: `cd OLD && .venv/bin/python NEW/cases/bench/aft.py --law normal2d`).
 
-    python cases/bench/aft.py [--quick] [--law normal1d|normal2d|both]
+    python cases/bench/aft.py [--quick] [--law normal1d|normal2d|both] [--only NE:H:N ...]
+
+--only runs the normal1d table at the given sizes only (e.g. the hooks' ROM_II:
+--only 170:3:128 170:3:64 1000:3:256), with repeats enough for stable minima.
 
 Both run on one core (OPENBLAS_NUM_THREADS=1 is set before numpy loads).
 """
@@ -166,7 +169,11 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller grid (smoke run)")
     ap.add_argument("--law", choices=("normal1d", "normal2d", "both"), default="both")
+    ap.add_argument("--only", nargs="+", metavar="NE:H:N",
+                    help="normal1d sizes to run (elements:harmonics:samples)")
     args = ap.parse_args()
+    if args.only:
+        args.law = "normal1d"
     if args.law != "normal1d":
         bench_normal2d(args.quick)
     if args.law == "normal2d":
@@ -176,24 +183,25 @@ def main() -> None:
     print(f"{'elements':>8} {'H':>2} {'N':>4} {'frirom s':>10} {'numpy s':>10} "
           f"{'frirom Mel-samp/s':>18} {'numpy Mel-samp/s':>17} {'speed-up':>9} {'max rel diff':>12}")
     last = None
-    for ne in sizes:
-        for h in (1, 3, 7):
-            for n in (64, 256):
-                x, kt, kn, mu, n0 = make_inputs(ne, h, rng)
-                params = np.stack([kt, kn, mu, n0], axis=1)
-                rep = max(3, int(2e6 // (ne * n)))
-                t_f = best_of(lambda: contact.aft("normal1d", x, params, n), rep)
-                r = contact.aft("normal1d", x, params, n)
-                rep_np = 1 if ne * n > 1e6 else 3
-                t_n = best_of(lambda: numpy_aft(x, kt, kn, mu, n0, n), rep_np)
-                fnp, jnp_ = numpy_aft(x, kt, kn, mu, n0, n)
-                diff = max(np.abs(fnp - r.forces).max() / np.abs(r.forces).max(),
-                           np.abs(jnp_ - r.jacobian).max() / np.abs(r.jacobian).max())
-                rate_f, rate_n = ne * n / t_f / 1e6, ne * n / t_n / 1e6
-                print(f"{ne:8d} {h:2d} {n:4d} {t_f:10.2e} {t_n:10.2e} {rate_f:18.1f} "
-                      f"{rate_n:17.2f} {t_n / t_f:9.1f} {diff:12.1e}", flush=True)
-                if ne == 1000 and h == 3 and n == 256:
-                    last = (t_n / t_f, rate_f)
+    grid = [(ne, h, n) for ne in sizes for h in (1, 3, 7) for n in (64, 256)]
+    if args.only:
+        grid = [tuple(int(v) for v in spec.split(":")) for spec in args.only]
+    for ne, h, n in grid:
+        x, kt, kn, mu, n0 = make_inputs(ne, h, rng)
+        params = np.stack([kt, kn, mu, n0], axis=1)
+        rep = max(3, int(2e6 // (ne * n)))
+        t_f = best_of(lambda: contact.aft("normal1d", x, params, n), rep)
+        r = contact.aft("normal1d", x, params, n)
+        rep_np = 1 if ne * n > 1e6 else 3
+        t_n = best_of(lambda: numpy_aft(x, kt, kn, mu, n0, n), rep_np)
+        fnp, jnp_ = numpy_aft(x, kt, kn, mu, n0, n)
+        diff = max(np.abs(fnp - r.forces).max() / np.abs(r.forces).max(),
+                   np.abs(jnp_ - r.jacobian).max() / np.abs(r.jacobian).max())
+        rate_f, rate_n = ne * n / t_f / 1e6, ne * n / t_n / 1e6
+        print(f"{ne:8d} {h:2d} {n:4d} {t_f:10.2e} {t_n:10.2e} {rate_f:18.1f} "
+              f"{rate_n:17.2f} {t_n / t_f:9.1f} {diff:12.1e}", flush=True)
+        if ne == 1000 and h == 3 and n == 256:
+            last = (t_n / t_f, rate_f)
     if last is not None:
         print(f"1000 elements, H = 3, N = 256: frirom/numpy speed-up {last[0]:.1f}x, "
               f"{last[1]:.1f} million element-samples/s")
