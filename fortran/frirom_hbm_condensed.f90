@@ -227,7 +227,13 @@ contains
         dense = sum(real(sys%ecp(2:) - sys%ecp(:size(sys%ecp) - 1), wp)**2)*nc**2 > &
                 real(n, wp)**2
         if (dense) then
-            allocate (kc(n, n), stat=stat)
+            ! kc: the workspace kept between Jacobians (no allocation, page zeroing per call)
+            stat = 0
+            if (allocated(sys%kcw)) then
+                if (size(sys%kcw, 1) /= n) deallocate (sys%kcw)
+            end if
+            if (.not. allocated(sys%kcw)) allocate (sys%kcw(n, n), stat=stat)
+            if (stat == 0) call move_alloc(sys%kcw, kc)
             if (stat == 0 .and. krylov .and. .not. allocated(sys%jcur)) &
                 allocate (sys%jcur(n, n), stat=stat)
         else if (krylov .and. .not. allocated(sys%jcur)) then
@@ -250,7 +256,10 @@ contains
             call move_alloc(sys%jm, jt)
         end if
         jt = 0.0_wp
-        if (dense) call jac_dense(sys, n, kc, jt)
+        if (dense) then
+            call jac_dense(sys, n, kc, jt)
+            call move_alloc(kc, sys%kcw)
+        end if
         ie = 0
         do g = 1, merge(0, size(sys%cs%grp), dense)   ! element by element unless dense
             associate (gr => sys%cs%grp(g), gg => sys%cs%g)

@@ -200,7 +200,7 @@ contains
         type(csr_matrix), intent(in) :: gg
         integer(ip), intent(in) :: nc
         integer(ip), allocatable :: pos(:)
-        integer(ip) :: k, r, ns, nrg, k1, k2, stat
+        integer(ip) :: ns, nrg, k1, k2, stat
         gr%gx_mode = 1
         nrg = gr%ne*gr%ndir
         k1 = gg%p(gr%row0 + 1)
@@ -212,7 +212,24 @@ contains
         pos(gg%i(k1:k2)) = 1
         ns = count(pos /= 0)
         if (real(ns, wp)*real(nrg, wp) > 2.0_wp*real(k2 - k1 + 1, wp)) return
-        allocate (gr%gcols(ns), gr%gt(ns, nrg), gr%gxs(ns, nc), stat=stat)
+        if (.not. allocated(gr%gt)) call group_gt(gr, gg, pos)
+        if (.not. allocated(gr%gt)) return
+        allocate (gr%gxs(ns, nc), stat=stat)
+        if (stat /= 0) return
+        gr%gx_mode = 2
+    end subroutine choose_gx
+
+    !> gr%gcols (the columns the group's rows read, ascending; pos(col) /= 0 marks them on
+    !> entry, becomes the index in gcols) and gr%gt = those rows over gcols, transposed.
+    !> Left unallocated when memory runs out (the callers then take the sparse rows).
+    subroutine group_gt(gr, gg, pos)
+        type(contact_group), intent(inout) :: gr
+        type(csr_matrix), intent(in) :: gg
+        integer(ip), intent(inout) :: pos(:)       !! (ncol) marks in, index in gcols out
+        integer(ip) :: k, r, ns, nrg, stat
+        nrg = gr%ne*gr%ndir
+        ns = count(pos /= 0)
+        allocate (gr%gcols(ns), gr%gt(ns, nrg), stat=stat)
         if (stat /= 0) then
             if (allocated(gr%gcols)) deallocate (gr%gcols)
             if (allocated(gr%gt)) deallocate (gr%gt)
@@ -231,17 +248,18 @@ contains
                 gr%gt(pos(gg%i(k)), r) = gr%gt(pos(gg%i(k)), r) + gg%x(k)
             end do
         end do
-        gr%gx_mode = 2
-    end subroutine choose_gx
+    end subroutine group_gt
 
     !> kd += G_g^T J_loc G_g of one contact group by matrix products when its rows are
     !> dense over the columns they read (an interface reduced to a few generalised DoFs):
-    !> with S the group's columns (ns of them) and Gd (nrg, ns) its rows,
-    !> Y_c1 = (J_e G_e) rows of harmonic c1 over all elements, kd(S c1, S :) += Gd^T Y_c1
-    !> (one dgemm per harmonic coefficient c1). done = .false. (nothing added): the rows
-    !> are sparse, the element loops of contact_assemble are cheaper.
+    !> with S the group's columns (ns of them, gr%gcols) and Gd (nrg, ns) its rows (gr%gt
+    !> = Gd^T, shared with contact_eval), Y_c1 = (J_e G_e) rows of harmonic c1 over all
+    !> elements, kd(S c1, S :) += Gd^T Y_c1 (one dgemm per harmonic coefficient c1). The
+    !> choice (gr%asm_mode) and the work arrays stay with the group between calls.
+    !> done = .false. (nothing added): the rows are sparse, the element loops of
+    !> contact_assemble are cheaper.
     subroutine assemble_dense(gr, gg, nc, ldc, kd, info, errmsg, done, colmap)
-        type(contact_group), intent(in) :: gr
+        type(contact_group), intent(inout) :: gr
         type(csr_matrix), intent(in) :: gg
         integer(ip), intent(in) :: nc, ldc               !! coefficients, harmonic stride
         real(wp), intent(inout) :: kd(:, :)
@@ -249,41 +267,28 @@ contains
         character(len=*), intent(inout) :: errmsg
         logical, intent(out) :: done
         integer(ip), intent(in), optional :: colmap(:)
-        integer(ip), allocatable :: pos(:), cols(:)
-        real(wp), allocatable :: gt(:, :), yt(:, :), kt(:, :)
-        integer(ip) :: nd, ne, nrg, ns, r0, e, d1, d2, c1, c2, k, r, s1, s2, stat, m1, m2
-        real(wp) :: sparse_cost, v
+        integer(ip), allocatable :: cols(:)
+        integer(ip) :: nd, ne, nrg, ns, e, d1, d2, c1, c2, r, s1, s2, m1, m2
+        real(wp) :: v
         info = FRIROM_OK
         done = .false.
+        if (gr%asm_mode == 0) call choose_dense(gr, gg)
+        if (gr%asm_mode /= 2) return
         nd = gr%ndir
         ne = gr%ne
         nrg = ne*nd
-        r0 = gr%row0
-        ! the columns the group reads, ascending, and the element loops' operation count
-        allocate (pos(gg%ncol), stat=stat)
-        if (stat /= 0) return                   ! the element loops need no workspace
-        pos = 0
-        sparse_cost = 0.0_wp
-        do e = 1, ne
-            k = gg%p(r0 + e*nd + 1) - gg%p(r0 + (e - 1)*nd + 1)
-            sparse_cost = sparse_cost + real(k, wp)**2
-            do k = gg%p(r0 + (e - 1)*nd + 1), gg%p(r0 + e*nd + 1) - 1
-                pos(gg%i(k)) = 1
-            end do
-        end do
-        ns = count(pos /= 0)
-        ! BLAS runs the products ~10x faster than the scalar loops: take them up to 4x the
-        ! loops' operations (dense GSI columns: nd times fewer)
-        if (ns == 0 .or. real(ns, wp)**2*real(nrg, wp) > 4.0_wp*sparse_cost) return
-        allocate (cols(ns), gt(ns, nrg), yt(ns*nc, nrg), kt(ns, ns*nc), stat=stat)
-        if (stat /= 0) return
-        ns = 0
-        do k = 1, gg%ncol
-            if (pos(k) == 0) cycle
-            ns = ns + 1
-            pos(k) = ns
-            cols(ns) = k
-        end do
+        ns = size(gr%gcols)
+        if (allocated(gr%yt)) then
+            if (any(shape(gr%yt) /= [ns*nc, nrg])) deallocate (gr%yt, gr%kt)
+        end if
+        if (.not. allocated(gr%yt)) then
+            allocate (gr%yt(ns*nc, nrg), gr%kt(ns, ns*nc), stat=r)
+            if (r /= 0) then
+                if (allocated(gr%yt)) deallocate (gr%yt)
+                return                          ! the element loops need no workspace
+            end if
+        end if
+        cols = gr%gcols
         if (present(colmap)) cols = colmap(cols)
         if (any(cols < 1) .or. any(cols > ldc) .or. size(kd, 1) < ldc*nc .or. &
             size(kd, 2) < ldc*nc) then
@@ -291,42 +296,68 @@ contains
                             'outside the dense matrix')
             return
         end if
-        ! gt = Gd^T: column r of gt is row r0 + r of G over S
-        gt = 0.0_wp
-        do r = 1, nrg
-            do k = gg%p(r0 + r), gg%p(r0 + r + 1) - 1
-                gt(pos(gg%i(k)), r) = gt(pos(gg%i(k)), r) + gg%x(k)
-            end do
-        end do
-        do c1 = 1, nc
-            ! yt(s2 + ns (c2-1), (e-1) nd + d1) = sum_d2 J_e(c1 d1, c2 d2) G(e d2, s2)
-            yt = 0.0_wp
-            do e = 1, ne
-                do d1 = 1, nd
-                    r = (e - 1)*nd + d1
-                    do c2 = 1, nc
-                        do d2 = 1, nd
-                            v = gr%jac(c1 + nc*(d1 - 1), c2 + nc*(d2 - 1), e)
-                            if (v == 0.0_wp) cycle
-                            yt(ns*(c2 - 1) + 1:ns*c2, r) = yt(ns*(c2 - 1) + 1:ns*c2, r) + &
-                                v*gt(:, (e - 1)*nd + d2)
+        associate (gt => gr%gt, yt => gr%yt, kt => gr%kt)
+            do c1 = 1, nc
+                ! yt(s2 + ns (c2-1), (e-1) nd + d1) = sum_d2 J_e(c1 d1, c2 d2) G(e d2, s2)
+                yt = 0.0_wp
+                do e = 1, ne
+                    do d1 = 1, nd
+                        r = (e - 1)*nd + d1
+                        do c2 = 1, nc
+                            do d2 = 1, nd
+                                v = gr%jac(c1 + nc*(d1 - 1), c2 + nc*(d2 - 1), e)
+                                if (v == 0.0_wp) cycle
+                                yt(ns*(c2 - 1) + 1:ns*c2, r) = yt(ns*(c2 - 1) + 1:ns*c2, r) &
+                                                               + v*gt(:, (e - 1)*nd + d2)
+                            end do
+                        end do
+                    end do
+                end do
+                call dgemm('N', 'T', ns, ns*nc, nrg, 1.0_wp, gt, ns, yt, ns*nc, 0.0_wp, &
+                           kt, ns)
+                do c2 = 1, nc
+                    do s2 = 1, ns
+                        m2 = cols(s2) + ldc*(c2 - 1)
+                        do s1 = 1, ns
+                            m1 = cols(s1) + ldc*(c1 - 1)
+                            kd(m1, m2) = kd(m1, m2) + kt(s1, s2 + ns*(c2 - 1))
                         end do
                     end do
                 end do
             end do
-            call dgemm('N', 'T', ns, ns*nc, nrg, 1.0_wp, gt, ns, yt, ns*nc, 0.0_wp, kt, ns)
-            do c2 = 1, nc
-                do s2 = 1, ns
-                    m2 = cols(s2) + ldc*(c2 - 1)
-                    do s1 = 1, ns
-                        m1 = cols(s1) + ldc*(c1 - 1)
-                        kd(m1, m2) = kd(m1, m2) + kt(s1, s2 + ns*(c2 - 1))
-                    end do
-                end do
-            end do
-        end do
+        end associate
         done = .true.
     end subroutine assemble_dense
+
+    !> gr%asm_mode (once per contact set; G is fixed): 2 when assemble_dense's products
+    !> pay, with gr%gcols / gr%gt built if contact_eval has not; else 1. BLAS runs the
+    !> products ~10x faster than the scalar loops: take them up to 4x the loops'
+    !> operations (dense GSI columns: nd times fewer).
+    subroutine choose_dense(gr, gg)
+        type(contact_group), intent(inout) :: gr
+        type(csr_matrix), intent(in) :: gg
+        integer(ip), allocatable :: pos(:)
+        integer(ip) :: nd, ns, r0, e, k, stat
+        real(wp) :: sparse_cost
+        gr%asm_mode = 1
+        nd = gr%ndir
+        r0 = gr%row0
+        allocate (pos(gg%ncol), stat=stat)
+        if (stat /= 0) return
+        pos = 0
+        sparse_cost = 0.0_wp
+        do e = 1, gr%ne
+            k = gg%p(r0 + e*nd + 1) - gg%p(r0 + (e - 1)*nd + 1)
+            sparse_cost = sparse_cost + real(k, wp)**2
+            do k = gg%p(r0 + (e - 1)*nd + 1), gg%p(r0 + e*nd + 1) - 1
+                pos(gg%i(k)) = 1
+            end do
+        end do
+        ns = count(pos /= 0)
+        if (ns == 0 .or. real(ns, wp)**2*real(gr%ne*nd, wp) > 4.0_wp*sparse_cost) return
+        if (.not. allocated(gr%gt)) call group_gt(gr, gg, pos)
+        if (allocated(gr%gt)) gr%asm_mode = 2
+    end subroutine choose_dense
 
     module procedure hbm_contact_forces
         integer(ip) :: i, nc

@@ -210,6 +210,18 @@ contains
                                 'newton_correct: non-finite Newton update')
                 return
             end if
+            ! converged without the residual at y + dy: R(y) met its test and the full
+            ! update is below tol_x, the tests the evaluation there would pass (R moves by
+            ! J dy). The caller evaluates the point again anyway (accept, cont_tangent).
+            if (rn <= opts%tol_r .and. abs(g) <= max(opts%tol_x, 1.0e-12_wp)) then
+                y1 = y + dy
+                if (max(norm2(dy)/max(norm2(y1), opts%yscale), abs(dlam)/opts%lscale) <= &
+                    opts%tol_x) then
+                    y = y1
+                    lam = lam + dlam
+                    return
+                end if
+            end if
             ! backtracking on the merit ||R||^2/rref^2 + g^2
             phi0 = rn**2 + g**2
             alpha = 1.0_wp

@@ -15,6 +15,7 @@ module newton_test_system
     type, extends(nl_system) :: cubic_curve
         real(wp) :: j(2, 2) = 0.0_wp
         integer :: nfact = 0
+        integer :: neval = 0              !! residual evaluations
         integer :: naccept = 0            !! accepted points (accept hook calls)
         real(wp) :: worst_accept = 0.0_wp !! largest |R| at an accepted point
         real(wp) :: lam_accept = 0.0_wp   !! parameter of the last accepted point
@@ -65,6 +66,7 @@ contains
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
         info = 0
+        this%neval = this%neval + 1
         r(1) = y(1)**3 - 3*y(1) - lam
         r(2) = y(2) - y(1)**2
         rref = max(abs(lam), abs(y(1)**3), 1.0_wp)
@@ -157,7 +159,7 @@ program test_newton
                              cont_step_factor
     use newton_test_system
     implicit none
-    type(cubic_curve) :: s
+    type(cubic_curve) :: s, sq
     type(vee_curve) :: v
     type(ratchet_curve) :: r, rc
     type(cont_options) :: o
@@ -269,6 +271,22 @@ program test_newton
     call check(all(lout(2:npts) > lout(1:npts - 1)), 'ratchet corner: lam rises monotonically')
     call check(abs(yout(1, npts) - (rc%a*rc%c + rc%s2*(1.0_wp - rc%c))) < 1.0e-10_wp, &
                'ratchet corner: the branch beyond the corner followed to lam = 1')
+    ! Newton at fixed lam = -4, a fresh J every iteration, the update test deciding (tol_r
+    ! loose, as where a large static term sets rref): the 4th update (4.7e-8 < tol_x),
+    ! taken once R met tol_r (9.7e-8 < 1e-6), is not followed by an evaluation that could
+    ! only confirm it (before: 2 evaluations per iteration, 8; now 7), and the point is
+    ! on the curve to quadratic convergence's next error (|R| 5e-14; tolerance 1e-12)
+    sq%n = 2
+    o = cont_options(tol_r=1.0e-6_wp, tol_x=1.0e-7_wp, reuse_jac=.false.)
+    y = [-2.0_wp, 4.0_wp]
+    lam = -4.0_wp
+    hf = .false.
+    call newton_correct(sq, y, lam, y, lam, [0.0_wp, 0.0_wp], 1.0_wp, o, iters, info, msg, hf)
+    print '(a,i0,a,i0)', 'fixed-lam Newton: iterations ', iters, ', evaluations ', sq%neval
+    call check(info == 0 .and. iters >= 3, 'fixed-lam Newton converged: '//trim(msg))
+    call check(sq%neval == 2*iters - 1, 'no evaluation after the last, converged update')
+    call check(abs(y(1)**3 - 3*y(1) + 4.0_wp) < 1.0e-12_wp .and. &
+               abs(y(2) - y(1)**2) < 1.0e-11_wp, 'fixed-lam Newton: on the curve')
     call check_done('test_newton')
 contains
     !> cont_run of a ratchet (slope a = 3) from y = 0 at lam = 0 towards lam = 1, steps of
