@@ -114,7 +114,8 @@ end subroutine hbm_rcm
 !> tan0), or solve at lam0 only. ropt, iopt: Newton and continuation settings by slot
 !> (RCONT_*, ICONT_* of frirom_newton; Python reads all of these names with int_constant).
 !> Outputs: npts points; timings(T_*): AFT, assembly, factorisation, solve, receptances (s),
-!> residual evaluations, factorisations, GMRES iterations; timings(N_TIMERS): total (s).
+!> residual evaluations, factorisations, GMRES iterations, double-precision fall-back
+!> factorisations (N_DOUBLE); timings(N_TIMERS): total (s).
 subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, &
                         mi, mx, nnzc, cp, ci, cx, perm, nnl, nl, fe0, fe1, omega_fix, ngroup, &
                         ginfo, nrows, nnzg, gp, gi, gx, npart, params, nw0, w0, nout, outdofs, &
@@ -289,7 +290,7 @@ end subroutine hbm_lu_holds
 !> Value of a named integer constant of this interface, so that Python reads slots, modes
 !> and codes from Fortran instead of typing their numbers: RCONT_*, N_RCONT, ICONT_*,
 !> N_ICONT (option slots of hbm_continue, frirom_newton), HBM_START_* (start modes),
-!> T_*, N_EVAL, N_FACT, N_KRYLOV, N_TIMERS (timings slots, frirom_hbm) and the FRIROM_*
+!> T_*, N_EVAL, N_FACT, N_KRYLOV, N_DOUBLE, N_TIMERS (timings slots, frirom_hbm) and the FRIROM_*
 !> status codes.
 !> An unknown name returns info = FRIROM_ERR_PARAM.
 !> The default AFT samples per period for nh harmonics (frirom_solve's rule, the one place
@@ -310,7 +311,7 @@ subroutine int_constant(name, value, info, msg)
                              RCONT_LSCALE, RCONT_DS, RCONT_DS_MIN, RCONT_DS_MAX, RCONT_LAM_END, &
                              RCONT_LAM_LO, N_RCONT, ICONT_MAX_ITER, ICONT_REUSE_JAC, N_ICONT
     use frirom_hbm, only: T_AFT, T_ASM, T_FACT, T_SOLVE, T_REC, N_EVAL, N_FACT, N_KRYLOV, &
-                          N_TIMERS, HILL_DENSE_MAX, &
+                          N_DOUBLE, N_TIMERS, HILL_DENSE_MAX, &
                           HBM_START_CONTINUE, HBM_START_RESUME, HBM_START_SOLVE_ONLY
     implicit none
     character(len=*), intent(in) :: name
@@ -373,6 +374,8 @@ subroutine int_constant(name, value, info, msg)
         value = N_FACT
     case ('N_KRYLOV')
         value = N_KRYLOV
+    case ('N_DOUBLE')
+        value = N_DOUBLE
     case ('N_TIMERS')
         value = N_TIMERS
     case default

@@ -497,6 +497,7 @@ contains
             this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
             if (ok) return
             ! J too ill-conditioned for single precision: the double LU of the J in jm
+            this%timers(N_DOUBLE) = this%timers(N_DOUBLE) + 1.0_wp
             call cond_factor(this, info, errmsg, double=.true.)
             if (info /= 0) return
             t0 = wtime()

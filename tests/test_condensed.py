@@ -232,6 +232,8 @@ def test_large_system_solves_by_gmres_on_the_held_lu():
     assert "1120 unknowns" in r.solver_info
     assert r.timings["krylov_iterations"] > 0
     assert r.timings["factorizations"] < 0.8 * len(r)
+    # the single-precision LU preconditions this well-conditioned J: no double fall-back
+    assert r.timings["double_factorizations"] == 0
     assert max(p.state_fractions[0][1] for p in kept) > 0.01      # slip on the way
     for k in (1, len(kept) // 2, len(kept) - 1):
         # a new system holds no LU: its Newton solves are by a fresh LU

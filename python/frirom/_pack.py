@@ -74,7 +74,7 @@ _TIMER_SLOTS = {name: int_constant(slot) - 1 for name, slot in (
     ("aft", "T_AFT"), ("assembly", "T_ASM"), ("factorization", "T_FACT"),
     ("solve", "T_SOLVE"), ("receptance", "T_REC"), ("evaluations", "N_EVAL"),
     ("factorizations", "N_FACT"), ("krylov_iterations", "N_KRYLOV"),
-    ("fortran_total", "N_TIMERS"))}
+    ("double_factorizations", "N_DOUBLE"), ("fortran_total", "N_TIMERS"))}
 TIMER_NAMES = tuple(sorted(_TIMER_SLOTS, key=_TIMER_SLOTS.get))
 
 

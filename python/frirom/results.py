@@ -237,7 +237,8 @@ class FRF:
     stability_computed: bool = False
     slider: np.ndarray | None = None
     #: Fortran time split of the run: aft, assembly, factorization, solve, receptance (s),
-    #: evaluations, factorizations (counts), fortran_total (s)
+    #: evaluations, factorizations, krylov_iterations, double_factorizations (counts),
+    #: fortran_total (s)
     timings: dict = field(default_factory=dict)
     #: (n_out,) Peak per output solved on the curve by the solver (None: not computed)
     peaks: list | None = None
