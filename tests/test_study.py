@@ -351,3 +351,33 @@ def test_reduction_ladder_gets_one_cache_per_rung(tmp_path, monkeypatch):
     got = member_arrays(res["file"], "m001")
     assert got["omega"].shape == ref.omega.shape
     assert np.allclose(got["amp_max"], ref.amp_max, rtol=1e-10, atol=0)
+
+
+def test_reduction_ladder_beside_a_named_cache_file(tmp_path, monkeypatch):
+    """A deck that names its cache file (reduction.cache = "*.h5") keeps its own reduced
+    model there; a ladder member with another reduction gets its content-keyed entry in
+    that file's folder instead of overwriting it (one file per reduction: the deck's
+    fingerprint stays in the named file, the other rung's in its own)."""
+    if shutil.which("ccx") is None:
+        pytest.skip("ccx not installed")
+    pytest.importorskip("gmsh")
+    sys.path.insert(0, str(ROOT / "cases" / "lap_joint"))
+    import make_lap_joint
+    from test_lap_joint_case import small
+    monkeypatch.delenv("FRIROM_CACHE", raising=False)
+    make_lap_joint.make(tmp_path, size=0.012)
+    deck = small(16).replace("825.0", "835.0").replace("880.0", "860.0")
+    assert deck.count("[reduction]\n") == 1
+    (tmp_path / "lap.toml").write_text(deck.replace(
+        "[reduction]\n", '[reduction]\ncache = "lap.rom.h5"\n'))
+    (tmp_path / "ladder.toml").write_text(
+        '[study]\nbase = "lap.toml"\nkind = "convergence"\nscheduler = "serial"\n'
+        '[study.parameters]\n"reduction.interface_modes.free" = [4, 8]\n'
+        '"reduction.interface_modes.stick" = [4, 8]\n')
+    res = run_study(tmp_path / "ladder.toml", tmp_path / "out", quiet=True)
+    roms = [Path(m["rom"]) for m in res["study"].members]
+    assert len(set(roms)) == 2 and all(p.is_file() for p in roms), roms
+    own = load_deck(tmp_path / "lap.toml").reduced
+    assert own.from_cache                    # the deck's model, left in its named file
+    assert (tmp_path / "lap.rom.h5") in roms
+    assert all(p.parent == tmp_path for p in roms)

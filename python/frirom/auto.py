@@ -43,7 +43,6 @@ from __future__ import annotations
 import dataclasses
 import time
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -335,12 +334,10 @@ def _rung_deck(deck, values: dict):
     """The deck with the interface-mode counts ``values``, built by the deck builder (the
     reduced model comes from the content-keyed cache when it was built before)."""
     from .deck import build_deck
+    from .deck.build import beside_named_cache
     s = deck.settings
-    cache = s.reduction.cache       # a file names one model: the rungs go beside it
-    if cache is not None and Path(cache).suffix == ".h5":
-        cache = Path(cache).parent
-    return build_deck(dataclasses.replace(s, reduction=dataclasses.replace(
-        s.reduction, cache=cache, **values), modes_auto=None))
+    return build_deck(beside_named_cache(dataclasses.replace(
+        s, reduction=dataclasses.replace(s.reduction, **values), modes_auto=None), s))
 
 
 def _rung_peaks(deck, H, opts, window, full):

@@ -82,11 +82,12 @@ def load_study(path) -> Study:
     deck = path
     if st.base is not None:
         deck, raw = st.base, read_toml(st.base)
-    from .deck.build import rom_file
+    from .deck.build import beside_named_cache, rom_file
+    base = parse_deck(deck, raw)
     members = []
     for i, values in enumerate(st.members()):
         try:
-            rom = rom_file(parse_deck(deck, member_raw(raw, values)))
+            rom = rom_file(beside_named_cache(parse_deck(deck, member_raw(raw, values)), base))
         except InputError as exc:
             raise InputError(f"study member {i} ({_label(values)}): {exc}") from None
         members.append({"name": f"m{i:03d}", "values": values,
@@ -98,8 +99,11 @@ def load_member(deck_path, overrides: dict):
     """The built :class:`frirom.deck.Deck` of one member: the deck file with ``overrides``
     {key path: value} written, through the deck parser and builder."""
     from .deck import build_deck
+    from .deck.build import beside_named_cache
     deck_path = Path(deck_path)
-    return build_deck(parse_deck(deck_path, member_raw(read_toml(deck_path), overrides)))
+    raw = read_toml(deck_path)
+    return build_deck(beside_named_cache(parse_deck(deck_path, member_raw(raw, overrides)),
+                                         parse_deck(deck_path, raw)))
 
 
 def prepare_member(deck_path, overrides: dict) -> dict:

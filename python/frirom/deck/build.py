@@ -10,6 +10,7 @@ modes (:mod:`frirom.deck.build_cyclic`). :meth:`Deck.model`, :meth:`Deck.excitat
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,7 +23,8 @@ from ..contact import LAWS
 from ..io import DIRECTION_NAMES, read_mtx
 from ..io._common import read_text
 from ..model import ContactGroup, CyclicModel, Damping, Excitation, Model, check_definite
-from ..reduction.rom import PairSpec, build_reduced_model, cache_file, rom_key
+from ..reduction.rom import (PairSpec, build_reduced_model, cache_file, rom_key,
+                             same_reduction)
 from ..solver import SolverOptions
 from .build_cyclic import check_sector_contacts, cyclic_modes, cyclic_sector_of
 from .fields import Context, DofRef
@@ -106,7 +108,6 @@ class Deck:
 
     def result_meta(self) -> dict:
         """What a result file keeps of how it was made (frirom.results.META_KEYS)."""
-        import dataclasses
         import json
 
         from .. import __version__
@@ -415,6 +416,21 @@ def rom_file(settings: DeckSettings) -> Path | None:
         return None
     key = rom_key(settings.fe_model, settings.reduction, pair_specs(settings))
     return cache_file(settings.fe_model, settings.reduction, key)
+
+
+def beside_named_cache(settings: DeckSettings, base: DeckSettings) -> DeckSettings:
+    """``settings`` (a study member, an "auto" rung) with its reduced model in the folder of
+    the deck's named cache file when its reduction differs from the deck's own (``base``):
+    a ``reduction.cache = "*.h5"`` holds the deck's model only, and other reductions get
+    their content-keyed entries beside it instead of overwriting it."""
+    cache = None if settings.fe_model is None else settings.reduction.cache
+    if (cache is None or Path(cache).suffix != ".h5"
+            or base.fe_model is not None and same_reduction(
+                (settings.fe_model, settings.reduction, pair_specs(settings)),
+                (base.fe_model, base.reduction, pair_specs(base)))):
+        return settings
+    return dataclasses.replace(settings, reduction=dataclasses.replace(
+        settings.reduction, cache=Path(cache).parent))
 
 
 def build_deck(settings: DeckSettings) -> Deck:

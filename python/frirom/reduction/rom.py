@@ -435,12 +435,27 @@ def rom_key(source: FESource, spec: ReductionSpec, pairs: list) -> str:
         with open(f, "rb") as fh:
             for chunk in iter(lambda: fh.read(1 << 22), b""):
                 h.update(chunk)
+    h.update(json.dumps([source.options, *_key_settings(spec, pairs)], sort_keys=True,
+                        default=str).encode())
+    return h.hexdigest()
+
+
+def _key_settings(spec: ReductionSpec, pairs: list) -> tuple:
+    """The reduction settings and pair geometry that enter :func:`rom_key`."""
     cfg = {k: v for k, v in asdict(spec).items() if k != "cache"}
     stick = spec.method == "gsi" and spec.stick + spec.separate_stick > 0
     pc = [{k: v for k, v in asdict(p).items()
            if k != "key" and (stick or k not in ("kt", "kn"))} for p in pairs]
-    h.update(json.dumps([source.options, cfg, pc], sort_keys=True, default=str).encode())
-    return h.hexdigest()
+    return cfg, pc
+
+
+def same_reduction(a: tuple, b: tuple) -> bool:
+    """Whether two (source, spec, pairs) give the same reduced model by the FE files'
+    names and options and :func:`rom_key`'s settings (no file is read)."""
+    def text(source, spec, pairs):
+        return json.dumps([source.format, [str(p) for p in source.paths()], source.options,
+                           *_key_settings(spec, pairs)], sort_keys=True, default=str)
+    return text(*a) == text(*b)
 
 
 def cache_file(source: FESource, spec: ReductionSpec, key: str) -> Path:
@@ -572,12 +587,13 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
     if spec.method == "none":
         basis = None
     elif spec.method == "gsi":
-        if spec.stick and not pairs0:
-            raise InputError(f"{pre}.stick: full-stick modes need contacts on node sets "
+        key = "stick" if spec.stick else "separate_stick"
+        if (spec.stick or spec.separate_stick) and not pairs0:
+            raise InputError(f"{pre}.{key}: full-stick modes need contacts on node sets "
                              "([[contacts]] with a and b)")
         allp = None
-        if spec.stick and rot:
-            raise InputError(f"{pre}.stick: full-stick modes with contacts to the next "
+        if (spec.stick or spec.separate_stick) and rot:
+            raise InputError(f"{pre}.{key}: full-stick modes with contacts to the next "
                              "sector (b_sector = 1) are not implemented; use free modes")
         if (spec.stick or spec.separate_stick) and pairs0 and not rot:
             if len({p.n_dir for p in pairs0.values()}) > 1:
