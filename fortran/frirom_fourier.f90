@@ -143,9 +143,8 @@ contains
         plan%cout = (0.0_wp, 0.0_wp)
 
         plan%direct = nharm <= DIRECT_MAX_HARM
-        allocate (plan%coef(plan%nbatch, nc))
-        allocate (plan%basis(nsamp, nc), plan%weight(nc), plan%prefix(4*nharm + 1, 0:nsamp), &
-                  stat=stat)
+        allocate (plan%coef(plan%nbatch, nc), plan%basis(nsamp, nc), plan%weight(nc), &
+                  plan%prefix(4*nharm + 1, 0:nsamp), stat=stat)
         if (stat /= 0) then
             call fourier_plan_destroy(plan)
             write (buf, '(a,i0,a,i0)') 'allocate failed: no memory, N = ', nsamp, &

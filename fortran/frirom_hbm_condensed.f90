@@ -416,7 +416,6 @@ contains
             call sgetrf(n, n, sys%jms, n, sys%ipiv, linfo)
             ! J (at the LU's frequency gj and contact state) applied matrix-free
             sys%jfree = .true.
-            sys%lu_single = .true.
             if (linfo == 0) call wb_build(sys)
         else
             call dgetrf(n, n, sys%jm, n, sys%ipiv, linfo)
@@ -682,10 +681,11 @@ contains
         type(hbm_condensed), intent(inout) :: sys
         real(wp), allocatable :: sens(:, :), nphi(:), xv(:, :), f(:, :)
         real(real32), allocatable :: ws(:, :)
-        integer(ip) :: nu, nc, nm, np, k, h, r, c, q, loc(2), linfo, n
+        integer(ip) :: nu, nc, nm, np, k, h, r, c, q, loc(2), linfo, n, stat
         real(wp) :: smax, hw
         sys%wb_ok = .false.
         sys%wb_at = -1.0_wp
+        sys%wb_w0 = sys%wj
         if (.not. allocated(sys%phr) .or. sys%nh < 1) return
         nu = sys%nnl
         nc = sys%nc
@@ -701,11 +701,13 @@ contains
                                                    sys%wm(:, h)*h, wp))*sys%wj*nphi
         end do
         smax = maxval(sens)
-        if (.not. smax > 0.0_wp) return
+        ! an undamped mode at resonance: no finite scale to rank the pairs by
+        if (.not. (smax > 0.0_wp .and. smax <= huge(smax))) return
         np = min(WB_PAIRS, nm*sys%nh)
-        if (allocated(sys%wbm)) deallocate (sys%wbm, sys%wbh, sys%wbg, sys%wbw, sys%wbv, &
-                                            sys%wbs, sys%wbl, sys%wbp)
-        allocate (sys%wbm(np), sys%wbh(np), sys%wbg(np))
+        if (allocated(sys%wbm)) deallocate (sys%wbm, sys%wbh, sys%wbg)
+        if (allocated(sys%wbw)) deallocate (sys%wbw, sys%wbv, sys%wbs, sys%wbl, sys%wbp)
+        allocate (sys%wbm(np), sys%wbh(np), sys%wbg(np), stat=stat)
+        if (stat /= 0) return
         k = 0
         do while (k < np)
             loc = maxloc(sens)
@@ -719,7 +721,11 @@ contains
         np = k
         if (np == 0) return
         allocate (sys%wbw(n, 2*np), sys%wbv(2*np, n), sys%wbs(2*np, 2*np), &
-                  sys%wbl(2*np, 2*np), sys%wbp(2*np), xv(nu, nc), f(nu, nc))
+                  sys%wbl(2*np, 2*np), sys%wbp(2*np), xv(nu, nc), f(nu, nc), stat=stat)
+        if (stat /= 0) then     ! no correction: the LU alone preconditions
+            if (allocated(sys%wbw)) deallocate (sys%wbw, sys%wbv, sys%wbs, sys%wbl, sys%wbp)
+            return
+        end if
         sys%wbw = 0.0_wp
         do k = 1, np
             do q = 0, 1
@@ -748,6 +754,8 @@ contains
         complex(wp) :: d
         real(wp) :: dr, di
         if (.not. (sys%wb_ok .and. sys%lu_single) .or. sys%wb_at == sys%wj) return
+        sys%wb_at = sys%wj
+        if (sys%wj == sys%wb_w0) return       ! D = 0 at the LU's own frequency
         m = size(sys%wbs, 1)
         do k = 1, m/2
             d = sys%gj(sys%wbm(k), sys%wbh(k)) - sys%wbg(k)
@@ -761,11 +769,7 @@ contains
             sys%wbl(i, i) = sys%wbl(i, i) + 1.0_wp
         end do
         call dgetrf(m, m, sys%wbl, m, sys%wbp, linfo)
-        if (linfo /= 0) then
-            sys%wb_ok = .false.
-            return
-        end if
-        sys%wb_at = sys%wj
+        if (linfo /= 0) sys%wb_ok = .false.
     end subroutine wb_prepare
 
     !> w := M^-1 w for the LU held (jms single precision, or jm), all columns at once.
@@ -781,7 +785,7 @@ contains
             ws = real(w, real32)
             call sgetrs('N', n, size(w, 2), sys%jms, n, sys%ipiv, ws, n, linfo)
             w = real(ws, wp)
-            if (sys%wb_ok .and. sys%wb_at == sys%wj) then
+            if (sys%wb_ok .and. sys%wb_at == sys%wj .and. sys%wj /= sys%wb_w0) then
                 ! w -= W (I + D S)^-1 D V w
                 m = size(sys%wbs, 1)
                 allocate (t(m, size(w, 2)), t2(m, size(w, 2)))

@@ -200,7 +200,7 @@ contains
         type(csr_matrix), intent(in) :: gg
         integer(ip), intent(in) :: nc
         integer(ip), allocatable :: pos(:)
-        integer(ip) :: ns, nrg, k1, k2, stat
+        integer(ip) :: ns, nrg, k1, k2, k, stat
         gr%gx_mode = 1
         nrg = gr%ne*gr%ndir
         k1 = gg%p(gr%row0 + 1)
@@ -209,7 +209,9 @@ contains
         allocate (pos(gg%ncol), stat=stat)
         if (stat /= 0) return
         pos = 0
-        pos(gg%i(k1:k2)) = 1
+        do k = k1, k2       ! (a vector subscript with repeated columns may not be assigned)
+            pos(gg%i(k)) = 1
+        end do
         ns = count(pos /= 0)
         if (real(ns, wp)*real(nrg, wp) > 2.0_wp*real(k2 - k1 + 1, wp)) return
         if (.not. allocated(gr%gt)) call group_gt(gr, gg, pos)
