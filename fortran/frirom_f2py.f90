@@ -122,8 +122,8 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
                         nmodes, phi, wmodes, zmodes, hmodes, psi, wharm, zharm, ny, y0, lam0, &
                         tan0, start_mode, nropt, ropt, niopt, iopt, stability, history, &
                         maxpts, netot, ntim, ys, lams, tans, iters, xo, states, hill_re, &
-                        sliders, npts, finished, ds_out, timings, info, msg, tcontact, krylov, &
-                        sparse, nlu, lu, lupiv, lustate)
+                        sliders, yscales, npts, finished, ds_out, timings, info, msg, &
+                        tcontact, krylov, sparse, nlu, lu, lupiv, lustate)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options, cont_options_from, N_RCONT, N_ICONT, RCONT_DS, &
@@ -177,6 +177,9 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     !> contact history each point leaves: the sliders its closed cycles start with, in the
     !> layout of w0 (the w0 to restart a run from that point)
     real(8), intent(out) :: sliders(nw0, maxpts)
+    !> the arc-length scale of the unknowns each point's tangent is in (grown with the
+    !> solution after every point): resume from a point with its tangent and this
+    real(8), intent(out) :: yscales(maxpts)
     integer(4), intent(out) :: npts, finished
     real(8), intent(out) :: ds_out, timings(ntim)
     integer(4), intent(out) :: info
@@ -210,6 +213,7 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     xo = 0.0d0
     states = 0.0d0
     sliders = 0.0d0
+    yscales = 0.0d0
     hill_re = 0.0d0
     linfo = 0
     if (nropt /= N_RCONT .or. niopt /= N_ICONT .or. ntim /= N_TIMERS) then
@@ -259,10 +263,12 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     dsl = ropt(RCONT_DS)
     if (stability /= 0) then
         call hbm_run(sys, start_mode, y, lam, t, dsl, ropt(RCONT_LAM_LO), opts, ys, lams, &
-                     tans, itl, xo, states, np, fin, linfo, msg, hill_re, sliders=sliders)
+                     tans, itl, xo, states, np, fin, linfo, msg, hill_re, sliders=sliders, &
+                     yscales=yscales)
     else
         call hbm_run(sys, start_mode, y, lam, t, dsl, ropt(RCONT_LAM_LO), opts, ys, lams, &
-                     tans, itl, xo, states, np, fin, linfo, msg, sliders=sliders)
+                     tans, itl, xo, states, np, fin, linfo, msg, sliders=sliders, &
+                     yscales=yscales)
     end if
     call hbm_lu_export(sys, lu, lupiv, lustate, lu_used)
     npts = np

@@ -328,6 +328,8 @@ contains
         end if
         allocate (zero(sys%n), yb(sys%n, 1), lb(1), tb(sys%n + 1, 1), t0(sys%n + 1))
         zero = 0.0_wp
+        o1 = opts
+        o1%max_points = 1
         if (start_mode /= HBM_START_RESUME) then
             have_fact = .false.
             call newton_correct(sys, y, lam, y, lam, zero, 1.0_wp, opts, it, info, errmsg, &
@@ -346,14 +348,22 @@ contains
                 return
             end if
         end if
-        o1 = opts
-        o1%max_points = 1
         have_fact = start_mode /= HBM_START_RESUME   ! cont_tangent left J at the first point
+        if (.not. have_fact .and. opts%reuse_jac) then
+            ! J at the resumed point, as the run that made the point holds it (cont_tangent
+            ! left it there; t0 is the same tangent): the first corrector's chord steps,
+            ! and so the path, do not depend on where the caller's calls begin
+            t0 = t
+            call cont_tangent(sys, y, lam, o1, t0, 1.0_wp, tb(:, 1), info, errmsg)
+            if (info /= 0) return
+            have_fact = .true.
+        end if
         do while (npts < maxpts)
             call cont_run(sys, y, lam, t, ds, lam_lo, o1, yb, lb, tb, ib, n1, finished, &
                           info, errmsg, have_fact)
             if (n1 == 1) then
                 it = info
+                call rescale()
                 call store(ib(1))
                 if (it /= 0) info = it
             end if
@@ -361,6 +371,21 @@ contains
         end do
 
     contains
+
+        !> The arc length measures the unknowns against the largest solution so far
+        !> (o1%yscale, grown to |y| once |y| exceeds twice it; t follows into the new
+        !> scaling): near a resonance 100x above the first point, steps would otherwise
+        !> crawl in the parameter, and at ds_min the chord between points would be corrector
+        !> noise. After every point, so that the path does not depend on how often the
+        !> caller takes the points (yscales).
+        subroutine rescale()
+            real(wp) :: ny
+            ny = norm2(y)
+            if (.not. (ny > 2.0_wp*o1%yscale)) return
+            t(1:sys%n) = t(1:sys%n)*(o1%yscale/ny)
+            t = t/norm2(t)
+            o1%yscale = ny
+        end subroutine rescale
 
         subroutine store(itn)
             integer(ip), intent(in) :: itn
@@ -371,6 +396,7 @@ contains
             lams(npts) = lam
             tans(:, npts) = t
             iters(npts) = itn
+            if (present(yscales)) yscales(npts) = o1%yscale
             if (present(sliders)) call hbm_sliders(sys, sliders(:, npts))
             call sys%outputs(y, lam, xo(:, :, npts), info, errmsg)
             if (info /= 0) return

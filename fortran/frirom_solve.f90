@@ -10,8 +10,8 @@
 !>
 !> The continuation follows frirom.solver.frf step for step: a first solve at the start
 !> frequency with a purely relative update test, arc length scaled by the largest solution
-!> so far (rescaled every `batch` points), the run complete only when it reaches the end
-!> frequency. Receptances are factorised per harmonic (Python's receptances =
+!> so far (rescaled after every point, in hbm_run), the run complete only when it reaches
+!> the end frequency. Receptances are factorised per harmonic (Python's receptances =
 !> 'factorization'); condensed unknowns are the contact coordinates G x when they are
 !> fewer than the contact DoFs (Python's coordinates = 'auto').
 module frirom_solve
@@ -46,7 +46,7 @@ module frirom_solve
         integer(c_int) :: formulation = FRF_CONDENSED
         integer(c_int) :: max_points = 2000    !! points of the curve at most
         integer(c_int) :: max_iter = 25        !! Newton iterations per corrector
-        integer(c_int) :: batch = 10           !! points between rescalings of the arc length
+        integer(c_int) :: batch = 10           !! points per hbm_run call
         integer(c_int) :: reuse_jacobian = 1   !! 1: keep a factorisation while it contracts
         integer(c_int) :: history = 1          !! 1: carry the contact sliders along the curve
         real(c_double) :: tol_residual = 1.0e-8_c_double
@@ -305,10 +305,10 @@ contains
                                     perm(:), nl(:)
         real(wp), allocatable :: kx(:), mx(:), cx(:), gx(:), cd(:, :), wsl(:)
         real(wp), allocatable :: y0(:), t0(:), ys(:, :), lams(:), tans(:, :), xo(:, :, :), &
-                                 st(:, :, :), tan_last(:)
+                                 st(:, :, :), tan_last(:), yscs(:)
         integer(ip), allocatable :: itb(:)
         integer(ip) :: nh, nc, nrows, ne, info, i, j, k, nout, cap, maxpts, np, k0, start
-        real(wp) :: lscale, lam_lo, yscale, lam0, ds, ny0, rv(N_RCONT)
+        real(wp) :: lscale, lam_lo, yscale, lam0, ds, ysc_last, rv(N_RCONT)
         integer(ip) :: iv(N_ICONT)
         logical :: fin, pending, tcontact
         character(len=512) :: msg
@@ -412,6 +412,7 @@ contains
             k0 = 1
             if (pending .and. np > 0) k0 = 2     ! the first point again: its tangent only
             if (pending .and. np > 0) tan_last = tans(:, 1)
+            if (pending .and. np > 0) ysc_last = yscs(1)
             pending = .false.
             do k = k0, np
                 call keep(k)
@@ -421,19 +422,13 @@ contains
                 res%message = msg
                 exit
             end if
-            ! continue from the last point; the arc length measures unknowns against the
-            ! largest solution so far
+            ! continue from the last point, in the arc-length scale of its tangent
             j = res%npts
             y0 = res%y(:, j)
             lam0 = res%omega(j)
             t0 = tan_last
+            yscale = ysc_last
             start = HBM_START_RESUME
-            ny0 = norm2(y0)
-            if (ny0 > 2.0_wp*yscale) then
-                t0(1:sys%n) = t0(1:sys%n)*yscale/ny0
-                t0 = t0/norm2(t0)
-                yscale = ny0
-            end if
             if (fin) then
                 res%complete = .true.
                 exit
@@ -587,16 +582,16 @@ contains
             iv(ICONT_REUSE_JAC) = s%reuse_jacobian
             opts = cont_options_from(rv, iv)
             opts%max_points = mx
-            if (allocated(ys)) deallocate (ys, lams, tans, itb, xo, st)
+            if (allocated(ys)) deallocate (ys, lams, tans, itb, xo, st, yscs)
             allocate (ys(sys%n, mx), lams(mx), tans(sys%n + 1, mx), itb(mx), &
-                      xo(nout, nc, mx), st(3, max(ne, 1), mx))
+                      xo(nout, nc, mx), st(3, max(ne, 1), mx), yscs(mx))
             sys%carry = s%history /= 0
             y = y0
             t = t0
             lam = lam0
             dsl = ds
             call hbm_run(sys, mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itb, xo, st, &
-                         np, fin, info, msg)
+                         np, fin, info, msg, yscales=yscs)
             ds = dsl
         end subroutine run_call
 
@@ -618,6 +613,7 @@ contains
             res%states(:, :, j) = st(:, :, kk)
             res%iters(j) = itb(kk)
             tan_last = tans(:, kk)
+            ysc_last = yscs(kk)
         end subroutine keep
         !> Room for nn points in the result arrays (the npts kept are copied); false, with
         !> info = FRIROM_ERR_ALLOC and the message, when memory runs out.

@@ -296,6 +296,7 @@ class _CallResult(NamedTuple):
     states: np.ndarray       # (3, ne_tot, maxpts) stick/slip/open fractions per element
     hill_re: np.ndarray      # (maxpts,) max real part of the Floquet exponents, 1/s
     sliders: np.ndarray      # (nw, maxpts) contact history each point leaves
+    yscales: np.ndarray      # (maxpts,) arc-length scale of the unknowns of each tangent
     npts: int
     finished: int            # 1: reached lam_end (or a solve-only call)
     ds_out: float            # arc-length step to continue with
@@ -481,7 +482,8 @@ class _Packed:
                                 iterations=int(res.iters[k]), time_s=t_call / max(res.npts, 1),
                                 stable=bool(res.hill_re[k] <= 1e-7 * max(abs(om), 1.0)),
                                 floquet_max_re=float(res.hill_re[k]),
-                                slider=res.sliders[:self.nw, k].copy()))
+                                slider=res.sliders[:self.nw, k].copy(),
+                                yscale=float(res.yscales[k])))
         return pts
 
 

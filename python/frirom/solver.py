@@ -306,7 +306,7 @@ class _Continuation:
         if self.pending and new:
             self.prev_t = new[0].tangent[-1]
             self.points[-1].tangent = new[0].tangent
-            self.points[-1].yscale = self.yscale
+            self.points[-1].yscale = new[0].yscale
             self.points[-1].ds_next = new[0].ds_next
             self._emit(self.points[-1])
             new = new[1:]
@@ -333,8 +333,6 @@ class _Continuation:
             self.t0 = time.perf_counter()
             add_timings(self.timings, res.timings)
             new = self.packed.points(res, self.omega_fix, t_call)
-            for p in new:
-                p.yscale = self.yscale
             if new and res.info == 0:
                 new[-1].ds_next = res.ds_out      # a checkpoint (FRFWriter.resume_point)
             self._take(new)
@@ -358,23 +356,18 @@ class _Continuation:
         return message
 
     def _advance(self, ds_out: float) -> None:
-        """The next call resumes from the last point. The arc length measures unknowns
-        against the largest solution so far: near a resonance 100x above the first point,
-        steps would otherwise crawl in frequency."""
+        """The next call resumes from the last point, in the arc-length scale of its
+        tangent (Fortran grows the scale with the solution after every point, so the path
+        does not depend on `batch`)."""
         last = self.points[-1]
+        self.yscale = last.yscale
         self._continue_from(last.unknowns, last.parameter, last.tangent, ds_out)
 
     def _continue_from(self, y, lam, tan, ds) -> None:
-        """The next call starts from the converged point (y, lam) with tangent tan and
-        step ds (the arc-length scale grows with the solution, see _advance)."""
+        """The next call starts from the converged point (y, lam) with tangent tan (in
+        the scale self.yscale) and step ds."""
         self.y0, self.lam0, self.tan0 = y, lam, tan
         self.ds, self.start_mode = ds, START_RESUME
-        ny0 = float(np.linalg.norm(self.y0))
-        if ny0 > 2.0 * self.yscale:
-            self.tan0 = self.tan0.copy()
-            self.tan0[:-1] *= self.yscale / ny0
-            self.tan0 /= np.linalg.norm(self.tan0)
-            self.yscale = ny0
 
     def finish(self, complete: bool, message: str, keep_unknowns: bool) -> FRF:
         p, pts = self.packed, self.points
