@@ -313,7 +313,7 @@ contains
 
     module procedure hbm_run
         type(cont_options) :: o1
-        real(wp), allocatable :: zero(:), yb(:, :), lb(:), tb(:, :), t0(:)
+        real(wp), allocatable :: zero(:), yb(:, :), lb(:), tb(:, :), t0(:), tj(:)
         integer(ip) :: it, n1, maxpts, ib(1)
         logical :: have_fact
         info = FRIROM_OK
@@ -326,7 +326,8 @@ contains
             call set_status(info, FRIROM_ERR_SIZE, errmsg, 'hbm_run: array sizes')
             return
         end if
-        allocate (zero(sys%n), yb(sys%n, 1), lb(1), tb(sys%n + 1, 1), t0(sys%n + 1))
+        allocate (zero(sys%n), yb(sys%n, 1), lb(1), tb(sys%n + 1, 1), t0(sys%n + 1), &
+                  tj(sys%n + 1))
         zero = 0.0_wp
         o1 = opts
         o1%max_points = 1
@@ -341,6 +342,7 @@ contains
             call cont_tangent(sys, y, lam, opts, t0, sign(1.0_wp, opts%lam_end - lam), t, &
                               info, errmsg)
             if (info /= 0) return
+            tj = t
             call store(it)
             if (info /= 0) return
             if (start_mode == HBM_START_SOLVE_ONLY) then
@@ -348,19 +350,17 @@ contains
                 return
             end if
         end if
-        have_fact = start_mode /= HBM_START_RESUME   ! cont_tangent left J at the first point
-        if (.not. have_fact .and. opts%reuse_jac) then
-            ! J at the resumed point, as the run that made the point holds it (cont_tangent
-            ! left it there; t0 is the same tangent): the first corrector's chord steps,
-            ! and so the path, do not depend on where the caller's calls begin
-            t0 = t
-            call cont_tangent(sys, y, lam, o1, t0, 1.0_wp, tb(:, 1), info, errmsg)
+        if (start_mode == HBM_START_RESUME) then
+            ! J at the resumed point and its tangent tj, as the run that made the point
+            ! holds them (cont_tangent left them there): the first corrector's chord steps
+            ! and the corner rules, and so the path, do not depend on where calls begin
+            call cont_tangent(sys, y, lam, o1, t, 1.0_wp, tj, info, errmsg)
             if (info /= 0) return
-            have_fact = .true.
         end if
+        have_fact = .true.
         do while (npts < maxpts)
             call cont_run(sys, y, lam, t, ds, lam_lo, o1, yb, lb, tb, ib, n1, finished, &
-                          info, errmsg, have_fact)
+                          info, errmsg, have_fact, tj)
             if (n1 == 1) then
                 it = info
                 call rescale()
@@ -384,6 +384,8 @@ contains
             if (.not. (ny > 2.0_wp*o1%yscale)) return
             t(1:sys%n) = t(1:sys%n)*(o1%yscale/ny)
             t = t/norm2(t)
+            tj(1:sys%n) = tj(1:sys%n)*(o1%yscale/ny)
+            tj = tj/norm2(tj)
             o1%yscale = ny
         end subroutine rescale
 

@@ -15,6 +15,7 @@ module frirom_newton
     implicit none
     private
     public :: nl_system, cont_options, newton_correct, cont_tangent, cont_run, cont_step_factor
+    public :: chord_wins
     public :: cont_options_from, YSCALE_RELATIVE
     public :: RCONT_TOL_R, RCONT_TOL_X, RCONT_TOL_STALL, RCONT_YSCALE, RCONT_LSCALE, &
               RCONT_DS, RCONT_DS_MIN, RCONT_DS_MAX, RCONT_LAM_END, RCONT_LAM_LO, N_RCONT
@@ -311,7 +312,7 @@ contains
     !> twice too long for the curve's shape is retried once with the step
     !> cont_step_factor gives.
     subroutine cont_run(sys, y, lam, t, ds, lam_lo, opts, yout, lout, tout, itout, npts, &
-                        finished, info, errmsg, have_fact)
+                        finished, info, errmsg, have_fact, tj)
         class(nl_system), intent(inout) :: sys
         real(wp), intent(inout) :: y(:)        !! (n) start point in, last point out
         real(wp), intent(inout) :: lam
@@ -328,7 +329,10 @@ contains
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
         logical, intent(inout) :: have_fact    !! the system holds J at (y, lam) (in/out)
-        real(wp), allocatable :: y1(:), yp(:), t1(:), cy(:)
+        !> (n+1) the unit tangent J gives at (y, lam), in/out: t itself unless a chord
+        !> replaced it (the secant rule); absent, t is taken for it at the start
+        real(wp), intent(inout), optional :: tj(:)
+        real(wp), allocatable :: y1(:), yp(:), t1(:), cy(:), ch(:), tjl(:)
         real(wp) :: lam1, lp, dirn, frac, cl, angle, dist
         integer(ip) :: n, iters
         logical :: last, turned, retried
@@ -352,7 +356,9 @@ contains
                             'ds_max and ds > 0')
             return
         end if
-        allocate (y1(n), yp(n), t1(n + 1), cy(n))
+        allocate (y1(n), yp(n), t1(n + 1), cy(n), ch(n + 1))
+        tjl = t
+        if (present(tj)) tjl = tj
         dirn = sign(1.0_wp, opts%lam_end - lam_lo)
         fresh_opts = opts
         fresh_opts%reuse_jac = .false.
@@ -396,9 +402,10 @@ contains
                 end if
             end if
             turned = .false.
-            if (info /= 0 .and. .not. last) call turn_corner(sys, y, lam, t, ds, fresh_opts, &
-                                                             y1, lam1, t1, iters, nf, turned, &
-                                                             info, errmsg, have_fact)
+            if (info /= 0 .and. .not. last) call turn_corner(sys, y, lam, t, tjl, ds, &
+                                                             fresh_opts, y1, lam1, t1, iters, &
+                                                             nf, turned, info, errmsg, &
+                                                             have_fact)
             if (info == 0 .and. .not. (last .or. retried .or. turned) .and. &
                 ds > 0.25_wp*opts%ds_max) then
                 ! a long step far too long for the curve's shape (the corrector moved off
@@ -440,6 +447,8 @@ contains
             have_fact = .true.
             retried = .false.
             npts = npts + 1
+            tjl = t1
+            if (present(tj)) tj = tjl
             if (.not. last) then
                 ! the curve has a corner at the new point: its tangent turns more than 60
                 ! degrees from the chord that reached it, or 3 angle_target once steps
@@ -447,13 +456,9 @@ contains
                 ! where they last slipped make every point of a rising response a corner
                 ! between the stick tangent J gives and the slip branch ahead, 40-80
                 ! degrees on the paper_hooks ROM_II). Predict along the chord (secant).
-                cy(1:n) = (y1 - y)/opts%yscale
-                dist = sqrt(sum(cy**2) + ((lam1 - lam)/opts%lscale)**2)
-                if (dist > 0.0_wp .and. dot_product(cy, t1(1:n)) + &
-                    (lam1 - lam)/opts%lscale*t1(n + 1) < secant_cos(ds, opts)*dist) then
-                    t1(1:n) = cy/dist
-                    t1(n + 1) = (lam1 - lam)/opts%lscale/dist
-                end if
+                ch(1:n) = (y1 - y)/opts%yscale
+                ch(n + 1) = (lam1 - lam)/opts%lscale
+                if (chord_wins(ch, t1, t, ds, opts)) t1 = ch/norm2(ch)
             end if
             angle = acos(max(-1.0_wp, min(1.0_wp, dot_product(t, t1))))
             dist = 0.0_wp
@@ -487,17 +492,18 @@ contains
     !> direction: the corrector runs across tc, oriented along t first, then against it.
     !> A point is taken (turned true, tc its direction) only if it lies within 3 ds and
     !> its chord turns by less than 120 degrees from t (never back along the curve).
-    !> Where t is a chord, not the tangent J gives at (y, lam) (a carried contact history:
+    !> Where t is a chord, not the tangent tj J gives at (y, lam) (a carried contact history:
     !> J gives the stick tangent and every point is a corner), the tangent at the predictor
     !> says nothing about a corner while the step is long: a failure there is a step too
     !> long, halved first (nothing is tried above ds_max / 20); and a point against the
     !> parameter's direction of travel is the frozen history's branch behind (y, lam), not
     !> the curve ahead: it is never taken.
-    subroutine turn_corner(sys, y, lam, t, ds, opts, y1, lam1, tc, iters, nf, turned, info, &
-                           errmsg, have_fact)
+    subroutine turn_corner(sys, y, lam, t, tj, ds, opts, y1, lam1, tc, iters, nf, turned, &
+                           info, errmsg, have_fact)
         class(nl_system), intent(inout) :: sys
         real(wp), intent(in) :: y(:), lam     !! (n) last converged point
         real(wp), intent(in) :: t(:)          !! (n+1) its unit tangent (scaled)
+        real(wp), intent(in) :: tj(:)         !! (n+1) the unit tangent J gives there
         real(wp), intent(in) :: ds            !! step (scaled)
         type(cont_options), intent(in) :: opts
         real(wp), intent(out) :: y1(:), lam1  !! (n) the point past the corner
@@ -517,11 +523,9 @@ contains
         iters = 0
         nf = 0
         allocate (yp(n), ch(n + 1))
-        msg2 = ''
         ! is t the tangent J gives here, or a chord (see cont_run)?
-        call cont_tangent(sys, y, lam, opts, t, 1.0_wp, tc, info2, msg2)
-        ratchet = dot_product(tc, t) < secant_cos(ds, opts)
-        if (info2 /= 0 .or. (ratchet .and. ds >= 0.05_wp*opts%ds_max)) then
+        ratchet = abs(dot_product(tj, t)) < secant_cos(ds, opts)
+        if (ratchet .and. ds >= 0.05_wp*opts%ds_max) then
             have_fact = .false.
             return
         end if
@@ -554,6 +558,28 @@ contains
         end do
         have_fact = .false.
     end subroutine turn_corner
+
+    !> Whether the chord ch that reached a point (scaled, not unit; ch(n+1) the parameter)
+    !> replaces the tangent tj that J gives there (unit, oriented along tprev, the tangent
+    !> the step left from) as the direction of the next step: they differ by more than
+    !> secant_cos says (a corner of the curve), unless the chord reverses the parameter's
+    !> direction of travel (tprev's) while tj keeps it. Such a chord is no fold: where
+    !> the step was near the corrector's tolerance, at a corner of a contact state, it
+    !> pointed backward by corrector noise (the paper hooks ROM_II, 1e-8 rad/s back), and
+    !> predicting along it made the run turn back.
+    pure logical function chord_wins(ch, tj, tprev, ds, opts)
+        real(wp), intent(in) :: ch(:)          !! (n+1) y1 - y, lam1 - lam (scaled)
+        real(wp), intent(in) :: tj(:)          !! (n+1) J's unit tangent at the point
+        real(wp), intent(in) :: tprev(:)       !! (n+1) the previous point's tangent
+        real(wp), intent(in) :: ds             !! the step (scaled)
+        type(cont_options), intent(in) :: opts
+        integer(ip) :: m
+        real(wp) :: dist
+        m = size(ch)
+        dist = norm2(ch)
+        chord_wins = dist > 0.0_wp .and. dot_product(ch, tj) < secant_cos(ds, opts)*dist
+        if (ch(m)*tprev(m) < 0.0_wp .and. tj(m)*tprev(m) > 0.0_wp) chord_wins = .false.
+    end function chord_wins
 
     !> Cosine below which the tangent J gives at a point is replaced by the chord that
     !> reached it (60 degrees; 3 angle_target once steps have shrunk below ds_max / 20).

@@ -156,7 +156,7 @@ program test_newton
     use frirom_kinds, only: wp, ip
     use frirom_check, only: check, check_done
     use frirom_newton, only: cont_options, newton_correct, cont_tangent, cont_run, &
-                             cont_step_factor
+                             cont_step_factor, chord_wins
     use newton_test_system
     implicit none
     type(cubic_curve) :: s, sq
@@ -221,6 +221,22 @@ program test_newton
     call check(cont_step_factor(0.0_wp, 0.0_wp, o%iter_target + 3, o) == 0.6_wp, &
                'hard Newton shrinks')
     call check(cont_step_factor(100.0_wp, 100.0_wp, 1_ip, o) == 0.25_wp, 'shrink bounded')
+    ! the secant rule (ds = ds_max: the chord wins beyond 60 degrees from J's tangent tj).
+    ! tj = (0.3, 0.954) keeps the parameter rising, as the previous tangent (0, 1) did:
+    ! a chord 72.6 degrees off it pointing 1e-3 back in lam is corrector noise at a corner
+    ! and must not be predicted along (the rule before took it: cos 0.299 < 0.5); the
+    ! same chord forward is a corner (taken); 30 degrees off is no corner (not taken);
+    ! where tj itself turns the parameter back (a fold), a chord back is taken.
+    o%ds_max = 0.05_wp
+    call check(.not. chord_wins([1.0_wp, -1.0e-3_wp], [0.3_wp, sqrt(0.91_wp)], &
+                                [0.0_wp, 1.0_wp], 0.05_wp, o), &
+               'secant: no chord back in lam while J keeps the direction')
+    call check(chord_wins([1.0_wp, 1.0e-3_wp], [0.3_wp, sqrt(0.91_wp)], [0.0_wp, 1.0_wp], &
+                          0.05_wp, o), 'secant: a forward chord at a corner is taken')
+    call check(.not. chord_wins([1.0_wp, sqrt(3.0_wp)], [0.0_wp, 1.0_wp], [0.0_wp, 1.0_wp], &
+                                0.05_wp, o), 'secant: no corner within 60 degrees')
+    call check(chord_wins([0.0_wp, -1.0_wp], [0.9_wp, -sqrt(0.19_wp)], [0.8_wp, 0.6_wp], &
+                          0.05_wp, o), 'secant: a chord back where J turns back too')
     ! a failing corrector at the minimum step stops with a diagnostic, keeping points
     o%max_iter = 1
     o%ds_min = 0.04_wp
