@@ -4,7 +4,9 @@ posteriori error estimate on the response amplitude is within a tolerance (docs/
 The estimate costs a coarse run and a few point solves, not a ladder of FRFs:
 
 1. a run at the smallest H (the highest loaded harmonic, at least 1) finds, per output, the
-   point of largest amplitude: the **probe points** (distinct frequencies);
+   point of largest amplitude and its two neighbours on the curve: the **probe points**
+   (distinct frequencies; one point alone made the estimate depend on where the
+   continuation's points fell on a flat friction peak);
 2. at each probe frequency the solution is followed up the harmonics, H -> H+1, each solve
    started from the one below (padded with zeros) and from the coarse point's contact
    history, so it stays on the coarse curve's branch;
@@ -158,7 +160,8 @@ class AutoChoice:
         if self.probes:
             out.append(f"auto: probe points at "
                        f"{', '.join(f'{w / 2 / np.pi:.6g}' for w in self.probes)} Hz "
-                       "(largest amplitude of each output on a run at the smallest H)")
+                       "(largest amplitude of each output and its neighbours on a run at "
+                       "the smallest H)")
         for name, est in (("H", self.h_estimates), ("N", self.n_estimates)):
             if est:
                 out.append(f"auto: {name} estimate (relative change of the amplitudes at "
@@ -185,7 +188,8 @@ def _excitation(F: np.ndarray, H: int):
 
 
 def _probes(model, F, omega_start, omega_end, opts, outputs, H0, notes) -> list:
-    """The coarse run at H0: per output its largest-amplitude point (distinct omegas)."""
+    """The coarse run at H0: per output its largest-amplitude point and that point's
+    neighbours on the curve (distinct omegas)."""
     from .solver import frf
     pts = []
     o = dataclasses.replace(opts, harmonics=H0, stability=False, refine_peak=False)
@@ -200,9 +204,10 @@ def _probes(model, F, omega_start, omega_end, opts, outputs, H0, notes) -> list:
     amp = np.array([p.amp_max for p in pts])
     out = []
     for j in range(amp.shape[1]):
-        p = pts[int(np.argmax(amp[:, j]))]
-        if all(abs(p.omega - q.omega) > 1e-9 * p.omega for q in out):
-            out.append(p)
+        i = int(np.argmax(amp[:, j]))
+        for p in pts[max(i - 1, 0):i + 2]:
+            if all(abs(p.omega - q.omega) > 1e-9 * p.omega for q in out):
+                out.append(p)
     return out
 
 
