@@ -6,8 +6,8 @@
 !> triplets with a duplicate entry. Both formulations, Newton tolerances 1e-12 (a Jacobian
 !> kept from an earlier frequency makes steps inexact, so a point is as exact as the
 !> tolerance: 3e-10 of the amplitude at the default 1e-8); tolerance 1e-11 of the largest
-!> amplitude (5e-14 measured). Also: max_points ends a run incomplete with a
-!> message, and bad damping input is refused naming the field.
+!> amplitude (5e-14 measured). Also: the points do not depend on batch, max_points ends
+!> a run incomplete with a message, and bad damping input is refused naming the field.
 program test_solve
     use frirom_kinds, only: wp, ip
     use frirom_check, only: check, check_done
@@ -26,6 +26,7 @@ program test_solve
     type(frf_settings) :: s
     type(frf_result) :: res
     real(wp) :: fe(2, 5), c(2, 2), phi(2, 2), w(2), x(5), err, amax
+    real(wp), allocatable :: om1(:), am1(:, :)
     complex(wp) :: a(2, 2), f(2), xr(2), det
     integer(ip) :: form, p, j, r
     character(len=40) :: what
@@ -75,6 +76,25 @@ program test_solve
         print '(a,i0,a,i0,a,es9.2)', 'formulation ', form, ': ', res%npts, &
             ' points, max error / max amplitude ', err/amax
     end do
+    ! the path does not depend on batch (points per hbm_run call): the arc-length scale
+    ! grows after every point inside hbm_run (the amplitude grows 20x from 50 Hz to the
+    ! first resonance), and a call that resumes factorises J at its start point as the
+    ! uninterrupted run holds it. The same arithmetic split into calls differently, so
+    ! the points agree bit for bit (before, the scale grew only between calls: 1 and 1000
+    ! gave different points)
+    s%batch = 1
+    call frf_solve(2, kr, kc, kv, md, md, mv, cr, cc, cv, alpha, beta, zeta, ginfo, gr, gc, &
+                   gv, params, fe, 50.0_wp, 250.0_wp, [1, 2], s, res)
+    om1 = res%omega
+    am1 = res%amp
+    s%batch = 1000
+    call frf_solve(2, kr, kc, kv, md, md, mv, cr, cc, cv, alpha, beta, zeta, ginfo, gr, gc, &
+                   gv, params, fe, 50.0_wp, 250.0_wp, [1, 2], s, res)
+    print '(a,i0,a,i0,a)', 'batch 1: ', size(om1), ' points, batch 1000: ', res%npts, ' points'
+    call check(res%complete .and. res%npts == size(om1), 'batch 1 and 1000: as many points')
+    if (res%npts == size(om1)) call check(all(res%omega == om1) .and. all(res%amp == am1), &
+                                          'batch 1 and 1000: the same points')
+    s%batch = 10
     ! max_points: an incomplete run keeps its points and says why
     s%max_points = 3
     call frf_solve(2, kr, kc, kv, md, md, mv, cr, cc, cv, alpha, beta, zeta, ginfo, gr, gc, &

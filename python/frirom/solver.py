@@ -90,7 +90,8 @@ class SolverOptions:
         Phi^T C Phi) instead of factorising the dynamic stiffness at every frequency
         (truncation: no residual flexibility). None: exact receptances.
     batch : int
-        Points per call into Fortran: how often `sink` receives points.
+        Points per call into Fortran: how often `sink` receives points (and where a
+        resumed run may start); the points themselves do not depend on it.
     refine_peak : bool
         Frequency runs: solve each output's peak on the curve between the points around
         the largest one (FRF.peaks, FRF.peak; about ten corrector solves per output).
