@@ -6,7 +6,7 @@
 !> LU, and the outputs by Eq. 9.
 submodule (frirom_hbm) frirom_hbm_condensed
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_ALLOC, FRIROM_ERR_LAPACK, &
-                             FRIROM_ERR_SINGULAR, set_status
+                             FRIROM_ERR_SINGULAR, FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     implicit none
 
     !> GMRES (Krylov mode): relative residual, iteration limit before the J is factorised,
@@ -73,6 +73,112 @@ contains
         sys%lu_any = .false.
     end procedure cond_init
 
+    module procedure hbm_set_selection
+        integer(ip) :: nu, nc, h, j, c, k, n, stat
+        real(wp) :: on, off
+        info = FRIROM_OK
+        select type (sys => sysc)
+        type is (hbm_condensed)
+            nu = sys%nnl
+            nc = sys%nc
+            if (size(keep, 1) /= nu .or. size(keep, 2) /= sys%nh + 1) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'selection: keep must be '// &
+                                '(nonlinear DoFs, H+1)')
+            else if (sys%tcontact) then
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: needs the '// &
+                                'unknowns in the nonlinear DoFs, not in contact coordinates')
+            else if (use_krylov(sys)) then
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: needs direct '// &
+                                'solves (krylov off)')
+            else if (all(keep == 0)) then
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: keeps no unknown')
+            end if
+            if (info /= 0) return
+            if (allocated(sys%sel)) deallocate (sys%sel, sys%kpt, sys%kptr, sys%kmask)
+            n = 0
+            do c = 1, nc
+                n = n + count(keep(:, c/2) /= 0)
+            end do
+            allocate (sys%kptr(sys%nh + 2), sys%kpt(count(keep /= 0)), sys%sel(n), &
+                      sys%kmask(nu, 0:sys%nh), stat=stat)
+            if (stat == 0) then
+                if (allocated(sys%jm)) deallocate (sys%jm)
+                if (allocated(sys%ipiv)) deallocate (sys%ipiv)
+                allocate (sys%jm(n, n), sys%ipiv(n), stat=stat)
+            end if
+            if (stat /= 0) then
+                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'selection: Jacobian')
+                return
+            end if
+            sys%kmask = keep /= 0
+            sys%kptr(1) = 1
+            k = 0
+            do h = 0, sys%nh
+                do j = 1, nu
+                    if (keep(j, h) == 0) cycle
+                    k = k + 1
+                    sys%kpt(k) = j
+                end do
+                sys%kptr(h + 2) = k + 1
+            end do
+            ! y: coefficient by coefficient (harmonic c/2), the kept coordinates ascending
+            k = 0
+            do c = 1, nc
+                h = c/2
+                sys%sel(k + 1:k + sys%kptr(h + 2) - sys%kptr(h + 1)) = &
+                    sys%kpt(sys%kptr(h + 1):sys%kptr(h + 2) - 1) + nu*(c - 1)
+                k = k + sys%kptr(h + 2) - sys%kptr(h + 1)
+            end do
+            sys%n = n
+            if (allocated(sys%jcur)) deallocate (sys%jcur)
+            if (allocated(sys%jms)) deallocate (sys%jms)
+            if (allocated(sys%kcw)) deallocate (sys%kcw)
+            sys%lu_any = .false.
+            sys%lu_fresh = .false.
+            sys%lu_now = .false.
+            sys%lu_single = .false.
+            sys%gm_worth = 0.0_wp
+            sys%c0_leak = 0.0_wp
+            sys%xe_leak = 0.0_wp
+            if (allocated(sys%cs%c0)) then
+                on = sum(sys%cs%c0**2, mask=keep(:, 0) /= 0)
+                off = sum(sys%cs%c0**2, mask=keep(:, 0) == 0)
+                sys%c0_leak = ratio(off, on)
+            end if
+            if (present(sel)) sel = sys%sel
+        class default
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: needs the '// &
+                            'condensed formulation')
+        end select
+    end procedure hbm_set_selection
+
+    module procedure cond_leak
+        integer(ip) :: c
+        real(wp) :: on, off
+        leak = 0.0_wp
+        if (.not. allocated(sys%sel) .or. .not. allocated(sys%fd)) return
+        ! each part summed on its own: a leak at round-off is not lost to cancellation
+        on = 0.0_wp
+        off = 0.0_wp
+        do c = 1, sys%nc
+            on = on + sum(sys%fd(:, c)**2, mask=sys%kmask(:, c/2))
+            off = off + sum(sys%fd(:, c)**2, mask=.not. sys%kmask(:, c/2))
+        end do
+        leak = max(ratio(off, on), sys%c0_leak, sys%xe_leak)
+    end procedure cond_leak
+
+    !> sqrt(off / on) for two sums of squares: 0 when both are 0, huge when only on is.
+    pure real(wp) function ratio(off, on)
+        real(wp), intent(in) :: off, on
+        if (on > 0.0_wp) then
+            ratio = sqrt(off/on)
+        else if (off > 0.0_wp) then
+            ratio = huge(1.0_wp)
+        else
+            ratio = 0.0_wp
+        end if
+    end function ratio
+
     !> Whether solves go through GMRES on jcur (see hbm_condensed%krylov).
     pure logical function use_krylov(sys)
         type(hbm_condensed), intent(in) :: sys
@@ -80,10 +186,11 @@ contains
     end function use_krylov
 
     module procedure cond_eval
-        real(wp) :: w, s, nx, nxe, nhf, nrc, nxd, nhd
-        integer(ip) :: nnl, nc, h, n, nm
+        real(wp) :: w, s, nx, nxe, nhf, nrc, nxd, nhd, xon, xoff
+        integer(ip) :: nnl, nc, h, n, nm, nhd0
         complex(wp), allocatable :: fc(:), z(:), dz(:), rh(:), xe(:), v(:), x3(:, :), b3(:, :)
         real(wp), allocatable :: r2(:, :), rl2(:, :)   !! (nnl, nc) r and rlam by harmonic
+        real(wp), allocatable :: rf(:)                 !! (nnl nc) all rows (a selection)
         info = FRIROM_OK
         nnl = this%nnl
         nc = this%nc
@@ -103,6 +210,8 @@ contains
             allocate (z(this%ndof), dz(this%ndof))
         end if
         nxe = 0.0_wp
+        xon = 0.0_wp
+        xoff = 0.0_wp
         nhf = 0.0_wp
         nxd = 0.0_wp
         nhd = 0.0_wp
@@ -148,6 +257,10 @@ contains
             end if
             nhf = nhf + sum(abs(rh)**2)
             nxe = nxe + sum(abs(xe)**2)
+            if (allocated(this%sel)) then
+                xon = xon + sum(abs(xe)**2, mask=this%kmask(:, h))
+                xoff = xoff + sum(abs(xe)**2, mask=.not. this%kmask(:, h))
+            end if
             if (h > 0) then
                 nhd = nhd + sum(abs(rh)**2)
                 nxd = nxd + sum(abs(xe)**2)
@@ -173,12 +286,33 @@ contains
             end if
             call harm_set(rl2, h, xe)
         end do
-        r = reshape(r2, [n])
-        rlam = reshape(rl2, [n])
+        if (allocated(this%sel)) then
+            ! the kept rows (hbm_set_selection); y holds no harmonic 0 after its kept rows
+            this%xe_leak = ratio(xoff, xon)
+            rf = reshape(r2, [nnl*nc])
+            r = rf(this%sel)
+            rf = reshape(rl2, [nnl*nc])
+            rlam = rf(this%sel)
+            nhd0 = this%kptr(2) - this%kptr(1)
+        else
+            r = reshape(r2, [n])
+            rlam = reshape(rl2, [n])
+            nhd0 = nnl
+        end if
         rref = max(sqrt(nxe), nx, sqrt(nhf), nrc)
         ! harmonics 1..H alone (hbm_roundoff)
-        this%rref_dyn = max(sqrt(nxd), norm2(y(nnl + 1:)), sqrt(nhd))
+        this%rref_dyn = max(sqrt(nxd), norm2(y(nhd0 + 1:)), sqrt(nhd))
         if (.not. jac) return
+        if (allocated(this%sel)) then
+            ! the kept rows and columns only, a new LU every time (cond_jacobian_sel)
+            if (this%modal) then
+                this%gj = this%g
+                this%wj = w
+            end if
+            this%jfree = .false.
+            call cond_jacobian_sel(this, info, errmsg)
+            return
+        end if
         if (this%modal) then
             this%gj = this%g
             this%wj = w
@@ -386,6 +520,227 @@ contains
         end do
     end subroutine jac_dense
 
+    !> J of a selected system (hbm_set_selection) on its kept rows and columns: kc, the
+    !> kept part of dF_c/dU in y's order, by products over each contact group's dense
+    !> rows (gr%gt) or by its sparse rows, then J = I + R_h kc with R_h on the
+    !> coordinates kept at harmonic h only (exact for a tuned rotor, whose R_h does not
+    !> couple the index families), then the LU.
+    subroutine cond_jacobian_sel(sys, info, errmsg)
+        type(hbm_condensed), intent(inout) :: sys
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        integer(ip) :: n, nu, nc, g, h, c, kh, ca, cb, stat, i
+        integer(ip), allocatable :: at(:), off(:)
+        real(wp), allocatable :: kc(:, :), a(:, :), b(:, :)
+        real(wp) :: t0
+        info = FRIROM_OK
+        t0 = wtime()
+        n = sys%n
+        nu = sys%nnl
+        nc = sys%nc
+        stat = 0
+        if (allocated(sys%kcw)) then
+            if (size(sys%kcw, 1) /= n) deallocate (sys%kcw)
+        end if
+        if (.not. allocated(sys%kcw)) allocate (sys%kcw(n, n), stat=stat)
+        if (stat /= 0) then
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: Jacobian')
+            return
+        end if
+        call move_alloc(sys%kcw, kc)
+        ! at: position j + nu (c-1) -> its index in y (0: left out); off(c): y's entries
+        ! before coefficient c
+        allocate (at(nu*nc), off(nc + 1))
+        at = 0
+        at(sys%sel) = [(i, i=1, n)]
+        off(1) = 0
+        do c = 1, nc
+            h = c/2
+            off(c + 1) = off(c) + sys%kptr(h + 2) - sys%kptr(h + 1)
+        end do
+        kc = 0.0_wp
+        do g = 1, size(sys%cs%grp)
+            associate (gr => sys%cs%grp(g))
+                if (gr%asm_mode == 0) call choose_dense(gr, sys%cs%g)
+                if (gr%asm_mode == 2) then
+                    call kc_dense_sel(gr, nu, nc, at, kc)
+                else
+                    call kc_rows_sel(gr, sys%cs%g, nu, nc, at, kc)
+                end if
+            end associate
+        end do
+        sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
+        do h = 0, sys%nh
+            kh = sys%kptr(h + 2) - sys%kptr(h + 1)
+            if (kh == 0) cycle
+            call rec_block(sys, h, sys%kpt(sys%kptr(h + 1):sys%kptr(h + 2) - 1), a, b)
+            t0 = wtime()
+            if (h == 0) then
+                ca = off(1) + 1
+                call dgemm('N', 'N', kh, n, kh, 1.0_wp, a, kh, kc(ca, 1), n, 0.0_wp, &
+                           sys%jm(ca, 1), n)
+            else
+                ! a-rows: A Kc_a + B Kc_b ; b-rows: -B Kc_a + A Kc_b
+                ca = off(2*h) + 1
+                cb = off(2*h + 1) + 1
+                call dgemm('N', 'N', kh, n, kh, 1.0_wp, a, kh, kc(ca, 1), n, 0.0_wp, &
+                           sys%jm(ca, 1), n)
+                call dgemm('N', 'N', kh, n, kh, 1.0_wp, b, kh, kc(cb, 1), n, 1.0_wp, &
+                           sys%jm(ca, 1), n)
+                call dgemm('N', 'N', kh, n, kh, -1.0_wp, b, kh, kc(ca, 1), n, 0.0_wp, &
+                           sys%jm(cb, 1), n)
+                call dgemm('N', 'N', kh, n, kh, 1.0_wp, a, kh, kc(cb, 1), n, 1.0_wp, &
+                           sys%jm(cb, 1), n)
+            end if
+            sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
+        end do
+        do i = 1, n
+            sys%jm(i, i) = sys%jm(i, i) + 1.0_wp
+        end do
+        call move_alloc(kc, sys%kcw)
+        call cond_factor(sys, info, errmsg)
+    end subroutine cond_jacobian_sel
+
+    !> R_h = a + i b on the coordinates rows (both sides), at the Jacobian's frequency:
+    !> from the modes (A_h(rows) diag(g_h) A_h(rows)^H, only these rows) or read from the
+    !> factorised receptances ar, ai.
+    subroutine rec_block(sys, h, rows, a, b)
+        type(hbm_condensed), intent(inout) :: sys
+        integer(ip), intent(in) :: h, rows(:)
+        real(wp), allocatable, intent(out) :: a(:, :), b(:, :)
+        real(wp), allocatable :: p(:, :), pd(:, :)
+        complex(wp), allocatable :: z(:, :), zd(:, :), rz(:, :)
+        integer(ip) :: k, nm, r
+        real(wp) :: t0
+        t0 = wtime()
+        k = size(rows)
+        allocate (a(k, k), b(k, k))
+        if (.not. sys%modal) then
+            a = sys%ar(rows, rows, h)
+            b = sys%ai(rows, rows, h)
+        else if (allocated(sys%phr)) then
+            nm = size(sys%gj, 1)
+            p = sys%phr(rows, :)
+            allocate (pd(k, nm))
+            do r = 1, nm
+                pd(:, r) = p(:, r)*real(sys%gj(r, h), wp)
+            end do
+            call dgemm('N', 'T', k, k, nm, 1.0_wp, pd, k, p, k, 0.0_wp, a, k)
+            do r = 1, nm
+                pd(:, r) = p(:, r)*aimag(sys%gj(r, h))
+            end do
+            call dgemm('N', 'T', k, k, nm, 1.0_wp, pd, k, p, k, 0.0_wp, b, k)
+        else
+            nm = size(sys%gj, 1)
+            z = sys%psi(rows, :, h)
+            allocate (zd(k, nm), rz(k, k))
+            do r = 1, nm
+                zd(:, r) = z(:, r)*sys%gj(r, h)
+            end do
+            call zgemm('N', 'C', k, k, nm, (1.0_wp, 0.0_wp), zd, k, z, k, (0.0_wp, 0.0_wp), &
+                       rz, k)
+            a = real(rz, wp)
+            b = aimag(rz)
+        end if
+        sys%timers(T_REC) = sys%timers(T_REC) + wtime() - t0
+    end subroutine rec_block
+
+    !> kc += the kept part of G_g^T J_loc G_g for a group with dense rows over its columns
+    !> (gt = Gd^T, gcols): per coefficient c1, the kept columns S1 of the group at c1 and
+    !> all kept (column, c2) Q: kc(S1 c1, Q) += Gd(:, S1)^T Y, Y = J_loc Gd on Q.
+    subroutine kc_dense_sel(gr, nu, nc, at, kc)
+        type(contact_group), intent(in) :: gr
+        integer(ip), intent(in) :: nu, nc, at(:)
+        real(wp), intent(inout) :: kc(:, :)
+        integer(ip), allocatable :: ls(:, :), py(:, :), ln(:), qoff(:)
+        real(wp), allocatable :: yt(:, :), gs(:, :), kt(:, :)
+        integer(ip) :: ns, nd, nrg, c, c1, c2, d1, d2, e, r, s, q, m1, nq, p
+        real(wp) :: v
+        nd = gr%ndir
+        nrg = gr%ne*nd
+        ns = size(gr%gcols)
+        ! ls(:, c): the group's columns (index into gcols) kept at coefficient c; py their
+        ! indices in y
+        allocate (ls(ns, nc), py(ns, nc), ln(nc), qoff(nc + 1))
+        qoff(1) = 0
+        do c = 1, nc
+            ln(c) = 0
+            do s = 1, ns
+                p = at(gr%gcols(s) + nu*(c - 1))
+                if (p == 0) cycle
+                ln(c) = ln(c) + 1
+                ls(ln(c), c) = s
+                py(ln(c), c) = p
+            end do
+            qoff(c + 1) = qoff(c) + ln(c)
+        end do
+        nq = qoff(nc + 1)
+        if (nq == 0) return
+        allocate (yt(nq, nrg), gs(maxval(ln), nrg), kt(maxval(ln), nq))
+        do c1 = 1, nc
+            m1 = ln(c1)
+            if (m1 == 0) cycle
+            yt = 0.0_wp
+            do e = 1, gr%ne
+                do d1 = 1, nd
+                    r = (e - 1)*nd + d1
+                    do c2 = 1, nc
+                        if (ln(c2) == 0) cycle
+                        do d2 = 1, nd
+                            v = gr%jac(c1 + nc*(d1 - 1), c2 + nc*(d2 - 1), e)
+                            if (v == 0.0_wp) cycle
+                            yt(qoff(c2) + 1:qoff(c2 + 1), r) = yt(qoff(c2) + 1:qoff(c2 + 1), r) &
+                                + v*gr%gt(ls(1:ln(c2), c2), (e - 1)*nd + d2)
+                        end do
+                    end do
+                end do
+            end do
+            gs(1:m1, :) = gr%gt(ls(1:m1, c1), :)
+            call dgemm('N', 'T', m1, nq, nrg, 1.0_wp, gs, size(gs, 1), yt, nq, 0.0_wp, kt, &
+                       size(kt, 1))
+            do c2 = 1, nc
+                do q = 1, ln(c2)
+                    kc(py(1:m1, c1), py(q, c2)) = kc(py(1:m1, c1), py(q, c2)) + &
+                                                  kt(1:m1, qoff(c2) + q)
+                end do
+            end do
+        end do
+    end subroutine kc_dense_sel
+
+    !> kc += the kept part of G_g^T J_loc G_g element by element over the group's sparse
+    !> rows (contact_assemble's loops, kept entries only).
+    subroutine kc_rows_sel(gr, gg, nu, nc, at, kc)
+        type(contact_group), intent(in) :: gr
+        type(csr_matrix), intent(in) :: gg
+        integer(ip), intent(in) :: nu, nc, at(:)
+        real(wp), intent(inout) :: kc(:, :)
+        integer(ip) :: e, d1, d2, r1, r2, k1, k2, c1, c2, p1, p2
+        real(wp) :: v
+        do e = 1, gr%ne
+            do d1 = 1, gr%ndir
+                r1 = gr%row0 + (e - 1)*gr%ndir + d1
+                do d2 = 1, gr%ndir
+                    r2 = gr%row0 + (e - 1)*gr%ndir + d2
+                    do k1 = gg%p(r1), gg%p(r1 + 1) - 1
+                        do k2 = gg%p(r2), gg%p(r2 + 1) - 1
+                            v = gg%x(k1)*gg%x(k2)
+                            do c2 = 1, nc
+                                p2 = at(gg%i(k2) + nu*(c2 - 1))
+                                if (p2 == 0) cycle
+                                do c1 = 1, nc
+                                    p1 = at(gg%i(k1) + nu*(c1 - 1))
+                                    if (p1 == 0) cycle
+                                    kc(p1, p2) = kc(p1, p2) + &
+                                        v*gr%jac(c1 + nc*(d1 - 1), c2 + nc*(d2 - 1), e)
+                                end do
+                            end do
+                        end do
+                    end do
+                end do
+            end do
+        end do
+    end subroutine kc_rows_sel
+
     !> LU of J (jm := jcur first in Krylov mode). Systems that hold their LU
     !> (cond_lu_holds) factorise a single-precision copy into jms: half the flops of the LU
     !> and half the memory traffic of each triangular solve; it only preconditions GMRES
@@ -536,11 +891,11 @@ contains
         hold = lu_worth(nnl*(2*nh + 1), nh, nnl, nm) >= GN_WORTH_MIN
     end procedure cond_lu_holds
 
-    !> Whether sys keeps LUs across runs: modal, direct mode, worth holding.
+    !> Whether sys keeps LUs across runs: modal, direct mode, no selection, worth holding.
     logical function holds(sys)
         type(hbm_condensed), intent(in) :: sys
         holds = .false.
-        if (.not. sys%modal .or. use_krylov(sys)) return
+        if (.not. sys%modal .or. use_krylov(sys) .or. allocated(sys%sel)) return
         holds = lu_worth(sys%n, sys%nh, sys%nnl, size(sys%g, 1)) >= GN_WORTH_MIN
     end function holds
 
