@@ -84,6 +84,7 @@ def test_family_rom2_peaks_match_rom1(decks, f0):
     time harmonics 0, 2, 3 (indices 0, 4, 6) matter."""
     r1 = pf.sweep(decks["rom1"], f0)
     rf = pf.sweep(decks["rom2_family"], f0)
+    rt = pf.sweep(decks["rom2_tw"], f0)     # its deck's travelling_wave = true
     r2 = pf.sweep(decks["rom2"], f0)
     re = pf.sweep(decks["rom2_eo"], f0)
     ea = max(abs(re["peak_amp"][k] / r1["peak_amp"][k] - 1) for k in range(2))
@@ -95,6 +96,13 @@ def test_family_rom2_peaks_match_rom1(decks, f0):
     for k in range(2):
         assert abs(rf["peak_amp"][k] / r1["peak_amp"][k] - 1) < pf.TARGET_AMP
         assert abs(rf["peak_f"][k] / r1["peak_f"][k] - 1) < pf.TARGET_FREQ
+        # the family solved for the travelling wave's pairs only: the family's peaks
+        # within 1e-4 / 1e-5 (measured up to 7.7e-6 / 1.6e-7 at 300 N: the deck's family
+        # runs in contact coordinates, another Newton path through the slipping peak;
+        # equality point for point in the same coordinates: tests/test_travelling_wave.py)
+        assert abs(rt["peak_amp"][k] / rf["peak_amp"][k] - 1) < 1e-2 * pf.TARGET_AMP
+        assert abs(rt["peak_f"][k] / rf["peak_f"][k] - 1) < 1e-2 * pf.TARGET_FREQ
+    assert rt["leak"] < 1e-8 and rt["complete"]
     ef = abs(r2["peak_f"][0] / r1["peak_f"][0] - 1)
     assert ef > pf.TARGET_FREQ
     assert pf.row_flag(0.0, ef) == "DIFFERS"

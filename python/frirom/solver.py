@@ -40,11 +40,13 @@ from .results import FRF, FRFPoint
 FORMULATIONS = ("condensed", "banded")
 
 #: Largest leak of a travelling-wave selection (FRFPoint.leak) a run accepts without a
-#: warning. A tuned rotor leaks at round-off (below 1e-12 on the flange cases); a force
-#: off the selection of 1e-6 of those on it changes the response by about that fraction
-#: (times the amplification of an off-selection resonance), far below the 1e-3 the
-#: paper's comparisons resolve, while any physical mistuning (a changed preload or
-#: stiffness at one pair) leaks 1e-3 or more.
+#: warning. A tuned rotor leaks at round-off: 5e-10 on the coarse flange in stick (the
+#: cyclic symmetry of the mesh and matrices to their digits), 2.5e-9 with slip and
+#: lift-off (the closed-cycle iteration of the slipping elements). A force off the
+#: selection of 1e-6 of those on it moves the response by about that fraction (times the
+#: amplification of an off-selection resonance), far below the 1e-3 the paper's
+#: comparisons resolve; a changed preload or stiffness at one of 12 pairs leaks 4e-2 or
+#: more, and so do the sliders a re-stuck flange keeps from slipping (4e-3, static part).
 LEAK_TOL = 1e-6
 
 
@@ -419,11 +421,15 @@ class _Continuation:
             worst = float(np.max(out.leak))
             out.solver_info += f"; leak max {worst:.1e}"
             if worst > LEAK_TOL:
+                at = pts[int(np.argmax(out.leak))].omega
                 warnings.warn(f"frirom: the travelling-wave selection leaks: contact forces off "
-                              f"the selection reach {worst:.2g} of those on it (tolerance "
-                              f"{LEAK_TOL:g}); the rotor, its contacts or its load are not "
-                              "cyclically symmetric, and the selected solution is not the "
-                              "full one (solve without the selection)", stacklevel=3)
+                              f"the selection reach {worst:.2g} of those on it at "
+                              f"{at / 2 / np.pi:.6g} Hz (tolerance {LEAK_TOL:g}); the rotor, its "
+                              "contacts, its load or the contact history carried from point "
+                              "to point (sliders frozen at different phases) are not a "
+                              "travelling wave there, and the selected solution is not the "
+                              "full one (solve without the selection to see how far)",
+                              stacklevel=3)
         if keep_unknowns and pts:
             out._last_unknowns = pts[-1].unknowns
             out._last_slider = pts[-1].slider
