@@ -186,7 +186,7 @@ contains
     end function use_krylov
 
     module procedure cond_eval
-        real(wp) :: w, s, nx, nxe, nhf, nrc, nxd, nhd, xon, xoff
+        real(wp) :: w, s, nx, nxe, nhf, nrc, nxd, nhd
         integer(ip) :: nnl, nc, h, n, nm, nhd0
         complex(wp), allocatable :: fc(:), z(:), dz(:), rh(:), xe(:), v(:), x3(:, :), b3(:, :)
         real(wp), allocatable :: r2(:, :), rl2(:, :)   !! (nnl, nc) r and rlam by harmonic
@@ -210,8 +210,6 @@ contains
             allocate (z(this%ndof), dz(this%ndof))
         end if
         nxe = 0.0_wp
-        xon = 0.0_wp
-        xoff = 0.0_wp
         nhf = 0.0_wp
         nxd = 0.0_wp
         nhd = 0.0_wp
@@ -245,7 +243,14 @@ contains
                         x3(:, 3) = -this%dg(:, h)*(q - v)
                     end if
                 end associate
-                call modal_apply(this, h, 1, nnl, x3, b3)
+                if (allocated(this%sel)) then
+                    ! the kept rows only (the others are dropped; cond_outputs measures the
+                    ! loads' leak)
+                    call modal_rows(this, h, this%kpt(this%kptr(h + 1):this%kptr(h + 2) - 1), &
+                                    x3, b3)
+                else
+                    call modal_apply(this, h, 1, nnl, x3, b3)
+                end if
                 xe = b3(:, 1)
                 rh = b3(:, 2)
             else
@@ -257,10 +262,6 @@ contains
             end if
             nhf = nhf + sum(abs(rh)**2)
             nxe = nxe + sum(abs(xe)**2)
-            if (allocated(this%sel)) then
-                xon = xon + sum(abs(xe)**2, mask=this%kmask(:, h))
-                xoff = xoff + sum(abs(xe)**2, mask=.not. this%kmask(:, h))
-            end if
             if (h > 0) then
                 nhd = nhd + sum(abs(rh)**2)
                 nxd = nxd + sum(abs(xe)**2)
@@ -288,7 +289,6 @@ contains
         end do
         if (allocated(this%sel)) then
             ! the kept rows (hbm_set_selection); y holds no harmonic 0 after its kept rows
-            this%xe_leak = ratio(xoff, xon)
             rf = reshape(r2, [nnl*nc])
             r = rf(this%sel)
             rf = reshape(rl2, [nnl*nc])
@@ -519,6 +519,36 @@ contains
             end if
         end do
     end subroutine jac_dense
+
+    !> Modal route, a selection: b(rows, :) = A_h(rows, :) x, the other rows of b zero.
+    subroutine modal_rows(sys, h, rows, x, b)
+        type(hbm_condensed), intent(in) :: sys
+        integer(ip), intent(in) :: h, rows(:)
+        complex(wp), intent(in) :: x(:, :)     !! (nm, k)
+        complex(wp), intent(out) :: b(:, :)    !! (nnl, k)
+        real(wp), allocatable :: pk(:, :), xr(:, :), br(:, :)
+        complex(wp), allocatable :: zk(:, :), bk(:, :)
+        integer(ip) :: nm, k, nr
+        nm = size(x, 1)
+        k = size(x, 2)
+        nr = size(rows)
+        b = (0.0_wp, 0.0_wp)
+        if (nr == 0) return
+        if (allocated(sys%phr)) then
+            pk = sys%phr(rows, :)
+            allocate (xr(nm, 2*k), br(nr, 2*k))
+            xr(:, 1:k) = real(x, wp)
+            xr(:, k + 1:) = aimag(x)
+            call dgemm('N', 'N', nr, 2*k, nm, 1.0_wp, pk, nr, xr, nm, 0.0_wp, br, nr)
+            b(rows, :) = cmplx(br(:, 1:k), br(:, k + 1:), wp)
+        else
+            zk = sys%psi(rows, :, h)
+            allocate (bk(nr, k))
+            call zgemm('N', 'N', nr, k, nm, (1.0_wp, 0.0_wp), zk, nr, x, nm, &
+                       (0.0_wp, 0.0_wp), bk, nr)
+            b(rows, :) = bk
+        end if
+    end subroutine modal_rows
 
     !> J of a selected system (hbm_set_selection) on its kept rows and columns: kc, the
     !> kept part of dF_c/dU in y's order, by products over each contact group's dense
@@ -1284,6 +1314,33 @@ contains
         ok = .true.
     end subroutine gmres
 
+    !> xe_leak at the receptances' frequency and load factor s: |T X_e off the selection|
+    !> / |on it|, T X_e the loads' linear response at the coordinates (every row; the
+    !> residual keeps only the kept ones).
+    subroutine load_leak(sys, s)
+        type(hbm_condensed), intent(inout) :: sys
+        real(wp), intent(in) :: s
+        complex(wp), allocatable :: x1(:, :), b1(:, :), xe(:)
+        real(wp) :: on, off
+        integer(ip) :: h
+        on = 0.0_wp
+        off = 0.0_wp
+        allocate (xe(sys%nnl))
+        if (sys%modal) allocate (x1(size(sys%g, 1), 1), b1(sys%nnl, 1))
+        do h = 0, sys%nh
+            if (sys%modal) then
+                x1(:, 1) = sys%g(:, h)*(sys%qf(:, h) + s*sys%qf1(:, h))
+                call modal_apply(sys, h, 1, sys%nnl, x1, b1)
+                xe = b1(:, 1)
+            else
+                xe = sys%tye0(:, h) + s*sys%tye1(:, h)
+            end if
+            on = on + sum(abs(xe)**2, mask=sys%kmask(:, h))
+            off = off + sum(abs(xe)**2, mask=.not. sys%kmask(:, h))
+        end do
+        sys%xe_leak = ratio(off, on)
+    end subroutine load_leak
+
     module procedure cond_outputs
         real(wp) :: w, s
         integer(ip) :: h, j, o, nu, nout
@@ -1298,6 +1355,7 @@ contains
         if (info /= 0) return
         nu = this%nnl
         nout = size(this%outdofs)
+        if (allocated(this%sel)) call load_leak(this, s)
         allocate (fc(nu), z(nout))
         if (this%modal) allocate (v(size(this%g, 1)), x1(size(this%g, 1), 1), b1(nout, 1))
         do h = 0, this%nh

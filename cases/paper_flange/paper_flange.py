@@ -12,7 +12,9 @@ contact pairs per sector, one blade node per sector active), runs ccx, and write
 decks ``rom1.toml`` (Craig-Bampton: every flange DoF physical), ``rom2.toml`` (ms,
 ``harmonic_indices = [2]``: the paper's ROM_II), ``rom2_eo.toml`` (ms, ``engine_orders =
 [2]``: index 2 and its aliases z N +- 2, the family of time harmonic 1) and
-``rom2_family.toml`` (ms, the whole family that EO 2 and its time harmonics 0..3 excite) with F0 = 20 N, and one deck per
+``rom2_family.toml`` (ms, the whole family that EO 2 and its time harmonics 0..3 excite) and
+``rom2_tw.toml`` (that family with ``travelling_wave = true``: solved only for the (index,
+time harmonic) pairs of the tuned rotor's travelling wave, its reduced model shared) with F0 = 20 N, and one deck per
 member of the family (``rom1_F0_<F0>.toml`` ...): each runs with ``frirom run``.
 ``family`` solves the members with every ROM (ROM_I at paper size: each FRF takes minutes;
 ``--rom1 ends`` runs it at the smallest and largest F0 only and says so), prints Table 1,
