@@ -706,7 +706,11 @@ contains
         end do
         nq = qoff(nc + 1)
         if (nq == 0) return
-        allocate (yt(nq, nrg), gs(maxval(ln), nrg), kt(maxval(ln), nq))
+        ! gs: Gd^T on Q, the kept columns of every coefficient stacked (contiguous rows)
+        allocate (yt(nq, nrg), gs(nq, nrg), kt(maxval(ln), nq))
+        do c = 1, nc
+            gs(qoff(c) + 1:qoff(c + 1), :) = gr%gt(ls(1:ln(c), c), :)
+        end do
         do c1 = 1, nc
             m1 = ln(c1)
             if (m1 == 0) cycle
@@ -720,14 +724,13 @@ contains
                             v = gr%jac(c1 + nc*(d1 - 1), c2 + nc*(d2 - 1), e)
                             if (v == 0.0_wp) cycle
                             yt(qoff(c2) + 1:qoff(c2 + 1), r) = yt(qoff(c2) + 1:qoff(c2 + 1), r) &
-                                + v*gr%gt(ls(1:ln(c2), c2), (e - 1)*nd + d2)
+                                + v*gs(qoff(c2) + 1:qoff(c2 + 1), (e - 1)*nd + d2)
                         end do
                     end do
                 end do
             end do
-            gs(1:m1, :) = gr%gt(ls(1:m1, c1), :)
-            call dgemm('N', 'T', m1, nq, nrg, 1.0_wp, gs, size(gs, 1), yt, nq, 0.0_wp, kt, &
-                       size(kt, 1))
+            call dgemm('N', 'T', m1, nq, nrg, 1.0_wp, gs(qoff(c1) + 1, 1), nq, yt, nq, 0.0_wp, &
+                       kt, size(kt, 1))
             do c2 = 1, nc
                 do q = 1, ln(c2)
                     kc(py(1:m1, c1), py(q, c2)) = kc(py(1:m1, c1), py(q, c2)) + &
