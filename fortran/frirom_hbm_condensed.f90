@@ -552,7 +552,7 @@ contains
 
     !> J of a selected system (hbm_set_selection) on its kept rows and columns: kc, the
     !> kept part of dF_c/dU in y's order, by products over each contact group's dense
-    !> rows (gr%gt) or by its sparse rows, then J = I + R_h kc with R_h on the
+    !> rows (gr%gt) or taken from the element loops, then J = I + R_h kc with R_h on the
     !> coordinates kept at harmonic h only (exact for a tuned rotor, whose R_h does not
     !> couple the index families), then the LU.
     subroutine cond_jacobian_sel(sys, info, errmsg)
@@ -561,8 +561,9 @@ contains
         character(len=*), intent(inout) :: errmsg
         integer(ip) :: n, nu, nc, g, h, c, kh, ca, cb, stat, i
         integer(ip), allocatable :: at(:), off(:)
-        real(wp), allocatable :: kc(:, :), a(:, :), b(:, :)
+        real(wp), allocatable :: kc(:, :), kf(:, :), a(:, :), b(:, :)
         real(wp) :: t0
+        logical :: dense
         info = FRIROM_OK
         t0 = wtime()
         n = sys%n
@@ -589,16 +590,31 @@ contains
             off(c + 1) = off(c) + sys%kptr(h + 2) - sys%kptr(h + 1)
         end do
         kc = 0.0_wp
+        dense = .true.
         do g = 1, size(sys%cs%grp)
-            associate (gr => sys%cs%grp(g))
-                if (gr%asm_mode == 0) call choose_dense(gr, sys%cs%g)
-                if (gr%asm_mode == 2) then
-                    call kc_dense_sel(gr, nu, nc, at, kc)
-                else
-                    call kc_rows_sel(gr, sys%cs%g, nu, nc, at, kc)
-                end if
-            end associate
+            if (sys%cs%grp(g)%asm_mode == 0) call choose_dense(sys%cs%grp(g), sys%cs%g)
+            dense = dense .and. sys%cs%grp(g)%asm_mode == 2
         end do
+        if (dense) then
+            do g = 1, size(sys%cs%grp)
+                call kc_dense_sel(sys%cs%grp(g), nu, nc, at, kc)
+            end do
+        else
+            ! sparse rows (physical contact DoFs, not what a selection is for): the element
+            ! loops of contact_assemble in the full layout, then the kept part
+            allocate (kf(nu*nc, nu*nc), stat=stat)
+            if (stat == 0) then
+                kf = 0.0_wp
+                call contact_assemble(sys%cs, kd=kf, info=info, errmsg=errmsg, loops=.true.)
+                kc = kf(sys%sel, sys%sel)
+            else
+                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: Jacobian')
+            end if
+            if (info /= 0) then
+                call move_alloc(kc, sys%kcw)
+                return
+            end if
+        end if
         sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
         do h = 0, sys%nh
             kh = sys%kptr(h + 2) - sys%kptr(h + 1)
@@ -739,40 +755,6 @@ contains
             end do
         end do
     end subroutine kc_dense_sel
-
-    !> kc += the kept part of G_g^T J_loc G_g element by element over the group's sparse
-    !> rows (contact_assemble's loops, kept entries only).
-    subroutine kc_rows_sel(gr, gg, nu, nc, at, kc)
-        type(contact_group), intent(in) :: gr
-        type(csr_matrix), intent(in) :: gg
-        integer(ip), intent(in) :: nu, nc, at(:)
-        real(wp), intent(inout) :: kc(:, :)
-        integer(ip) :: e, d1, d2, r1, r2, k1, k2, c1, c2, p1, p2
-        real(wp) :: v
-        do e = 1, gr%ne
-            do d1 = 1, gr%ndir
-                r1 = gr%row0 + (e - 1)*gr%ndir + d1
-                do d2 = 1, gr%ndir
-                    r2 = gr%row0 + (e - 1)*gr%ndir + d2
-                    do k1 = gg%p(r1), gg%p(r1 + 1) - 1
-                        do k2 = gg%p(r2), gg%p(r2 + 1) - 1
-                            v = gg%x(k1)*gg%x(k2)
-                            do c2 = 1, nc
-                                p2 = at(gg%i(k2) + nu*(c2 - 1))
-                                if (p2 == 0) cycle
-                                do c1 = 1, nc
-                                    p1 = at(gg%i(k1) + nu*(c1 - 1))
-                                    if (p1 == 0) cycle
-                                    kc(p1, p2) = kc(p1, p2) + &
-                                        v*gr%jac(c1 + nc*(d1 - 1), c2 + nc*(d2 - 1), e)
-                                end do
-                            end do
-                        end do
-                    end do
-                end do
-            end do
-        end do
-    end subroutine kc_rows_sel
 
     !> LU of J (jm := jcur first in Krylov mode). Systems that hold their LU
     !> (cond_lu_holds) factorise a single-precision copy into jms: half the flops of the LU

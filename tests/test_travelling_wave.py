@@ -148,32 +148,29 @@ def test_resume_with_a_selection_is_exact(fam, tmp_path):
     uninterrupted run's bit for bit (the points hold the full layout, zeros where left
     out; tolerance 0)."""
     _, d, sel = fam
-    out, names = d.outputs, [c.name for c in d.contacts]
+    names = [c.name for c in d.contacts]
+    files = {k: FRFWriter(tmp_path / f"{k}.h5", d.outputs, names, pf.H) for k in ("ref", "cut")}
+    full = _run(d, 300.0, sel, sink=files["ref"].append)
+    files["ref"].close(full.complete, full.message)
+    cut = files["cut"]
 
-    def writer(path, append=False):
-        return FRFWriter(path, out, names, pf.H, append=append)
-    w = writer(tmp_path / "ref.h5")
-    full = _run(d, 300.0, sel, sink=w.append)
-    w.close(full.complete, full.message)
-    ref = FRF.load(tmp_path / "ref.h5")
-    path = tmp_path / "cut.h5"
-    w = writer(path)
-
-    def dying(p):
-        if w._commit[0] == 25:
-            raise Killed
-        w.append(p)
+    def until_25(p):            # the process dies inside the 26th point's record
+        (cut.append if cut._commit[0] < 25 else _die)(p)
     with pytest.raises(Killed):
-        _run(d, 300.0, sel, sink=dying)
-    w.f.close()
-    start = FRFWriter.resume_point(path)
-    w = writer(path, append=True)
-    rest = _run(d, 300.0, sel, sink=w.append, start=start)
-    w.close(rest.complete, rest.message)
-    got = FRF.load(path)
-    assert len(got) == len(ref)
+        _run(d, 300.0, sel, sink=until_25)
+    cut.f.close()
+    start = FRFWriter.resume_point(tmp_path / "cut.h5")
+    again = FRFWriter(tmp_path / "cut.h5", d.outputs, names, pf.H, append=True)
+    rest = _run(d, 300.0, sel, sink=again.append, start=start)
+    again.close(rest.complete, rest.message)
+    got, ref = FRF.load(tmp_path / "cut.h5"), FRF.load(tmp_path / "ref.h5")
+    assert start["n_points"] < 25 and len(got) == len(ref)
     for name in ("omega", "X", "state_fractions", "slider"):
         np.testing.assert_array_equal(getattr(got, name), getattr(ref, name), err_msg=name)
+
+
+def _die(p):
+    raise Killed
 
 
 def _deck(work, name, edit):
