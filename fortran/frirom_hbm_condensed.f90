@@ -693,60 +693,102 @@ contains
 
     !> kc += the kept part of G_g^T J_loc G_g for a group with dense rows over its columns
     !> (gt = Gd^T, gcols): per coefficient c1, the kept columns S1 of the group at c1 and
-    !> all kept (column, c2) Q: kc(S1 c1, Q) += Gd(:, S1)^T Y, Y = J_loc Gd on Q.
+    !> all kept (column, c2) Q: kc(S1 c1, Q) += Gd(:, S1)^T Y, Y = J_loc Gd on Q, direction
+    !> by direction over the columns that direction's rows read. Those are a range: each
+    !> coefficient's columns are ordered by the directions that read them (an MS
+    !> coordinate is one cylindrical component: a normal or a tangential row reads a third).
     subroutine kc_dense_sel(gr, nu, nc, at, kc)
         type(contact_group), intent(in) :: gr
         integer(ip), intent(in) :: nu, nc, at(:)
         real(wp), intent(inout) :: kc(:, :)
-        integer(ip), allocatable :: ls(:, :), py(:, :), ln(:), qoff(:)
-        real(wp), allocatable :: yt(:, :), gs(:, :), kt(:, :)
-        integer(ip) :: ns, nd, nrg, c, c1, c2, d1, d2, e, r, s, q, m1, nq, p
+        integer(ip), allocatable :: ls(:, :), py(:, :), ln(:), qoff(:), key(:), ord(:), &
+                                    lo(:, :), hi(:, :)
+        real(wp), allocatable :: yt(:, :, :), gs(:, :, :), kt(:, :)
+        logical, allocatable :: rd(:, :)
+        !> two directions, by the mask of those that read a column: d1 only, both, d2 only,
+        !> none (each direction's columns are then one range)
+        integer(ip), parameter :: ORDER2(0:3) = [3, 0, 2, 1]
+        integer(ip) :: ns, nd, ne, nrg, c, c1, c2, d1, d2, e, s, q, m1, nq, p, k, a, b
         real(wp) :: v
         nd = gr%ndir
-        nrg = gr%ne*nd
+        ne = gr%ne
+        nrg = ne*nd
         ns = size(gr%gcols)
-        ! ls(:, c): the group's columns (index into gcols) kept at coefficient c; py their
-        ! indices in y
-        allocate (ls(ns, nc), py(ns, nc), ln(nc), qoff(nc + 1))
+        ! rd(s, d): direction d's rows read column s; key: the order of the columns within
+        ! a coefficient (more than two directions: a range may hold columns it does not read)
+        allocate (rd(ns, nd), key(ns), ord(ns))
+        do d1 = 1, nd
+            rd(:, d1) = any(gr%gt(:, d1:nrg:nd) /= 0.0_wp, dim=2)
+        end do
+        do s = 1, ns
+            key(s) = sum([(merge(2**(d1 - 1), 0, rd(s, d1)), d1=1, nd)])
+            if (nd == 2) key(s) = ORDER2(key(s))
+        end do
+        k = 0
+        do p = 0, maxval(key)
+            do s = 1, ns
+                if (key(s) /= p) cycle
+                k = k + 1
+                ord(k) = s
+            end do
+        end do
+        ! ls(:, c): the group's columns (index into gcols) kept at coefficient c in that
+        ! order, py their indices in y, lo:hi(c, d) those direction d reads
+        allocate (ls(ns, nc), py(ns, nc), ln(nc), qoff(nc + 1), lo(nc, nd), hi(nc, nd))
         qoff(1) = 0
         do c = 1, nc
             ln(c) = 0
-            do s = 1, ns
+            lo(c, :) = 1
+            hi(c, :) = 0
+            do k = 1, ns
+                s = ord(k)
                 p = at(gr%gcols(s) + nu*(c - 1))
                 if (p == 0) cycle
                 ln(c) = ln(c) + 1
                 ls(ln(c), c) = s
                 py(ln(c), c) = p
+                do d1 = 1, nd
+                    if (.not. rd(s, d1)) cycle
+                    if (hi(c, d1) == 0) lo(c, d1) = ln(c)
+                    hi(c, d1) = ln(c)
+                end do
             end do
             qoff(c + 1) = qoff(c) + ln(c)
         end do
         nq = qoff(nc + 1)
         if (nq == 0) return
-        ! gs: Gd^T on Q, the kept columns of every coefficient stacked (contiguous rows)
-        allocate (yt(nq, nrg), gs(nq, nrg), kt(maxval(ln), nq))
-        do c = 1, nc
-            gs(qoff(c) + 1:qoff(c + 1), :) = gr%gt(ls(1:ln(c), c), :)
+        ! gs(q, e, d): Gd^T on Q (the kept columns of every coefficient stacked), by direction
+        allocate (yt(nq, ne, nd), gs(nq, ne, nd), kt(maxval(ln), nq))
+        do d1 = 1, nd
+            do c = 1, nc
+                gs(qoff(c) + 1:qoff(c + 1), :, d1) = gr%gt(ls(1:ln(c), c), d1:nrg:nd)
+            end do
         end do
         do c1 = 1, nc
             m1 = ln(c1)
             if (m1 == 0) cycle
             yt = 0.0_wp
-            do e = 1, gr%ne
-                do d1 = 1, nd
-                    r = (e - 1)*nd + d1
+            do d1 = 1, nd
+                do e = 1, ne
                     do c2 = 1, nc
-                        if (ln(c2) == 0) cycle
                         do d2 = 1, nd
                             v = gr%jac(c1 + nc*(d1 - 1), c2 + nc*(d2 - 1), e)
-                            if (v == 0.0_wp) cycle
-                            yt(qoff(c2) + 1:qoff(c2 + 1), r) = yt(qoff(c2) + 1:qoff(c2 + 1), r) &
-                                + v*gs(qoff(c2) + 1:qoff(c2 + 1), (e - 1)*nd + d2)
+                            if (v == 0.0_wp .or. hi(c2, d2) == 0) cycle
+                            a = qoff(c2) + lo(c2, d2)
+                            b = qoff(c2) + hi(c2, d2)
+                            yt(a:b, e, d1) = yt(a:b, e, d1) + v*gs(a:b, e, d2)
                         end do
                     end do
                 end do
             end do
-            call dgemm('N', 'T', m1, nq, nrg, 1.0_wp, gs(qoff(c1) + 1, 1), nq, yt, nq, 0.0_wp, &
-                       kt, size(kt, 1))
+            kt(1:m1, :) = 0.0_wp
+            do d1 = 1, nd
+                if (hi(c1, d1) == 0) cycle
+                a = lo(c1, d1)
+                call dgemm('N', 'T', hi(c1, d1) - a + 1, nq, ne, 1.0_wp, &
+                           gs(qoff(c1) + a, 1, d1), nq, yt(1, 1, d1), nq, 1.0_wp, kt(a, 1), &
+                           size(kt, 1))
+            end do
             do c2 = 1, nc
                 do q = 1, ln(c2)
                     kc(py(1:m1, c1), py(q, c2)) = kc(py(1:m1, c1), py(q, c2)) + &
