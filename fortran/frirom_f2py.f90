@@ -123,14 +123,14 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
                         tan0, start_mode, nropt, ropt, niopt, iopt, stability, history, &
                         maxpts, netot, ntim, ys, lams, tans, iters, xo, states, hill_re, &
                         sliders, yscales, npts, finished, ds_out, timings, info, msg, &
-                        tcontact, krylov, sparse, nlu, lu, lupiv, lustate)
+                        tcontact, krylov, sparse, nlu, lu, lupiv, lustate, selected, keep, leak)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options, cont_options_from, N_RCONT, N_ICONT, RCONT_DS, &
                              RCONT_LAM_LO
     use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
                           hbm_set_modes_harmonic, hbm_run, hbm_lu_import, hbm_lu_export, &
-                          HBM_FREQUENCY, HBM_LOAD, N_TIMERS
+                          hbm_set_selection, HBM_FREQUENCY, HBM_LOAD, N_TIMERS
     implicit none
     character(len=*), intent(in) :: formulation  !! 'condensed' (Eq. 5-9) or 'banded'
     character(len=*), intent(in) :: lam_kind     !! the parameter lam: 'frequency' or 'load'
@@ -191,7 +191,14 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     integer(4), intent(in) :: nlu
     real(8), intent(inout) :: lu(nlu, nlu), lustate(2)
     integer(4), intent(inout) :: lupiv(nlu)
+    !> selected = 1: solve only for the (nonlinear DoF, harmonic) pairs with keep(j, h+1)
+    !> = 1, the others zero (hbm_set_selection); y0, tan0, ys and tans keep the full
+    !> layout (zeros where left out)
+    integer(4), intent(in) :: selected, keep(nnl, nh + 1)
+    real(8), intent(out) :: leak(maxpts)     !! per point: frirom_hbm cond_leak
     class(hbm_system), allocatable :: sys
+    integer(ip), allocatable :: sel(:)
+    real(wp), allocatable :: ysel(:, :), tsel(:, :)
     logical :: lu_used
     type(cont_options) :: opts
     real(wp), allocatable :: y(:), t(:)
@@ -215,6 +222,7 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     sliders = 0.0d0
     yscales = 0.0d0
     hill_re = 0.0d0
+    leak = 0.0d0
     linfo = 0
     if (nropt /= N_RCONT .or. niopt /= N_ICONT .or. ntim /= N_TIMERS) then
         call set_status(linfo, FRIROM_ERR_SIZE, msg, 'hbm_continue: ropt, iopt and timings '// &
@@ -249,6 +257,14 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     if (linfo == 0 .and. nmodes > 0) call hbm_set_modes(sys, phi, wmodes, zmodes, linfo, msg)
     if (linfo == 0 .and. hmodes > 0) call hbm_set_modes_harmonic(sys, psi, wharm, zharm, &
                                                                  linfo, msg)
+    if (linfo == 0 .and. selected /= 0) then
+        if (stability /= 0) then
+            call set_status(linfo, FRIROM_ERR_PARAM, msg, 'selection: Hill stability would '// &
+                            'see only perturbations inside the selection; not with stability')
+        else
+            call hbm_set_selection(sys, int(keep, ip), linfo, msg, sel)
+        end if
+    end if
     if (linfo /= 0) then
         info = linfo
         return
@@ -261,7 +277,18 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     t = tan0
     lam = lam0
     dsl = ropt(RCONT_DS)
-    if (stability /= 0) then
+    if (allocated(sel)) then
+        ! the run in the kept unknowns; the points back in the full layout
+        y = y0(sel)
+        t = [tan0(sel), tan0(ny + 1)]
+        allocate (ysel(size(sel), maxpts), tsel(size(sel) + 1, maxpts))
+        call hbm_run(sys, start_mode, y, lam, t, dsl, ropt(RCONT_LAM_LO), opts, ysel, lams, &
+                     tsel, itl, xo, states, np, fin, linfo, msg, sliders=sliders, &
+                     yscales=yscales, leak=leak)
+        ys(sel, 1:np) = ysel(:, 1:np)
+        tans(sel, 1:np) = tsel(1:size(sel), 1:np)
+        tans(ny + 1, 1:np) = tsel(size(sel) + 1, 1:np)
+    else if (stability /= 0) then
         call hbm_run(sys, start_mode, y, lam, t, dsl, ropt(RCONT_LAM_LO), opts, ys, lams, &
                      tans, itl, xo, states, np, fin, linfo, msg, hill_re, sliders=sliders, &
                      yscales=yscales)

@@ -6,7 +6,7 @@
 !> LU, and the outputs by Eq. 9.
 submodule (frirom_hbm) frirom_hbm_condensed
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_ALLOC, FRIROM_ERR_LAPACK, &
-                             FRIROM_ERR_SINGULAR, set_status
+                             FRIROM_ERR_SINGULAR, FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     implicit none
 
     !> GMRES (Krylov mode): relative residual, iteration limit before the J is factorised,
@@ -73,6 +73,112 @@ contains
         sys%lu_any = .false.
     end procedure cond_init
 
+    module procedure hbm_set_selection
+        integer(ip) :: nu, nc, h, j, c, k, n, stat
+        real(wp) :: on, off
+        info = FRIROM_OK
+        select type (sys => sysc)
+        type is (hbm_condensed)
+            nu = sys%nnl
+            nc = sys%nc
+            if (size(keep, 1) /= nu .or. size(keep, 2) /= sys%nh + 1) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'selection: keep must be '// &
+                                '(nonlinear DoFs, H+1)')
+            else if (sys%tcontact) then
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: needs the '// &
+                                'unknowns in the nonlinear DoFs, not in contact coordinates')
+            else if (use_krylov(sys)) then
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: needs direct '// &
+                                'solves (krylov off)')
+            else if (all(keep == 0)) then
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: keeps no unknown')
+            end if
+            if (info /= 0) return
+            if (allocated(sys%sel)) deallocate (sys%sel, sys%kpt, sys%kptr, sys%kmask)
+            n = 0
+            do c = 1, nc
+                n = n + count(keep(:, c/2) /= 0)
+            end do
+            allocate (sys%kptr(sys%nh + 2), sys%kpt(count(keep /= 0)), sys%sel(n), &
+                      sys%kmask(nu, 0:sys%nh), stat=stat)
+            if (stat == 0) then
+                if (allocated(sys%jm)) deallocate (sys%jm)
+                if (allocated(sys%ipiv)) deallocate (sys%ipiv)
+                allocate (sys%jm(n, n), sys%ipiv(n), stat=stat)
+            end if
+            if (stat /= 0) then
+                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'selection: Jacobian')
+                return
+            end if
+            sys%kmask = keep /= 0
+            sys%kptr(1) = 1
+            k = 0
+            do h = 0, sys%nh
+                do j = 1, nu
+                    if (keep(j, h) == 0) cycle
+                    k = k + 1
+                    sys%kpt(k) = j
+                end do
+                sys%kptr(h + 2) = k + 1
+            end do
+            ! y: coefficient by coefficient (harmonic c/2), the kept coordinates ascending
+            k = 0
+            do c = 1, nc
+                h = c/2
+                sys%sel(k + 1:k + sys%kptr(h + 2) - sys%kptr(h + 1)) = &
+                    sys%kpt(sys%kptr(h + 1):sys%kptr(h + 2) - 1) + nu*(c - 1)
+                k = k + sys%kptr(h + 2) - sys%kptr(h + 1)
+            end do
+            sys%n = n
+            if (allocated(sys%jcur)) deallocate (sys%jcur)
+            if (allocated(sys%jms)) deallocate (sys%jms)
+            if (allocated(sys%kcw)) deallocate (sys%kcw)
+            sys%lu_any = .false.
+            sys%lu_fresh = .false.
+            sys%lu_now = .false.
+            sys%lu_single = .false.
+            sys%gm_worth = 0.0_wp
+            sys%c0_leak = 0.0_wp
+            sys%xe_leak = 0.0_wp
+            if (allocated(sys%cs%c0)) then
+                on = sum(sys%cs%c0**2, mask=keep(:, 0) /= 0)
+                off = sum(sys%cs%c0**2, mask=keep(:, 0) == 0)
+                sys%c0_leak = ratio(off, on)
+            end if
+            if (present(sel)) sel = sys%sel
+        class default
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: needs the '// &
+                            'condensed formulation')
+        end select
+    end procedure hbm_set_selection
+
+    module procedure cond_leak
+        integer(ip) :: c
+        real(wp) :: on, off
+        leak = 0.0_wp
+        if (.not. allocated(sys%sel) .or. .not. allocated(sys%fd)) return
+        ! each part summed on its own: a leak at round-off is not lost to cancellation
+        on = 0.0_wp
+        off = 0.0_wp
+        do c = 1, sys%nc
+            on = on + sum(sys%fd(:, c)**2, mask=sys%kmask(:, c/2))
+            off = off + sum(sys%fd(:, c)**2, mask=.not. sys%kmask(:, c/2))
+        end do
+        leak = max(ratio(off, on), sys%c0_leak, sys%xe_leak)
+    end procedure cond_leak
+
+    !> sqrt(off / on) for two sums of squares: 0 when both are 0, huge when only on is.
+    pure real(wp) function ratio(off, on)
+        real(wp), intent(in) :: off, on
+        if (on > 0.0_wp) then
+            ratio = sqrt(off/on)
+        else if (off > 0.0_wp) then
+            ratio = huge(1.0_wp)
+        else
+            ratio = 0.0_wp
+        end if
+    end function ratio
+
     !> Whether solves go through GMRES on jcur (see hbm_condensed%krylov).
     pure logical function use_krylov(sys)
         type(hbm_condensed), intent(in) :: sys
@@ -81,9 +187,10 @@ contains
 
     module procedure cond_eval
         real(wp) :: w, s, nx, nxe, nhf, nrc, nxd, nhd
-        integer(ip) :: nnl, nc, h, n, nm
+        integer(ip) :: nnl, nc, h, n, nm, nhd0
         complex(wp), allocatable :: fc(:), z(:), dz(:), rh(:), xe(:), v(:), x3(:, :), b3(:, :)
         real(wp), allocatable :: r2(:, :), rl2(:, :)   !! (nnl, nc) r and rlam by harmonic
+        real(wp), allocatable :: rf(:)                 !! (nnl nc) all rows (a selection)
         info = FRIROM_OK
         nnl = this%nnl
         nc = this%nc
@@ -136,7 +243,14 @@ contains
                         x3(:, 3) = -this%dg(:, h)*(q - v)
                     end if
                 end associate
-                call modal_apply(this, h, 1, nnl, x3, b3)
+                if (allocated(this%sel)) then
+                    ! the kept rows only (the others are dropped; cond_outputs measures the
+                    ! loads' leak)
+                    call modal_rows(this, h, this%kpt(this%kptr(h + 1):this%kptr(h + 2) - 1), &
+                                    x3, b3)
+                else
+                    call modal_apply(this, h, 1, nnl, x3, b3)
+                end if
                 xe = b3(:, 1)
                 rh = b3(:, 2)
             else
@@ -173,12 +287,32 @@ contains
             end if
             call harm_set(rl2, h, xe)
         end do
-        r = reshape(r2, [n])
-        rlam = reshape(rl2, [n])
+        if (allocated(this%sel)) then
+            ! the kept rows (hbm_set_selection); y holds no harmonic 0 after its kept rows
+            rf = reshape(r2, [nnl*nc])
+            r = rf(this%sel)
+            rf = reshape(rl2, [nnl*nc])
+            rlam = rf(this%sel)
+            nhd0 = this%kptr(2) - this%kptr(1)
+        else
+            r = reshape(r2, [n])
+            rlam = reshape(rl2, [n])
+            nhd0 = nnl
+        end if
         rref = max(sqrt(nxe), nx, sqrt(nhf), nrc)
         ! harmonics 1..H alone (hbm_roundoff)
-        this%rref_dyn = max(sqrt(nxd), norm2(y(nnl + 1:)), sqrt(nhd))
+        this%rref_dyn = max(sqrt(nxd), norm2(y(nhd0 + 1:)), sqrt(nhd))
         if (.not. jac) return
+        if (allocated(this%sel)) then
+            ! the kept rows and columns only, a new LU every time (cond_jacobian_sel)
+            if (this%modal) then
+                this%gj = this%g
+                this%wj = w
+            end if
+            this%jfree = .false.
+            call cond_jacobian_sel(this, info, errmsg)
+            return
+        end if
         if (this%modal) then
             this%gj = this%g
             this%wj = w
@@ -386,6 +520,284 @@ contains
         end do
     end subroutine jac_dense
 
+    !> Modal route, a selection: b(rows, :) = A_h(rows, :) x, the other rows of b zero.
+    subroutine modal_rows(sys, h, rows, x, b)
+        type(hbm_condensed), intent(in) :: sys
+        integer(ip), intent(in) :: h, rows(:)
+        complex(wp), intent(in) :: x(:, :)     !! (nm, k)
+        complex(wp), intent(out) :: b(:, :)    !! (nnl, k)
+        real(wp), allocatable :: pk(:, :), xr(:, :), br(:, :)
+        complex(wp), allocatable :: zk(:, :), bk(:, :)
+        integer(ip) :: nm, k, nr
+        nm = size(x, 1)
+        k = size(x, 2)
+        nr = size(rows)
+        b = (0.0_wp, 0.0_wp)
+        if (nr == 0) return
+        if (allocated(sys%phr)) then
+            pk = sys%phr(rows, :)
+            allocate (xr(nm, 2*k), br(nr, 2*k))
+            xr(:, 1:k) = real(x, wp)
+            xr(:, k + 1:) = aimag(x)
+            call dgemm('N', 'N', nr, 2*k, nm, 1.0_wp, pk, nr, xr, nm, 0.0_wp, br, nr)
+            b(rows, :) = cmplx(br(:, 1:k), br(:, k + 1:), wp)
+        else
+            zk = sys%psi(rows, :, h)
+            allocate (bk(nr, k))
+            call zgemm('N', 'N', nr, k, nm, (1.0_wp, 0.0_wp), zk, nr, x, nm, &
+                       (0.0_wp, 0.0_wp), bk, nr)
+            b(rows, :) = bk
+        end if
+    end subroutine modal_rows
+
+    !> J of a selected system (hbm_set_selection) on its kept rows and columns: kc, the
+    !> kept part of dF_c/dU in y's order, by products over each contact group's dense
+    !> rows (gr%gt) or taken from the element loops, then J = I + R_h kc with R_h on the
+    !> coordinates kept at harmonic h only (exact for a tuned rotor, whose R_h does not
+    !> couple the index families), then the LU.
+    subroutine cond_jacobian_sel(sys, info, errmsg)
+        type(hbm_condensed), intent(inout) :: sys
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        integer(ip) :: n, nu, nc, g, h, c, kh, ca, cb, stat, i
+        integer(ip), allocatable :: at(:), off(:)
+        real(wp), allocatable :: kc(:, :), kf(:, :), a(:, :), b(:, :)
+        real(wp) :: t0
+        logical :: dense
+        info = FRIROM_OK
+        t0 = wtime()
+        n = sys%n
+        nu = sys%nnl
+        nc = sys%nc
+        stat = 0
+        if (allocated(sys%kcw)) then
+            if (size(sys%kcw, 1) /= n) deallocate (sys%kcw)
+        end if
+        if (.not. allocated(sys%kcw)) allocate (sys%kcw(n, n), stat=stat)
+        if (stat /= 0) then
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: Jacobian')
+            return
+        end if
+        call move_alloc(sys%kcw, kc)
+        ! at: position j + nu (c-1) -> its index in y (0: left out); off(c): y's entries
+        ! before coefficient c
+        allocate (at(nu*nc), off(nc + 1))
+        at = 0
+        at(sys%sel) = [(i, i=1, n)]
+        off(1) = 0
+        do c = 1, nc
+            h = c/2
+            off(c + 1) = off(c) + sys%kptr(h + 2) - sys%kptr(h + 1)
+        end do
+        kc = 0.0_wp
+        dense = .true.
+        do g = 1, size(sys%cs%grp)
+            if (sys%cs%grp(g)%asm_mode == 0) call choose_dense(sys%cs%grp(g), sys%cs%g)
+            dense = dense .and. sys%cs%grp(g)%asm_mode == 2
+        end do
+        if (dense) then
+            do g = 1, size(sys%cs%grp)
+                call kc_dense_sel(sys%cs%grp(g), nu, nc, at, kc)
+            end do
+        else
+            ! sparse rows (physical contact DoFs, not what a selection is for): the element
+            ! loops of contact_assemble in the full layout, then the kept part
+            allocate (kf(nu*nc, nu*nc), stat=stat)
+            if (stat == 0) then
+                kf = 0.0_wp
+                call contact_assemble(sys%cs, kd=kf, info=info, errmsg=errmsg, loops=.true.)
+                kc = kf(sys%sel, sys%sel)
+            else
+                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: Jacobian')
+            end if
+            if (info /= 0) then
+                call move_alloc(kc, sys%kcw)
+                return
+            end if
+        end if
+        sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
+        do h = 0, sys%nh
+            kh = sys%kptr(h + 2) - sys%kptr(h + 1)
+            if (kh == 0) cycle
+            call rec_block(sys, h, sys%kpt(sys%kptr(h + 1):sys%kptr(h + 2) - 1), a, b)
+            t0 = wtime()
+            if (h == 0) then
+                ca = off(1) + 1
+                call dgemm('N', 'N', kh, n, kh, 1.0_wp, a, kh, kc(ca, 1), n, 0.0_wp, &
+                           sys%jm(ca, 1), n)
+            else
+                ! a-rows: A Kc_a + B Kc_b ; b-rows: -B Kc_a + A Kc_b
+                ca = off(2*h) + 1
+                cb = off(2*h + 1) + 1
+                call dgemm('N', 'N', kh, n, kh, 1.0_wp, a, kh, kc(ca, 1), n, 0.0_wp, &
+                           sys%jm(ca, 1), n)
+                call dgemm('N', 'N', kh, n, kh, 1.0_wp, b, kh, kc(cb, 1), n, 1.0_wp, &
+                           sys%jm(ca, 1), n)
+                call dgemm('N', 'N', kh, n, kh, -1.0_wp, b, kh, kc(ca, 1), n, 0.0_wp, &
+                           sys%jm(cb, 1), n)
+                call dgemm('N', 'N', kh, n, kh, 1.0_wp, a, kh, kc(cb, 1), n, 1.0_wp, &
+                           sys%jm(cb, 1), n)
+            end if
+            sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
+        end do
+        do i = 1, n
+            sys%jm(i, i) = sys%jm(i, i) + 1.0_wp
+        end do
+        call move_alloc(kc, sys%kcw)
+        call cond_factor(sys, info, errmsg)
+    end subroutine cond_jacobian_sel
+
+    !> R_h = a + i b on the coordinates rows (both sides), at the Jacobian's frequency:
+    !> from the modes (A_h(rows) diag(g_h) A_h(rows)^H, only these rows) or read from the
+    !> factorised receptances ar, ai.
+    subroutine rec_block(sys, h, rows, a, b)
+        type(hbm_condensed), intent(inout) :: sys
+        integer(ip), intent(in) :: h, rows(:)
+        real(wp), allocatable, intent(out) :: a(:, :), b(:, :)
+        real(wp), allocatable :: p(:, :), pd(:, :)
+        complex(wp), allocatable :: z(:, :), zd(:, :), rz(:, :)
+        integer(ip) :: k, nm, r
+        real(wp) :: t0
+        t0 = wtime()
+        k = size(rows)
+        allocate (a(k, k), b(k, k))
+        if (.not. sys%modal) then
+            a = sys%ar(rows, rows, h)
+            b = sys%ai(rows, rows, h)
+        else if (allocated(sys%phr)) then
+            nm = size(sys%gj, 1)
+            p = sys%phr(rows, :)
+            allocate (pd(k, nm))
+            do r = 1, nm
+                pd(:, r) = p(:, r)*real(sys%gj(r, h), wp)
+            end do
+            call dgemm('N', 'T', k, k, nm, 1.0_wp, pd, k, p, k, 0.0_wp, a, k)
+            do r = 1, nm
+                pd(:, r) = p(:, r)*aimag(sys%gj(r, h))
+            end do
+            call dgemm('N', 'T', k, k, nm, 1.0_wp, pd, k, p, k, 0.0_wp, b, k)
+        else
+            nm = size(sys%gj, 1)
+            z = sys%psi(rows, :, h)
+            allocate (zd(k, nm), rz(k, k))
+            do r = 1, nm
+                zd(:, r) = z(:, r)*sys%gj(r, h)
+            end do
+            call zgemm('N', 'C', k, k, nm, (1.0_wp, 0.0_wp), zd, k, z, k, (0.0_wp, 0.0_wp), &
+                       rz, k)
+            a = real(rz, wp)
+            b = aimag(rz)
+        end if
+        sys%timers(T_REC) = sys%timers(T_REC) + wtime() - t0
+    end subroutine rec_block
+
+    !> kc += the kept part of G_g^T J_loc G_g for a group with dense rows over its columns
+    !> (gt = Gd^T, gcols): per coefficient c1, the kept columns S1 of the group at c1 and
+    !> all kept (column, c2) Q: kc(S1 c1, Q) += Gd(:, S1)^T Y, Y = J_loc Gd on Q, direction
+    !> by direction over the columns that direction's rows read. Those are a range: each
+    !> coefficient's columns are ordered by the directions that read them (an MS
+    !> coordinate is one cylindrical component: a normal or a tangential row reads a third).
+    subroutine kc_dense_sel(gr, nu, nc, at, kc)
+        type(contact_group), intent(in) :: gr
+        integer(ip), intent(in) :: nu, nc, at(:)
+        real(wp), intent(inout) :: kc(:, :)
+        integer(ip), allocatable :: ls(:, :), py(:, :), ln(:), qoff(:), key(:), ord(:), &
+                                    lo(:, :), hi(:, :)
+        real(wp), allocatable :: yt(:, :, :), gs(:, :, :), kt(:, :)
+        logical, allocatable :: rd(:, :)
+        !> two directions, by the mask of those that read a column: d1 only, both, d2 only,
+        !> none (each direction's columns are then one range)
+        integer(ip), parameter :: ORDER2(0:3) = [3, 0, 2, 1]
+        integer(ip) :: ns, nd, ne, nrg, c, c1, c2, d1, d2, e, s, q, m1, nq, p, k, a, b
+        real(wp) :: v
+        nd = gr%ndir
+        ne = gr%ne
+        nrg = ne*nd
+        ns = size(gr%gcols)
+        ! rd(s, d): direction d's rows read column s; key: the order of the columns within
+        ! a coefficient (more than two directions: a range may hold columns it does not read)
+        allocate (rd(ns, nd), key(ns), ord(ns))
+        do d1 = 1, nd
+            rd(:, d1) = any(gr%gt(:, d1:nrg:nd) /= 0.0_wp, dim=2)
+        end do
+        do s = 1, ns
+            key(s) = sum([(merge(2**(d1 - 1), 0, rd(s, d1)), d1=1, nd)])
+            if (nd == 2) key(s) = ORDER2(key(s))
+        end do
+        k = 0
+        do p = 0, maxval(key)
+            do s = 1, ns
+                if (key(s) /= p) cycle
+                k = k + 1
+                ord(k) = s
+            end do
+        end do
+        ! ls(:, c): the group's columns (index into gcols) kept at coefficient c in that
+        ! order, py their indices in y, lo:hi(c, d) those direction d reads
+        allocate (ls(ns, nc), py(ns, nc), ln(nc), qoff(nc + 1), lo(nc, nd), hi(nc, nd))
+        qoff(1) = 0
+        do c = 1, nc
+            ln(c) = 0
+            lo(c, :) = 1
+            hi(c, :) = 0
+            do k = 1, ns
+                s = ord(k)
+                p = at(gr%gcols(s) + nu*(c - 1))
+                if (p == 0) cycle
+                ln(c) = ln(c) + 1
+                ls(ln(c), c) = s
+                py(ln(c), c) = p
+                do d1 = 1, nd
+                    if (.not. rd(s, d1)) cycle
+                    if (hi(c, d1) == 0) lo(c, d1) = ln(c)
+                    hi(c, d1) = ln(c)
+                end do
+            end do
+            qoff(c + 1) = qoff(c) + ln(c)
+        end do
+        nq = qoff(nc + 1)
+        if (nq == 0) return
+        ! gs(q, e, d): Gd^T on Q (the kept columns of every coefficient stacked), by direction
+        allocate (yt(nq, ne, nd), gs(nq, ne, nd), kt(maxval(ln), nq))
+        do d1 = 1, nd
+            do c = 1, nc
+                gs(qoff(c) + 1:qoff(c + 1), :, d1) = gr%gt(ls(1:ln(c), c), d1:nrg:nd)
+            end do
+        end do
+        do c1 = 1, nc
+            m1 = ln(c1)
+            if (m1 == 0) cycle
+            yt = 0.0_wp
+            do d1 = 1, nd
+                do e = 1, ne
+                    do c2 = 1, nc
+                        do d2 = 1, nd
+                            v = gr%jac(c1 + nc*(d1 - 1), c2 + nc*(d2 - 1), e)
+                            if (v == 0.0_wp .or. hi(c2, d2) == 0) cycle
+                            a = qoff(c2) + lo(c2, d2)
+                            b = qoff(c2) + hi(c2, d2)
+                            yt(a:b, e, d1) = yt(a:b, e, d1) + v*gs(a:b, e, d2)
+                        end do
+                    end do
+                end do
+            end do
+            kt(1:m1, :) = 0.0_wp
+            do d1 = 1, nd
+                if (hi(c1, d1) == 0) cycle
+                a = lo(c1, d1)
+                call dgemm('N', 'T', hi(c1, d1) - a + 1, nq, ne, 1.0_wp, &
+                           gs(qoff(c1) + a, 1, d1), nq, yt(1, 1, d1), nq, 1.0_wp, kt(a, 1), &
+                           size(kt, 1))
+            end do
+            do c2 = 1, nc
+                do q = 1, ln(c2)
+                    kc(py(1:m1, c1), py(q, c2)) = kc(py(1:m1, c1), py(q, c2)) + &
+                                                  kt(1:m1, qoff(c2) + q)
+                end do
+            end do
+        end do
+    end subroutine kc_dense_sel
+
     !> LU of J (jm := jcur first in Krylov mode). Systems that hold their LU
     !> (cond_lu_holds) factorise a single-precision copy into jms: half the flops of the LU
     !> and half the memory traffic of each triangular solve; it only preconditions GMRES
@@ -536,11 +948,11 @@ contains
         hold = lu_worth(nnl*(2*nh + 1), nh, nnl, nm) >= GN_WORTH_MIN
     end procedure cond_lu_holds
 
-    !> Whether sys keeps LUs across runs: modal, direct mode, worth holding.
+    !> Whether sys keeps LUs across runs: modal, direct mode, no selection, worth holding.
     logical function holds(sys)
         type(hbm_condensed), intent(in) :: sys
         holds = .false.
-        if (.not. sys%modal .or. use_krylov(sys)) return
+        if (.not. sys%modal .or. use_krylov(sys) .or. allocated(sys%sel)) return
         holds = lu_worth(sys%n, sys%nh, sys%nnl, size(sys%g, 1)) >= GN_WORTH_MIN
     end function holds
 
@@ -929,6 +1341,33 @@ contains
         ok = .true.
     end subroutine gmres
 
+    !> xe_leak at the receptances' frequency and load factor s: |T X_e off the selection|
+    !> / |on it|, T X_e the loads' linear response at the coordinates (every row; the
+    !> residual keeps only the kept ones).
+    subroutine load_leak(sys, s)
+        type(hbm_condensed), intent(inout) :: sys
+        real(wp), intent(in) :: s
+        complex(wp), allocatable :: x1(:, :), b1(:, :), xe(:)
+        real(wp) :: on, off
+        integer(ip) :: h
+        on = 0.0_wp
+        off = 0.0_wp
+        allocate (xe(sys%nnl))
+        if (sys%modal) allocate (x1(size(sys%g, 1), 1), b1(sys%nnl, 1))
+        do h = 0, sys%nh
+            if (sys%modal) then
+                x1(:, 1) = sys%g(:, h)*(sys%qf(:, h) + s*sys%qf1(:, h))
+                call modal_apply(sys, h, 1, sys%nnl, x1, b1)
+                xe = b1(:, 1)
+            else
+                xe = sys%tye0(:, h) + s*sys%tye1(:, h)
+            end if
+            on = on + sum(abs(xe)**2, mask=sys%kmask(:, h))
+            off = off + sum(abs(xe)**2, mask=.not. sys%kmask(:, h))
+        end do
+        sys%xe_leak = ratio(off, on)
+    end subroutine load_leak
+
     module procedure cond_outputs
         real(wp) :: w, s
         integer(ip) :: h, j, o, nu, nout
@@ -943,6 +1382,7 @@ contains
         if (info /= 0) return
         nu = this%nnl
         nout = size(this%outdofs)
+        if (allocated(this%sel)) call load_leak(this, s)
         allocate (fc(nu), z(nout))
         if (this%modal) allocate (v(size(this%g, 1)), x1(size(this%g, 1), 1), b1(nout, 1))
         do h = 0, this%nh

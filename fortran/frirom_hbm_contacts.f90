@@ -335,7 +335,7 @@ contains
     !> pay, with gr%gcols / gr%gt built if contact_eval has not; else 1. BLAS runs the
     !> products ~10x faster than the scalar loops: take them up to 4x the loops'
     !> operations (dense GSI columns: nd times fewer).
-    subroutine choose_dense(gr, gg)
+    module subroutine choose_dense(gr, gg)
         type(contact_group), intent(inout) :: gr
         type(csr_matrix), intent(in) :: gg
         integer(ip), allocatable :: pos(:)
@@ -370,7 +370,15 @@ contains
         nc = sys%nc
         select type (sys)
         type is (hbm_condensed)
-            sys%xd = reshape(y, [sys%nnl, nc])
+            if (allocated(sys%sel)) then
+                ! a selection (hbm_set_selection): the pairs left out are zero
+                sys%xd = 0.0_wp
+                do i = 1, size(sys%sel)
+                    sys%xd(mod(sys%sel(i) - 1, sys%nnl) + 1, (sys%sel(i) - 1)/sys%nnl + 1) = y(i)
+                end do
+            else
+                sys%xd = reshape(y, [sys%nnl, nc])
+            end if
         class default
             do i = 1, sys%ndof
                 sys%xd(i, :) = y(nc*(sys%iperm(i) - 1) + 1:nc*sys%iperm(i))

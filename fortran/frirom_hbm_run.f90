@@ -402,6 +402,14 @@ contains
             if (present(sliders)) call hbm_sliders(sys, sliders(:, npts))
             call sys%outputs(y, lam, xo(:, :, npts), info, errmsg)
             if (info /= 0) return
+            if (present(leak)) then
+                ! the contact forces of outputs' evaluation at y
+                leak(npts) = 0.0_wp
+                select type (sys)
+                type is (hbm_condensed)
+                    leak(npts) = cond_leak(sys)
+                end select
+            end if
             if (present(hill_re)) then
                 allocate (ex(2*sys%ndof))
                 call hbm_hill(sys, y, lam, ex, hill_re(npts), info, errmsg)

@@ -8,7 +8,8 @@ ROM_II's peak amplitude and frequency against ROM_I's.
         [--case paper_flange|paper_hooks]
 
 Rows come from ``bench_rows(work, quick)`` of cases/paper_flange/paper_flange.py (ROM_II
-with index 2, the paper's, and with the whole EO 2 family) and of the module in
+with index 2, the paper's, with the whole EO 2 family, and that family solved for the
+travelling wave's (index, harmonic) pairs only: "fam.TW") and of the module in
 cases/paper_hooks/ that offers it, when there is one. At paper size the flange's ROM_I
 peaks come from the case's stored run (``paper_flange.py family`` first, minutes per ROM_I
 FRF); ``--quick`` runs the coarse models whole in seconds.
@@ -55,15 +56,16 @@ def providers() -> dict:
 
 def print_table(rows: list) -> None:
     print(f"{'case':<7} {'member':<16} {'ROM_II':<7} {'FE':>7} {'ROM_I':>6} {'ROM_II':>6} "
-          f"{'nl I':>5} {'nl II':>5} {'red. s':>7} {'ROM_I FRF s':>16} {'ROM_II s':>8} "
-          f"{'speed-up':>8} {'amp err':>9} {'freq err':>9}")
+          f"{'nl I':>5} {'nl II':>5} {'unk II':>6} {'red. s':>7} {'ROM_I FRF s':>16} "
+          f"{'ROM_II s':>8} {'speed-up':>8} {'amp err':>9} {'freq err':>9}")
     for r in rows:
         t1 = f"{r['rom1_frf_s']:.1f}" + (" extrap." if r["rom1_extrapolated"] else
                                          " stored" if r.get("rom1_stored") else "")
         bad = (abs(r["peak_amp_err"]) > TARGET_AMP or abs(r["peak_freq_err"]) > TARGET_FREQ)
         print(f"{r['case']:<7} {r['member']:<16} {r.get('rom2', ''):<7} {r['fe_dofs']:7d} "
               f"{r['rom1_dofs']:6d} {r['rom2_dofs']:6d} {r['rom1_nonlinear']:5d} "
-              f"{r['rom2_nonlinear']:5d} {r['reduction_s']:7.1f} {t1:>16} "
+              f"{r['rom2_nonlinear']:5d} {r.get('rom2_unknowns', 0) or '':>6} "
+              f"{r['reduction_s']:7.1f} {t1:>16} "
               f"{r['rom2_frf_s']:8.2f} {r['speedup']:7.1f}x {100 * r['peak_amp_err']:8.3f}% "
               f"{100 * r['peak_freq_err']:8.4f}%" + ("  ABOVE TARGET" if bad else "")
               + ("" if r.get("complete", True) else "  INCOMPLETE (an FRF stopped early)"))
@@ -118,6 +120,11 @@ def summary(rows: list) -> str:
         main = [r for r in rc if r.get("rom2", "") in ("", "h=2", "gsi40")] or rc
         ext = " (ROM_I extrapolated)" if any(r["rom1_extrapolated"] for r in main) else ""
         parts.append(f"{case} {np.median([r['speedup'] for r in main]):.1f}x{ext}")
+        tw = [r for r in rc if r.get("rom2", "") == "fam.TW"]
+        if tw:      # the exact family ROM_II solved for the travelling wave's pairs only
+            parts.append(f"{case} fam.TW {np.median([r['speedup'] for r in tw]):.1f}x "
+                         f"({min(r['speedup'] for r in tw):.1f}-"
+                         f"{max(r['speedup'] for r in tw):.1f}x)")
         for kind in dict.fromkeys(r.get("rom2", "") for r in rc):
             rk = [r for r in rc if r.get("rom2", "") == kind and r.get("complete", True)]
             n_out = sum(1 for r in rc if r.get("rom2", "") == kind) - len(rk)
@@ -151,7 +158,9 @@ def main(argv=None):
     print_table(rows)
     print("extrap.: ROM_I sampled by solve_point, FRF time = s/evaluation x the evaluations "
           "of the (exact) family ROM_II's FRF; stored: ROM_I's whole FRF as timed by the "
-          "case's own run (paper_flange.py family); errors: largest over the outputs' peaks")
+          "case's own run (paper_flange.py family); errors: largest over the outputs' peaks; "
+          "unk II: ROM_II's condensed unknowns (its LU's size); fam.TW: the family ROM_II "
+          "solved only for the tuned rotor's travelling-wave (index, harmonic) pairs")
     print_profile(rows)
     print(summary(rows))
 

@@ -12,7 +12,9 @@ contact pairs per sector, one blade node per sector active), runs ccx, and write
 decks ``rom1.toml`` (Craig-Bampton: every flange DoF physical), ``rom2.toml`` (ms,
 ``harmonic_indices = [2]``: the paper's ROM_II), ``rom2_eo.toml`` (ms, ``engine_orders =
 [2]``: index 2 and its aliases z N +- 2, the family of time harmonic 1) and
-``rom2_family.toml`` (ms, the whole family that EO 2 and its time harmonics 0..3 excite) with F0 = 20 N, and one deck per
+``rom2_family.toml`` (ms, the whole family that EO 2 and its time harmonics 0..3 excite) and
+``rom2_tw.toml`` (that family with ``travelling_wave = true``: solved only for the (index,
+time harmonic) pairs of the tuned rotor's travelling wave, its reduced model shared) with F0 = 20 N, and one deck per
 member of the family (``rom1_F0_<F0>.toml`` ...): each runs with ``frirom run``.
 ``family`` solves the members with every ROM (ROM_I at paper size: each FRF takes minutes;
 ``--rom1 ends`` runs it at the smallest and largest F0 only and says so), prints Table 1,
@@ -65,7 +67,13 @@ ROMS = {
     "rom2_family": ("ROM_II family", "\n[reduction.interface_modes]\nmethod = \"ms\"\n"
                                      "sectors = {n}\nengine_orders = [{eo}]\n"
                                      "time_harmonics = [0, 1, 2, 3]\n"),
+    # the family's model, solved only for the travelling wave's (index, harmonic) pairs
+    "rom2_tw": ("ROM_II fam. TW", "\n[reduction.interface_modes]\nmethod = \"ms\"\n"
+                                  "sectors = {n}\nengine_orders = [{eo}]\n"
+                                  "time_harmonics = [0, 1, 2, 3]\ntravelling_wave = true\n"),
 }
+#: decks that share another's reduced model (the selection is not a reduction setting)
+CACHE_OF = {"rom2_tw": "rom2_family"}
 
 DECK = """title = "Two-stage flange, {label}, F0 = {f0:g} N"
 # written by cases/paper_flange/paper_flange.py make (reference paper 3.3.1)
@@ -148,7 +156,7 @@ def _samples(spec) -> int:
 def deck_text(spec, rom: str, f0: float, sets: dict, band, beta: float) -> str:
     label, ms = ROMS[rom]
     return DECK.format(
-        label=label, f0=f0, modes=2 * spec.n_modes, rom=rom,
+        label=label, f0=f0, modes=2 * spec.n_modes, rom=CACHE_OF.get(rom, rom),
         ms=ms.format(n=spec.sectors, eo=spec.eo), kt=spec.kt, kn=spec.kn, mu=spec.mu,
         n0=spec.n0, mn0=-spec.n0, beta=beta, eo=spec.eo,
         dofs1=json.dumps([f"{n}:z" for n in sets["ACTIVE1"]]),
@@ -286,15 +294,36 @@ def derived(d1, rom: str, spec):
     outputs = [int(R[o].indices[0]) for o in d1.outputs]
     info = types.SimpleNamespace(labels=red.labels, node_sets=r1.node_sets,
                                  build_seconds=time.perf_counter() - t0)
+    settings = d1.settings
+    if rom == "rom2_tw":
+        # the deck's [reduction.interface_modes] (travelling_wave = true): d.options() then
+        # carries the selection, as for the deck itself
+        settings = dataclasses.replace(settings, reduction=dataclasses.replace(
+            settings.reduction, method="ms", sectors=spec.sectors, engine_orders=(spec.eo,),
+            time_harmonics=(0, 1, 2, 3), travelling_wave=True))
     return dataclasses.replace(d1, K=sp.csr_matrix(red.K), M=sp.csr_matrix(red.M),
                                F=np.asarray(R.T @ d1.F), contacts=contacts,
-                               outputs=outputs, reduced=info,
-                               dof_labels=None if d1.dof_labels is None else red.labels)
+                               outputs=outputs, reduced=info, settings=settings,
+                               dof_labels=red.labels)
+
+
+def unknowns(d) -> int:
+    """The condensed solver's unknowns for a deck's model (its LU is that size): the
+    nonlinear DoFs or the contact coordinates, whichever is fewer ('auto'), times 2H+1;
+    with a travelling-wave selection, the pairs it keeps."""
+    m, o = d.model(), d.options()
+    nl = m.nonlinear_dofs()
+    if o.selection is not None:
+        keep = o.selection[nl]
+        return int(sum(keep[:, (c + 1) // 2].sum() for c in range(2 * o.harmonics + 1)))
+    rows = sum(g.G.shape[0] for g in m.contacts)
+    return min(rows, nl.size) * (2 * o.harmonics + 1)
 
 
 def sizes(d) -> dict:
     """Table 1 partition of a deck's reduced model: interface (physical flange DoFs or MS
-    coordinates), active (the blade nodes), CB modal, total, nonlinear (contact DoFs)."""
+    coordinates), active (the blade nodes), CB modal, total, nonlinear (contact DoFs),
+    unknowns (of the condensed solver, :func:`unknowns`)."""
     rom = d.reduced
     lab = rom.labels
     n_cb = sum(s.startswith("cb ") for s in lab)
@@ -303,7 +332,8 @@ def sizes(d) -> dict:
            for c in "XYZ"}
     active = sum(s in act for s in lab)
     return dict(interface=len(lab) - n_cb - active, ms=n_ms, active=active, modal=n_cb,
-                total=len(lab), nonlinear=int(d.model().nonlinear_dofs().size))
+                total=len(lab), nonlinear=int(d.model().nonlinear_dofs().size),
+                unknowns=unknowns(d))
 
 
 def sweep(d, f0: float, band=None) -> dict:
@@ -322,6 +352,7 @@ def sweep(d, f0: float, band=None) -> dict:
     return dict(f0=f0, seconds=sec, evals=int(r.timings.get("evaluations", 0)),
                 complete=bool(r.complete), f=(r.omega / 2 / np.pi).tolist(),
                 amp=r.amp_max.T.tolist(), peak_amp=[p.amplitude for p in peaks],
+                leak=float(r.leak.max()) if len(r) else 0.0,
                 peak_f=[p.omega / 2 / np.pi for p in peaks],
                 lift=float(np.max(r.state_fractions[:, 0, 2])),
                 slip=float(np.max(r.state_fractions[:, 0, 1])))
@@ -427,7 +458,7 @@ def family(work: Path, quick: bool, rom1: str = "all", log=print) -> dict:
     # the ROM_IIs first (fast), then ROM_I; ROM_II family at paper size costs more than
     # ROM_I (every pair reads its 168 MS coordinates: the solver's entry-by-entry G^T J G
     # assembly is ~90 % of its time), so it follows `rom1` too
-    for rom in ("rom2", "rom2_eo", "rom1", "rom2_family"):
+    for rom in ("rom2", "rom2_eo", "rom2_tw", "rom1", "rom2_family"):
         d = d1 if rom == "rom1" else derived(d1, rom, spec)
         res.setdefault(rom, {})
         res[rom + "_sizes"] = sizes(d)
@@ -461,14 +492,18 @@ def report(work: Path, quick: bool, res: dict) -> None:
     print(f"\nTable 1 (this model: {spec.sectors} + {spec.sectors} sectors, "
           f"{info['fe_dofs']} FE DoFs; paper: 1000 interface DoFs, ROM_I 1700, ROM_II 712)")
     print(f"  {'ROM':<14} {'interface':>9} {'active':>7} {'CB modal':>9} {'total':>6} "
-          f"{'nonlinear':>9} {'reduction s':>11}")
+          f"{'nonlinear':>9} {'unknowns':>8} {'reduction s':>11}")
     for rom in ROMS:
         s = res.get(rom + "_sizes")
         if s is None:
             print(f"  {ROMS[rom][0]:<14} not built in this run")
             continue
         print(f"  {ROMS[rom][0]:<14} {s['interface']:9d} {s['active']:7d} {s['modal']:9d} "
-              f"{s['total']:6d} {s['nonlinear']:9d} {res[rom + '_reduction_s']:11.1f}")
+              f"{s['total']:6d} {s['nonlinear']:9d} {s.get('unknowns', 0):8d} "
+              f"{res[rom + '_reduction_s']:11.1f}")
+    print("  unknowns: of the condensed solver (its LU is that size): harmonics of the "
+          "nonlinear DoFs or contact coordinates; ROM_II fam. TW: only the (index, harmonic) "
+          "pairs of the tuned rotor's travelling wave")
     print(f"  CB ROM within {100 * info['cb_err']:.3f} % of ccx over its lowest "
           f"{info['n_ref']} frequencies (target 0.3 %)")
     print("\nPeaks (stage 1 | stage 2) and errors of ROM_II against ROM_I "
@@ -519,7 +554,8 @@ def figures(work: Path, quick: bool, res: dict) -> list:
             for rom, style in (("rom1", dict(ls="-", lw=1.4)),
                                ("rom2", dict(ls="none", marker="o", ms=3.5, mfc="none")),
                                ("rom2_eo", dict(ls="none", marker="s", ms=3, mfc="none")),
-                               ("rom2_family", dict(ls="none", marker="x", ms=3))):
+                               ("rom2_family", dict(ls="none", marker="x", ms=3)),
+                               ("rom2_tw", dict(ls="none", marker="+", ms=5))):
                 r = res.get(rom, {}).get(f"{f0:g}")
                 if r is None:
                     continue
@@ -528,7 +564,8 @@ def figures(work: Path, quick: bool, res: dict) -> list:
                 step = max(1, len(f) // 40) if rom != "rom1" else 1
                 lab = {"rom1": f"ROM_I F0 = {f0:g} N", "rom2": "ROM_II (h = 2)",
                        "rom2_eo": "ROM_II (EO 2 family, j = 1)",
-                       "rom2_family": "ROM_II (family, j = 0..3)"}[rom]
+                       "rom2_family": "ROM_II (family, j = 0..3)",
+                       "rom2_tw": "ROM_II (family, travelling wave)"}[rom]
                 lab = lab if rom == "rom1" or i == 0 else None
                 ax.plot(f[::step], a[::step], color=c, label=lab, **style)
         ax.set_xlabel("frequency / stuck EO 2 resonance")
@@ -574,7 +611,8 @@ def bench_rows(work: Path, quick: bool) -> list[dict]:
         res = {"spec_key": spec.key(), "rom1": {}}
     d1, _ = load(work, "rom1")
     s1 = sizes(d1)
-    two = {rom: derived(d1, rom, spec) for rom in ("rom2", "rom2_eo", "rom2_family")}
+    two = {rom: derived(d1, rom, spec) for rom in ("rom2", "rom2_eo", "rom2_family",
+                                                   "rom2_tw")}
     rows = []
     for f0 in family_of(quick):
         r2 = {rom: sweep(d, f0) for rom, d in two.items()}
@@ -596,10 +634,12 @@ def bench_rows(work: Path, quick: bool) -> list[dict]:
             ea = max(abs(r["peak_amp"][k] / r1["peak_amp"][k] - 1) for k in range(2))
             ef = max(abs(r["peak_f"][k] / r1["peak_f"][k] - 1) for k in range(2))
             rows.append(dict(case="flange", member=f"F0 = {f0:g} N",
-                             rom2={"rom2": "h=2", "rom2_eo": "j=1"}.get(rom, "family"),
+                             rom2={"rom2": "h=2", "rom2_eo": "j=1",
+                                   "rom2_tw": "fam.TW"}.get(rom, "family"),
                              fe_dofs=info["fe_dofs"], rom1_dofs=s1["total"],
                              rom2_dofs=s2["total"], rom1_nonlinear=s1["nonlinear"],
-                             rom2_nonlinear=s2["nonlinear"],
+                             rom2_nonlinear=s2["nonlinear"], rom2_unknowns=s2["unknowns"],
+                             leak=r.get("leak", 0.0),
                              reduction_s=info["t_rom1_reduction"] + d.reduced.build_seconds,
                              rom1_frf_s=t1,
                              rom1_extrapolated=extrap, rom1_stored=kept,

@@ -303,6 +303,7 @@ class _CallResult(NamedTuple):
     timings: np.ndarray      # (N_TIMERS,) seconds and counts, see TIMER_NAMES
     info: int
     msg: str
+    leak: np.ndarray         # (maxpts,) travelling-wave selection's leak (FRFPoint.leak)
 
 
 @dataclass
@@ -347,6 +348,9 @@ class _Packed:
     #: of this object (the peak solves), filled at the first call; forget_lu at every
     #: continuation call boundary (exact resume)
     lu_hold: list = field(default_factory=list)
+    #: (nnl, H+1) bool: the travelling-wave selection over the nonlinear DoFs nl
+    #: (SolverOptions.selection), None: every unknown
+    keep: np.ndarray | None = None
 
     @property
     def nc(self) -> int:
@@ -409,8 +413,12 @@ class _Packed:
             stability=int(self.stability), history=int(o.history), maxpts=maxpts,
             netot=max(self.ne_tot, 1), ntim=len(_TIMER_SLOTS), nh=self.H, ndof=self.n_dof,
             nnl=self.nl.size or 1, tcontact=int(self.tcontact),
-            krylov=int(o.krylov), sparse=int(self.sparse), lu=lu, lupiv=piv, lustate=lust)
-        r = _CallResult(*res[:-1], msg=res[-1].decode(errors="replace"))
+            krylov=int(o.krylov), sparse=int(self.sparse), lu=lu, lupiv=piv, lustate=lust,
+            selected=int(self.keep is not None),
+            keep=np.asfortranarray(np.zeros((max(self.nl.size, 1), self.H + 1), np.int32)
+                                   if self.keep is None else self.keep.astype(np.int32)))
+        *head, msg, leak = res
+        r = _CallResult(*head, msg=msg.decode(errors="replace"), leak=leak)
         if r.npts > 0 and self.nw and o.history:
             self.w0 = r.sliders[:self.nw, r.npts - 1].copy()
         return r
@@ -422,7 +430,8 @@ class _Packed:
         if not self.lu_hold:
             nm = max(self.modes.nmodes, self.modes.hmodes)
             hold = (CARRY_LU and self.opts.formulation == "condensed" and nm > 0
-                    and not self.opts.krylov and _kernels.hbm_lu_holds(self.H, self.nrow, nm))
+                    and not self.opts.krylov and self.keep is None
+                    and _kernels.hbm_lu_holds(self.H, self.nrow, nm))
             n = self.ny if hold else 1
             self.lu_hold.extend([np.zeros((n, n), order="F"), np.zeros(n, np.int32),
                                  np.zeros(2)])
@@ -483,7 +492,8 @@ class _Packed:
                                 stable=bool(res.hill_re[k] <= 1e-7 * max(abs(om), 1.0)),
                                 floquet_max_re=float(res.hill_re[k]),
                                 slider=res.sliders[:self.nw, k].copy(),
-                                yscale=float(res.yscales[k])))
+                                yscale=float(res.yscales[k]),
+                                leak=float(res.leak[k])))
         return pts
 
 
@@ -521,7 +531,39 @@ def pack(model: Model | CyclicModel, excitation: Excitation, opts: SolverOptions
         packed = _pack_model(model, opts, fe0, fe1, outputs)
     if P is not None:
         packed.out_map, packed.outputs = P, _map_dofs(P, packed.outputs)
+    if opts.selection is not None:
+        _select(packed, model, opts.selection)
     return packed
+
+
+def _select(packed: _Packed, model, selection) -> None:
+    """Check SolverOptions.selection against the packed model and set packed.keep: the
+    rows of the nonlinear DoFs; loads on them outside the selection are refused (a
+    travelling wave of the selection's engine order has none)."""
+    if isinstance(model, CyclicModel):
+        raise ParameterError("options.selection: not for a cyclic sector (its harmonics "
+                             "already live on their own nodal diameters)")
+    H = packed.H
+    sel = np.asarray(selection)
+    if sel.shape != (packed.n_dof, H + 1):
+        raise SizeError(f"options.selection: expected (n_dof, H+1) = ({packed.n_dof}, "
+                        f"{H + 1}), got {sel.shape}")
+    keep = sel[packed.nl].astype(bool)
+    if not keep.any():
+        raise ParameterError("options.selection: keeps no harmonic of any nonlinear DoF")
+    for fe in (packed.fe0, packed.fe1):
+        for h in range(H + 1):
+            a = np.abs(fe[packed.nl][:, [0] if h == 0 else [2 * h - 1, 2 * h]]).max(axis=1)
+            off = np.where(keep[:, h], 0.0, a)
+            # 1e-9: the round-off of projecting a cyclic load on the MS columns
+            if off.max() > 1e-9 * max(a.max(), 1e-300):
+                raise ParameterError(
+                    f"options.selection: the excitation loads nonlinear DoF "
+                    f"{int(packed.nl[np.argmax(off)])} at harmonic {h}, outside the "
+                    "selection (not a travelling wave of the selection's engine order)")
+    packed.keep = keep
+    n = int(sum(keep[:, min((c + 1) // 2, H)].sum() for c in range(2 * H + 1)))
+    packed.info += f"; travelling-wave selection: {n} of {packed.ny} unknowns"
 
 
 def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed:
@@ -553,7 +595,8 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
     if opts.formulation == "condensed":
         nrows = c.G.shape[0]
         tcontact = opts.coordinates == "contact" or (
-            opts.coordinates == "auto" and nrows < nl.size and not opts.stability)
+            opts.coordinates == "auto" and nrows < nl.size and not opts.stability
+            and opts.selection is None)
         modes, route, sparse = _receptance_route(model, opts, H, bw)
         nu = nrows if tcontact else nl.size
         info = (f"condensed: {nu * (2 * H + 1)} unknowns, "

@@ -194,6 +194,9 @@ class FRFPoint:
     #: into Fortran (a checkpoint: resuming there repeats the uninterrupted run exactly);
     #: NaN for the other points
     ds_next: float = float("nan")
+    #: travelling-wave selection (SolverOptions.selection): |contact forces off the
+    #: selection| / |on it| at this point (or the preloads' own, if larger); 0 without one
+    leak: float = 0.0
 
 
 @dataclass
@@ -254,6 +257,8 @@ class FRF:
     #: how the result was made: META_KEYS (deck text, solver settings as JSON, reduced
     #: model's fingerprint, frirom version), strings
     meta: dict = field(default_factory=dict)
+    #: (n_pts,) FRFPoint.leak of each point (zeros without a travelling-wave selection)
+    leak: np.ndarray | None = None
 
     @property
     def labels(self) -> list:
@@ -335,6 +340,7 @@ class FRF:
                    state_fractions=stack("state_fractions", (len(group_names), 3)),
                    stable=stack("stable", (), bool), fold=stack("fold", (), bool),
                    iterations=stack("iterations", (), int), time_s=stack("time_s", ()),
+                   leak=stack("leak", ()),
                    slider=(np.array([p.slider for p in points], dtype=float) if points
                            else np.zeros((0, 0))),
                    unknowns=(np.array([p.unknowns for p in points], dtype=float)

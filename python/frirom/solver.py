@@ -39,6 +39,16 @@ from .results import FRF, FRFPoint
 #: Names of the formulations (SolverOptions.formulation).
 FORMULATIONS = ("condensed", "banded")
 
+#: Largest leak of a travelling-wave selection (FRFPoint.leak) a run accepts without a
+#: warning. A tuned rotor leaks at round-off: 5e-10 on the coarse flange in stick (the
+#: cyclic symmetry of the mesh and matrices to their digits), 2.5e-9 with slip and
+#: lift-off (the closed-cycle iteration of the slipping elements). A force off the
+#: selection of 1e-6 of those on it moves the response by about that fraction (times the
+#: amplification of an off-selection resonance), far below the 1e-3 the paper's
+#: comparisons resolve; a changed preload or stiffness at one of 12 pairs leaks 4e-2 or
+#: more, and so do the sliders a re-stuck flange keeps from slipping (4e-3, static part).
+LEAK_TOL = 1e-6
+
 
 @dataclass
 class SolverOptions:
@@ -118,6 +128,15 @@ class SolverOptions:
         size (2 800 unknowns, cases/bench/condensed.py): GMRES iterations are memory
         bound (~25 ms each, 2 cores shared) and the stale preconditioner needs ~8-18 per
         solve, so the FRF takes as long as with a new LU per Jacobian.
+    selection : ndarray or None
+        (n_dof, H+1) bool: a travelling-wave selection of the condensed unknowns. Harmonic
+        h of nonlinear DoF j is solved for only where ``selection[j, h]``; the others are
+        held at zero and their equations dropped. Exact for a tuned rotor under an
+        engine-order travelling wave on multi-stage coordinates
+        (:func:`frirom.reduction.multistage.travelling_wave_selection`), several times
+        fewer unknowns. Each point reports its leak (``FRFPoint.leak``: contact forces off
+        the selection over those on it); a run warns above :data:`LEAK_TOL`. Needs the
+        condensed formulation in the nonlinear DoFs, no Krylov solves and no stability.
     """
 
     harmonics: int = 3
@@ -141,6 +160,7 @@ class SolverOptions:
     coordinates: str = "auto"
     receptances: str = "auto"
     krylov: bool = False
+    selection: np.ndarray | None = field(default=None, repr=False)
 
     def check(self) -> None:
         """Raise ParameterError naming the first invalid field."""
@@ -177,6 +197,15 @@ class SolverOptions:
         if self.coordinates == "contact" and self.stability:
             raise ParameterError("options.coordinates: 'contact' cannot be used with "
                                  "stability (Hill's method needs the contact DoFs)")
+        if self.selection is not None:
+            for bad, why in ((self.formulation != "condensed", "the 'condensed' formulation"),
+                             (self.stability, "stability = false (Hill's method would see "
+                                              "only perturbations inside the selection)"),
+                             (self.krylov, "krylov = false (direct solves)"),
+                             (self.coordinates == "contact", "coordinates 'dofs' or 'auto'")):
+                if bad:
+                    raise ParameterError(f"options.selection: a travelling-wave selection "
+                                         f"needs {why}")
         for nm, allowed in (("coordinates", ("auto", "dofs", "contact")),
                             ("receptances", ("auto", "modes", "factorization", "sparse"))):
             if getattr(self, nm) not in allowed:
@@ -382,6 +411,19 @@ class _Continuation:
                               stability_computed=p.stability)
         out.timings = self.timings
         out.solver_info = p.info
+        if p.keep is not None and pts:
+            worst = float(np.max(out.leak))
+            out.solver_info += f"; leak max {worst:.1e}"
+            if worst > LEAK_TOL:
+                at = pts[int(np.argmax(out.leak))].omega
+                warnings.warn(f"frirom: the travelling-wave selection leaks: contact forces off "
+                              f"the selection reach {worst:.2g} of those on it at "
+                              f"{at / 2 / np.pi:.6g} Hz (tolerance {LEAK_TOL:g}); the rotor, its "
+                              "contacts, its load or the contact history carried from point "
+                              "to point (sliders frozen at different phases) are not a "
+                              "travelling wave there, and the selected solution is not the "
+                              "full one (solve without the selection to see how far)",
+                              stacklevel=3)
         if keep_unknowns and pts:
             out._last_unknowns = pts[-1].unknowns
             out._last_slider = pts[-1].slider

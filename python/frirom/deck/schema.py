@@ -18,8 +18,8 @@ from ..io._common import read_text
 from ..reduction.rom import FESource, ReductionSpec
 from .fields import Context, DofRef, boolean, dof_ref, file, number, string, table, unknown
 from .schema_contacts import parse_contacts
-from .schema_model import (CyclicSettings, MatrixModel, parse_fe_model, parse_matrix_model,
-                           parse_reduction)
+from .schema_model import (CyclicSettings, MatrixModel, check_travelling_wave, parse_fe_model,
+                           parse_matrix_model, parse_reduction)
 
 try:                                   # Python >= 3.11
     import tomllib
@@ -268,6 +268,8 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
     frequency = _frequency(ctx, table(ctx, raw, "frequency"))
     continuation = _continuation(ctx, table(ctx, raw, "continuation", required=False))
     outputs = _outputs(ctx, table(ctx, raw, "outputs"), fe, labels)
+    if spec is not None and spec.travelling_wave:
+        check_travelling_wave(ctx, raw, solver)
     return DeckSettings(path=path, title=title, model=model, fe_model=source, reduction=spec,
                         cyclic=cyc, solver=solver, damping=damping, loads=tuple(loads),
                         contacts=tuple(contacts), frequency=frequency,

@@ -128,7 +128,7 @@ def parse_reduction(ctx: Context, red: dict) -> tuple:
     allowed = {"none": {"method"}, "gsi": {"method", "free", "stick", "per_side",
                                                  "separate", "separate_stick"},
                "ms": {"method", "sectors", "engine_orders", "time_harmonics",
-                      "harmonic_indices", "axis", "origin"}}[method]
+                      "harmonic_indices", "axis", "origin", "travelling_wave"}}[method]
     im, modes_auto = parse_modes_auto(ctx, im, method)
     unknown(ctx, im, allowed, pre)
     kw = {}
@@ -185,6 +185,8 @@ def parse_reduction(ctx: Context, red: dict) -> tuple:
             kw["time_harmonics"] = th or (1,)
         kw["axis"] = vector(ctx, im, "axis", f"{pre}.axis", axis)
         kw["origin"] = vector(ctx, im, "origin", f"{pre}.origin", origin, nonzero=False)
+        kw["travelling_wave"] = boolean(ctx, im, "travelling_wave", f"{pre}.travelling_wave",
+                                        False)
     spec = ReductionSpec(interface=tuple(iface), active=tuple(active),
                          fixed_interface_modes=n_cb, method=method, cache=cache, **kw)
     return spec, cyc, modes_auto
@@ -226,3 +228,40 @@ def parse_cyclic(ctx: Context, cy: dict) -> CyclicSettings:
     return CyclicSettings(sectors=n, left=sides["left"], right=sides["right"],
                           dependent=dependent, engine_order=eo, boundary_modes=boundary_modes,
                           modes=modes, tol=tol, single_index=single)
+
+
+def check_travelling_wave(ctx: Context, raw: dict, solver) -> int:
+    """``[reduction.interface_modes] travelling_wave = true``: the deck's load must be one
+    engine order's travelling wave (every ``[[excitation.engine_order]]`` of the same
+    ``eo`` at harmonic 1, e.g. two clocked waves, one per stage; static point loads only)
+    and the solver condensed without Hill stability. Returns that engine order; raises
+    the field's error otherwise."""
+    key = "reduction.interface_modes.travelling_wave"
+    if solver.formulation != "condensed":
+        raise ctx.error("solver.formulation", f"'condensed' with {key} = true",
+                        solver.formulation)
+    if solver.stability:
+        raise ctx.error("solver.stability", f"false with {key} = true (Hill's method "
+                        "would see only perturbations inside the travelling wave); set "
+                        "[solver] stability = false", True)
+    exc = raw.get("excitation", {})
+    for k, ld in enumerate(exc.get("load", [])):
+        if int(ld.get("harmonic", 1)) != 0:
+            raise ctx.error(f"excitation.load[{k}].harmonic", f"0 with {key} = true (a "
+                            "point load at a harmonic >= 1 is not a travelling wave; "
+                            "give it as [[excitation.engine_order]])", ld.get("harmonic", 1))
+    eos = exc.get("engine_order", [])
+    eos = [eos] if isinstance(eos, dict) else eos
+    if not eos:
+        raise ctx.error("excitation.engine_order", f"an engine-order travelling wave with "
+                        f"{key} = true", None)
+    first = int(eos[0]["eo"])
+    for k, eo in enumerate(eos):
+        if int(eo.get("harmonic", 1)) != 1:
+            raise ctx.error(f"excitation.engine_order[{k}].harmonic", f"1 with {key} = "
+                            "true (the wave's time harmonic 1)", eo.get("harmonic"))
+        if int(eo["eo"]) != first:
+            raise ctx.error(f"excitation.engine_order[{k}].eo", f"{first}, the engine "
+                            f"order of excitation.engine_order[0], with {key} = true (one "
+                            "travelling wave)", eo["eo"])
+    return first

@@ -22,6 +22,7 @@ gcd(N_1, N_2) sectors, whose families are taken modulo that gcd (:func:`stage_in
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,7 +34,7 @@ from .interface import InterfaceReduction
 
 __all__ = ["RadialSegments", "MultistageInterface", "cylindrical_frame", "fourier_matrix",
            "fourier_columns", "harmonic_indices", "stage_indices", "shared_indices",
-           "radial_line_segments",
+           "radial_line_segments", "travelling_wave_selection",
            "ms_basis", "harmonic_content",
            "stage_contact_matrix", "assemble"]
 
@@ -154,6 +155,47 @@ def shared_indices(engine_orders, sector_counts, n_segments: int,
             fam = [set(harmonic_indices(eo, n, n_segments, (j,)).tolist()) for n in counts]
             out |= set.intersection(*fam)
     return np.array(sorted(out), dtype=np.int64)
+
+
+_MS_LABEL = re.compile(r"\bms h=(\d+) ")
+
+
+def travelling_wave_selection(labels, engine_order: int, n_sectors: int,
+                              harmonics: int) -> np.ndarray:
+    """Which time harmonics of each coordinate a tuned rotor's travelling wave can move.
+
+    Under an engine-order ``engine_order`` (e) travelling wave, a rotor that is cyclically
+    symmetric with ``n_sectors`` (N) sectors, contacts included, responds in a travelling
+    wave: its time harmonic h lives only on the spatial indices z N +- h e (h = 0: the
+    family of index 0). An MS coordinate of index p (label ``"... ms h=p ..."``, see
+    :meth:`MultistageInterface.labels`) is therefore identically zero at every other
+    time harmonic. Stages of different sector counts: pass N = their gcd (the assembly's
+    sectors). labels: (n_dof,) the model's DoF labels; harmonics: H.
+
+    Returns (n_dof, H+1) bool, for :class:`frirom.solver.SolverOptions` ``selection``:
+    True where harmonic h of a DoF is an unknown; a DoF without an MS label (a modal or
+    physical coordinate) keeps every harmonic. Raises InputError when no label is an MS
+    coordinate.
+    """
+    n = int(n_sectors)
+    e = int(engine_order)
+    if n < 1:
+        raise InputError(f"travelling_wave_selection: n_sectors must be >= 1, got {n}")
+    sel = np.ones((len(labels), int(harmonics) + 1), dtype=bool)
+    hh = np.arange(int(harmonics) + 1)
+    found = False
+    for i, lab in enumerate(labels):
+        m = _MS_LABEL.search(str(lab))
+        if m is None:
+            continue
+        found = True
+        p = int(m.group(1))
+        sel[i] = ((p - hh * e) % n == 0) | ((p + hh * e) % n == 0)
+    if not found:
+        raise InputError("travelling_wave_selection: no DoF is a multi-stage (MS) "
+                         "coordinate (labels 'ms h=<index>'); the selection needs an MS "
+                         "interface reduction")
+    return sel
 
 
 # --------------------------------------------------------------------------------------------

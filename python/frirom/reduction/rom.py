@@ -130,6 +130,8 @@ class ReductionSpec:
     engine_orders: tuple = ()
     time_harmonics: tuple = (1,)
     harmonic_indices: tuple = ()         # ms: explicit indices (else the EO family)
+    travelling_wave: bool = False        # ms: solve only the travelling wave's pairs (not
+                                         # a reduction setting: not in rom_key)
     axis: tuple = (0.0, 0.0, 1.0)
     origin: tuple = (0.0, 0.0, 0.0)
     cache: Path | None = None
@@ -442,7 +444,7 @@ def rom_key(source: FESource, spec: ReductionSpec, pairs: list) -> str:
 
 def _key_settings(spec: ReductionSpec, pairs: list) -> tuple:
     """The reduction settings and pair geometry that enter :func:`rom_key`."""
-    cfg = {k: v for k, v in asdict(spec).items() if k != "cache"}
+    cfg = {k: v for k, v in asdict(spec).items() if k not in ("cache", "travelling_wave")}
     stick = spec.method == "gsi" and spec.stick + spec.separate_stick > 0
     pc = [{k: v for k, v in asdict(p).items()
            if k != "key" and (stick or k not in ("kt", "kn"))} for p in pairs]
