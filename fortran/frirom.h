@@ -34,7 +34,7 @@ struct frirom_settings {
     int formulation;      /* FRIROM_CONDENSED (default) or FRIROM_BANDED */
     int max_points;       /* points of the curve at most (2000) */
     int max_iter;         /* Newton iterations per corrector (25) */
-    int batch;            /* points between rescalings of the arc length (10) */
+    int batch;            /* points per internal call; the points do not depend on it (10) */
     int reuse_jacobian;   /* 1: keep a factorisation while Newton contracts (1) */
     int history;          /* 1: carry the contact sliders along the curve (1) */
     double tol_residual;  /* 1e-8 */

@@ -85,8 +85,8 @@ program test_solve
     s%batch = 1
     call frf_solve(2, kr, kc, kv, md, md, mv, cr, cc, cv, alpha, beta, zeta, ginfo, gr, gc, &
                    gv, params, fe, 50.0_wp, 250.0_wp, [1, 2], s, res)
-    om1 = res%omega
-    am1 = res%amp
+    allocate (om1, source=res%omega)
+    allocate (am1, source=res%amp)
     s%batch = 1000
     call frf_solve(2, kr, kc, kv, md, md, mv, cr, cc, cv, alpha, beta, zeta, ginfo, gr, gc, &
                    gv, params, fe, 50.0_wp, 250.0_wp, [1, 2], s, res)

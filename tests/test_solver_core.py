@@ -173,6 +173,23 @@ def test_start_from_lower_harmonics():
     assert abs(np.hypot(*p5.X[0, 1:3]) - np.hypot(*p1.X[0, 1:3])) < 0.05 * np.hypot(*p1.X[0, 1:3])
 
 
+def test_frf_from_a_solve_point_start():
+    """A point solved at fixed frequency carries a tangent in no arc-length scale (its
+    solve ran with the purely relative one): frf(start=it) takes a new tangent from the
+    point and follows the same curve as a run from nothing (found by review: for a while
+    such points carried the relative scale 1e-300, the resumed predictor did not move y,
+    and the run stopped at its first step). Peaks within 1e-8 (both converge to 1e-12)."""
+    model, ex = duffing()
+    o = SolverOptions(harmonics=3, samples=32, tol_residual=1e-12, tol_update=1e-12)
+    p = solve_point(model, ex, 0.5, o, outputs=[0])
+    assert p.yscale == 0.0
+    ref = frf(model, ex, 0.5, 2.0, o, outputs=[0])
+    run = frf(model, ex, 0.5, 2.0, o, outputs=[0], start=p)
+    assert ref.complete and run.complete
+    assert abs(run.peak(0).amplitude / ref.peak(0).amplitude - 1) < 1e-8
+    assert abs(run.peak(0).omega / ref.peak(0).omega - 1) < 1e-8
+
+
 def test_model_validation_names_the_field():
     M, K = chain(3)
     with pytest.raises(frirom.SizeError, match="K"):

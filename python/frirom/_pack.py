@@ -492,9 +492,16 @@ class _Packed:
                                 stable=bool(res.hill_re[k] <= 1e-7 * max(abs(om), 1.0)),
                                 floquet_max_re=float(res.hill_re[k]),
                                 slider=res.sliders[:self.nw, k].copy(),
-                                yscale=float(res.yscales[k]),
+                                yscale=_scale_known(res.yscales[k]),
                                 leak=float(res.leak[k])))
         return pts
+
+
+def _scale_known(yscale: float) -> float:
+    """A point's arc-length scale, 0 where none is known: a solve at fixed parameter (the
+    first point, solve_point) runs with the purely relative YSCALE_RELATIVE, and its
+    tangent is in no scale a continuation could resume in."""
+    return float(yscale) if yscale > YSCALE_RELATIVE else 0.0
 
 
 def _split_load(fe: np.ndarray, part: str) -> tuple[np.ndarray, np.ndarray]:

@@ -280,9 +280,12 @@ class _Continuation:
             self.lam0 = float(start.get("parameter", start.get("omega")))
             tan = start.get("tangent")
             # without the history the point was computed with (a file from before it was
-            # kept), the saved point need not solve the equations: re-solve it first
+            # kept), the saved point need not solve the equations: re-solve it first; a
+            # tangent without a scale (a solve at fixed parameter: solve_point, a run's
+            # first point) is in no scale to resume in: from the point, a new tangent
             unknown_history = p.nw and p.opts.history and start.get("slider") is None
-            if tan is None or H_start not in (None, p.H) or unknown_history:
+            if tan is None or not start.get("yscale") or H_start not in (None, p.H) or \
+                    unknown_history:
                 self.start_mode, self.tan0 = START_CONTINUE, np.zeros(p.ny + 1)
             else:
                 self.start_mode, self.tan0 = START_RESUME, np.asarray(tan, dtype=float)
@@ -294,9 +297,7 @@ class _Continuation:
         self.yscale = float(np.linalg.norm(self.y0)) or 1.0
         if self.start_mode == START_RESUME:
             self.prev_t = self.tan0[-1]
-            # keep the arc-length scaling the saved tangent was computed with
-            if start.get("yscale"):
-                self.yscale = float(start["yscale"])
+            self.yscale = float(start["yscale"])    # the saved tangent's scaling
             if start.get("ds") is not None:
                 # a checkpoint: the uninterrupted run's next call, as _advance made it
                 tan = self.tan0
