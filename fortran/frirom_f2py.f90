@@ -189,7 +189,6 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     real(8), intent(inout) :: lu(nlu, nlu), lustate(2)
     integer(4), intent(inout) :: lupiv(nlu)
     class(hbm_system), allocatable :: sys
-    logical :: lu_used
     type(cont_options) :: opts
     real(wp), allocatable :: y(:), t(:)
     real(wp) :: lam, dsl
@@ -250,7 +249,7 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
         return
     end if
     sys%carry = history /= 0
-    call hbm_lu_import(sys, lu, lupiv, lustate, lu_used)
+    call hbm_lu_import(sys, lu, lupiv, lustate)
     opts = cont_options_from(ropt, iopt)
     opts%max_points = maxpts
     y = y0
@@ -264,7 +263,7 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
         call hbm_run(sys, start_mode, y, lam, t, dsl, ropt(RCONT_LAM_LO), opts, ys, lams, &
                      tans, itl, xo, states, np, fin, linfo, msg, sliders=sliders)
     end if
-    call hbm_lu_export(sys, lu, lupiv, lustate, lu_used)
+    call hbm_lu_export(sys, lu, lupiv, lustate)
     npts = np
     iters = itl
     finished = merge(1, 0, fin)

@@ -15,7 +15,7 @@ submodule (frirom_hbm) frirom_hbm_condensed
     integer(ip), parameter :: GM_MAXIT = 40, GM_REFRESH = 8
     !> Direct mode, modal route: the first solve after an eval with jac is GMRES on that
     !> J preconditioned by the LU held (of an older J), to this relative residual. An LU
-    !> is worth gm_worth GMRES iterations (gm_cost: flops of each, the LU's counted
+    !> is worth lu_worth GMRES iterations (flops of each, the LU's counted
     !> LU_SPEEDUP times faster, blocked against memory-bound); J is factorised instead
     !> once the iterations since the last LU reach that, or when one solve needs more
     !> than a third of it (at least GN_MINIT); always when an LU is worth less than
@@ -182,12 +182,11 @@ contains
         if (this%modal) then
             this%gj = this%g
             this%wj = w
-            if (.not. use_krylov(this) .and. this%lu_any .and. gm_cost(this) >= GN_WORTH_MIN &
-                .and. this%gm_spent < gm_cost(this)) then
+            if (this%lu_any .and. this%gm_spent < gm_cost(this) .and. holds(this)) then
                 ! J for products only, the LU stays: the next solve by GMRES (cond_solve)
                 this%jfree = .true.
                 this%gm_next = .true.
-                this%lu_now = .false.
+                this%lu_fresh = .false.
                 return
             end if
             if (use_krylov(this)) then
@@ -421,7 +420,6 @@ contains
             call dgetrf(n, n, sys%jm, n, sys%ipiv, linfo)
         end if
         sys%lu_single = single
-        sys%lu_now = linfo == 0
         sys%timers(T_FACT) = sys%timers(T_FACT) + wtime() - t0
         sys%timers(N_FACT) = sys%timers(N_FACT) + 1
         sys%lu_fresh = linfo == 0
@@ -483,7 +481,7 @@ contains
             this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
             return
         end if
-        if (this%lu_single .and. .not. this%lu_now) then
+        if (this%lu_single .and. .not. this%lu_fresh) then
             ! a chord step (Jacobian reused) with the LU of an older J, as a double one
             call wb_prepare(this)
             call lu_apply(this, b)
@@ -507,37 +505,33 @@ contains
         if (linfo /= 0) call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'dgetrs failed')
     end procedure cond_solve
 
-    !> GMRES iterations an LU of J is worth (direct mode, modal route): LU 2/3 n^3 flops
-    !> at LU_SPEEDUP times the rate of an iteration's triangular solves (2 n^2) and
-    !> matrix-free product (8 (nh+1) nnl nm: projection and back, complex).
-    real(wp) function gm_cost(sys)
-        type(hbm_condensed), intent(inout) :: sys
-        real(wp) :: n
-        if (sys%gm_worth <= 0.0_wp) then
-            n = real(sys%n, wp)
-            sys%gm_worth = (2.0_wp/3.0_wp*n**3/LU_SPEEDUP)/(2.0_wp*n**2 + 8.0_wp* &
-                           real(sys%nh + 1, wp)*real(sys%nnl, wp)*real(size(sys%g, 1), wp))
-        end if
-        gm_cost = sys%gm_worth
-    end function gm_cost
-
-    !> gm_cost's number for nu unknowns, nh harmonics, nnl unknowns per coefficient and nm
-    !> modes, for the carry decision (gm_cost keeps its own expression: its rounding
-    !> decides knife-edge comparisons of the Newton paths, which stay those of before).
-    pure real(wp) function lu_worth(nu, nh, nnl, nm)
-        integer(ip), intent(in) :: nu, nh, nnl, nm
-        real(wp) :: n
-        n = real(nu, wp)
-        lu_worth = (2.0_wp/3.0_wp*n**3/LU_SPEEDUP)/(2.0_wp*n**2 + 8.0_wp* &
+    !> GMRES iterations an LU of J is worth (direct mode, modal route) for n unknowns, nh
+    !> harmonics, nnl unknowns per coefficient and nm modes: LU 2/3 n^3 flops at LU_SPEEDUP
+    !> times the rate of an iteration's triangular solves (2 n^2) and matrix-free product
+    !> (8 (nh+1) nnl nm: projection and back, complex).
+    pure real(wp) function lu_worth(n, nh, nnl, nm)
+        integer(ip), intent(in) :: n, nh, nnl, nm
+        real(wp) :: rn
+        rn = real(n, wp)
+        lu_worth = (2.0_wp/3.0_wp*rn**3/LU_SPEEDUP)/(2.0_wp*rn**2 + 8.0_wp* &
                    real(nh + 1, wp)*real(nnl, wp)*real(nm, wp))
     end function lu_worth
+
+    !> lu_worth of sys (modal route), kept in gm_worth.
+    real(wp) function gm_cost(sys)
+        type(hbm_condensed), intent(inout) :: sys
+        if (sys%gm_worth <= 0.0_wp) sys%gm_worth = lu_worth(sys%n, sys%nh, sys%nnl, &
+                                                           size(sys%g, 1))
+        gm_cost = sys%gm_worth
+    end function gm_cost
 
     module procedure cond_lu_holds
         hold = lu_worth(nnl*(2*nh + 1), nh, nnl, nm) >= GN_WORTH_MIN
     end procedure cond_lu_holds
 
-    !> Whether sys keeps LUs across runs: modal, direct mode, worth holding.
-    logical function holds(sys)
+    !> Whether sys keeps LUs (single precision, carried across runs): modal, direct mode,
+    !> an LU worth at least GN_WORTH_MIN GMRES iterations.
+    pure logical function holds(sys)
         type(hbm_condensed), intent(in) :: sys
         holds = .false.
         if (.not. sys%modal .or. use_krylov(sys)) return
@@ -545,7 +539,6 @@ contains
     end function holds
 
     module procedure hbm_lu_import
-        used = .false.
         select type (sys => sysc)
         type is (hbm_condensed)
             if (.not. holds(sys) .or. size(state) < 2) return
@@ -554,7 +547,6 @@ contains
             if (.not. allocated(sys%jm)) return
             ! state(1) = 2: a single-precision LU (exact in lu)
             sys%lu_single = state(1) == 2.0_wp
-            sys%lu_now = .false.
             sys%wb_ok = .false.
             if (sys%lu_single) then
                 sys%jms = real(lu, real32)
@@ -565,12 +557,10 @@ contains
             sys%lu_any = .true.
             sys%lu_fresh = .false.
             sys%gm_spent = state(2)
-            used = .true.
         end select
     end procedure hbm_lu_import
 
     module procedure hbm_lu_export
-        new = .false.
         if (size(state) < 2) return
         state(1) = 0.0_wp
         select type (sys => sysc)
@@ -584,7 +574,6 @@ contains
                     lu = sys%jm
                 end if
                 piv = sys%ipiv
-                new = .true.
             end if
             state(1) = merge(2.0_wp, 1.0_wp, sys%lu_single)
             state(2) = sys%gm_spent
@@ -682,11 +671,12 @@ contains
         real(wp), allocatable :: sens(:, :), nphi(:), xv(:, :), f(:, :)
         real(real32), allocatable :: ws(:, :)
         integer(ip) :: nu, nc, nm, np, k, h, r, c, q, loc(2), linfo, n, stat
-        real(wp) :: smax, hw
+        real(wp) :: smax
         sys%wb_ok = .false.
         sys%wb_at = -1.0_wp
         sys%wb_w0 = sys%wj
-        if (.not. allocated(sys%phr) .or. sys%nh < 1) return
+        ! dg is that of the receptances' w, the J's (each eval with jac precedes its solve)
+        if (.not. allocated(sys%phr) .or. sys%nh < 1 .or. sys%w_cache /= sys%wj) return
         nu = sys%nnl
         nc = sys%nc
         n = sys%n
@@ -696,9 +686,7 @@ contains
             nphi(r) = sum(sys%phr(1:nu, r)**2)
         end do
         do h = 1, sys%nh
-            hw = h*sys%wj
-            sens(:, h) = abs(sys%gj(:, h)**2*cmplx(-2.0_wp*h*hw, 2.0_wp*sys%zm(:, h)* &
-                                                   sys%wm(:, h)*h, wp))*sys%wj*nphi
+            sens(:, h) = abs(sys%dg(:, h))*sys%wj*nphi
         end do
         smax = maxval(sens)
         ! an undamped mode at resonance: no finite scale to rank the pairs by
