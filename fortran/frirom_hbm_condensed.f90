@@ -13,6 +13,8 @@ submodule (frirom_hbm) frirom_hbm_condensed
     !> iterations above which the next J is factorised.
     real(wp), parameter :: GM_TOL = 1.0e-11_wp
     integer(ip), parameter :: GM_MAXIT = 40, GM_REFRESH = 8
+    !> GMRES restart length (Krylov basis size)
+    integer(ip), parameter :: GM_RESTART = 30
     !> Direct mode, modal route: the first solve after an eval with jac is GMRES on that
     !> J preconditioned by the LU held (of an older J), to this relative residual. An LU
     !> is worth lu_worth GMRES iterations (flops of each, the LU's counted
@@ -760,36 +762,51 @@ contains
         if (linfo /= 0) sys%wb_ok = .false.
     end subroutine wb_prepare
 
-    !> w := M^-1 w for the LU held (jms single precision, or jm), all columns at once.
+    !> w := M^-1 w for the LU held (jms single precision, or jm), all columns at once. Its
+    !> work arrays are kept on sys (lws, wbt) from call to call.
     subroutine lu_apply(sys, w)
-        type(hbm_condensed), intent(in) :: sys
+        type(hbm_condensed), intent(inout) :: sys
         real(wp), intent(inout) :: w(:, :)
         real(real32), allocatable :: ws(:, :)
-        real(wp), allocatable :: t(:, :), t2(:, :)
+        real(wp), allocatable :: t(:, :)
         complex(wp) :: d
-        integer(ip) :: n, linfo, m, k
+        integer(ip) :: n, linfo, m, k, nr
         n = sys%n
+        nr = size(w, 2)
         if (sys%lu_single) then
-            ws = real(w, real32)
-            call sgetrs('N', n, size(w, 2), sys%jms, n, sys%ipiv, ws, n, linfo)
-            w = real(ws, wp)
+            call move_alloc(sys%lws, ws)
+            if (allocated(ws)) then
+                if (size(ws, 1) /= n .or. size(ws, 2) < nr) deallocate (ws)
+            end if
+            if (.not. allocated(ws)) allocate (ws(n, nr))
+            ws(:, 1:nr) = real(w, real32)
+            call sgetrs('N', n, nr, sys%jms, n, sys%ipiv, ws, n, linfo)
+            w = real(ws(:, 1:nr), wp)
+            call move_alloc(ws, sys%lws)
             if (sys%wb_ok .and. sys%wb_at == sys%wj .and. sys%wj /= sys%wb_w0) then
-                ! w -= W (I + D S)^-1 D V w
+                ! w -= W (I + D S)^-1 D V w; t(:, 1:nr) = V w, t(:, nr+1:) = D V w
                 m = size(sys%wbs, 1)
-                allocate (t(m, size(w, 2)), t2(m, size(w, 2)))
-                call dgemm('N', 'N', m, size(w, 2), n, 1.0_wp, sys%wbv, m, w, size(w, 1), &
+                call move_alloc(sys%wbt, t)
+                if (allocated(t)) then
+                    if (size(t, 1) /= m .or. size(t, 2) < 2*nr) deallocate (t)
+                end if
+                if (.not. allocated(t)) allocate (t(m, 2*nr))
+                call dgemm('N', 'N', m, nr, n, 1.0_wp, sys%wbv, m, w, size(w, 1), &
                            0.0_wp, t, m)
-                do k = 1, m/2
-                    d = sys%gj(sys%wbm(k), sys%wbh(k)) - sys%wbg(k)
-                    t2(2*k - 1, :) = real(d, wp)*t(2*k - 1, :) + aimag(d)*t(2*k, :)
-                    t2(2*k, :) = -aimag(d)*t(2*k - 1, :) + real(d, wp)*t(2*k, :)
-                end do
-                call dgetrs('N', m, size(w, 2), sys%wbl, m, sys%wbp, t2, m, linfo)
-                call dgemm('N', 'N', n, size(w, 2), m, -1.0_wp, sys%wbw, n, t2, m, 1.0_wp, &
+                associate (t1 => t(:, 1:nr), t2 => t(:, nr + 1:2*nr))
+                    do k = 1, m/2
+                        d = sys%gj(sys%wbm(k), sys%wbh(k)) - sys%wbg(k)
+                        t2(2*k - 1, :) = real(d, wp)*t1(2*k - 1, :) + aimag(d)*t1(2*k, :)
+                        t2(2*k, :) = -aimag(d)*t1(2*k - 1, :) + real(d, wp)*t1(2*k, :)
+                    end do
+                end associate
+                call dgetrs('N', m, nr, sys%wbl, m, sys%wbp, t(1, nr + 1), m, linfo)
+                call dgemm('N', 'N', n, nr, m, -1.0_wp, sys%wbw, n, t(1, nr + 1), m, 1.0_wp, &
                            w, size(w, 1))
+                call move_alloc(t, sys%wbt)
             end if
         else
-            call dgetrs('N', n, size(w, 2), sys%jm, n, sys%ipiv, w, size(w, 1), linfo)
+            call dgetrs('N', n, nr, sys%jm, n, sys%ipiv, w, size(w, 1), linfo)
         end if
     end subroutine lu_apply
 
@@ -807,24 +824,32 @@ contains
         logical, intent(out) :: ok
         real(wp), intent(in), optional :: tol
         integer(ip), intent(in), optional :: maxit
-        integer(ip), parameter :: m = 30
+        integer(ip), parameter :: m = GM_RESTART
         real(wp), allocatable :: v(:, :, :), z(:, :, :), hh(:, :, :), cs(:, :), sn(:, :), &
                                  gv(:, :), x(:, :), r(:), w(:, :), bn(:)
         real(wp) :: beta, tmp, rtol
         integer(ip) :: n, nb, c, q, na, j, i, itmax
         integer(ip), allocatable :: itc(:), kk(:), ac(:)
         logical, allocatable :: done(:), act(:)
+        logical :: slow
         n = sys%n
         nb = size(b, 2)
         rtol = GM_TOL
         if (present(tol)) rtol = tol
         itmax = GM_MAXIT
         if (present(maxit)) itmax = maxit
-        allocate (v(n, m + 1, nb), z(n, m, nb), hh(m + 1, m, nb), cs(m, nb), sn(m, nb), &
-                  gv(m + 1, nb), r(n), w(n, nb), bn(nb), itc(nb), kk(nb), ac(nb), &
-                  done(nb), act(nb))
+        ! the bases: kept on sys (gmv, gmz) from call to call, lent here
+        call move_alloc(sys%gmv, v)
+        call move_alloc(sys%gmz, z)
+        if (allocated(v)) then
+            if (size(v, 1) /= n .or. size(v, 3) < nb) deallocate (v, z)
+        end if
+        if (.not. allocated(v)) allocate (v(n, m + 1, nb), z(n, m, nb))
+        allocate (hh(m + 1, m, nb), cs(m, nb), sn(m, nb), gv(m + 1, nb), r(n), w(n, nb), &
+                  bn(nb), itc(nb), kk(nb), ac(nb), done(nb), act(nb))
         its = 0
         ok = .false.
+        slow = .false.
         itc = 0
         do c = 1, nb
             bn(c) = norm2(b(:, c))
@@ -833,7 +858,7 @@ contains
         call wb_prepare(sys)
         x = b
         call lu_apply(sys, x)
-        do
+        restarts: do
             ! r = b - J x per open column
             act = .false.
             do c = 1, nb
@@ -846,8 +871,8 @@ contains
                     cycle
                 end if
                 if (itc(c) >= itmax) then
-                    its = sum(itc)
-                    return
+                    slow = .true.           ! too slow: b unchanged
+                    exit restarts
                 end if
                 v(:, 1, c) = r/beta
                 gv(:, c) = 0.0_wp
@@ -911,8 +936,11 @@ contains
                 call dgemv('N', n, kk(c), 1.0_wp, z(:, :, c), n, gv(:, c), 1, 1.0_wp, &
                            x(:, c), 1)
             end do
-        end do
+        end do restarts
         its = sum(itc)
+        call move_alloc(v, sys%gmv)
+        call move_alloc(z, sys%gmz)
+        if (slow) return
         b = x
         ok = .true.
     end subroutine gmres
