@@ -82,7 +82,7 @@ contains
     end function use_krylov
 
     module procedure cond_eval
-        real(wp) :: w, s, nx, nxe, nhf, nrc, nxd, nhd
+        real(wp) :: w, s, nx, nxe, nhf, nxd, nhd
         integer(ip) :: nnl, nc, h, n, nm
         complex(wp), allocatable :: fc(:), z(:), dz(:), rh(:), xe(:), v(:), x3(:, :), b3(:, :)
         real(wp), allocatable :: r2(:, :), rl2(:, :)   !! (nnl, nc) r and rlam by harmonic
@@ -109,19 +109,23 @@ contains
         nxd = 0.0_wp
         nhd = 0.0_wp
         nx = norm2(y)
-        nrc = 0.0_wp
-        if (allocated(this%cs%c0)) then
+        if (this%nrc < 0.0_wp) then
             ! |R_0 c0|: the rest forces' image, left out of fd and fe0 (contact_set), stays in
-            ! the reference: the residual's scale is that of the terms before the shift
-            fc = cmplx(this%cs%c0, 0.0_wp, wp)
-            if (this%modal) then
-                call modal_project(this, 0, fc, v)
-                x3(:, 1) = this%g(:, 0)*v
-                call modal_apply(this, 0, 1, nnl, x3(:, 1:1), b3(:, 1:1))
-                nrc = norm2(abs(b3(:, 1)))
-            else
-                nrc = hypot(norm2(matmul(this%ar(:, :, 0), this%cs%c0)), &
-                            norm2(matmul(this%ai(:, :, 0), this%cs%c0)))
+            ! the reference: the residual's scale is that of the terms before the shift. c0
+            ! and R_0 (no frequency in it) are fixed once the modes are set (which reset
+            ! nrc): computed once, after the first receptances
+            this%nrc = 0.0_wp
+            if (allocated(this%cs%c0)) then
+                fc = cmplx(this%cs%c0, 0.0_wp, wp)
+                if (this%modal) then
+                    call modal_project(this, 0, fc, v)
+                    x3(:, 1) = this%g(:, 0)*v
+                    call modal_apply(this, 0, 1, nnl, x3(:, 1:1), b3(:, 1:1))
+                    this%nrc = norm2(abs(b3(:, 1)))
+                else
+                    this%nrc = hypot(norm2(matmul(this%ar(:, :, 0), this%cs%c0)), &
+                                     norm2(matmul(this%ai(:, :, 0), this%cs%c0)))
+                end if
             end if
         end if
         do h = 0, this%nh
@@ -177,7 +181,7 @@ contains
         end do
         r = reshape(r2, [n])
         rlam = reshape(rl2, [n])
-        rref = max(sqrt(nxe), nx, sqrt(nhf), nrc)
+        rref = max(sqrt(nxe), nx, sqrt(nhf), this%nrc)
         ! harmonics 1..H alone (hbm_roundoff)
         this%rref_dyn = max(sqrt(nxd), norm2(y(nnl + 1:)), sqrt(nhd))
         if (.not. jac) return
