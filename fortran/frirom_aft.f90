@@ -182,25 +182,32 @@ module frirom_aft
             real(wp), intent(in) :: x(:, :, :), params(:, :), w0(:, :), tol
         end subroutine time_batch
 
-        !> Derivative m(2, 2) of the end-of-period 2-D slider of element j of the batch with
-        !> respect to its start, from the states and slip tangents of the period just
-        !> marched: the product over the samples of A_k/kt at slip, I at stick, 0 at
-        !> lift-off (frirom_aft_march). opened: the period has a lift-off sample.
-        pure module subroutine slider_map(plan, j, kt, m, opened)
+        !> The slider fixed point w = P(w) of 2-D element j of the batch, P one period as
+        !> just marched and M = dP/dw (frirom_aft_march slider_map): a = I - M, det its
+        !> determinant, isolated = det >= DET_ISOLATED (the closed cycle's slider is then
+        !> unique and its tangent solves a dw = r), opened: the period has a lift-off
+        !> sample (M = 0). The march's Newton steps and isolation test and the Jacobian's
+        !> solve all read this one routine.
+        pure module subroutine slider_fixed_point(plan, j, a, det, isolated, opened)
             type(aft_plan), intent(in) :: plan
             integer(ip), intent(in) :: j
-            real(wp), intent(in) :: kt
-            real(wp), intent(out) :: m(2, 2)
-            logical, intent(out) :: opened
-        end subroutine slider_map
+            real(wp), intent(out) :: a(2, 2), det
+            logical, intent(out) :: isolated, opened
+        end subroutine slider_fixed_point
 
-        !> Same-sample coefficient series of the Jacobian, written after the forces:
-        !> Jenkins slot 2 = kt [stick]; normal1d slot 3 = kt [stick], slot 4 = d ft/dv (the
-        !> march wrote it), slot 5 = kn [contact]; normal2d slot 4 = kt [stick], slot 5 = kn
-        !> [contact]; cubic slot 2 = df/du (the spring wrote it).
-        pure module subroutine fill_series(plan, law, m)
+        !> (x1, x2) = a^-1 (g1, g2) for slider_fixed_point's a (2 x 2, determinant det) by
+        !> Cramer's rule, elementwise in g and x.
+        pure elemental module subroutine cramer2(a11, a12, a21, a22, det, g1, g2, x1, x2)
+            real(wp), intent(in) :: a11, a12, a21, a22, det, g1, g2
+            real(wp), intent(out) :: x1, x2
+        end subroutine cramer2
+
+        !> Same-sample coefficient series of the 2-D law's Jacobian, written after the
+        !> forces of the first m elements: slot 4 = kt [stick], slot 5 = kn [contact]. (The
+        !> 1-D laws' Jacobian scans the states; the cubic's reads its spring's df/du.)
+        pure module subroutine fill_series(plan, m)
             type(aft_plan), intent(inout) :: plan
-            integer(ip), intent(in) :: law, m
+            integer(ip), intent(in) :: m
         end subroutine fill_series
 
         !> Jacobian block of element j of the batch, after fill_series and the forward

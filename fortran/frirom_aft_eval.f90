@@ -50,7 +50,7 @@ contains
             if (present(states)) call state_fractions(plan%state, m, states(:, e0:e0 + m - 1))
             ! the series slots are read by the 2-D law's Jacobian only (the 1-D one scans the
             ! states, the cubic reads its march's derivative)
-            if (want_jac .and. law == LAW_NORMAL2D) call fill_series(plan, law, m)
+            if (want_jac .and. law == LAW_NORMAL2D) call fill_series(plan, m)
             if (rel) call relative_normal(m)
             do s = 1, np
                 if (plan%fp%direct) then

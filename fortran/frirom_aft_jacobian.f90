@@ -13,16 +13,8 @@ contains
         integer(ip) :: k
         associate (rout => plan%fp%rout, st => plan%state, par => plan%par)
             do k = 1, plan%fp%nsamp
-                select case (law)
-                case (LAW_JENKINS)
-                    rout(1:m, k, 2) = merge(par(1:m, 1), 0.0_wp, st(1:m, k) == STATE_STICK)
-                case (LAW_NORMAL1D)
-                    rout(1:m, k, 3) = merge(par(1:m, 1), 0.0_wp, st(1:m, k) == STATE_STICK)
-                    rout(1:m, k, 5) = merge(par(1:m, 2), 0.0_wp, st(1:m, k) /= STATE_LIFTOFF)
-                case (LAW_NORMAL2D)
-                    rout(1:m, k, 4) = merge(par(1:m, 1), 0.0_wp, st(1:m, k) == STATE_STICK)
-                    rout(1:m, k, 5) = merge(par(1:m, 2), 0.0_wp, st(1:m, k) /= STATE_LIFTOFF)
-                end select
+                rout(1:m, k, 4) = merge(par(1:m, 1), 0.0_wp, st(1:m, k) == STATE_STICK)
+                rout(1:m, k, 5) = merge(par(1:m, 2), 0.0_wp, st(1:m, k) /= STATE_LIFTOFF)
             end do
         end associate
     end procedure fill_series
@@ -264,32 +256,26 @@ contains
     end subroutine jac_friction2d
 
     !> Jacobian terms of a 2-D cycle that is an isolated fixed point of the period map
-    !> (det(I - M) >= DET_ISOLATED, M = slider_map): its slider, unique, does not depend on
-    !> the settling periods, and its tangent solves dw = M dw + r exactly, r the tangent
-    !> one period leaves from dw = 0 (the recursion repeated until it closes contracts as
+    !> (slider_fixed_point, the march's test): its slider, unique, does not depend on the
+    !> settling periods, and its tangent solves dw = M dw + r exactly, r the tangent one
+    !> period leaves from dw = 0 (the recursion repeated until it closes contracts as
     !> slowly as plain marching). .false. (nothing added) for a cycle that is not isolated.
     logical function fixed_point2d(plan, j, kt, jac) result(done)
         type(aft_plan), intent(inout) :: plan
         integer(ip), intent(in) :: j
         real(wp), intent(in) :: kt
         real(wp), intent(inout) :: jac(:, :)
-        real(wp) :: mm(2, 2), a11, a12, a21, a22, det
+        real(wp) :: a(2, 2), det
         real(wp) :: r1(size(plan%dw, 2)), r2(size(plan%dw, 2))
         logical :: opened
-        call slider_map(plan, j, kt, mm, opened)
-        a11 = 1.0_wp - mm(1, 1)
-        a12 = -mm(1, 2)
-        a21 = -mm(2, 1)
-        a22 = 1.0_wp - mm(2, 2)
-        det = a11*a22 - a12*a21
-        done = det >= DET_ISOLATED
+        call slider_fixed_point(plan, j, a, det, done, opened)
         if (.not. done) return
         plan%dw = 0.0_wp
         call propagate2d(plan, j, kt, .false., jac)
         r1 = plan%dw(1, :)
         r2 = plan%dw(2, :)
-        plan%dw(1, :) = (a22*r1 - a12*r2)/det
-        plan%dw(2, :) = (a11*r2 - a21*r1)/det
+        call cramer2(a(1, 1), a(1, 2), a(2, 1), a(2, 2), det, r1, r2, plan%dw(1, :), &
+                     plan%dw(2, :))
         call propagate2d(plan, j, kt, .true., jac)
     end function fixed_point2d
 

@@ -43,6 +43,8 @@ contains
         real(wp), intent(in) :: tol
         integer(ip), intent(in) :: max_periods
         integer(ip) :: ns, d, j, i, nper
+        real(wp) :: a(2, 2), det
+        logical :: isolated, opened
         associate (rin => plan%fp%rin, rout => plan%fp%rout, st => plan%state(1:m, :), &
                    w => plan%w(1:m, :), par => plan%par(1:m, :), uf => plan%follow(1:m, :, :))
             ns = NSLIDER_OF(law)
@@ -125,10 +127,9 @@ contains
             end do
             if (law == LAW_NORMAL2D) then
                 do j = 1, m
-                    if (plan%accelerated(j)) then
-                        if (.not. isolated2d(plan, j)) &
-                            call march_plain2d(plan, j, w0(:, j), tol, max_periods)
-                    end if
+                    if (.not. plan%accelerated(j)) cycle
+                    call slider_fixed_point(plan, j, a, det, isolated, opened)
+                    if (.not. isolated) call march_plain2d(plan, j, w0(:, j), tol, max_periods)
                 end do
             end if
         end associate
@@ -161,8 +162,8 @@ contains
         real(wp), parameter :: DET_MIN = 1.0e-8_wp
         integer(ip), parameter :: HOLD = 2
         real(wp), parameter :: DAMP_MIN = 2.0_wp**(-12)
-        real(wp) :: res, mm(2, 2), a(2, 2), det, g(2)
-        logical :: opened, try
+        real(wp) :: res, a(2, 2), det, g(2), x(2)
+        logical :: opened, isolated, try
         associate (w => plan%w(j, 1:2), ws => plan%wstart(j, 1:2))
             res = maxval(abs(w - ws))
             try = .false.
@@ -187,35 +188,44 @@ contains
             plan%hold(j) = max(plan%hold(j) - 1, 0_ip)
             plan%res_last(j) = res
             if (.not. try) return
-            call slider_map(plan, j, plan%par(j, 1), mm, opened)
-            a(1, 1) = 1.0_wp - mm(1, 1)
-            a(2, 1) = -mm(2, 1)
-            a(1, 2) = -mm(1, 2)
-            a(2, 2) = 1.0_wp - mm(2, 2)
-            det = a(1, 1)*a(2, 2) - a(1, 2)*a(2, 1)
+            call slider_fixed_point(plan, j, a, det, isolated, opened)
             if (opened .or. abs(det) < DET_MIN) return
             g = w - ws
             plan%wplain(j, :) = w
             plan%res_base(j) = res
-            w(1) = ws(1) + plan%damp(j)*(a(2, 2)*g(1) - a(1, 2)*g(2))/det
-            w(2) = ws(2) + plan%damp(j)*(a(1, 1)*g(2) - a(2, 1)*g(1))/det
+            call cramer2(a(1, 1), a(1, 2), a(2, 1), a(2, 2), det, g(1), g(2), x(1), x(2))
+            w = ws + plan%damp(j)*x        ! damp: a power of 2
             plan%stepped(j) = .true.
             plan%accelerated(j) = .true.
         end associate
     end subroutine settle_step2d
 
-    !> Whether the closed 2-D cycle of element j is an isolated fixed point of the period
-    !> map: det(I - M) >= DET_ISOLATED.
-    logical function isolated2d(plan, j)
+    module procedure slider_fixed_point
+        real(wp) :: mm(2, 2)
+        call slider_map(plan, j, plan%par(j, 1), mm, opened)
+        a(1, 1) = 1.0_wp - mm(1, 1)
+        a(2, 1) = -mm(2, 1)
+        a(1, 2) = -mm(1, 2)
+        a(2, 2) = 1.0_wp - mm(2, 2)
+        det = a(1, 1)*a(2, 2) - a(1, 2)*a(2, 1)
+        isolated = det >= DET_ISOLATED
+    end procedure slider_fixed_point
+
+    module procedure cramer2
+        x1 = (a22*g1 - a12*g2)/det
+        x2 = (a11*g2 - a21*g1)/det
+    end procedure cramer2
+
+    !> Derivative m(2, 2) of the end-of-period 2-D slider of element j of the batch with
+    !> respect to its start, from the states and slip tangents of the period just
+    !> marched: the product over the samples of A_k/kt at slip, I at stick, 0 at
+    !> lift-off. opened: the period has a lift-off sample.
+    pure subroutine slider_map(plan, j, kt, m, opened)
         type(aft_plan), intent(in) :: plan
         integer(ip), intent(in) :: j
-        real(wp) :: mm(2, 2)
-        logical :: opened
-        call slider_map(plan, j, plan%par(j, 1), mm, opened)
-        isolated2d = (1.0_wp - mm(1, 1))*(1.0_wp - mm(2, 2)) - mm(1, 2)*mm(2, 1) >= DET_ISOLATED
-    end function isolated2d
-
-    module procedure slider_map
+        real(wp), intent(in) :: kt
+        real(wp), intent(out) :: m(2, 2)
+        logical, intent(out) :: opened
         integer(ip) :: k
         real(wp) :: b(2, 2)
         m = reshape([1.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [2, 2])
@@ -230,10 +240,10 @@ contains
                 opened = .true.
             end select
         end do
-    end procedure slider_map
+    end subroutine slider_map
 
     !> March 2-D element j again from w0j without steps, for a march with a kept step whose
-    !> closed cycle is not isolated (isolated2d): if plain marching closes within
+    !> closed cycle is not isolated (slider_fixed_point): if plain marching closes within
     !> max_periods its cycle replaces the stepped one (the plain march's stuck slider,
     !> which settle2d of frirom_aft_jacobian differentiates); otherwise the stepped cycle
     !> stays, closed where plain marching does not close.

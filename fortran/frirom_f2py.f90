@@ -199,7 +199,6 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     class(hbm_system), allocatable :: sys
     integer(ip), allocatable :: sel(:)
     real(wp), allocatable :: ysel(:, :), tsel(:, :)
-    logical :: lu_used
     type(cont_options) :: opts
     real(wp), allocatable :: y(:), t(:)
     real(wp) :: lam, dsl
@@ -270,7 +269,7 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
         return
     end if
     sys%carry = history /= 0
-    call hbm_lu_import(sys, lu, lupiv, lustate, lu_used)
+    call hbm_lu_import(sys, lu, lupiv, lustate)
     opts = cont_options_from(ropt, iopt)
     opts%max_points = maxpts
     y = y0
@@ -297,7 +296,7 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
                      tans, itl, xo, states, np, fin, linfo, msg, sliders=sliders, &
                      yscales=yscales)
     end if
-    call hbm_lu_export(sys, lu, lupiv, lustate, lu_used)
+    call hbm_lu_export(sys, lu, lupiv, lustate)
     npts = np
     iters = itl
     finished = merge(1, 0, fin)

@@ -13,9 +13,11 @@ submodule (frirom_hbm) frirom_hbm_condensed
     !> iterations above which the next J is factorised.
     real(wp), parameter :: GM_TOL = 1.0e-11_wp
     integer(ip), parameter :: GM_MAXIT = 40, GM_REFRESH = 8
+    !> GMRES restart length (Krylov basis size)
+    integer(ip), parameter :: GM_RESTART = 30
     !> Direct mode, modal route: the first solve after an eval with jac is GMRES on that
     !> J preconditioned by the LU held (of an older J), to this relative residual. An LU
-    !> is worth gm_worth GMRES iterations (gm_cost: flops of each, the LU's counted
+    !> is worth lu_worth GMRES iterations (flops of each, the LU's counted
     !> LU_SPEEDUP times faster, blocked against memory-bound); J is factorised instead
     !> once the iterations since the last LU reach that, or when one solve needs more
     !> than a third of it (at least GN_MINIT); always when an LU is worth less than
@@ -186,7 +188,7 @@ contains
     end function use_krylov
 
     module procedure cond_eval
-        real(wp) :: w, s, nx, nxe, nhf, nrc, nxd, nhd
+        real(wp) :: w, s, nx, nxe, nhf, nxd, nhd
         integer(ip) :: nnl, nc, h, n, nm, nhd0
         complex(wp), allocatable :: fc(:), z(:), dz(:), rh(:), xe(:), v(:), x3(:, :), b3(:, :)
         real(wp), allocatable :: r2(:, :), rl2(:, :)   !! (nnl, nc) r and rlam by harmonic
@@ -214,19 +216,23 @@ contains
         nxd = 0.0_wp
         nhd = 0.0_wp
         nx = norm2(y)
-        nrc = 0.0_wp
-        if (allocated(this%cs%c0)) then
+        if (this%nrc < 0.0_wp) then
             ! |R_0 c0|: the rest forces' image, left out of fd and fe0 (contact_set), stays in
-            ! the reference: the residual's scale is that of the terms before the shift
-            fc = cmplx(this%cs%c0, 0.0_wp, wp)
-            if (this%modal) then
-                call modal_project(this, 0, fc, v)
-                x3(:, 1) = this%g(:, 0)*v
-                call modal_apply(this, 0, 1, nnl, x3(:, 1:1), b3(:, 1:1))
-                nrc = norm2(abs(b3(:, 1)))
-            else
-                nrc = hypot(norm2(matmul(this%ar(:, :, 0), this%cs%c0)), &
-                            norm2(matmul(this%ai(:, :, 0), this%cs%c0)))
+            ! the reference: the residual's scale is that of the terms before the shift. c0
+            ! and R_0 (no frequency in it) are fixed once the modes are set (which reset
+            ! nrc): computed once, after the first receptances
+            this%nrc = 0.0_wp
+            if (allocated(this%cs%c0)) then
+                fc = cmplx(this%cs%c0, 0.0_wp, wp)
+                if (this%modal) then
+                    call modal_project(this, 0, fc, v)
+                    x3(:, 1) = this%g(:, 0)*v
+                    call modal_apply(this, 0, 1, nnl, x3(:, 1:1), b3(:, 1:1))
+                    this%nrc = norm2(abs(b3(:, 1)))
+                else
+                    this%nrc = hypot(norm2(matmul(this%ar(:, :, 0), this%cs%c0)), &
+                                     norm2(matmul(this%ai(:, :, 0), this%cs%c0)))
+                end if
             end if
         end if
         do h = 0, this%nh
@@ -299,7 +305,7 @@ contains
             rlam = reshape(rl2, [n])
             nhd0 = nnl
         end if
-        rref = max(sqrt(nxe), nx, sqrt(nhf), nrc)
+        rref = max(sqrt(nxe), nx, sqrt(nhf), this%nrc)
         ! harmonics 1..H alone (hbm_roundoff)
         this%rref_dyn = max(sqrt(nxd), norm2(y(nhd0 + 1:)), sqrt(nhd))
         if (.not. jac) return
@@ -316,12 +322,11 @@ contains
         if (this%modal) then
             this%gj = this%g
             this%wj = w
-            if (.not. use_krylov(this) .and. this%lu_any .and. gm_cost(this) >= GN_WORTH_MIN &
-                .and. this%gm_spent < gm_cost(this)) then
+            if (this%lu_any .and. this%gm_spent < gm_cost(this) .and. holds(this)) then
                 ! J for products only, the LU stays: the next solve by GMRES (cond_solve)
                 this%jfree = .true.
                 this%gm_next = .true.
-                this%lu_now = .false.
+                this%lu_fresh = .false.
                 return
             end if
             if (use_krylov(this)) then
@@ -833,7 +838,6 @@ contains
             call dgetrf(n, n, sys%jm, n, sys%ipiv, linfo)
         end if
         sys%lu_single = single
-        sys%lu_now = linfo == 0
         sys%timers(T_FACT) = sys%timers(T_FACT) + wtime() - t0
         sys%timers(N_FACT) = sys%timers(N_FACT) + 1
         sys%lu_fresh = linfo == 0
@@ -895,7 +899,7 @@ contains
             this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
             return
         end if
-        if (this%lu_single .and. .not. this%lu_now) then
+        if (this%lu_single .and. .not. this%lu_fresh) then
             ! a chord step (Jacobian reused) with the LU of an older J, as a double one
             call wb_prepare(this)
             call lu_apply(this, b)
@@ -919,37 +923,33 @@ contains
         if (linfo /= 0) call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'dgetrs failed')
     end procedure cond_solve
 
-    !> GMRES iterations an LU of J is worth (direct mode, modal route): LU 2/3 n^3 flops
-    !> at LU_SPEEDUP times the rate of an iteration's triangular solves (2 n^2) and
-    !> matrix-free product (8 (nh+1) nnl nm: projection and back, complex).
-    real(wp) function gm_cost(sys)
-        type(hbm_condensed), intent(inout) :: sys
-        real(wp) :: n
-        if (sys%gm_worth <= 0.0_wp) then
-            n = real(sys%n, wp)
-            sys%gm_worth = (2.0_wp/3.0_wp*n**3/LU_SPEEDUP)/(2.0_wp*n**2 + 8.0_wp* &
-                           real(sys%nh + 1, wp)*real(sys%nnl, wp)*real(size(sys%g, 1), wp))
-        end if
-        gm_cost = sys%gm_worth
-    end function gm_cost
-
-    !> gm_cost's number for nu unknowns, nh harmonics, nnl unknowns per coefficient and nm
-    !> modes, for the carry decision (gm_cost keeps its own expression: its rounding
-    !> decides knife-edge comparisons of the Newton paths, which stay those of before).
-    pure real(wp) function lu_worth(nu, nh, nnl, nm)
-        integer(ip), intent(in) :: nu, nh, nnl, nm
-        real(wp) :: n
-        n = real(nu, wp)
-        lu_worth = (2.0_wp/3.0_wp*n**3/LU_SPEEDUP)/(2.0_wp*n**2 + 8.0_wp* &
+    !> GMRES iterations an LU of J is worth (direct mode, modal route) for n unknowns, nh
+    !> harmonics, nnl unknowns per coefficient and nm modes: LU 2/3 n^3 flops at LU_SPEEDUP
+    !> times the rate of an iteration's triangular solves (2 n^2) and matrix-free product
+    !> (8 (nh+1) nnl nm: projection and back, complex).
+    pure real(wp) function lu_worth(n, nh, nnl, nm)
+        integer(ip), intent(in) :: n, nh, nnl, nm
+        real(wp) :: rn
+        rn = real(n, wp)
+        lu_worth = (2.0_wp/3.0_wp*rn**3/LU_SPEEDUP)/(2.0_wp*rn**2 + 8.0_wp* &
                    real(nh + 1, wp)*real(nnl, wp)*real(nm, wp))
     end function lu_worth
+
+    !> lu_worth of sys (modal route), kept in gm_worth.
+    real(wp) function gm_cost(sys)
+        type(hbm_condensed), intent(inout) :: sys
+        if (sys%gm_worth <= 0.0_wp) sys%gm_worth = lu_worth(sys%n, sys%nh, sys%nnl, &
+                                                           size(sys%g, 1))
+        gm_cost = sys%gm_worth
+    end function gm_cost
 
     module procedure cond_lu_holds
         hold = lu_worth(nnl*(2*nh + 1), nh, nnl, nm) >= GN_WORTH_MIN
     end procedure cond_lu_holds
 
-    !> Whether sys keeps LUs across runs: modal, direct mode, no selection, worth holding.
-    logical function holds(sys)
+    !> Whether sys keeps LUs (single precision, carried across runs): modal, direct mode,
+    !> no selection, an LU worth at least GN_WORTH_MIN GMRES iterations.
+    pure logical function holds(sys)
         type(hbm_condensed), intent(in) :: sys
         holds = .false.
         if (.not. sys%modal .or. use_krylov(sys) .or. allocated(sys%sel)) return
@@ -957,7 +957,6 @@ contains
     end function holds
 
     module procedure hbm_lu_import
-        used = .false.
         select type (sys => sysc)
         type is (hbm_condensed)
             if (.not. holds(sys) .or. size(state) < 2) return
@@ -966,7 +965,6 @@ contains
             if (.not. allocated(sys%jm)) return
             ! state(1) = 2: a single-precision LU (exact in lu)
             sys%lu_single = state(1) == 2.0_wp
-            sys%lu_now = .false.
             sys%wb_ok = .false.
             if (sys%lu_single) then
                 sys%jms = real(lu, real32)
@@ -977,12 +975,10 @@ contains
             sys%lu_any = .true.
             sys%lu_fresh = .false.
             sys%gm_spent = state(2)
-            used = .true.
         end select
     end procedure hbm_lu_import
 
     module procedure hbm_lu_export
-        new = .false.
         if (size(state) < 2) return
         state(1) = 0.0_wp
         select type (sys => sysc)
@@ -996,7 +992,6 @@ contains
                     lu = sys%jm
                 end if
                 piv = sys%ipiv
-                new = .true.
             end if
             state(1) = merge(2.0_wp, 1.0_wp, sys%lu_single)
             state(2) = sys%gm_spent
@@ -1094,11 +1089,12 @@ contains
         real(wp), allocatable :: sens(:, :), nphi(:), xv(:, :), f(:, :)
         real(real32), allocatable :: ws(:, :)
         integer(ip) :: nu, nc, nm, np, k, h, r, c, q, loc(2), linfo, n, stat
-        real(wp) :: smax, hw
+        real(wp) :: smax
         sys%wb_ok = .false.
         sys%wb_at = -1.0_wp
         sys%wb_w0 = sys%wj
-        if (.not. allocated(sys%phr) .or. sys%nh < 1) return
+        ! dg is that of the receptances' w, the J's (each eval with jac precedes its solve)
+        if (.not. allocated(sys%phr) .or. sys%nh < 1 .or. sys%w_cache /= sys%wj) return
         nu = sys%nnl
         nc = sys%nc
         n = sys%n
@@ -1108,9 +1104,7 @@ contains
             nphi(r) = sum(sys%phr(1:nu, r)**2)
         end do
         do h = 1, sys%nh
-            hw = h*sys%wj
-            sens(:, h) = abs(sys%gj(:, h)**2*cmplx(-2.0_wp*h*hw, 2.0_wp*sys%zm(:, h)* &
-                                                   sys%wm(:, h)*h, wp))*sys%wj*nphi
+            sens(:, h) = abs(sys%dg(:, h))*sys%wj*nphi
         end do
         smax = maxval(sens)
         ! an undamped mode at resonance: no finite scale to rank the pairs by
@@ -1184,36 +1178,51 @@ contains
         if (linfo /= 0) sys%wb_ok = .false.
     end subroutine wb_prepare
 
-    !> w := M^-1 w for the LU held (jms single precision, or jm), all columns at once.
+    !> w := M^-1 w for the LU held (jms single precision, or jm), all columns at once. Its
+    !> work arrays are kept on sys (lws, wbt) from call to call.
     subroutine lu_apply(sys, w)
-        type(hbm_condensed), intent(in) :: sys
+        type(hbm_condensed), intent(inout) :: sys
         real(wp), intent(inout) :: w(:, :)
         real(real32), allocatable :: ws(:, :)
-        real(wp), allocatable :: t(:, :), t2(:, :)
+        real(wp), allocatable :: t(:, :)
         complex(wp) :: d
-        integer(ip) :: n, linfo, m, k
+        integer(ip) :: n, linfo, m, k, nr
         n = sys%n
+        nr = size(w, 2)
         if (sys%lu_single) then
-            ws = real(w, real32)
-            call sgetrs('N', n, size(w, 2), sys%jms, n, sys%ipiv, ws, n, linfo)
-            w = real(ws, wp)
+            call move_alloc(sys%lws, ws)
+            if (allocated(ws)) then
+                if (size(ws, 1) /= n .or. size(ws, 2) < nr) deallocate (ws)
+            end if
+            if (.not. allocated(ws)) allocate (ws(n, nr))
+            ws(:, 1:nr) = real(w, real32)
+            call sgetrs('N', n, nr, sys%jms, n, sys%ipiv, ws, n, linfo)
+            w = real(ws(:, 1:nr), wp)
+            call move_alloc(ws, sys%lws)
             if (sys%wb_ok .and. sys%wb_at == sys%wj .and. sys%wj /= sys%wb_w0) then
-                ! w -= W (I + D S)^-1 D V w
+                ! w -= W (I + D S)^-1 D V w; t(:, 1:nr) = V w, t(:, nr+1:) = D V w
                 m = size(sys%wbs, 1)
-                allocate (t(m, size(w, 2)), t2(m, size(w, 2)))
-                call dgemm('N', 'N', m, size(w, 2), n, 1.0_wp, sys%wbv, m, w, size(w, 1), &
+                call move_alloc(sys%wbt, t)
+                if (allocated(t)) then
+                    if (size(t, 1) /= m .or. size(t, 2) < 2*nr) deallocate (t)
+                end if
+                if (.not. allocated(t)) allocate (t(m, 2*nr))
+                call dgemm('N', 'N', m, nr, n, 1.0_wp, sys%wbv, m, w, size(w, 1), &
                            0.0_wp, t, m)
-                do k = 1, m/2
-                    d = sys%gj(sys%wbm(k), sys%wbh(k)) - sys%wbg(k)
-                    t2(2*k - 1, :) = real(d, wp)*t(2*k - 1, :) + aimag(d)*t(2*k, :)
-                    t2(2*k, :) = -aimag(d)*t(2*k - 1, :) + real(d, wp)*t(2*k, :)
-                end do
-                call dgetrs('N', m, size(w, 2), sys%wbl, m, sys%wbp, t2, m, linfo)
-                call dgemm('N', 'N', n, size(w, 2), m, -1.0_wp, sys%wbw, n, t2, m, 1.0_wp, &
+                associate (t1 => t(:, 1:nr), t2 => t(:, nr + 1:2*nr))
+                    do k = 1, m/2
+                        d = sys%gj(sys%wbm(k), sys%wbh(k)) - sys%wbg(k)
+                        t2(2*k - 1, :) = real(d, wp)*t1(2*k - 1, :) + aimag(d)*t1(2*k, :)
+                        t2(2*k, :) = -aimag(d)*t1(2*k - 1, :) + real(d, wp)*t1(2*k, :)
+                    end do
+                end associate
+                call dgetrs('N', m, nr, sys%wbl, m, sys%wbp, t(1, nr + 1), m, linfo)
+                call dgemm('N', 'N', n, nr, m, -1.0_wp, sys%wbw, n, t(1, nr + 1), m, 1.0_wp, &
                            w, size(w, 1))
+                call move_alloc(t, sys%wbt)
             end if
         else
-            call dgetrs('N', n, size(w, 2), sys%jm, n, sys%ipiv, w, size(w, 1), linfo)
+            call dgetrs('N', n, nr, sys%jm, n, sys%ipiv, w, size(w, 1), linfo)
         end if
     end subroutine lu_apply
 
@@ -1231,24 +1240,32 @@ contains
         logical, intent(out) :: ok
         real(wp), intent(in), optional :: tol
         integer(ip), intent(in), optional :: maxit
-        integer(ip), parameter :: m = 30
+        integer(ip), parameter :: m = GM_RESTART
         real(wp), allocatable :: v(:, :, :), z(:, :, :), hh(:, :, :), cs(:, :), sn(:, :), &
                                  gv(:, :), x(:, :), r(:), w(:, :), bn(:)
         real(wp) :: beta, tmp, rtol
         integer(ip) :: n, nb, c, q, na, j, i, itmax
         integer(ip), allocatable :: itc(:), kk(:), ac(:)
         logical, allocatable :: done(:), act(:)
+        logical :: slow
         n = sys%n
         nb = size(b, 2)
         rtol = GM_TOL
         if (present(tol)) rtol = tol
         itmax = GM_MAXIT
         if (present(maxit)) itmax = maxit
-        allocate (v(n, m + 1, nb), z(n, m, nb), hh(m + 1, m, nb), cs(m, nb), sn(m, nb), &
-                  gv(m + 1, nb), r(n), w(n, nb), bn(nb), itc(nb), kk(nb), ac(nb), &
-                  done(nb), act(nb))
+        ! the bases: kept on sys (gmv, gmz) from call to call, lent here
+        call move_alloc(sys%gmv, v)
+        call move_alloc(sys%gmz, z)
+        if (allocated(v)) then
+            if (size(v, 1) /= n .or. size(v, 3) < nb) deallocate (v, z)
+        end if
+        if (.not. allocated(v)) allocate (v(n, m + 1, nb), z(n, m, nb))
+        allocate (hh(m + 1, m, nb), cs(m, nb), sn(m, nb), gv(m + 1, nb), r(n), w(n, nb), &
+                  bn(nb), itc(nb), kk(nb), ac(nb), done(nb), act(nb))
         its = 0
         ok = .false.
+        slow = .false.
         itc = 0
         do c = 1, nb
             bn(c) = norm2(b(:, c))
@@ -1257,7 +1274,7 @@ contains
         call wb_prepare(sys)
         x = b
         call lu_apply(sys, x)
-        do
+        restarts: do
             ! r = b - J x per open column
             act = .false.
             do c = 1, nb
@@ -1270,8 +1287,8 @@ contains
                     cycle
                 end if
                 if (itc(c) >= itmax) then
-                    its = sum(itc)
-                    return
+                    slow = .true.           ! too slow: b unchanged
+                    exit restarts
                 end if
                 v(:, 1, c) = r/beta
                 gv(:, c) = 0.0_wp
@@ -1335,8 +1352,11 @@ contains
                 call dgemv('N', n, kk(c), 1.0_wp, z(:, :, c), n, gv(:, c), 1, 1.0_wp, &
                            x(:, c), 1)
             end do
-        end do
+        end do restarts
         its = sum(itc)
+        call move_alloc(v, sys%gmv)
+        call move_alloc(z, sys%gmz)
+        if (slow) return
         b = x
         ok = .true.
     end subroutine gmres

@@ -77,6 +77,7 @@ contains
             if (allocated(sys%psi)) deallocate (sys%psi)
             if (allocated(sys%wm)) deallocate (sys%wm, sys%zm, sys%g, sys%dg, sys%qf, sys%qf1)
             sys%gm_worth = 0.0_wp     ! gm_cost depends on the number of modes
+            sys%nrc = -1.0_wp         ! so does R_0
             allocate (sys%wm(nm, 0:sys%nh), sys%zm(nm, 0:sys%nh), sys%g(nm, 0:sys%nh), &
                       sys%dg(nm, 0:sys%nh), sys%qf(nm, 0:sys%nh), sys%qf1(nm, 0:sys%nh), &
                       stat=stat)

@@ -13,7 +13,7 @@ import pytest
 
 from frirom._errors import InputError
 from frirom.cli import main
-from frirom.auto import _excitation, _rung_peaks, resolve_deck
+from frirom.auto import RATE_MAX, _excitation, _rung_peaks, _tail, resolve_deck
 from frirom.deck import build_deck, load_deck, parse_deck
 from frirom.deck.schema import read_toml
 from frirom.results import FRF
@@ -69,6 +69,19 @@ def test_estimate_that_cannot_reach_tolerance_is_flagged():
     assert any("WARNING" in s and "did not reach" in s for s in lines)
     assert "NOT within the tolerance" in ch.summary()
     assert deck.F.shape[1] == 10 and deck.samples is None   # N not asked: default rule
+
+
+def test_tail_without_a_rate_is_that_of_a_first_rung():
+    # The error of a rung is its estimate e over 1 - r, r the observed rate. A first rung
+    # has no rate (r = 1/2: 2 e), nor has a rung after one whose estimate is inf (a solve
+    # or curve failed): before, e / inf made r = 0 there, and that rung passed on e alone.
+    # Exact arithmetic on powers of two.
+    e = 2.0**-10
+    assert _tail([("a", e)], 1) == 2 * e
+    assert _tail([("a", float("inf")), ("b", e)], 1) == 2 * e
+    assert _tail([("a", 4 * e), ("b", e)], 1) == e / (1 - 0.25)              # r = 1/4
+    assert _tail([("a", e), ("b", 2 * e)], 1) == 2 * e / (1 - RATE_MAX)      # rising
+    assert _tail([("a", float("inf")), ("b", 4 * e), ("c", e)], 2) == 2 * e  # H: parity
 
 
 def test_integer_deck_unchanged():
@@ -175,7 +188,9 @@ def test_interface_modes_auto_meets_tolerance_on_lap_joint(lap, tmp_path, monkey
     # frf.h5 and put on the plot; the run's peak is within 1 % in amplitude and frequency
     # of a separately run, much richer model (60 + 60 GSI modes, twice the ladder's top,
     # over the whole range: not a rung the estimate saw). Measured: 20 + 20 chosen,
-    # 7e-4 in amplitude, 5e-4 in frequency.
+    # 7e-4 in amplitude, 5e-4 in frequency. Its estimate (20 -> 30) is 4.8e-3: when the
+    # 10 + 10 curve stops (below) no rate is known and its tail is 2 e = 9.6e-3, still
+    # within 1 %; when that curve runs through, the rate from 10 + 10 (1.0e1) makes it e.
     case, text = lap
     monkeypatch.setenv("FRIROM_CACHE", str(tmp_path / "cache"))
     (case / "auto.toml").write_text(text(tolerance_auto=0.01, max_modes=30))

@@ -241,6 +241,46 @@ def test_large_system_solves_by_gmres_on_the_held_lu():
         assert np.abs(kept[k].X - ref.X).max() / np.abs(ref.X).max() < TOL
 
 
+def test_ill_conditioned_j_falls_back_to_a_double_lu():
+    """The held LU is single precision: it only preconditions GMRES, and when GMRES on it
+    does not converge (J too ill-conditioned for single precision) J is factorised in
+    double. Forced here by a lightly damped mode at the excitation frequency: the model of
+    the large-system test with modal damping (its Rayleigh ratios), the resonant mode's
+    ratio 2e-10 instead of 0.002. That mode's receptance factor 1/(2 zeta w^2) is then 1e7
+    times larger, so a single-precision LU of J = I + R dF/dU is off by ~6e-8 x 1e7 ~ 0.6:
+    GMRES on it stalls (the fall-back counter, asserted), a double LU is off by ~1e-9.
+    The answer against two other paths from the same contact history: double LUs of J
+    throughout (krylov mode: GMRES preconditioned by an older double LU) and the dense
+    path (unknowns on the contact DoFs, receptances by a banded LU of D_h, C assembled
+    from the same modal ratios). Tolerance 1e-7: at zeta 5e-11 to 4e-10 the three agree
+    pairwise to 0.5-6e-8, the round-off floor of this conditioning (Newton stops at 1e-10
+    of the residual; the well-damped model agrees to ~1e-11); with zeta >= 1e-9 the
+    single LU suffices and no fall-back fires."""
+    import sys
+    from pathlib import Path
+    import scipy.linalg as sla
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "bench"))
+    from condensed import F_RES, reduced_model
+    model, ex = reduced_model(n=600, nc=80, seed=3)   # 160 coordinates: 1 120 unknowns
+    w = np.sqrt(sla.eigh(model.K.toarray(), model.M.toarray(), eigvals_only=True))
+    zeta = model.damping.beta * w / 2.0               # its Rayleigh ratios, as modal ones
+    wr = 2 * np.pi * F_RES
+    zeta[np.argmin(abs(w - wr))] = 2e-10
+    light = Model(model.M, model.K, Damping.modal(zeta), model.contacts)
+    out = np.arange(6)
+    o = SolverOptions(harmonics=3, samples=64, tol_residual=1e-10, tol_update=1e-10,
+                      modes=w.size)
+    hist = {"slider": solve_point(light, ex, wr, o, outputs=out).slider}
+    p = solve_point(light, ex, wr, o, outputs=out, start=hist)
+    assert p.timings["double_factorizations"] >= 1
+    assert p.state_fractions[0][0] > 0.1 and p.state_fractions[0][1] > 0.1   # stick, slip
+    for kw in (dict(krylov=True),
+               dict(modes=None, coordinates="dofs", receptances="factorization")):
+        ref = solve_point(light, ex, wr, dataclasses.replace(o, **kw), outputs=out,
+                          start=hist)
+        assert np.abs(p.X - ref.X).max() / np.abs(ref.X).max() < 1e-7, kw
+
+
 def test_held_lu_carried_from_call_to_call():
     """The LU a large system holds is carried from one hbm_continue call to the next of
     the same run (the FRF's batches and its peak solves: each call builds a new system).

@@ -14,9 +14,9 @@ The estimate costs a coarse run and a few point solves, not a ladder of FRFs:
    (max over the period of |x(t)|) from H to H+2 over the probes: H+2, not H+1, because
    a symmetric friction contact excites odd harmonics only and an even H+1 adds nothing;
    the error of H is taken as the geometric tail e(H) / (1 - r), r = e(H) / e(H-2) the
-   observed rate (at most :data:`RATE_MAX`; 1/2 before two rungs), and the smallest H
-   whose tail is within the budget is chosen: the tolerance, or half of it when N is
-   chosen too (the other half is N's);
+   observed rate (at most :data:`RATE_MAX`; 1/2 before two rungs or after a failed one),
+   and the smallest H whose tail is within the budget is chosen: the tolerance, or half
+   of it when N is chosen too (the other half is N's);
 4. the **N estimate** e(N) at the chosen H is the same change from N to 2N AFT samples
    (aliasing of the contact forces; it falls like 1/N^2 for smooth laws, slower at state
    switches), N over the powers of two from the first >= 2H+1, with the tail
@@ -62,13 +62,19 @@ WINDOW = 0.05
 
 def _tail(est: list, back: int) -> float:
     """The error of the last rung from its estimate e (its change to the next rung) and
-    the rate r = e / (the estimate ``back`` rungs below, 1 for H: the same parity, 1 for
-    N): the geometric tail e / (1 - r), r clamped to [0, RATE_MAX]; r = 1/2 for the first
-    rungs."""
+    the rate r = e / (the estimate ``back`` rungs below, 2 for H: the same parity, 1 for
+    N and modes): the geometric tail e / (1 - r), r clamped to [0, RATE_MAX]; r = 1/2 when
+    there is no rate: for the first rungs, and after a rung whose estimate is not finite
+    (a failed solve or curve gives no rate, not a rate of 0)."""
     e = est[-1][1]
-    r = 0.5 if len(est) <= back else min(max(e / max(est[-1 - back][1], 1e-300), 0.0),
-                                         RATE_MAX)
+    below = est[-1 - back][1] if len(est) > back else float("nan")
+    r = min(max(e / max(below, 1e-300), 0.0), RATE_MAX) if np.isfinite(below) else 0.5
     return e / (1.0 - r)
+
+
+def _first_harmonic(F: np.ndarray) -> int:
+    """The smallest H: the highest loaded harmonic of F (n, H+1), at least 1."""
+    return max([1] + [h for h in range(F.shape[1]) if np.any(F[:, h] != 0)])
 
 
 @dataclass
@@ -255,8 +261,7 @@ def choose(model, F, omega_start, omega_end, options, outputs=None, *, harmonics
     """
     t0 = time.perf_counter()
     budget = tolerance / 2 if harmonics and samples else tolerance
-    loaded = [h for h in range(F.shape[1]) if np.any(F[:, h] != 0)]
-    H_lo = max([1] + loaded)
+    H_lo = _first_harmonic(F)
     notes = []
     fixed_N = None if samples else options.samples
 
@@ -358,8 +363,7 @@ def _rung_peaks(deck, H, opts, window, full):
         r = frf(model, exc, *((hi, lo) if down else (lo, hi)), opts,
                 outputs=deck.solver_outputs)
         n = len(r)
-        peaks = r.peaks if r.peaks is not None else [r.peak(j) for j in
-                                                      range(r.amp_max.shape[1])] if n else []
+        peaks = [r.peak(j) for j in range(r.amp_max.shape[1])] if n else []
         edge = any(p.index in (0, n - 1) for p in peaks)
         if not edge or (lo, hi) == (min(full), max(full)):
             break
@@ -397,8 +401,7 @@ def choose_modes(deck, log=print):
     t0 = time.perf_counter()
     s = deck.settings
     ma, sol = s.modes_auto, s.solver
-    loaded = [h for h in range(deck.F.shape[1]) if np.any(deck.F[:, h] != 0)]
-    H = max([1] + loaded) if sol.auto_harmonics else deck.harmonics
+    H = _first_harmonic(deck.F) if sol.auto_harmonics else deck.harmonics
     opts = dataclasses.replace(deck.options(), harmonics=H, stability=False,
                                **({"samples": None} if sol.auto_samples else {}))
     full = (deck.omega_start, deck.omega_end)
