@@ -137,7 +137,6 @@ contains
             if (allocated(sys%kcw)) deallocate (sys%kcw)
             sys%lu_any = .false.
             sys%lu_fresh = .false.
-            sys%lu_now = .false.
             sys%lu_single = .false.
             sys%gm_worth = 0.0_wp
             sys%c0_leak = 0.0_wp
