@@ -1,0 +1,112 @@
+"""Where one ROM_II FRF of the paper cases spends its wall time, call by call into Fortran
+(issue 11's speed-up): per kind of hbm_continue call (first solve, continuation batches,
+peak-refinement solves) the count, wall seconds, the Fortran timers (AFT, assembly, LU,
+solves, receptances) and the rest of the Fortran time (per-call set-up plus the
+evaluations' untimed products), and the Python time outside the calls; every part also as
+a fraction of the FRF's wall time measured in the same run (min over --repeat runs).
+
+    OPENBLAS_NUM_THREADS=1 .venv/bin/python cases/bench/callsplit.py \
+        --flange WORK F0 | --hooks WORK F0 [--repeat 3]
+
+WORK is a case's work folder made by its make script (paper_flange.py: the folder with
+rom1.toml, whose travelling-wave ROM_II is built from ROM_I; paper_hooks: the folder with
+the hooks model, rom2_gsi40.toml is (re)written into it). Nothing is timed in the test suite.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import dataclasses
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+ROOT = Path(__file__).resolve().parents[2]
+sys.path[:0] = [str(ROOT / "cases" / "paper_flange"), str(ROOT / "cases" / "paper_hooks")]
+
+import numpy as np  # noqa: E402
+
+from frirom import _pack  # noqa: E402
+from frirom.solver import frf  # noqa: E402
+
+TIMED = ("aft", "assembly", "factorization", "solve", "receptance")
+
+
+def _problem(args):
+    """(frf positional arguments, keyword arguments) of the chosen case at F0."""
+    if args.flange:
+        import paper_flange as pf
+        work, f0 = Path(args.flange[0]), float(args.flange[1])
+        d1, _ = pf.load(work, "rom1")
+        quick = json.loads((work / "case.json").read_text())["quick"]
+        d = pf.derived(d1, "rom2_tw", pf.QUICK if quick else pf.PAPER)
+        model, exc = d.model(), d.excitation()
+        exc.F[:, 1:] *= f0 / pf.F0_DECK
+        opts = dataclasses.replace(d.options(), stability=False)
+        return ("flange TW ROM_II", f0, (model, exc, d.omega_start, d.omega_end, opts),
+                dict(outputs=d.outputs))
+    import paper_hooks as ph
+    work, f0 = Path(args.hooks[0]), float(args.hooks[1])
+    rom = ph.Rom(work, "rom2", "paper" if "paper" in work.name else "coarse", 40)
+    rom.set_preload(f0)
+    return ("hooks ROM_II", f0, (rom.model, rom.excitation, rom.deck.omega_start,
+                                 rom.deck.omega_end, rom.options),
+            dict(outputs=rom.deck.outputs))
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    g = ap.add_mutually_exclusive_group(required=True)
+    g.add_argument("--flange", nargs=2, metavar=("WORK", "F0"))
+    g.add_argument("--hooks", nargs=2, metavar=("WORK", "F0"))
+    ap.add_argument("--repeat", type=int, default=3)
+    args = ap.parse_args(argv)
+    name, f0, fargs, fkw = _problem(args)
+    slots = _pack._TIMER_SLOTS
+    stats = collections.defaultdict(lambda: np.zeros(5))  # n, wall, fortran, timed, evals
+    call = _pack._Packed.call
+
+    def counted(self, y0, lam0, tan0, start_mode, ds, *rest):
+        t0 = time.perf_counter()
+        r = call(self, y0, lam0, tan0, start_mode, ds, *rest)
+        kind = ("first solve" if start_mode == _pack.START_SOLVE_ONLY else
+                "peak solve" if self.opts.ds_max == 1e3 else "continuation")
+        stats[kind] += [1, time.perf_counter() - t0, r.timings[slots["fortran_total"]],
+                        sum(r.timings[slots[k]] for k in TIMED),
+                        r.timings[slots["evaluations"]]]
+        return r
+
+    best = None
+    _pack._Packed.call = counted
+    try:
+        for _ in range(args.repeat):
+            stats.clear()
+            t0 = time.perf_counter()
+            r = frf(*fargs, **fkw)
+            wall = time.perf_counter() - t0
+            if best is None or wall < best[0]:
+                best = (wall, {k: v.copy() for k, v in stats.items()}, len(r))
+    finally:
+        _pack._Packed.call = call
+    wall, st, npts = best
+    print(f"{name} at F0 = {f0:g}: {npts} points, {wall:.3f} s (min of {args.repeat})")
+    print(f"{'call kind':<14}{'calls':>6}{'evals':>7}{'wall s':>9}{'timers s':>10}"
+          f"{'other F s':>10}{'ms/call':>9}{'of FRF':>8}")
+    tot = np.zeros(5)
+    for kind, v in sorted(st.items()):
+        tot += v
+        print(f"{kind:<14}{v[0]:6.0f}{v[4]:7.0f}{v[1]:9.3f}{v[3]:10.3f}{v[2] - v[3]:10.3f}"
+              f"{1e3 * v[1] / v[0]:9.1f}{v[1] / wall:8.1%}")
+    py = wall - tot[1]
+    print(f"{'all calls':<14}{tot[0]:6.0f}{tot[4]:7.0f}{tot[1]:9.3f}{tot[3]:10.3f}"
+          f"{tot[2] - tot[3]:10.3f}{1e3 * tot[1] / tot[0]:9.1f}{tot[1] / wall:8.1%}")
+    print(f"python outside the calls: {py:.3f} s ({py / wall:.1%}); untimed Fortran per "
+          f"evaluation {1e3 * (tot[2] - tot[3]) / tot[4]:.2f} ms")
+
+
+if __name__ == "__main__":
+    main()
