@@ -660,6 +660,7 @@ contains
         real(wp), allocatable, intent(out) :: a(:, :), b(:, :)
         real(wp), allocatable :: p(:, :), pd(:, :)
         complex(wp), allocatable :: z(:, :), zd(:, :), rz(:, :)
+        integer(ip), allocatable :: use(:)
         integer(ip) :: k, nm, r
         real(wp) :: t0
         t0 = wtime()
@@ -669,17 +670,17 @@ contains
             a = sys%ar(rows, rows, h)
             b = sys%ai(rows, rows, h)
         else if (allocated(sys%phr)) then
-            nm = size(sys%gj, 1)
-            p = sys%phr(rows, :)
-            allocate (pd(k, nm))
+            ! only the modes that reach these rows (a tuned rotor's family ROM: about a
+            ! quarter at each harmonic), the others' terms below the products' round-off
+            call modes_on_rows(sys%phr(rows, :), sys%gj(:, h), use, nm)
+            p = sys%phr(rows, use(1:nm))
+            allocate (pd(k, 2*nm + 1))
             do r = 1, nm
-                pd(:, r) = p(:, r)*real(sys%gj(r, h), wp)
+                pd(:, r) = p(:, r)*real(sys%gj(use(r), h), wp)
+                pd(:, nm + r) = p(:, r)*aimag(sys%gj(use(r), h))
             end do
             call dgemm('N', 'T', k, k, nm, 1.0_wp, pd, k, p, k, 0.0_wp, a, k)
-            do r = 1, nm
-                pd(:, r) = p(:, r)*aimag(sys%gj(r, h))
-            end do
-            call dgemm('N', 'T', k, k, nm, 1.0_wp, pd, k, p, k, 0.0_wp, b, k)
+            call dgemm('N', 'T', k, k, nm, 1.0_wp, pd(1, nm + 1), k, p, k, 0.0_wp, b, k)
         else
             nm = size(sys%gj, 1)
             z = sys%psi(rows, :, h)
@@ -694,6 +695,32 @@ contains
         end if
         sys%timers(T_REC) = sys%timers(T_REC) + wtime() - t0
     end subroutine rec_block
+
+    !> The modes r whose term g_r p_r p_r^T of R = P diag(g) P^T on these rows (p: (k, nm))
+    !> exceeds REC_SKIP times the largest term (max |p_r|^2 |g_r|): use(1:nu). A term left
+    !> out is below the round-off of the sum over all nm modes (~nm eps the largest term),
+    !> so R is the same to round-off; rows a mode does not reach at all are zero.
+    subroutine modes_on_rows(p, g, use, nu)
+        real(wp), intent(in) :: p(:, :)
+        complex(wp), intent(in) :: g(:)
+        integer(ip), allocatable, intent(out) :: use(:)
+        integer(ip), intent(out) :: nu
+        real(wp), parameter :: REC_SKIP = 1.0e-14_wp
+        real(wp), allocatable :: w(:)
+        real(wp) :: wmin
+        integer(ip) :: r
+        allocate (w(size(p, 2)), use(size(p, 2)))
+        do r = 1, size(p, 2)
+            w(r) = maxval(abs(p(:, r)))**2*abs(g(r))
+        end do
+        wmin = REC_SKIP*maxval(w)
+        nu = 0
+        do r = 1, size(p, 2)
+            if (w(r) <= wmin .or. w(r) == 0.0_wp) cycle
+            nu = nu + 1
+            use(nu) = r
+        end do
+    end subroutine modes_on_rows
 
     !> kc += the kept part of G_g^T J_loc G_g for a group with dense rows over its columns
     !> (gt = Gd^T, gcols): per coefficient c1, the kept columns S1 of the group at c1 and

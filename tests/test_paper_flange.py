@@ -204,6 +204,11 @@ def test_selected_equals_unselected_point_for_point(fam, f0):
         assert abs(b.amplitude / a.amplitude - 1) < 1e-8
         assert abs(b.omega / a.omega - 1) < 1e-8
     assert part.leak.max() < 1e-8 and np.all(full.leak == 0)
+    # the selected Jacobian is the unselected one's kept block to round-off (its
+    # receptance blocks skip only the modes whose terms are below round-off): Newton takes
+    # the same iterations (measured 622 at 1 N, 1 109 at 300 N; skipping every mode below
+    # 1e-3 of the largest term fails this test's X comparison above)
+    assert part.timings["evaluations"] == full.timings["evaluations"]
     # the unknowns left out stay zero
     keep = np.concatenate([sel[full_nl(d)][:, (c + 1) // 2] for c in range(2 * pf.H + 1)])
     assert np.all(part.unknowns[:, ~keep] == 0)
