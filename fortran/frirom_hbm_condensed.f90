@@ -714,9 +714,11 @@ contains
             w(r) = maxval(abs(p(:, r)))**2*abs(g(r))
         end do
         wmin = REC_SKIP*maxval(w)
+        ! a non-finite term (an undamped mode at resonance) gives no scale: every mode
+        if (.not. wmin < huge(1.0_wp)) wmin = -1.0_wp
         nu = 0
         do r = 1, size(p, 2)
-            if (w(r) <= wmin .or. w(r) == 0.0_wp) cycle
+            if (w(r) <= wmin .or. (w(r) == 0.0_wp .and. wmin >= 0.0_wp)) cycle
             nu = nu + 1
             use(nu) = r
         end do

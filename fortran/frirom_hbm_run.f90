@@ -12,6 +12,7 @@ contains
 
     module procedure hbm_roundoff
         real(wp) :: r0, rd, tiny_r
+        integer(ip) :: n0
         tiny_r = 100.0_wp*epsilon(1.0_wp)
         if (this%rref_dyn < 0.0_wp) then
             yes = norm2(r) <= tiny_r*rref
@@ -19,9 +20,12 @@ contains
         end if
         select type (this)
         type is (hbm_condensed)
-            ! harmonic by harmonic, nnl unknowns each: harmonic 0 first
-            r0 = norm2(r(1:this%nnl))
-            rd = norm2(r(this%nnl + 1:))
+            ! harmonic by harmonic, harmonic 0 first: nnl unknowns each, or with a
+            ! selection (hbm_set_selection) the kept ones of harmonic 0
+            n0 = this%nnl
+            if (allocated(this%sel)) n0 = this%kptr(2) - this%kptr(1)
+            r0 = norm2(r(1:n0))
+            rd = norm2(r(n0 + 1:))
         class default
             ! DoF by DoF, nc harmonics each: harmonic 0 first
             associate (rr => reshape(r, [this%nc, size(r)/this%nc]))

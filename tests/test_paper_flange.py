@@ -306,6 +306,8 @@ def test_deck_key_builds_the_selection(work, fam):
 
 @pytest.mark.parametrize("edit, field", [
     (lambda t: t.replace("stability = false", "stability = true"), "solver.stability"),
+    (lambda t: t.replace("[solver]", "[solver]\nmax_harmonics = 5")
+     .replace("harmonics = 3\n", "harmonics = \"auto\"\n"), "solver.harmonics"),
     (lambda t: t.replace("[solver]", "[solver]\nformulation = \"banded\""),
      "solver.formulation"),
     (lambda t: "eo = 4".join(t.rsplit("eo = 2", 1)), "excitation.engine_order[1].eo"),

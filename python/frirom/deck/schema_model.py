@@ -240,6 +240,9 @@ def check_travelling_wave(ctx: Context, raw: dict, solver) -> int:
     if solver.formulation != "condensed":
         raise ctx.error("solver.formulation", f"'condensed' with {key} = true",
                         solver.formulation)
+    if solver.auto_harmonics:
+        raise ctx.error("solver.harmonics", f"an integer with {key} = true (the selection "
+                        "is built for one H; choose H with a run without it)", "auto")
     if solver.stability:
         raise ctx.error("solver.stability", f"false with {key} = true (Hill's method "
                         "would see only perturbations inside the travelling wave); set "
