@@ -505,24 +505,29 @@ contains
         integer(ip) :: nnl, h, ca, cb
         nnl = sys%nnl
         do h = 0, sys%nh
-            if (h == 0) then
-                call dgemm('N', 'N', nnl, n, nnl, 1.0_wp, sys%ar(:, :, 0), nnl, kc, n, &
-                           0.0_wp, jm, n)
-            else
+            ca = 1
+            cb = 0
+            if (h > 0) then
                 ca = nnl*(2*h - 1) + 1
                 cb = nnl*(2*h) + 1
-                ! a-rows: A Kc_a + B Kc_b ; b-rows: -B Kc_a + A Kc_b
-                call dgemm('N', 'N', nnl, n, nnl, 1.0_wp, sys%ar(:, :, h), nnl, kc(ca, 1), n, &
-                           0.0_wp, jm(ca, 1), n)
-                call dgemm('N', 'N', nnl, n, nnl, 1.0_wp, sys%ai(:, :, h), nnl, kc(cb, 1), n, &
-                           1.0_wp, jm(ca, 1), n)
-                call dgemm('N', 'N', nnl, n, nnl, -1.0_wp, sys%ai(:, :, h), nnl, kc(ca, 1), &
-                           n, 0.0_wp, jm(cb, 1), n)
-                call dgemm('N', 'N', nnl, n, nnl, 1.0_wp, sys%ar(:, :, h), nnl, kc(cb, 1), n, &
-                           1.0_wp, jm(cb, 1), n)
             end if
+            call harm_rows(nnl, n, sys%ar(:, :, h), sys%ai(:, :, h), kc, ca, cb, jm)
         end do
     end subroutine jac_dense
+
+    !> One harmonic's rows of J - I = R_h kc, R_h = a + i b on k coordinates: harmonic 0
+    !> (cb = 0) jm(ca.., :) = a kc(ca.., :); else a-rows A Kc_a + B Kc_b and b-rows
+    !> -B Kc_a + A Kc_b (kc's and jm's rows of the cosine block from ca, the sine from cb).
+    subroutine harm_rows(k, n, a, b, kc, ca, cb, jm)
+        integer(ip), intent(in) :: k, n, ca, cb
+        real(wp), intent(in) :: a(k, k), b(k, k), kc(n, n)
+        real(wp), intent(inout) :: jm(n, n)
+        call dgemm('N', 'N', k, n, k, 1.0_wp, a, k, kc(ca, 1), n, 0.0_wp, jm(ca, 1), n)
+        if (cb == 0) return
+        call dgemm('N', 'N', k, n, k, 1.0_wp, b, k, kc(cb, 1), n, 1.0_wp, jm(ca, 1), n)
+        call dgemm('N', 'N', k, n, k, -1.0_wp, b, k, kc(ca, 1), n, 0.0_wp, jm(cb, 1), n)
+        call dgemm('N', 'N', k, n, k, 1.0_wp, a, k, kc(cb, 1), n, 1.0_wp, jm(cb, 1), n)
+    end subroutine harm_rows
 
     !> Modal route, a selection: b(rows, :) = A_h(rows, :) x, the other rows of b zero.
     subroutine modal_rows(sys, h, rows, x, b)
@@ -625,23 +630,13 @@ contains
             if (kh == 0) cycle
             call rec_block(sys, h, sys%kpt(sys%kptr(h + 1):sys%kptr(h + 2) - 1), a, b)
             t0 = wtime()
-            if (h == 0) then
-                ca = off(1) + 1
-                call dgemm('N', 'N', kh, n, kh, 1.0_wp, a, kh, kc(ca, 1), n, 0.0_wp, &
-                           sys%jm(ca, 1), n)
-            else
-                ! a-rows: A Kc_a + B Kc_b ; b-rows: -B Kc_a + A Kc_b
+            ca = off(1) + 1
+            cb = 0
+            if (h > 0) then
                 ca = off(2*h) + 1
                 cb = off(2*h + 1) + 1
-                call dgemm('N', 'N', kh, n, kh, 1.0_wp, a, kh, kc(ca, 1), n, 0.0_wp, &
-                           sys%jm(ca, 1), n)
-                call dgemm('N', 'N', kh, n, kh, 1.0_wp, b, kh, kc(cb, 1), n, 1.0_wp, &
-                           sys%jm(ca, 1), n)
-                call dgemm('N', 'N', kh, n, kh, -1.0_wp, b, kh, kc(ca, 1), n, 0.0_wp, &
-                           sys%jm(cb, 1), n)
-                call dgemm('N', 'N', kh, n, kh, 1.0_wp, a, kh, kc(cb, 1), n, 1.0_wp, &
-                           sys%jm(cb, 1), n)
             end if
+            call harm_rows(kh, n, a, b, kc, ca, cb, sys%jm)
             sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
         end do
         do i = 1, n
