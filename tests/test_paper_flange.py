@@ -230,7 +230,7 @@ def test_mistuned_rotor_leaks_and_warns(fam, what):
         p[0, :2] *= 1.5
     else:
         p[0, 3] *= 1.5
-    with pytest.warns(UserWarning, match="travelling-wave selection leaks"):
+    with pytest.warns(RuntimeWarning, match="travelling-wave selection leaks"):
         r = _run(d, 1.0, sel, contacts=[dataclasses.replace(c, params=p)])
     assert r.leak.max() > 100 * LEAK_TOL and r.leak.min() > 1e-3
 

@@ -424,7 +424,7 @@ class _Continuation:
                               "to point (sliders frozen at different phases) are not a "
                               "travelling wave there, and the selected solution is not the "
                               "full one (solve without the selection to see how far)",
-                              stacklevel=3)
+                              RuntimeWarning, stacklevel=4)
         if keep_unknowns and pts:
             out._last_unknowns = pts[-1].unknowns
             out._last_slider = pts[-1].slider
