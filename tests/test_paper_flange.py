@@ -24,7 +24,7 @@ from frirom import InputError, ParameterError  # noqa: E402
 from frirom.deck import load_deck  # noqa: E402
 from frirom.reduction.multistage import travelling_wave_selection  # noqa: E402
 from frirom.results import FRF, FRFWriter  # noqa: E402
-from frirom.solver import LEAK_TOL, frf  # noqa: E402
+from frirom.solver import LEAK_TOL, frf, solve_point  # noqa: E402
 
 pytestmark = pytest.mark.skipif(shutil.which("ccx") is None, reason="ccx not installed")
 
@@ -203,7 +203,7 @@ def test_selected_equals_unselected_point_for_point(fam, f0):
         a, b = full.peak(k), part.peak(k)
         assert abs(b.amplitude / a.amplitude - 1) < 1e-8
         assert abs(b.omega / a.omega - 1) < 1e-8
-    assert part.leak.max() < 1e-8 and np.all(full.leak == 0)
+    assert part.leak.max() < 1e-8 and full.leak is None     # no selection, no leak
     # the selected Jacobian is the unselected one's kept block to round-off (its
     # receptance blocks skip only the modes whose terms are below round-off): Newton takes
     # the same iterations (measured 622 at 1 N, 1 109 at 300 N; skipping every mode below
@@ -285,6 +285,92 @@ def test_resume_with_a_selection_is_exact(fam, tmp_path):
 
 def _die(p):
     raise Killed
+
+
+def test_leak_is_stored_per_point(fam, tmp_path):
+    """frf.h5 (FRFWriter and FRF.save_h5) and the CSV keep each point's leak, the very
+    floats of the run (tolerance 0 in the file; the CSV's 3 digits to 5e-3 relative); a
+    run without a selection keeps none (FRF.leak None, no dataset, no column), and a file
+    written before the leak was kept still loads (the dataset removed: leak None)."""
+    _, d, sel = fam
+    names = [c.name for c in d.contacts]
+    files = {}
+    for key, s in (("sel", sel), ("full", None)):
+        w = FRFWriter(tmp_path / f"{key}.h5", d.outputs, names, pf.H)
+        r = _run(d, 1.0, s, sink=w.append)
+        w.close(r.complete, r.message)
+        files[key] = (r, FRF.load(tmp_path / f"{key}.h5"))
+    r, got = files["sel"]
+    np.testing.assert_array_equal(got.leak, r.leak)
+    assert r.leak.max() > 0
+    got.save_h5(tmp_path / "again.h5")
+    np.testing.assert_array_equal(FRF.load(tmp_path / "again.h5").leak, r.leak)
+    got.save_csv(tmp_path / "sel.csv")
+    rows = np.genfromtxt(tmp_path / "sel.csv", delimiter=",", names=True)
+    np.testing.assert_allclose(rows["leak"], r.leak, rtol=5e-3, atol=0)
+    r, got = files["full"]
+    assert r.leak is None and got.leak is None
+    got.save_csv(tmp_path / "full.csv")
+    assert "leak" not in (tmp_path / "full.csv").read_text().splitlines()[0]
+    import h5py
+    with h5py.File(tmp_path / "full.h5", "r") as f:
+        assert "leak" not in f
+    with h5py.File(tmp_path / "sel.h5", "a") as f:      # as written before the leak was kept
+        del f["leak"]
+    assert FRF.load(tmp_path / "sel.h5").leak is None
+
+
+def test_resumed_run_warns_on_a_stored_leak(fam, tmp_path):
+    """A run killed after 25 points whose stored points leak (one doctored to 0.5: a
+    tuned rotor's run leaks at round-off), resumed from its checkpoint: the resumed run
+    warns, naming that point's frequency, as the uninterrupted run would have; the tuned
+    rotor's own resumed points do not (the same resume without the doctored point is
+    silent)."""
+    _, d, sel = fam
+    names = [c.name for c in d.contacts]
+    cut = FRFWriter(tmp_path / "cut.h5", d.outputs, names, pf.H)
+
+    def until_25(p):
+        (cut.append if cut._commit[0] < 25 else _die)(p)
+    with pytest.raises(Killed):
+        _run(d, 1.0, sel, sink=until_25)
+    cut.f.close()
+    shutil.copyfile(tmp_path / "cut.h5", tmp_path / "quiet.h5")
+    import h5py
+    with h5py.File(tmp_path / "cut.h5", "a") as f:
+        f["leak"][3] = 0.5
+        hz = float(f["omega"][3]) / 2 / np.pi
+    for name, leaks in (("quiet", False), ("cut", True)):
+        start = FRFWriter.resume_point(tmp_path / f"{name}.h5")
+        assert 3 < start["n_points"] < 25
+        with warnings.catch_warnings(record=True) as got:
+            warnings.simplefilter("always")
+            _run(d, 1.0, sel, start=start)
+        msgs = [str(w.message) for w in got if issubclass(w.category, RuntimeWarning)]
+        assert any("selection leaks" in m and f"{hz:.6g} Hz" in m for m in msgs) == leaks
+
+
+def test_solve_point_warns_on_a_leak(fam):
+    """solve_point with a selection warns on a leak as frf does: the mistuned rotor (one
+    pair's preload x1.5, leak 0.04-0.08 along the FRF) warns and reports its leak; the
+    tuned rotor does not (leak below 1e-8, as along its FRF); without a selection the
+    point has no leak (None)."""
+    _, d, sel = fam
+    c = d.contacts[0]
+    p = c.params.copy()
+    p[0, 3] *= 1.5
+    w = 0.5 * (d.omega_start + d.omega_end)
+    o = dataclasses.replace(d.options(), stability=False, coordinates="dofs", selection=sel)
+    with pytest.warns(RuntimeWarning, match="travelling-wave selection leaks"):
+        pt = solve_point(dataclasses.replace(d, contacts=[dataclasses.replace(c, params=p)])
+                         .model(), d.excitation(), w, o, outputs=d.outputs)
+    assert pt.leak > 1e-3
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        pt = solve_point(d.model(), d.excitation(), w, o, outputs=d.outputs)
+    assert pt.leak < 1e-8
+    o = dataclasses.replace(o, selection=None)
+    assert solve_point(d.model(), d.excitation(), w, o, outputs=d.outputs).leak is None
 
 
 def _deck(work, name, edit):

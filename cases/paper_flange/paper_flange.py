@@ -352,7 +352,7 @@ def sweep(d, f0: float, band=None) -> dict:
     return dict(f0=f0, seconds=sec, evals=int(r.timings.get("evaluations", 0)),
                 complete=bool(r.complete), f=(r.omega / 2 / np.pi).tolist(),
                 amp=r.amp_max.T.tolist(), peak_amp=[p.amplitude for p in peaks],
-                leak=float(r.leak.max()) if len(r) else 0.0,
+                leak=float(r.leak.max()) if r.leak is not None and len(r) else 0.0,
                 peak_f=[p.omega / 2 / np.pi for p in peaks],
                 lift=float(np.max(r.state_fractions[:, 0, 2])),
                 slip=float(np.max(r.state_fractions[:, 0, 1])))

@@ -493,7 +493,8 @@ class _Packed:
                                 floquet_max_re=float(res.hill_re[k]),
                                 slider=res.sliders[:self.nw, k].copy(),
                                 yscale=_scale_known(res.yscales[k]),
-                                leak=float(res.leak[k])))
+                                leak=(float(res.leak[k]) if self.keep is not None
+                                      else None)))
         return pts
 
 

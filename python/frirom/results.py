@@ -195,8 +195,8 @@ class FRFPoint:
     #: NaN for the other points
     ds_next: float = float("nan")
     #: travelling-wave selection (SolverOptions.selection): |contact forces off the
-    #: selection| / |on it| at this point (or the preloads' own, if larger); 0 without one
-    leak: float = 0.0
+    #: selection| / |on it| at this point (or the preloads' own, if larger); None without one
+    leak: float | None = None
 
 
 @dataclass
@@ -257,7 +257,8 @@ class FRF:
     #: how the result was made: META_KEYS (deck text, solver settings as JSON, reduced
     #: model's fingerprint, frirom version), strings
     meta: dict = field(default_factory=dict)
-    #: (n_pts,) FRFPoint.leak of each point (zeros without a travelling-wave selection)
+    #: (n_pts,) FRFPoint.leak of each point (None without a travelling-wave selection; NaN
+    #: for points a resumed run's file held from before the leak was kept)
     leak: np.ndarray | None = None
 
     @property
@@ -340,7 +341,8 @@ class FRF:
                    state_fractions=stack("state_fractions", (len(group_names), 3)),
                    stable=stack("stable", (), bool), fold=stack("fold", (), bool),
                    iterations=stack("iterations", (), int), time_s=stack("time_s", ()),
-                   leak=stack("leak", ()),
+                   leak=(stack("leak", ()) if points and all(p.leak is not None
+                                                             for p in points) else None),
                    slider=(np.array([p.slider for p in points], dtype=float) if points
                            else np.zeros((0, 0))),
                    unknowns=(np.array([p.unknowns for p in points], dtype=float)
@@ -361,6 +363,8 @@ class FRF:
                 f.create_dataset(name, data=np.asarray(v if v is not None else self.omega))
             if self.slider is not None:
                 f.create_dataset("slider", data=np.asarray(self.slider, dtype=float))
+            if self.leak is not None:
+                f.create_dataset("leak", data=np.asarray(self.leak, dtype=float))
             _save_readable(f, self)
             if self.peaks is not None:
                 f.create_dataset("peak_omega", data=[p.omega for p in self.peaks])
@@ -378,7 +382,8 @@ class FRF:
         """One row per point: frequency (Hz, rad/s), the load parameter of a load curve,
         stable, fold, iterations, time, then per output (named as in the deck) the true
         peak over the period, the mean and each harmonic's amplitude and phase
-        (x_h = A cos(h omega t + phase), deg), then the state fractions per group."""
+        (x_h = A cos(h omega t + phase), deg), then the state fractions per group and,
+        with a travelling-wave selection, the leak (FRFPoint.leak)."""
         load = self.parameter_name != "omega"
         with open(path, "w", newline="") as fh:
             w = csv.writer(fh)
@@ -387,6 +392,7 @@ class FRF:
             head += output_columns(self.labels, self.harmonics)
             for g in self.group_names:
                 head += [f"{g}_stick", f"{g}_slip", f"{g}_liftoff"]
+            head += ["leak"] if self.leak is not None else []
             w.writerow(head)
             par = self.parameter if self.parameter is not None else self.omega
             fhz = self.frequency_hz
@@ -397,6 +403,7 @@ class FRF:
                         f"{self.time_s[i]:.6g}"]
                 row += output_values(self.X[i], self.amp_max[i])
                 row += [f"{s:.6g}" for s in self.state_fractions[i].ravel()]
+                row += [f"{self.leak[i]:.3g}"] if self.leak is not None else []
                 w.writerow(row)
 
     @classmethod
@@ -420,6 +427,8 @@ class FRF:
             if kw["slider"] is not None and kw["slider"].shape[0] != kw["omega"].shape[0]:
                 raise InputError(f"{path}: 'slider' has {kw['slider'].shape[0]} rows for "
                                  f"{kw['omega'].shape[0]} points")
+            # runs without a travelling-wave selection (and older files) keep no leak
+            kw["leak"] = f["leak"][:n] if "leak" in f else None
             if "peak_omega" in f:
                 kw["peaks"] = [Peak(float(w), float(a), int(i), m.decode()) for w, a, i, m in
                                zip(f["peak_omega"], f["peak_amplitude"], f["peak_index"],
@@ -596,6 +605,8 @@ class FRFWriter:
             d.resize(n + 1, axis=0)
             d[n] = getattr(p, name)
         _append_readable(f, n, p)
+        if p.leak is not None:      # a travelling-wave selection's run (NaN rows before)
+            _append_row(f, "leak", n, p.leak)
         if np.isfinite(p.ds_next):
             # the checkpoint's state goes to the slot the commit does not point at
             slot = 0 if slot != 0 else 1
@@ -627,9 +638,10 @@ class FRFWriter:
     def resume_point(path) -> dict:
         """The `start` argument of frirom.solver.frf at the file's last checkpoint:
         {'parameter', 'omega', 'unknowns', 'tangent', 'yscale', 'slider', 'ds' (the step
-        the run continued with), 'n_points' (points up to it)}. A file written before
-        checkpoints gives its last point without 'ds' (the run resumes with the deck's
-        first step); one written before the contact history was kept gives slider None
+        the run continued with), 'n_points' (points up to it), with a travelling-wave
+        selection 'leak' (the largest stored FRFPoint.leak up to it, its omega)}. A file
+        written before checkpoints gives its last point without 'ds' (the run resumes with
+        the deck's first step); one written before the contact history was kept gives slider None
         (the run resumes from the model's w0, with a warning: a contact stuck all cycle
         there may settle differently)."""
         import h5py
@@ -658,6 +670,10 @@ class FRFWriter:
                          "unknowns": f["ck_unknowns"][slot], "tangent": f["ck_tangent"][slot],
                          "yscale": float(sc[3]), "ds": float(sc[2]), "n_points": nck}
                 slider = f["slider"][nck - 1] if "slider" in f else None
+                leak = f["leak"][:nck] if "leak" in f else np.zeros(0)
+                if np.any(np.isfinite(leak)):   # the worst stored leak: the run warns on it
+                    k = int(np.nanargmax(leak))
+                    state["leak"] = (float(leak[k]), float(f["omega"][k]))
             if slider is None:
                 warnings.warn(f"{path}: written before frirom kept the contact history "
                               "(sliders); resuming from the model's initial sliders w0",

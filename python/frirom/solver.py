@@ -50,6 +50,20 @@ FORMULATIONS = ("condensed", "banded")
 LEAK_TOL = 1e-6
 
 
+def warn_leak(leak: float, omega: float, stacklevel: int) -> None:
+    """Warn (RuntimeWarning) when a travelling-wave selection's leak (FRFPoint.leak) is
+    above LEAK_TOL; omega: rad/s, where; stacklevel: warnings.warn's, counted from here."""
+    if leak > LEAK_TOL:
+        warnings.warn(f"frirom: the travelling-wave selection leaks: contact forces off "
+                      f"the selection reach {leak:.2g} of those on it at "
+                      f"{omega / 2 / np.pi:.6g} Hz (tolerance {LEAK_TOL:g}); the rotor, its "
+                      "contacts, its load or the contact history carried from point "
+                      "to point (sliders frozen at different phases) are not a "
+                      "travelling wave there, and the selected solution is not the "
+                      "full one (solve without the selection to see how far)",
+                      RuntimeWarning, stacklevel=stacklevel + 1)
+
+
 @dataclass
 class SolverOptions:
     """Settings of the harmonic balance solver.
@@ -242,6 +256,7 @@ class _Continuation:
     prev_t: float | None = None   # parameter part of the previous point's tangent
     pending: bool = False         # points[-1] awaits its tangent from the next call
     n_before: int = 0             # points a resumed run made before (count to max_points)
+    leak_before: tuple | None = None  # their largest leak and its omega (FRFWriter file)
     t0: float = 0.0               # perf_counter at the start of the current call
 
     @property
@@ -292,6 +307,7 @@ class _Continuation:
                 if self.tan0.size != p.ny + 1:
                     raise SizeError("start.tangent: size does not match the unknowns")
                 self.n_before = int(start.get("n_points", 0))
+                self.leak_before = start.get("leak")
         if self.start_mode == START_CONTINUE:
             self._first_point(start is None)
         self.yscale = float(np.linalg.norm(self.y0)) or 1.0
@@ -412,19 +428,13 @@ class _Continuation:
                               stability_computed=p.stability)
         out.timings = self.timings
         out.solver_info = p.info
-        if p.keep is not None and pts:
-            worst = float(np.max(out.leak))
+        if p.keep is not None and (pts or self.leak_before):
+            k = int(np.argmax(out.leak)) if pts else 0
+            worst, at = (float(out.leak[k]), pts[k].omega) if pts else (-1.0, 0.0)
+            if self.leak_before is not None and self.leak_before[0] > worst:
+                worst, at = self.leak_before      # a point stored before the resume
             out.solver_info += f"; leak max {worst:.1e}"
-            if worst > LEAK_TOL:
-                at = pts[int(np.argmax(out.leak))].omega
-                warnings.warn(f"frirom: the travelling-wave selection leaks: contact forces off "
-                              f"the selection reach {worst:.2g} of those on it at "
-                              f"{at / 2 / np.pi:.6g} Hz (tolerance {LEAK_TOL:g}); the rotor, its "
-                              "contacts, its load or the contact history carried from point "
-                              "to point (sliders frozen at different phases) are not a "
-                              "travelling wave there, and the selected solution is not the "
-                              "full one (solve without the selection to see how far)",
-                              RuntimeWarning, stacklevel=4)
+            warn_leak(worst, at, stacklevel=5)
         if keep_unknowns and pts:
             out._last_unknowns = pts[-1].unknowns
             out._last_slider = pts[-1].slider
@@ -640,6 +650,8 @@ def solve_point(model: Model | CyclicModel, excitation: Excitation, omega: float
                               float(omega), 1)
     raise_for_status(res.info, res.msg)
     pt = packed.points(res, 0.0, time.perf_counter() - t0)[0]
+    if pt.leak is not None:
+        warn_leak(pt.leak, pt.omega, stacklevel=3)
     pt.output_dofs = packed.outputs
     pt.timings = {}
     add_timings(pt.timings, res.timings)
