@@ -23,7 +23,7 @@ from ..contact import LAWS
 from ..io import DIRECTION_NAMES, read_mtx
 from ..io._common import read_text
 from ..model import ContactGroup, CyclicModel, Damping, Excitation, Model, check_definite
-from ..reduction.multistage import travelling_wave_selection
+from ..reduction.multistage import cylindrical_frame, travelling_wave_selection
 from ..reduction.rom import (PairSpec, build_reduced_model, cache_file, rom_key,
                              same_reduction)
 from ..solver import SolverOptions
@@ -185,6 +185,51 @@ class Deck:
         return opts
 
 
+def check_wave_sectors(ctx: Context, raw: dict, rom, spec) -> None:
+    """``travelling_wave = true``: each ``[[excitation.engine_order]]``'s DoFs are one per
+    sector, 360 / n_sectors degrees apart about the reduction's axis, every load listed
+    in the same direction, as the model's geometry says (nodes without stored coordinates,
+    node sets: not checked). A wrong ``n_sectors`` would make a load that is no wave of
+    the rotor; a load listed the other way round is the wave running backwards (with the
+    others, a standing wave): the selection of ``reduction.interface_modes.sectors`` would
+    drop what they move. Raises the field's error."""
+    eos = raw.get("excitation", {}).get("engine_order", [])
+    frame = cylindrical_frame(spec.axis)
+    first = None
+    for k, eo in enumerate([eos] if isinstance(eos, dict) else eos):
+        ns = int(eo.get("n_sectors", len(eo["dofs"])))
+        if ns <= 2:                 # no direction to tell
+            continue
+        try:
+            nodes = [int(str(d[0] if isinstance(d, list) else d).split(":")[0].lstrip("Nn"))
+                     for d in eo["dofs"]]
+            xyz = rom.coordinates(nodes) - np.asarray(spec.origin, float)
+        except (ValueError, InputError):
+            continue
+        phi = np.arctan2(xyz @ frame[1], xyz @ frame[0])
+        step = np.angle(np.exp(1j * np.diff(phi)))          # wrapped to (-pi, pi]
+        pitch = 2 * np.pi / ns
+        sense = 1 if np.all(np.abs(step - pitch) < 1e-3 * pitch) else (
+            -1 if np.all(np.abs(step + pitch) < 1e-3 * pitch) else 0)
+        where = (f"with reduction.interface_modes.travelling_wave = true; its DoFs sit "
+                 f"{np.degrees(step).round(3).tolist()} deg apart about the reduction's axis")
+        if not sense and np.ptp(step) < 1e-3 * pitch:    # evenly, but not 360/ns
+            raise ctx.error(f"excitation.engine_order[{k}].n_sectors", f"the sector count "
+                            f"of the rotor, 360 deg / their spacing, {where}", ns)
+        if not sense:
+            raise ctx.error(f"excitation.engine_order[{k}].dofs", f"one DoF per sector, in "
+                            f"order about the axis, 360 / n_sectors = {360 / ns:.6g} deg "
+                            f"apart, {where}", None)
+        if first is None:
+            first = sense
+        elif sense and sense != first:
+            raise ctx.error(f"excitation.engine_order[{k}].dofs", "sectors listed in the "
+                            "direction of excitation.engine_order[0]'s about the axis "
+                            "(listed the other way, the same eo is the wave running "
+                            "backwards, and the two a standing wave), with "
+                            "reduction.interface_modes.travelling_wave = true", None)
+
+
 def read_matrix(path: Path, fmt: str, what: str, deck_path: Path | None = None):
     """One matrix file as scipy CSR, as stored; ``fmt`` is one of :data:`MATRIX_FORMATS`.
 
@@ -241,6 +286,8 @@ class _Builder:
                 sector = cyclic_sector_of(s.path, rom, s.reduction, s.cyclic)
                 self.partner = check_sector_contacts(s.path, rom, sector, s.contacts)
             contacts = [self.reduced_contact(c) for c in s.contacts]
+            if getattr(s.reduction, "travelling_wave", False):
+                check_wave_sectors(ctx, s.raw, rom, s.reduction)
             if s.damping.type == "modal" and s.damping.zeta.size > n:
                 raise ctx.error("damping.zeta", f"at most {n} modal ratios (the reduced "
                                 "model's size)", s.damping.zeta.size)

@@ -259,12 +259,22 @@ def check_travelling_wave(ctx: Context, raw: dict, solver) -> int:
         raise ctx.error("excitation.engine_order", f"an engine-order travelling wave with "
                         f"{key} = true", None)
     first = int(eos[0]["eo"])
+    n = int(raw.get("reduction", {}).get("interface_modes", {}).get("sectors", 1))
     for k, eo in enumerate(eos):
         if int(eo.get("harmonic", 1)) != 1:
             raise ctx.error(f"excitation.engine_order[{k}].harmonic", f"1 with {key} = "
                             "true (the wave's time harmonic 1)", eo.get("harmonic"))
-        if int(eo["eo"]) != first:
-            raise ctx.error(f"excitation.engine_order[{k}].eo", f"{first}, the engine "
-                            f"order of excitation.engine_order[0], with {key} = true (one "
+        ns = int(eo.get("n_sectors", len(eo.get("dofs", []))))
+        if ns != len(eo.get("dofs", [])) or ns % n:
+            raise ctx.error(f"excitation.engine_order[{k}].n_sectors", f"one DoF per "
+                            f"sector of the whole stage ({len(eo.get('dofs', []))} given), "
+                            f"a multiple of reduction.interface_modes.sectors = {n}, with "
+                            f"{key} = true (a wave over every sector of the rotor)", ns)
+        # the same wave: e = e_0 modulo the N sectors (the loads' phases alias); -e_0 is
+        # the wave running the other way, which with e_0 makes a standing wave
+        if (int(eo["eo"]) - first) % n:
+            raise ctx.error(f"excitation.engine_order[{k}].eo", f"{first} modulo "
+                            f"reduction.interface_modes.sectors = {n} (the engine order of "
+                            f"excitation.engine_order[0]), with {key} = true (one "
                             "travelling wave)", eo["eo"])
     return first
