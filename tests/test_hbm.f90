@@ -7,7 +7,7 @@ program test_hbm
     use frirom_check, only: check, check_done, fixed_seed
     use frirom_newton, only: cont_options, newton_correct
     use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
-                          hbm_set_modes_harmonic
+                          hbm_set_modes_harmonic, hbm_set_selection
     implicit none
     integer(ip), parameter :: ndof = 4, nh = 3, nc = 2*nh + 1
     type(hbm_condensed) :: sc, scl
@@ -164,9 +164,45 @@ program test_hbm
     call hbm_setup(sbad, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
                    fe1, 1, 0.0_wp, ginfo, gp, gi, gx, params, w0, outd, info, msg)
     call check(info /= 0 .and. index(msg, 'perm') > 0, 'bad perm reported')
+    perm = [3, 1, 4, 2]
+    call roundoff_selection()
     call check_done('test_hbm')
 
 contains
+
+    !> hbm_roundoff under a selection (hbm_set_selection): harmonic 0 is the kept rows of
+    !> harmonic 0 only, tested against rref; the rest against rref_dyn. Kept rows: none of
+    !> harmonic 0 and DoF 1 at harmonic 1 (n = 2 unknowns, fewer than nnl = 3: the full
+    !> layout's split at nnl would read past r), then DoF 1 at harmonic 0 and DoFs 1, 2 at
+    !> harmonic 1 (n = 5: the split at nnl would count two harmonic-1 rows as static).
+    !> rref = 1, rref_dyn = 1e-6, round-off 100 eps = 2.2e-14: harmonic-1 rows of 1e-15
+    !> (round-off of the static scale, 4.5e-7 of the dynamic one's) are no round-off.
+    subroutine roundoff_selection()
+        type(hbm_condensed) :: s
+        integer(ip) :: keep(3, 0:nh)
+        real(wp), parameter :: d = 1.0e-15_wp
+        call hbm_setup(s, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
+                       fe1, 1, 0.0_wp, ginfo, gp, gi, gx, params, w0, outd, info, msg)
+        call check(info == 0, 'setup for the selection: '//trim(msg))
+        keep = 0
+        keep(1, 1) = 1
+        call hbm_set_selection(s, keep, info, msg)
+        call check(info == 0 .and. s%n == 2, 'selection of 2 unknowns: '//trim(msg))
+        s%rref_dyn = 1.0e-6_wp
+        call check(.not. s%roundoff([d, d], 1.0_wp), &
+                   'n < nnl: harmonic-1 rows of 1e-15 against rref_dyn, not round-off')
+        call check(s%roundoff([1.0e-22_wp, 1.0e-22_wp], 1.0_wp), &
+                   'n < nnl: harmonic-1 rows of 1e-22 are round-off')
+        keep(1, 0) = 1
+        keep(2, 1) = 1
+        call hbm_set_selection(s, keep, info, msg)
+        call check(info == 0 .and. s%n == 5, 'selection of 5 unknowns: '//trim(msg))
+        s%rref_dyn = 1.0e-6_wp
+        call check(.not. s%roundoff([0.0_wp, d, d, 0.0_wp, 0.0_wp], 1.0_wp), &
+                   'n > nnl: harmonic-1 rows of 1e-15 next to the static one, not round-off')
+        call check(s%roundoff([1.0e-15_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp], 1.0_wp), &
+                   'n > nnl: a static row of 1e-15 against rref is round-off')
+    end subroutine roundoff_selection
 
     !> J^-1 (R(y + e v) - R(y - e v)) / 2e must give v back, for v = each unit vector, at a
     !> random y; and rlam must match the central difference in lam. Tolerance 1e-6:
