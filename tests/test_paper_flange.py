@@ -24,7 +24,7 @@ from frirom import InputError, ParameterError  # noqa: E402
 from frirom.deck import load_deck  # noqa: E402
 from frirom.reduction.multistage import travelling_wave_selection  # noqa: E402
 from frirom.results import FRF, FRFWriter  # noqa: E402
-from frirom.solver import LEAK_TOL, frf, solve_point  # noqa: E402
+from frirom.solver import LEAK_TOL, frf, kept_unknowns, solve_point  # noqa: E402
 
 pytestmark = pytest.mark.skipif(shutil.which("ccx") is None, reason="ccx not installed")
 
@@ -174,6 +174,7 @@ def test_selection_counts(fam):
     assert sel[ms].sum(axis=0).tolist() == [12, 24, 24, 12]
     r = _run(d, 1.0, sel, sink=None)
     assert "travelling-wave selection: 132 of 252 unknowns" in r.solver_info
+    assert kept_unknowns(sel[full_nl(d)]) == 132        # what the case's Table 1 shows
 
 
 @pytest.mark.parametrize("f0", [1.0, 300.0])
@@ -382,11 +383,25 @@ def _deck(work, name, edit):
     return path
 
 
+#: EO 2 on 6 sectors: time harmonic h lives on the indices +-2h mod 6, written out for
+#: the MS indices 0, 2, 4, 6 of the coarse flange (12 segments per stage), h = 0..3
+_WAVE = {0: {0, 6}, 1: {2, 4}, 2: {2, 4}, 3: {0, 6}}
+
+
 def test_deck_key_builds_the_selection(work, fam):
-    """The deck's key gives the case's selection (the same MS labels, EO and sectors)."""
+    """The deck's key keeps, of each MS coordinate 'ms h=p', the harmonics h whose
+    indices (_WAVE, by hand) hold p, and every harmonic of the other coordinates (modal,
+    blade DoFs); the case's selection is that too."""
     _, _, sel = fam
     d = load_deck(_deck(work, "tw.toml", lambda t: t))
-    assert np.array_equal(d.options().selection, sel)
+    got = d.options().selection
+    want = np.ones_like(got)
+    for i, lab in enumerate(d.dof_labels):
+        if "ms h=" in lab:
+            p = int(lab.split("ms h=")[1].split()[0])
+            want[i] = [p in _WAVE[h] for h in range(pf.H + 1)]
+    assert pf.H == 3 and (~want).any() and want.any(axis=1).all()
+    assert np.array_equal(got, want) and np.array_equal(sel, want)
     assert "travelling_wave" in d.result_meta()["solver_settings"]
 
 

@@ -311,11 +311,11 @@ def unknowns(d) -> int:
     """The condensed solver's unknowns for a deck's model (its LU is that size): the
     nonlinear DoFs or the contact coordinates, whichever is fewer ('auto'), times 2H+1;
     with a travelling-wave selection, the pairs it keeps."""
+    from frirom.solver import kept_unknowns
     m, o = d.model(), d.options()
     nl = m.nonlinear_dofs()
     if o.selection is not None:
-        keep = o.selection[nl]
-        return int(sum(keep[:, (c + 1) // 2].sum() for c in range(2 * o.harmonics + 1)))
+        return kept_unknowns(o.selection[nl])
     rows = sum(g.G.shape[0] for g in m.contacts)
     return min(rows, nl.size) * (2 * o.harmonics + 1)
 

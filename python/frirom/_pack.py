@@ -570,8 +570,16 @@ def _select(packed: _Packed, model, selection) -> None:
                     f"{int(packed.nl[np.argmax(off)])} at harmonic {h}, outside the "
                     "selection (not a travelling wave of the selection's engine order)")
     packed.keep = keep
-    n = int(sum(keep[:, min((c + 1) // 2, H)].sum() for c in range(2 * H + 1)))
-    packed.info += f"; travelling-wave selection: {n} of {packed.ny} unknowns"
+    packed.info += (f"; travelling-wave selection: {kept_unknowns(keep)} of {packed.ny} "
+                    "unknowns")
+
+
+def kept_unknowns(keep) -> int:
+    """The condensed unknowns a selection keeps (the size of its Newton system): keep is
+    (nnl, H+1) bool over the nonlinear DoFs (SolverOptions.selection's rows nl); a kept
+    harmonic 0 is one coefficient, a kept harmonic h >= 1 two (cos, sin)."""
+    keep = np.asarray(keep, dtype=bool)
+    return int(keep[:, 0].sum() + 2 * keep[:, 1:].sum())
 
 
 def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed:

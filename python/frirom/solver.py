@@ -28,7 +28,7 @@ import numpy as np
 
 from ._errors import (CODES, MAX_HARMONICS, MAX_OMEGA, ParameterError, SizeError, check_integer,
                       check_number, raise_for_status, samples_problem)
-from ._pack import HILL_MAX, MODES_MAX, TIMER_NAMES  # noqa: F401 - public here
+from ._pack import HILL_MAX, MODES_MAX, TIMER_NAMES, kept_unknowns  # noqa: F401 - public here
 from ._pack import (START_CONTINUE, START_RESUME, START_SOLVE_ONLY, YSCALE_RELATIVE, _Packed,
                     _split_load, add_timings, pack)
 from .harmonics import default_samples
