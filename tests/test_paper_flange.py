@@ -5,6 +5,7 @@ index-2 ROM_II's error is reported, not hidden; the family solved as a travellin
 (the selection of the condensed unknowns) is the family."""
 
 import dataclasses
+import inspect
 import os
 import shutil
 import sys
@@ -231,9 +232,14 @@ def test_mistuned_rotor_leaks_and_warns(fam, what):
         p[0, :2] *= 1.5
     else:
         p[0, 3] *= 1.5
-    with pytest.warns(RuntimeWarning, match="travelling-wave selection leaks"):
+    with pytest.warns(RuntimeWarning, match="travelling-wave selection leaks") as got:
         r = _run(d, 1.0, sel, contacts=[dataclasses.replace(c, params=p)])
     assert r.leak.max() > 100 * LEAK_TOL and r.leak.min() > 1e-3
+    # the warning points at the line that called frf (in _run)
+    src, first = inspect.getsourcelines(_run)
+    at = first + next(i for i, line in enumerate(src) if "frf(" in line)
+    assert all((w.filename, w.lineno) == (__file__, at) for w in got
+               if "leaks" in str(w.message))
 
 
 def test_keeping_everything_equals_no_selection(fam):
@@ -349,6 +355,8 @@ def test_resumed_run_warns_on_a_stored_leak(fam, tmp_path):
             _run(d, 1.0, sel, start=start)
         msgs = [str(w.message) for w in got if issubclass(w.category, RuntimeWarning)]
         assert any("selection leaks" in m and f"{hz:.6g} Hz" in m for m in msgs) == leaks
+        # the quiet resume warns of no leak at all
+        assert any("selection leaks" in m for m in msgs) == leaks
 
 
 def test_solve_point_warns_on_a_leak(fam):
@@ -362,10 +370,11 @@ def test_solve_point_warns_on_a_leak(fam):
     p[0, 3] *= 1.5
     w = 0.5 * (d.omega_start + d.omega_end)
     o = dataclasses.replace(d.options(), stability=False, coordinates="dofs", selection=sel)
-    with pytest.warns(RuntimeWarning, match="travelling-wave selection leaks"):
+    with pytest.warns(RuntimeWarning, match="travelling-wave selection leaks") as got:
         pt = solve_point(dataclasses.replace(d, contacts=[dataclasses.replace(c, params=p)])
                          .model(), d.excitation(), w, o, outputs=d.outputs)
     assert pt.leak > 1e-3
+    assert all(w.filename == __file__ for w in got if "leaks" in str(w.message))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         pt = solve_point(d.model(), d.excitation(), w, o, outputs=d.outputs)

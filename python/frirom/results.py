@@ -429,6 +429,9 @@ class FRF:
                                  f"{kw['omega'].shape[0]} points")
             # runs without a travelling-wave selection (and older files) keep no leak
             kw["leak"] = f["leak"][:n] if "leak" in f else None
+            if kw["leak"] is not None and kw["leak"].shape[0] != kw["omega"].shape[0]:
+                raise InputError(f"{path}: 'leak' has {kw['leak'].shape[0]} rows for "
+                                 f"{kw['omega'].shape[0]} points")
             if "peak_omega" in f:
                 kw["peaks"] = [Peak(float(w), float(a), int(i), m.decode()) for w, a, i, m in
                                zip(f["peak_omega"], f["peak_amplitude"], f["peak_index"],

@@ -52,7 +52,8 @@ LEAK_TOL = 1e-6
 
 def warn_leak(leak: float, omega: float, stacklevel: int) -> None:
     """Warn (RuntimeWarning) when a travelling-wave selection's leak (FRFPoint.leak) is
-    above LEAK_TOL; omega: rad/s, where; stacklevel: warnings.warn's, counted from here."""
+    above LEAK_TOL; omega: rad/s, where; stacklevel: 1 = the caller of warn_leak, 2 = its
+    caller, and so on."""
     if leak > LEAK_TOL:
         warnings.warn(f"frirom: the travelling-wave selection leaks: contact forces off "
                       f"the selection reach {leak:.2g} of those on it at "
@@ -307,7 +308,8 @@ class _Continuation:
                 if self.tan0.size != p.ny + 1:
                     raise SizeError("start.tangent: size does not match the unknowns")
                 self.n_before = int(start.get("n_points", 0))
-                self.leak_before = start.get("leak")
+            # the stored points' worst leak, whichever way the run goes on from them
+            self.leak_before = start.get("leak")
         if self.start_mode == START_CONTINUE:
             self._first_point(start is None)
         self.yscale = float(np.linalg.norm(self.y0)) or 1.0
@@ -434,7 +436,7 @@ class _Continuation:
             if self.leak_before is not None and self.leak_before[0] > worst:
                 worst, at = self.leak_before      # a point stored before the resume
             out.solver_info += f"; leak max {worst:.1e}"
-            warn_leak(worst, at, stacklevel=5)
+            warn_leak(worst, at, stacklevel=4)
         if keep_unknowns and pts:
             out._last_unknowns = pts[-1].unknowns
             out._last_slider = pts[-1].slider
@@ -651,7 +653,7 @@ def solve_point(model: Model | CyclicModel, excitation: Excitation, omega: float
     raise_for_status(res.info, res.msg)
     pt = packed.points(res, 0.0, time.perf_counter() - t0)[0]
     if pt.leak is not None:
-        warn_leak(pt.leak, pt.omega, stacklevel=3)
+        warn_leak(pt.leak, pt.omega, stacklevel=2)
     pt.output_dofs = packed.outputs
     pt.timings = {}
     add_timings(pt.timings, res.timings)

@@ -185,6 +185,17 @@ class Deck:
         return opts
 
 
+def _node_id(ref) -> int:
+    """The node id of a deck DoF reference "NODE:DIR" (fields.dof_ref's rule: digits, or
+    N + digits); ValueError for a node set name."""
+    node = str(ref).split(":")[0].strip()
+    if node[:1].upper() == "N" and node[1:].isdigit():
+        node = node[1:]
+    if not node.isdigit():
+        raise ValueError(f"{ref!r}: a node set, not a node id")
+    return int(node)
+
+
 def check_wave_sectors(ctx: Context, raw: dict, rom, spec) -> None:
     """``travelling_wave = true``: each ``[[excitation.engine_order]]``'s DoFs are one per
     sector, 360 / n_sectors degrees apart about the reduction's axis, every load listed
@@ -201,8 +212,8 @@ def check_wave_sectors(ctx: Context, raw: dict, rom, spec) -> None:
         if ns <= 2:                 # no direction to tell
             continue
         try:
-            nodes = [int(str(d[0] if isinstance(d, list) else d).split(":")[0].lstrip("Nn"))
-                     for d in eo["dofs"]]
+            # the node ids as the deck's DoF references read them (a node set: no check)
+            nodes = [_node_id(d[0] if isinstance(d, list) else d) for d in eo["dofs"]]
             xyz = rom.coordinates(nodes) - np.asarray(spec.origin, float)
         except (ValueError, InputError):
             continue
@@ -221,10 +232,10 @@ def check_wave_sectors(ctx: Context, raw: dict, rom, spec) -> None:
                             f"order about the axis, 360 / n_sectors = {360 / ns:.6g} deg "
                             f"apart, {where}", None)
         if first is None:
-            first = sense
+            first, k0 = sense, k
         elif sense and sense != first:
             raise ctx.error(f"excitation.engine_order[{k}].dofs", "sectors listed in the "
-                            "direction of excitation.engine_order[0]'s about the axis "
+                            f"direction of excitation.engine_order[{k0}]'s about the axis "
                             "(listed the other way, the same eo is the wave running "
                             "backwards, and the two a standing wave), with "
                             "reduction.interface_modes.travelling_wave = true", None)
