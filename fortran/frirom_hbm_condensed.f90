@@ -76,7 +76,11 @@ contains
     end procedure cond_init
 
     module procedure hbm_set_selection
-        integer(ip) :: nu, nc, h, j, c, k, n, stat
+        integer(ip) :: nu, nc, h, j, c, k, n, m, i, q, stat
+        integer(ip), allocatable :: ksel(:), kpt(:), kptr(:), at(:, :), tk(:, :), ptn(:, :)
+        real(wp), allocatable :: tw(:, :), jm(:, :), jk(:, :)
+        integer(ip), allocatable :: ipiv(:)
+        logical, allocatable :: kmask(:, :)
         real(wp) :: on, off
         info = FRIROM_OK
         select type (sys => sysc)
@@ -96,42 +100,93 @@ contains
                 call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: keeps no unknown')
             end if
             if (info /= 0) return
-            if (allocated(sys%sel)) deallocate (sys%sel, sys%kpt, sys%kptr, sys%kmask)
+            if (present(pair)) then
+                call check_pairs(keep, pair, ptn, info, errmsg)
+                if (info /= 0) return
+            end if
+            ! everything is built in locals first: a failed call leaves sys as it was
             n = 0
             do c = 1, nc
                 n = n + count(keep(:, c/2) /= 0)
             end do
-            allocate (sys%kptr(sys%nh + 2), sys%kpt(count(keep /= 0)), sys%sel(n), &
-                      sys%kmask(nu, 0:sys%nh), stat=stat)
-            if (stat == 0) then
-                if (allocated(sys%jm)) deallocate (sys%jm)
-                if (allocated(sys%ipiv)) deallocate (sys%ipiv)
-                allocate (sys%jm(n, n), sys%ipiv(n), stat=stat)
-            end if
+            allocate (kptr(sys%nh + 2), kpt(count(keep /= 0)), ksel(n), at(nu, nc), &
+                      tk(2, n), tw(2, n), kmask(nu, 0:sys%nh), stat=stat)
             if (stat /= 0) then
-                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'selection: Jacobian')
+                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'selection: index arrays')
                 return
             end if
-            sys%kmask = keep /= 0
-            sys%kptr(1) = 1
+            kptr(1) = 1
             k = 0
             do h = 0, sys%nh
                 do j = 1, nu
                     if (keep(j, h) == 0) cycle
                     k = k + 1
-                    sys%kpt(k) = j
+                    kpt(k) = j
                 end do
-                sys%kptr(h + 2) = k + 1
+                kptr(h + 2) = k + 1
             end do
-            ! y: coefficient by coefficient (harmonic c/2), the kept coordinates ascending
+            ! y: coefficient by coefficient (harmonic c/2), the kept coordinates ascending;
+            ! at(j, c) its position (0: left out)
             k = 0
+            at = 0
             do c = 1, nc
                 h = c/2
-                sys%sel(k + 1:k + sys%kptr(h + 2) - sys%kptr(h + 1)) = &
-                    sys%kpt(sys%kptr(h + 1):sys%kptr(h + 2) - 1) + nu*(c - 1)
-                k = k + sys%kptr(h + 2) - sys%kptr(h + 1)
+                do i = kptr(h + 1), kptr(h + 2) - 1
+                    k = k + 1
+                    ksel(k) = kpt(i) + nu*(c - 1)
+                    at(kpt(i), c) = k
+                end do
             end do
-            sys%n = n
+            ! T: in the kept order, a pair's column where its first member (j, the cosine
+            ! or sine of a coordinate with pair(j, h) /= 0) is, none for its second (k)
+            m = 0
+            do i = 1, n
+                j = mod(ksel(i) - 1, nu) + 1
+                c = (ksel(i) - 1)/nu + 1
+                h = c/2
+                m = m + 1
+                tk(:, m) = [i, 0_ip]
+                tw(:, m) = [1.0_wp, 0.0_wp]
+                if (.not. present(pair) .or. h == 0) cycle
+                if (ptn(j, h) /= 0) then
+                    m = m - 1                         ! a second member: in its pair's column
+                else if (pair(j, h) /= 0) then
+                    q = abs(pair(j, h))
+                    if (c == 2*h) then                ! (y(j, cos) + s y(q, sin)) / sqrt 2
+                        tk(2, m) = at(q, c + 1)
+                        tw(:, m) = [1.0_wp, real(sign(1_ip, pair(j, h)), wp)]/sqrt(2.0_wp)
+                    else                              ! (y(j, sin) - s y(q, cos)) / sqrt 2
+                        tk(2, m) = at(q, c - 1)
+                        tw(:, m) = [1.0_wp, -real(sign(1_ip, pair(j, h)), wp)]/sqrt(2.0_wp)
+                    end if
+                end if
+            end do
+            if (m < n) then
+                allocate (jk(n, n), stat=stat)
+            else
+                allocate (jk(0, 0), stat=stat)
+            end if
+            if (stat == 0) allocate (jm(m, m), ipiv(m), stat=stat)
+            if (stat /= 0) then
+                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'selection: Jacobian')
+                return
+            end if
+            call move_alloc(kptr, sys%kptr)
+            call move_alloc(kpt, sys%kpt)
+            call move_alloc(ksel, sys%sel)
+            call move_alloc(jm, sys%jm)
+            call move_alloc(ipiv, sys%ipiv)
+            if (allocated(sys%tk)) deallocate (sys%tk, sys%tw, sys%jk, sys%kpair)
+            if (m < n) then
+                sys%tk = tk(:, 1:m)
+                sys%tw = tw(:, 1:m)
+                allocate (sys%kpair(nu, 0:sys%nh))
+                sys%kpair = pair
+                call move_alloc(jk, sys%jk)
+            end if
+            kmask = keep /= 0
+            call move_alloc(kmask, sys%kmask)
+            sys%n = m
             if (allocated(sys%jcur)) deallocate (sys%jcur)
             if (allocated(sys%jms)) deallocate (sys%jms)
             if (allocated(sys%kcw)) deallocate (sys%kcw)
@@ -153,6 +208,118 @@ contains
         end select
     end procedure hbm_set_selection
 
+    !> Check hbm_set_selection's pair against keep: pairs at harmonics >= 1 only, between
+    !> two different coordinates both kept there, each coordinate in one pair at most;
+    !> ptn(k, h) = j for the second member k of j's pair, else 0.
+    subroutine check_pairs(keep, pair, ptn, info, errmsg)
+        integer(ip), intent(in) :: keep(:, 0:), pair(:, 0:)
+        integer(ip), allocatable, intent(out) :: ptn(:, :)
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        integer(ip) :: nu, nh, h, j, q, stat
+        info = FRIROM_OK
+        nu = size(keep, 1)
+        nh = size(keep, 2) - 1
+        if (size(pair, 1) /= nu .or. size(pair, 2) /= nh + 1) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'selection: pair must be '// &
+                            '(nonlinear DoFs, H+1)')
+            return
+        end if
+        allocate (ptn(nu, 0:nh), stat=stat)
+        if (stat /= 0) then
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'selection: pairs')
+            return
+        end if
+        ptn = 0
+        if (any(pair(:, 0) /= 0)) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: pair at harmonic 0 '// &
+                            '(it has no sine)')
+            return
+        end if
+        do h = 1, nh
+            do j = 1, nu
+                q = abs(pair(j, h))
+                if (q == 0) cycle
+                if (q > nu .or. q == j) then
+                    call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: pair names '// &
+                                    'no other coordinate')
+                else if (keep(j, h) == 0 .or. keep(q, h) == 0) then
+                    call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: pair of a '// &
+                                    'coordinate and harmonic left out')
+                else if (pair(q, h) /= 0 .or. ptn(q, h) /= 0 .or. ptn(j, h) /= 0) then
+                    call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: a '// &
+                                    'coordinate in two pairs')
+                end if
+                if (info /= 0) return
+                ptn(q, h) = j
+            end do
+        end do
+    end subroutine check_pairs
+
+    module procedure hbm_sel_expand
+        integer(ip) :: i
+        real(wp), allocatable :: yk(:)
+        select type (sys => sysc)
+        type is (hbm_condensed)
+            if (.not. allocated(sys%sel)) then
+                yf = y
+                return
+            end if
+            yf = 0.0_wp
+            if (allocated(sys%tk)) then
+                allocate (yk(size(sys%sel)))
+                call pair_expand(sys, y, yk)
+                yf(sys%sel) = yk
+            else
+                do i = 1, size(sys%sel)
+                    yf(sys%sel(i)) = y(i)
+                end do
+            end if
+        class default
+            yf = y
+        end select
+    end procedure hbm_sel_expand
+
+    module procedure hbm_sel_reduce
+        select type (sys => sysc)
+        type is (hbm_condensed)
+            if (.not. allocated(sys%sel)) then
+                y = yf
+            else if (allocated(sys%tk)) then
+                call pair_reduce(sys, yf(sys%sel), y)
+            else
+                y = yf(sys%sel)
+            end if
+        class default
+            y = yf
+        end select
+    end procedure hbm_sel_reduce
+
+    !> yk = T z (kept layout; hbm_condensed%tk).
+    pure subroutine pair_expand(sys, z, yk)
+        type(hbm_condensed), intent(in) :: sys
+        real(wp), intent(in) :: z(:)
+        real(wp), intent(out) :: yk(:)
+        integer(ip) :: i
+        yk = 0.0_wp
+        do i = 1, size(sys%tk, 2)
+            yk(sys%tk(1, i)) = sys%tw(1, i)*z(i)
+            if (sys%tk(2, i) > 0) yk(sys%tk(2, i)) = sys%tw(2, i)*z(i)
+        end do
+    end subroutine pair_expand
+
+    !> z = T^T yk (kept layout; hbm_condensed%tk).
+    pure subroutine pair_reduce(sys, yk, z)
+        type(hbm_condensed), intent(in) :: sys
+        real(wp), intent(in) :: yk(:)
+        real(wp), intent(out) :: z(:)
+        integer(ip) :: i
+        do i = 1, size(sys%tk, 2)
+            z(i) = sys%tw(1, i)*yk(sys%tk(1, i))
+            if (sys%tk(2, i) > 0) z(i) = z(i) + sys%tw(2, i)*yk(sys%tk(2, i))
+        end do
+    end subroutine pair_reduce
+
     module procedure cond_leak
         integer(ip) :: c
         real(wp) :: on, off
@@ -165,8 +332,32 @@ contains
             on = on + sum(sys%fd(:, c)**2, mask=sys%kmask(:, c/2))
             off = off + sum(sys%fd(:, c)**2, mask=.not. sys%kmask(:, c/2))
         end do
+        ! the pairs: the other travelling direction counts as off the selection too
+        if (allocated(sys%tk)) then
+            do c = 1, sys%nh
+                off = off + pair_off(sys, c, sys%fd(:, 2*c), sys%fd(:, 2*c + 1))
+            end do
+        end if
         leak = max(ratio(off, on), sys%c0_leak, sys%xe_leak)
     end procedure cond_leak
+
+    !> The part of harmonic h (cosines a, sines b by coordinate) against its pairs
+    !> (hbm_condensed%kpair), squared: sum over the pairs (j, k, s) of
+    !> ((a_j - s b_k)^2 + (b_j + s a_k)^2) / 2, the wave in the other direction.
+    pure real(wp) function pair_off(sys, h, a, b) result(off)
+        type(hbm_condensed), intent(in) :: sys
+        integer(ip), intent(in) :: h
+        real(wp), intent(in) :: a(:), b(:)
+        integer(ip) :: j, k
+        real(wp) :: s
+        off = 0.0_wp
+        do j = 1, sys%nnl
+            k = abs(sys%kpair(j, h))
+            if (k == 0) cycle
+            s = real(sign(1_ip, sys%kpair(j, h)), wp)
+            off = off + 0.5_wp*((a(j) - s*b(k))**2 + (b(j) + s*a(k))**2)
+        end do
+    end function pair_off
 
     !> sqrt(off / on) for two sums of squares: 0 when both are 0, huge when only on is.
     pure real(wp) function ratio(off, on)
@@ -295,9 +486,9 @@ contains
         if (allocated(this%sel)) then
             ! the kept rows (hbm_set_selection); y holds no harmonic 0 after its kept rows
             rf = reshape(r2, [nnl*nc])
-            r = rf(this%sel)
+            call hbm_sel_reduce(this, rf, r)
             rf = reshape(rl2, [nnl*nc])
-            rlam = rf(this%sel)
+            call hbm_sel_reduce(this, rf, rlam)
             nhd0 = this%kptr(2) - this%kptr(1)
         else
             r = reshape(r2, [n])
@@ -568,7 +759,7 @@ contains
         type(hbm_condensed), intent(inout) :: sys
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
-        integer(ip) :: n, nu, nc, g, h, c, kh, ca, cb, stat, i
+        integer(ip) :: n, nu, nc, g, h, c, kh, ca, cb, stat, i, nk
         integer(ip), allocatable :: at(:), off(:)
         real(wp), allocatable :: kc(:, :), kf(:, :), a(:, :), b(:, :)
         real(wp) :: t0
@@ -576,13 +767,14 @@ contains
         info = FRIROM_OK
         t0 = wtime()
         n = sys%n
+        nk = size(sys%sel)
         nu = sys%nnl
         nc = sys%nc
         stat = 0
         if (allocated(sys%kcw)) then
-            if (size(sys%kcw, 1) /= n) deallocate (sys%kcw)
+            if (size(sys%kcw, 1) /= nk) deallocate (sys%kcw)
         end if
-        if (.not. allocated(sys%kcw)) allocate (sys%kcw(n, n), stat=stat)
+        if (.not. allocated(sys%kcw)) allocate (sys%kcw(nk, nk), stat=stat)
         if (stat /= 0) then
             call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: Jacobian')
             return
@@ -590,9 +782,14 @@ contains
         call move_alloc(sys%kcw, kc)
         ! at: position j + nu (c-1) -> its index in y (0: left out); off(c): y's entries
         ! before coefficient c
-        allocate (at(nu*nc), off(nc + 1))
+        allocate (at(nu*nc), off(nc + 1), stat=stat)
+        if (stat /= 0) then
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: Jacobian')
+            call move_alloc(kc, sys%kcw)
+            return
+        end if
         at = 0
-        at(sys%sel) = [(i, i=1, n)]
+        at(sys%sel) = [(i, i=1, nk)]
         off(1) = 0
         do c = 1, nc
             h = c/2
@@ -636,15 +833,44 @@ contains
                 ca = off(2*h) + 1
                 cb = off(2*h + 1) + 1
             end if
-            call harm_rows(kh, n, a, b, kc, ca, cb, sys%jm)
+            if (allocated(sys%tk)) then
+                call harm_rows(kh, nk, a, b, kc, ca, cb, sys%jk)
+            else
+                call harm_rows(kh, nk, a, b, kc, ca, cb, sys%jm)
+            end if
             sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
         end do
+        call move_alloc(kc, sys%kcw)
+        ! pairs: J_z = T^T J T (I stays I, T orthonormal)
+        if (allocated(sys%tk)) call pair_jac(sys)
         do i = 1, n
             sys%jm(i, i) = sys%jm(i, i) + 1.0_wp
         end do
-        call move_alloc(kc, sys%kcw)
         call cond_factor(sys, info, errmsg)
     end subroutine cond_jacobian_sel
+
+    !> jm = T^T jk T for a selection with pairs (hbm_condensed%tk): columns, then rows.
+    subroutine pair_jac(sys)
+        type(hbm_condensed), intent(inout) :: sys
+        real(wp), allocatable :: jt(:, :)
+        integer(ip) :: i, j, m
+        real(wp) :: t0
+        t0 = wtime()
+        m = sys%n
+        allocate (jt(size(sys%jk, 1), m))
+        do i = 1, m
+            jt(:, i) = sys%tw(1, i)*sys%jk(:, sys%tk(1, i))
+            if (sys%tk(2, i) > 0) jt(:, i) = jt(:, i) + sys%tw(2, i)*sys%jk(:, sys%tk(2, i))
+        end do
+        do j = 1, m
+            do i = 1, m
+                sys%jm(i, j) = sys%tw(1, i)*jt(sys%tk(1, i), j)
+                if (sys%tk(2, i) > 0) sys%jm(i, j) = sys%jm(i, j) + &
+                                                     sys%tw(2, i)*jt(sys%tk(2, i), j)
+            end do
+        end do
+        sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
+    end subroutine pair_jac
 
     !> R_h = a + i b on the coordinates rows (both sides), at the Jacobian's frequency:
     !> from the modes (A_h(rows) diag(g_h) A_h(rows)^H, only these rows) or read from the
@@ -1407,6 +1633,9 @@ contains
             end if
             on = on + sum(abs(xe)**2, mask=sys%kmask(:, h))
             off = off + sum(abs(xe)**2, mask=.not. sys%kmask(:, h))
+            ! harm_col: cosine real(xe), sine -aimag(xe)
+            if (allocated(sys%tk) .and. h > 0) off = off + pair_off(sys, h, real(xe, wp), &
+                                                                     -aimag(xe))
         end do
         sys%xe_leak = ratio(off, on)
     end subroutine load_leak
