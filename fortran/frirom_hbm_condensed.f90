@@ -162,7 +162,7 @@ contains
                 end if
             end do
             if (m < n) then
-                allocate (jk(n, n), stat=stat)
+                allocate (jk(n, m), stat=stat)
             else
                 allocate (jk(0, 0), stat=stat)
             end if
@@ -702,22 +702,23 @@ contains
                 ca = nnl*(2*h - 1) + 1
                 cb = nnl*(2*h) + 1
             end if
-            call harm_rows(nnl, n, sys%ar(:, :, h), sys%ai(:, :, h), kc, ca, cb, jm)
+            call harm_rows(nnl, n, n, sys%ar(:, :, h), sys%ai(:, :, h), kc, ca, cb, jm)
         end do
     end subroutine jac_dense
 
-    !> One harmonic's rows of J - I = R_h kc, R_h = a + i b on k coordinates: harmonic 0
-    !> (cb = 0) jm(ca.., :) = a kc(ca.., :); else a-rows A Kc_a + B Kc_b and b-rows
-    !> -B Kc_a + A Kc_b (kc's and jm's rows of the cosine block from ca, the sine from cb).
-    subroutine harm_rows(k, n, a, b, kc, ca, cb, jm)
-        integer(ip), intent(in) :: k, n, ca, cb
-        real(wp), intent(in) :: a(k, k), b(k, k), kc(n, n)
-        real(wp), intent(inout) :: jm(n, n)
-        call dgemm('N', 'N', k, n, k, 1.0_wp, a, k, kc(ca, 1), n, 0.0_wp, jm(ca, 1), n)
+    !> One harmonic's rows of J - I = R_h kc, R_h = a + i b on k coordinates, for kc's m
+    !> columns: harmonic 0 (cb = 0) jm(ca.., :) = a kc(ca.., :); else a-rows A Kc_a + B Kc_b
+    !> and b-rows -B Kc_a + A Kc_b (kc's and jm's rows of the cosine block from ca, the sine
+    !> from cb).
+    subroutine harm_rows(k, n, m, a, b, kc, ca, cb, jm)
+        integer(ip), intent(in) :: k, n, m, ca, cb
+        real(wp), intent(in) :: a(k, k), b(k, k), kc(n, m)
+        real(wp), intent(inout) :: jm(n, m)
+        call dgemm('N', 'N', k, m, k, 1.0_wp, a, k, kc(ca, 1), n, 0.0_wp, jm(ca, 1), n)
         if (cb == 0) return
-        call dgemm('N', 'N', k, n, k, 1.0_wp, b, k, kc(cb, 1), n, 1.0_wp, jm(ca, 1), n)
-        call dgemm('N', 'N', k, n, k, -1.0_wp, b, k, kc(ca, 1), n, 0.0_wp, jm(cb, 1), n)
-        call dgemm('N', 'N', k, n, k, 1.0_wp, a, k, kc(cb, 1), n, 1.0_wp, jm(cb, 1), n)
+        call dgemm('N', 'N', k, m, k, 1.0_wp, b, k, kc(cb, 1), n, 1.0_wp, jm(ca, 1), n)
+        call dgemm('N', 'N', k, m, k, -1.0_wp, b, k, kc(ca, 1), n, 0.0_wp, jm(cb, 1), n)
+        call dgemm('N', 'N', k, m, k, 1.0_wp, a, k, kc(cb, 1), n, 1.0_wp, jm(cb, 1), n)
     end subroutine harm_rows
 
     !> Modal route, a selection: b(rows, :) = A_h(rows, :) x, the other rows of b zero.
@@ -760,8 +761,9 @@ contains
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
         integer(ip) :: n, nu, nc, g, h, c, kh, ca, cb, stat, i, nk
-        integer(ip), allocatable :: at(:), off(:)
-        real(wp), allocatable :: kc(:, :), kf(:, :), a(:, :), b(:, :)
+        integer(ip), allocatable :: at(:), off(:), zc(:)
+        real(wp), allocatable :: kc(:, :), kf(:, :), a(:, :), b(:, :), zw(:), kz(:, :)
+        logical :: paired
         real(wp) :: t0
         logical :: dense
         info = FRIROM_OK
@@ -770,6 +772,7 @@ contains
         nk = size(sys%sel)
         nu = sys%nnl
         nc = sys%nc
+        paired = allocated(sys%tk)
         stat = 0
         if (allocated(sys%kcw)) then
             if (size(sys%kcw, 1) /= nk) deallocate (sys%kcw)
@@ -782,7 +785,7 @@ contains
         call move_alloc(sys%kcw, kc)
         ! at: position j + nu (c-1) -> its index in y (0: left out); off(c): y's entries
         ! before coefficient c
-        allocate (at(nu*nc), off(nc + 1), stat=stat)
+        allocate (at(nu*nc), off(nc + 1), zc(nk), zw(nk), stat=stat)
         if (stat /= 0) then
             call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: Jacobian')
             call move_alloc(kc, sys%kcw)
@@ -790,6 +793,16 @@ contains
         end if
         at = 0
         at(sys%sel) = [(i, i=1, nk)]
+        ! zc(k), zw(k): T's column that holds kept unknown k, and its weight there
+        if (paired) then
+            do i = 1, n
+                do c = 1, 2
+                    if (sys%tk(c, i) == 0) cycle
+                    zc(sys%tk(c, i)) = i
+                    zw(sys%tk(c, i)) = sys%tw(c, i)
+                end do
+            end do
+        end if
         off(1) = 0
         do c = 1, nc
             h = c/2
@@ -821,6 +834,19 @@ contains
                 return
             end if
         end if
+        if (paired) then
+            ! kz = kc T: R_h's products then on T's columns only
+            allocate (kz(nk, n), stat=stat)
+            if (stat /= 0) then
+                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: Jacobian')
+                call move_alloc(kc, sys%kcw)
+                return
+            end if
+            kz = 0.0_wp
+            do i = 1, nk
+                kz(:, zc(i)) = kz(:, zc(i)) + zw(i)*kc(:, i)
+            end do
+        end if
         sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
         do h = 0, sys%nh
             kh = sys%kptr(h + 2) - sys%kptr(h + 1)
@@ -833,44 +859,37 @@ contains
                 ca = off(2*h) + 1
                 cb = off(2*h + 1) + 1
             end if
-            if (allocated(sys%tk)) then
-                call harm_rows(kh, nk, a, b, kc, ca, cb, sys%jk)
+            if (paired) then
+                call harm_rows(kh, nk, n, a, b, kz, ca, cb, sys%jk)
             else
-                call harm_rows(kh, nk, a, b, kc, ca, cb, sys%jm)
+                call harm_rows(kh, nk, n, a, b, kc, ca, cb, sys%jm)
             end if
             sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
         end do
         call move_alloc(kc, sys%kcw)
-        ! pairs: J_z = T^T J T (I stays I, T orthonormal)
-        if (allocated(sys%tk)) call pair_jac(sys)
+        ! pairs: J_z = T^T (J T) (I stays I, T orthonormal)
+        if (paired) call pair_rows(sys)
         do i = 1, n
             sys%jm(i, i) = sys%jm(i, i) + 1.0_wp
         end do
         call cond_factor(sys, info, errmsg)
     end subroutine cond_jacobian_sel
 
-    !> jm = T^T jk T for a selection with pairs (hbm_condensed%tk): columns, then rows.
-    subroutine pair_jac(sys)
+    !> jm = T^T jk for a selection with pairs (hbm_condensed%tk; jk = J T): the rows.
+    subroutine pair_rows(sys)
         type(hbm_condensed), intent(inout) :: sys
-        real(wp), allocatable :: jt(:, :)
-        integer(ip) :: i, j, m
+        integer(ip) :: i, j
         real(wp) :: t0
         t0 = wtime()
-        m = sys%n
-        allocate (jt(size(sys%jk, 1), m))
-        do i = 1, m
-            jt(:, i) = sys%tw(1, i)*sys%jk(:, sys%tk(1, i))
-            if (sys%tk(2, i) > 0) jt(:, i) = jt(:, i) + sys%tw(2, i)*sys%jk(:, sys%tk(2, i))
-        end do
-        do j = 1, m
-            do i = 1, m
-                sys%jm(i, j) = sys%tw(1, i)*jt(sys%tk(1, i), j)
+        do j = 1, sys%n
+            do i = 1, sys%n
+                sys%jm(i, j) = sys%tw(1, i)*sys%jk(sys%tk(1, i), j)
                 if (sys%tk(2, i) > 0) sys%jm(i, j) = sys%jm(i, j) + &
-                                                     sys%tw(2, i)*jt(sys%tk(2, i), j)
+                                                     sys%tw(2, i)*sys%jk(sys%tk(2, i), j)
             end do
         end do
         sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
-    end subroutine pair_jac
+    end subroutine pair_rows
 
     !> R_h = a + i b on the coordinates rows (both sides), at the Jacobian's frequency:
     !> from the modes (A_h(rows) diag(g_h) A_h(rows)^H, only these rows) or read from the
@@ -1043,10 +1062,13 @@ contains
                            gs(qoff(c1) + a, 1, d1), nq, yt(1, 1, d1), nq, 1.0_wp, kt(a, 1), &
                            size(kt, 1))
             end do
+            ! element by element: a vector subscript on both sides made a temporary each
             do c2 = 1, nc
                 do q = 1, ln(c2)
-                    kc(py(1:m1, c1), py(q, c2)) = kc(py(1:m1, c1), py(q, c2)) + &
-                                                  kt(1:m1, qoff(c2) + q)
+                    b = py(q, c2)
+                    do k = 1, m1
+                        kc(py(k, c1), b) = kc(py(k, c1), b) + kt(k, qoff(c2) + q)
+                    end do
                 end do
             end do
         end do

@@ -183,6 +183,10 @@ program test_hbm
     call check(info /= 0 .and. index(msg, 'harmonic 0') > 0 .and. scp%n == 3*nc - 4, &
                'a failed selection keeps the pairs set before')
     call fd_check(scp, 'condensed paired')
+    ! the same on the element loops' path (sparse rows: kc T from the full assembly)
+    call check(scp%cs%grp(1)%asm_mode == 2, 'the chain takes the dense rows')
+    scp%cs%grp(1)%asm_mode = 1
+    call fd_check(scp, 'condensed paired, element loops')
     ! T^T T = I, and T z has the pairs' relations (full layout j + 3 (c - 1), c = 2 h
     ! the cosine): y(k, sin) = s y(j, cos), y(k, cos) = -s y(j, sin)
     call random_number(zp)
