@@ -774,10 +774,18 @@ contains
         nc = sys%nc
         paired = allocated(sys%tk)
         stat = 0
+        dense = .true.
+        do g = 1, size(sys%cs%grp)
+            if (sys%cs%grp(g)%asm_mode == 0) call choose_dense(sys%cs%grp(g), sys%cs%g)
+            dense = dense .and. sys%cs%grp(g)%asm_mode == 2
+        end do
+        ! kc on the kept columns, or with pairs and dense rows straight on T's (kc T)
+        i = nk
+        if (paired .and. dense) i = n
         if (allocated(sys%kcw)) then
-            if (size(sys%kcw, 1) /= nk) deallocate (sys%kcw)
+            if (size(sys%kcw, 2) /= i) deallocate (sys%kcw)
         end if
-        if (.not. allocated(sys%kcw)) allocate (sys%kcw(nk, nk), stat=stat)
+        if (.not. allocated(sys%kcw)) allocate (sys%kcw(nk, i), stat=stat)
         if (stat /= 0) then
             call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: Jacobian')
             return
@@ -809,14 +817,13 @@ contains
             off(c + 1) = off(c) + sys%kptr(h + 2) - sys%kptr(h + 1)
         end do
         kc = 0.0_wp
-        dense = .true.
-        do g = 1, size(sys%cs%grp)
-            if (sys%cs%grp(g)%asm_mode == 0) call choose_dense(sys%cs%grp(g), sys%cs%g)
-            dense = dense .and. sys%cs%grp(g)%asm_mode == 2
-        end do
         if (dense) then
             do g = 1, size(sys%cs%grp)
-                call kc_dense_sel(sys%cs%grp(g), nu, nc, at, kc)
+                if (paired) then
+                    call kc_dense_sel(sys%cs%grp(g), nu, nc, at, kc, zc, zw)
+                else
+                    call kc_dense_sel(sys%cs%grp(g), nu, nc, at, kc)
+                end if
             end do
         else
             ! sparse rows (physical contact DoFs, not what a selection is for): the element
@@ -834,7 +841,7 @@ contains
                 return
             end if
         end if
-        if (paired) then
+        if (paired .and. .not. dense) then
             ! kz = kc T: R_h's products then on T's columns only
             allocate (kz(nk, n), stat=stat)
             if (stat /= 0) then
@@ -846,6 +853,7 @@ contains
             do i = 1, nk
                 kz(:, zc(i)) = kz(:, zc(i)) + zw(i)*kc(:, i)
             end do
+            call move_alloc(kz, kc)
         end if
         sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
         do h = 0, sys%nh
@@ -860,7 +868,7 @@ contains
                 cb = off(2*h + 1) + 1
             end if
             if (paired) then
-                call harm_rows(kh, nk, n, a, b, kz, ca, cb, sys%jk)
+                call harm_rows(kh, nk, n, a, b, kc, ca, cb, sys%jk)
             else
                 call harm_rows(kh, nk, n, a, b, kc, ca, cb, sys%jm)
             end if
@@ -970,10 +978,15 @@ contains
     !> by direction over the columns that direction's rows read. Those are a range: each
     !> coefficient's columns are ordered by the directions that read them (an MS
     !> coordinate is one cylindrical component: a normal or a tangential row reads a third).
-    subroutine kc_dense_sel(gr, nu, nc, at, kc)
+    subroutine kc_dense_sel(gr, nu, nc, at, kc, zc, zw)
         type(contact_group), intent(in) :: gr
         integer(ip), intent(in) :: nu, nc, at(:)
         real(wp), intent(inout) :: kc(:, :)
+        !> a selection's pairs: kc is then (kept, T's columns) and gets kc T
+        !> (kc_dense_pairs); zc(k) the column of T that holds kept unknown k, zw(k) its
+        !> weight there
+        integer(ip), intent(in), optional :: zc(:)
+        real(wp), intent(in), optional :: zw(:)
         integer(ip), allocatable :: ls(:, :), py(:, :), ln(:), qoff(:), key(:), ord(:), &
                                     lo(:, :), hi(:, :)
         real(wp), allocatable :: yt(:, :, :), gs(:, :, :), kt(:, :)
@@ -1031,12 +1044,17 @@ contains
         nq = qoff(nc + 1)
         if (nq == 0) return
         ! gs(q, e, d): Gd^T on Q (the kept columns of every coefficient stacked), by direction
-        allocate (yt(nq, ne, nd), gs(nq, ne, nd), kt(maxval(ln), nq))
+        allocate (gs(nq, ne, nd))
         do d1 = 1, nd
             do c = 1, nc
                 gs(qoff(c) + 1:qoff(c + 1), :, d1) = gr%gt(ls(1:ln(c), c), d1:nrg:nd)
             end do
         end do
+        if (present(zc)) then
+            call kc_dense_pairs(gr, nc, ln, qoff, ls, py, lo, hi, rd, key, gs, zc, zw, kc)
+            return
+        end if
+        allocate (yt(nq, ne, nd), kt(maxval(ln), nq))
         do c1 = 1, nc
             m1 = ln(c1)
             if (m1 == 0) cycle
@@ -1073,6 +1091,132 @@ contains
             end do
         end do
     end subroutine kc_dense_sel
+
+    !> kc_dense_sel for a selection's pairs: kc(S1 c1, z) += Gd(:, S1)^T Y_z, Y_z = J_loc
+    !> Gd T on T's columns z that touch the group (one or two members in Q, a pair's in
+    !> coefficients c and c + 1), the products then on half the columns. The z are grouped
+    !> by their members' coefficients (ca, cb), so that J_loc's two entries are the same
+    !> for a group, and ordered within it by the directions that read them: Y_z is formed
+    !> from gs1 = zw Gd^T on the first members and gs2 on the second, range by range.
+    subroutine kc_dense_pairs(gr, nc, ln, qoff, ls, py, lo, hi, rd, key, gs, zc, zw, kc)
+        type(contact_group), intent(in) :: gr
+        integer(ip), intent(in) :: nc, ln(:), qoff(:), ls(:, :), py(:, :), lo(:, :), &
+                                   hi(:, :), key(:), zc(:)
+        logical, intent(in) :: rd(:, :)
+        real(wp), intent(in) :: gs(qoff(nc + 1), gr%ne, gr%ndir), zw(:)
+        real(wp), intent(inout) :: kc(:, :)
+        integer(ip), allocatable :: zl(:), zm(:, :), zco(:, :), zs(:, :), perm(:), zcs(:), &
+                                    bca(:), bcb(:), blo(:, :), bhi(:, :)
+        real(wp), allocatable :: zwt(:, :), gs1(:, :, :), gs2(:, :, :), yz(:, :, :), kt(:, :)
+        integer(ip) :: nd, ne, nq, nz, nb, c, t, p, i, k, ca, cb, d1, d2, e, c1, m1, a, b, &
+                       ib, iz
+        real(wp) :: v1, v2
+        nd = gr%ndir
+        ne = gr%ne
+        nq = qoff(nc + 1)
+        ! the columns z: members zm (stacked index in Q, 0: none), their coefficients zco,
+        ! group columns zs (index into gcols) and weights zwt; zl: T's column -> z
+        allocate (zl(size(kc, 2)), zm(2, nq), zco(2, nq), zs(2, nq), zwt(2, nq), zcs(nq))
+        zl = 0
+        nz = 0
+        do c = 1, nc
+            do t = 1, ln(c)
+                p = zc(py(t, c))
+                i = zl(p)
+                if (i == 0) then
+                    nz = nz + 1
+                    zl(p) = nz
+                    zcs(nz) = p
+                    zm(:, nz) = [qoff(c) + t, 0_ip]
+                    zco(:, nz) = [c, 0_ip]
+                    zs(:, nz) = [ls(t, c), 0_ip]
+                    zwt(:, nz) = [zw(py(t, c)), 0.0_wp]
+                else
+                    zm(2, i) = qoff(c) + t
+                    zco(2, i) = c
+                    zs(2, i) = ls(t, c)
+                    zwt(2, i) = zw(py(t, c))
+                end if
+            end do
+        end do
+        ! order: by (ca, cb), then by the first member's reading directions; the blocks
+        ! of one (ca, cb) and their ranges per direction (either member read)
+        allocate (perm(nz), bca(2*nc), bcb(2*nc), blo(2*nc, nd), bhi(2*nc, nd))
+        k = 0
+        nb = 0
+        do ca = 1, nc
+            do cb = 0, nc
+                i = k
+                do p = 0, maxval(key)
+                    do iz = 1, nz
+                        if (zco(1, iz) /= ca .or. zco(2, iz) /= cb) cycle
+                        if (key(zs(1, iz)) /= p) cycle
+                        k = k + 1
+                        perm(k) = iz
+                    end do
+                end do
+                if (k == i) cycle
+                nb = nb + 1
+                bca(nb) = ca
+                bcb(nb) = cb
+                blo(nb, :) = 1
+                bhi(nb, :) = 0
+                do iz = i + 1, k
+                    do d2 = 1, nd
+                        if (.not. (rd(zs(1, perm(iz)), d2) .or. (cb > 0 .and. &
+                                   rd(max(zs(2, perm(iz)), 1_ip), d2)))) cycle
+                        if (bhi(nb, d2) == 0) blo(nb, d2) = iz
+                        bhi(nb, d2) = iz
+                    end do
+                end do
+            end do
+        end do
+        allocate (gs1(nz, ne, nd), gs2(nz, ne, nd), yz(nz, ne, nd), kt(maxval(ln), nz))
+        gs2 = 0.0_wp
+        do iz = 1, nz
+            i = perm(iz)
+            gs1(iz, :, :) = zwt(1, i)*gs(zm(1, i), :, :)
+            if (zm(2, i) > 0) gs2(iz, :, :) = zwt(2, i)*gs(zm(2, i), :, :)
+        end do
+        zcs(1:nz) = zcs(perm)
+        do c1 = 1, nc
+            m1 = ln(c1)
+            if (m1 == 0) cycle
+            yz = 0.0_wp
+            do d1 = 1, nd
+                do e = 1, ne
+                    do ib = 1, nb
+                        do d2 = 1, nd
+                            if (bhi(ib, d2) == 0) cycle
+                            v1 = gr%jac(c1 + nc*(d1 - 1), bca(ib) + nc*(d2 - 1), e)
+                            v2 = 0.0_wp
+                            if (bcb(ib) > 0) v2 = gr%jac(c1 + nc*(d1 - 1), bcb(ib) + &
+                                                         nc*(d2 - 1), e)
+                            if (v1 == 0.0_wp .and. v2 == 0.0_wp) cycle
+                            a = blo(ib, d2)
+                            b = bhi(ib, d2)
+                            yz(a:b, e, d1) = yz(a:b, e, d1) + v1*gs1(a:b, e, d2) + &
+                                             v2*gs2(a:b, e, d2)
+                        end do
+                    end do
+                end do
+            end do
+            kt(1:m1, :) = 0.0_wp
+            do d1 = 1, nd
+                if (hi(c1, d1) == 0) cycle
+                a = lo(c1, d1)
+                call dgemm('N', 'T', hi(c1, d1) - a + 1, nz, ne, 1.0_wp, &
+                           gs(qoff(c1) + a, 1, d1), nq, yz(1, 1, d1), nz, 1.0_wp, kt(a, 1), &
+                           size(kt, 1))
+            end do
+            do iz = 1, nz
+                b = zcs(iz)
+                do k = 1, m1
+                    kc(py(k, c1), b) = kc(py(k, c1), b) + kt(k, iz)
+                end do
+            end do
+        end do
+    end subroutine kc_dense_pairs
 
     !> LU of J (jm := jcur first in Krylov mode). Systems that hold their LU
     !> (cond_lu_holds) factorise a single-precision copy into jms: half the flops of the LU
