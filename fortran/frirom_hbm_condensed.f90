@@ -988,13 +988,13 @@ contains
         integer(ip), intent(in), optional :: zc(:)
         real(wp), intent(in), optional :: zw(:)
         integer(ip), allocatable :: ls(:, :), py(:, :), ln(:), qoff(:), key(:), ord(:), &
-                                    lo(:, :), hi(:, :)
+                                    lo(:, :), hi(:, :), pq(:)
         real(wp), allocatable :: yt(:, :, :), gs(:, :, :), kt(:, :)
         logical, allocatable :: rd(:, :)
         !> two directions, by the mask of those that read a column: d1 only, both, d2 only,
         !> none (each direction's columns are then one range)
         integer(ip), parameter :: ORDER2(0:3) = [3, 0, 2, 1]
-        integer(ip) :: ns, nd, ne, nrg, c, c1, c2, d1, d2, e, s, q, m1, nq, p, k, a, b
+        integer(ip) :: ns, nd, ne, nrg, c, c1, c2, d1, d2, e, s, m1, nq, p, k, a, b
         real(wp) :: v
         nd = gr%ndir
         ne = gr%ne
@@ -1054,7 +1054,10 @@ contains
             call kc_dense_pairs(gr, nc, ln, qoff, ls, py, lo, hi, rd, key, gs, zc, zw, kc)
             return
         end if
-        allocate (yt(nq, ne, nd), kt(maxval(ln), nq))
+        allocate (yt(nq, ne, nd), kt(maxval(ln), nq), pq(nq))
+        do c = 1, nc
+            pq(qoff(c) + 1:qoff(c + 1)) = py(1:ln(c), c)
+        end do
         do c1 = 1, nc
             m1 = ln(c1)
             if (m1 == 0) cycle
@@ -1072,23 +1075,8 @@ contains
                     end do
                 end do
             end do
-            kt(1:m1, :) = 0.0_wp
-            do d1 = 1, nd
-                if (hi(c1, d1) == 0) cycle
-                a = lo(c1, d1)
-                call dgemm('N', 'T', hi(c1, d1) - a + 1, nq, ne, 1.0_wp, &
-                           gs(qoff(c1) + a, 1, d1), nq, yt(1, 1, d1), nq, 1.0_wp, kt(a, 1), &
-                           size(kt, 1))
-            end do
-            ! element by element: a vector subscript on both sides made a temporary each
-            do c2 = 1, nc
-                do q = 1, ln(c2)
-                    b = py(q, c2)
-                    do k = 1, m1
-                        kc(py(k, c1), b) = kc(py(k, c1), b) + kt(k, qoff(c2) + q)
-                    end do
-                end do
-            end do
+            call rows_into(nq, ne, nd, nq, size(kt, 1), gs, c1, m1, lo, hi, qoff, yt, &
+                           py(:, c1), pq, kt, kc)
         end do
     end subroutine kc_dense_sel
 
@@ -1201,22 +1189,35 @@ contains
                     end do
                 end do
             end do
-            kt(1:m1, :) = 0.0_wp
-            do d1 = 1, nd
-                if (hi(c1, d1) == 0) cycle
-                a = lo(c1, d1)
-                call dgemm('N', 'T', hi(c1, d1) - a + 1, nz, ne, 1.0_wp, &
-                           gs(qoff(c1) + a, 1, d1), nq, yz(1, 1, d1), nz, 1.0_wp, kt(a, 1), &
-                           size(kt, 1))
-            end do
-            do iz = 1, nz
-                b = zcs(iz)
-                do k = 1, m1
-                    kc(py(k, c1), b) = kc(py(k, c1), b) + kt(k, iz)
-                end do
-            end do
+            call rows_into(nq, ne, nd, nz, size(kt, 1), gs, c1, m1, lo, hi, qoff, yz, &
+                           py(:, c1), zcs(1:nz), kt, kc)
         end do
     end subroutine kc_dense_pairs
+
+    !> kc(rows, cols) += the rows S1 of coefficient c1 (m1 of them, direction d's from
+    !> lo(c1, d) to hi(c1, d)) of Gd^T on Q (gs: nq stacked columns, ne elements, nd
+    !> directions) times y(:, :, d)^T (ny columns), direction by direction: Gd(:, S1)^T Y;
+    !> kt the work (ldk >= m1, ny). Element by element into kc: a vector subscript on both
+    !> sides made a temporary each.
+    subroutine rows_into(nq, ne, nd, ny, ldk, gs, c1, m1, lo, hi, qoff, y, rows, cols, kt, kc)
+        integer(ip), intent(in) :: nq, ne, nd, ny, ldk
+        real(wp), intent(in) :: gs(nq, ne, nd), y(ny, ne, nd)
+        integer(ip), intent(in) :: c1, m1, lo(:, :), hi(:, :), qoff(:), rows(:), cols(:)
+        real(wp), intent(inout) :: kt(ldk, ny), kc(:, :)
+        integer(ip) :: d, a, j, k
+        kt(1:m1, :) = 0.0_wp
+        do d = 1, nd
+            if (hi(c1, d) == 0) cycle
+            a = lo(c1, d)
+            call dgemm('N', 'T', hi(c1, d) - a + 1, ny, ne, 1.0_wp, gs(qoff(c1) + a, 1, d), &
+                       nq, y(1, 1, d), ny, 1.0_wp, kt(a, 1), ldk)
+        end do
+        do j = 1, ny
+            do k = 1, m1
+                kc(rows(k), cols(j)) = kc(rows(k), cols(j)) + kt(k, j)
+            end do
+        end do
+    end subroutine rows_into
 
     !> LU of J (jm := jcur first in Krylov mode). Systems that hold their LU
     !> (cond_lu_holds) factorise a single-precision copy into jms: half the flops of the LU
