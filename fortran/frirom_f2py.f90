@@ -123,14 +123,15 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
                         tan0, start_mode, nropt, ropt, niopt, iopt, stability, history, &
                         maxpts, netot, ntim, ys, lams, tans, iters, xo, states, hill_re, &
                         sliders, yscales, npts, finished, ds_out, timings, info, msg, &
-                        tcontact, krylov, sparse, nlu, lu, lupiv, lustate, selected, keep, leak)
+                        tcontact, krylov, sparse, nlu, lu, lupiv, lustate, selected, keep, pair, &
+                        leak)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options, cont_options_from, N_RCONT, N_ICONT, RCONT_DS, &
                              RCONT_LAM_LO
     use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
                           hbm_set_modes_harmonic, hbm_run, hbm_lu_import, hbm_lu_export, &
-                          hbm_set_selection, HBM_FREQUENCY, HBM_LOAD, N_TIMERS
+                          hbm_set_selection, hbm_sel_expand, hbm_sel_reduce, HBM_FREQUENCY, HBM_LOAD, N_TIMERS
     implicit none
     character(len=*), intent(in) :: formulation  !! 'condensed' (Eq. 5-9) or 'banded'
     character(len=*), intent(in) :: lam_kind     !! the parameter lam: 'frequency' or 'load'
@@ -195,6 +196,9 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     !> = 1, the others zero (hbm_set_selection); y0, tan0, ys and tans keep the full
     !> layout (zeros where left out)
     integer(4), intent(in) :: selected, keep(nnl, nh + 1)
+    !> selected = 2: also pair(j, h+1) = s k, the pairs of one travelling direction
+    !> (hbm_set_selection's pair; 0: none); the points keep both members of a pair
+    integer(4), intent(in) :: pair(nnl, nh + 1)
     real(8), intent(out) :: leak(maxpts)     !! per point: frirom_hbm cond_leak
     class(hbm_system), allocatable :: sys
     integer(ip), allocatable :: sel(:)
@@ -202,7 +206,7 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     type(cont_options) :: opts
     real(wp), allocatable :: y(:), t(:)
     real(wp) :: lam, dsl
-    integer(ip) :: linfo, np, itl(maxpts), mode
+    integer(ip) :: linfo, np, itl(maxpts), mode, n, k
     integer(8) :: c0, c1, rate
     logical :: fin
     call system_clock(c0, rate)
@@ -261,7 +265,11 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
             call set_status(linfo, FRIROM_ERR_PARAM, msg, 'selection: Hill stability would '// &
                             'see only perturbations inside the selection; not with stability')
         else
-            call hbm_set_selection(sys, int(keep, ip), linfo, msg, sel)
+            if (selected == 2) then
+                call hbm_set_selection(sys, int(keep, ip), linfo, msg, sel, int(pair, ip))
+            else
+                call hbm_set_selection(sys, int(keep, ip), linfo, msg, sel)
+            end if
         end if
     end if
     if (linfo /= 0) then
@@ -278,15 +286,20 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     dsl = ropt(RCONT_DS)
     if (allocated(sel)) then
         ! the run in the kept unknowns; the points back in the full layout
-        y = y0(sel)
-        t = [tan0(sel), tan0(ny + 1)]
-        allocate (ysel(size(sel), maxpts), tsel(size(sel) + 1, maxpts))
+        n = sys%n
+        deallocate (y, t)
+        allocate (y(n), t(n + 1), ysel(n, maxpts), tsel(n + 1, maxpts))
+        call hbm_sel_reduce(sys, y0, y)
+        call hbm_sel_reduce(sys, tan0(1:ny), t(1:n))
+        t(n + 1) = tan0(ny + 1)
         call hbm_run(sys, start_mode, y, lam, t, dsl, ropt(RCONT_LAM_LO), opts, ysel, lams, &
                      tsel, itl, xo, states, np, fin, linfo, msg, sliders=sliders, &
                      yscales=yscales, leak=leak)
-        ys(sel, 1:np) = ysel(:, 1:np)
-        tans(sel, 1:np) = tsel(1:size(sel), 1:np)
-        tans(ny + 1, 1:np) = tsel(size(sel) + 1, 1:np)
+        do k = 1, np
+            call hbm_sel_expand(sys, ysel(:, k), ys(:, k))
+            call hbm_sel_expand(sys, tsel(1:n, k), tans(1:ny, k))
+        end do
+        tans(ny + 1, 1:np) = tsel(n + 1, 1:np)
     else if (stability /= 0) then
         call hbm_run(sys, start_mode, y, lam, t, dsl, ropt(RCONT_LAM_LO), opts, ys, lams, &
                      tans, itl, xo, states, np, fin, linfo, msg, hill_re, sliders=sliders, &

@@ -76,7 +76,11 @@ contains
     end procedure cond_init
 
     module procedure hbm_set_selection
-        integer(ip) :: nu, nc, h, j, c, k, n, stat
+        integer(ip) :: nu, nc, h, j, c, k, n, m, i, q, stat
+        integer(ip), allocatable :: ksel(:), kpt(:), kptr(:), at(:, :), tk(:, :), ptn(:, :)
+        real(wp), allocatable :: tw(:, :), jm(:, :), jk(:, :)
+        integer(ip), allocatable :: ipiv(:)
+        logical, allocatable :: kmask(:, :)
         real(wp) :: on, off
         info = FRIROM_OK
         select type (sys => sysc)
@@ -96,42 +100,93 @@ contains
                 call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: keeps no unknown')
             end if
             if (info /= 0) return
-            if (allocated(sys%sel)) deallocate (sys%sel, sys%kpt, sys%kptr, sys%kmask)
+            if (present(pair)) then
+                call check_pairs(keep, pair, ptn, info, errmsg)
+                if (info /= 0) return
+            end if
+            ! everything is built in locals first: a failed call leaves sys as it was
             n = 0
             do c = 1, nc
                 n = n + count(keep(:, c/2) /= 0)
             end do
-            allocate (sys%kptr(sys%nh + 2), sys%kpt(count(keep /= 0)), sys%sel(n), &
-                      sys%kmask(nu, 0:sys%nh), stat=stat)
-            if (stat == 0) then
-                if (allocated(sys%jm)) deallocate (sys%jm)
-                if (allocated(sys%ipiv)) deallocate (sys%ipiv)
-                allocate (sys%jm(n, n), sys%ipiv(n), stat=stat)
-            end if
+            allocate (kptr(sys%nh + 2), kpt(count(keep /= 0)), ksel(n), at(nu, nc), &
+                      tk(2, n), tw(2, n), kmask(nu, 0:sys%nh), stat=stat)
             if (stat /= 0) then
-                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'selection: Jacobian')
+                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'selection: index arrays')
                 return
             end if
-            sys%kmask = keep /= 0
-            sys%kptr(1) = 1
+            kptr(1) = 1
             k = 0
             do h = 0, sys%nh
                 do j = 1, nu
                     if (keep(j, h) == 0) cycle
                     k = k + 1
-                    sys%kpt(k) = j
+                    kpt(k) = j
                 end do
-                sys%kptr(h + 2) = k + 1
+                kptr(h + 2) = k + 1
             end do
-            ! y: coefficient by coefficient (harmonic c/2), the kept coordinates ascending
+            ! y: coefficient by coefficient (harmonic c/2), the kept coordinates ascending;
+            ! at(j, c) its position (0: left out)
             k = 0
+            at = 0
             do c = 1, nc
                 h = c/2
-                sys%sel(k + 1:k + sys%kptr(h + 2) - sys%kptr(h + 1)) = &
-                    sys%kpt(sys%kptr(h + 1):sys%kptr(h + 2) - 1) + nu*(c - 1)
-                k = k + sys%kptr(h + 2) - sys%kptr(h + 1)
+                do i = kptr(h + 1), kptr(h + 2) - 1
+                    k = k + 1
+                    ksel(k) = kpt(i) + nu*(c - 1)
+                    at(kpt(i), c) = k
+                end do
             end do
-            sys%n = n
+            ! T: in the kept order, a pair's column where its first member (j, the cosine
+            ! or sine of a coordinate with pair(j, h) /= 0) is, none for its second (k)
+            m = 0
+            do i = 1, n
+                j = mod(ksel(i) - 1, nu) + 1
+                c = (ksel(i) - 1)/nu + 1
+                h = c/2
+                m = m + 1
+                tk(:, m) = [i, 0_ip]
+                tw(:, m) = [1.0_wp, 0.0_wp]
+                if (.not. present(pair) .or. h == 0) cycle
+                if (ptn(j, h) /= 0) then
+                    m = m - 1                         ! a second member: in its pair's column
+                else if (pair(j, h) /= 0) then
+                    q = abs(pair(j, h))
+                    if (c == 2*h) then                ! (y(j, cos) + s y(q, sin)) / sqrt 2
+                        tk(2, m) = at(q, c + 1)
+                        tw(:, m) = [1.0_wp, real(sign(1_ip, pair(j, h)), wp)]/sqrt(2.0_wp)
+                    else                              ! (y(j, sin) - s y(q, cos)) / sqrt 2
+                        tk(2, m) = at(q, c - 1)
+                        tw(:, m) = [1.0_wp, -real(sign(1_ip, pair(j, h)), wp)]/sqrt(2.0_wp)
+                    end if
+                end if
+            end do
+            if (m < n) then
+                allocate (jk(n, m), stat=stat)
+            else
+                allocate (jk(0, 0), stat=stat)
+            end if
+            if (stat == 0) allocate (jm(m, m), ipiv(m), stat=stat)
+            if (stat /= 0) then
+                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'selection: Jacobian')
+                return
+            end if
+            call move_alloc(kptr, sys%kptr)
+            call move_alloc(kpt, sys%kpt)
+            call move_alloc(ksel, sys%sel)
+            call move_alloc(jm, sys%jm)
+            call move_alloc(ipiv, sys%ipiv)
+            if (allocated(sys%tk)) deallocate (sys%tk, sys%tw, sys%jk, sys%kpair)
+            if (m < n) then
+                sys%tk = tk(:, 1:m)
+                sys%tw = tw(:, 1:m)
+                allocate (sys%kpair(nu, 0:sys%nh))
+                sys%kpair = pair
+                call move_alloc(jk, sys%jk)
+            end if
+            kmask = keep /= 0
+            call move_alloc(kmask, sys%kmask)
+            sys%n = m
             if (allocated(sys%jcur)) deallocate (sys%jcur)
             if (allocated(sys%jms)) deallocate (sys%jms)
             if (allocated(sys%kcw)) deallocate (sys%kcw)
@@ -153,6 +208,118 @@ contains
         end select
     end procedure hbm_set_selection
 
+    !> Check hbm_set_selection's pair against keep: pairs at harmonics >= 1 only, between
+    !> two different coordinates both kept there, each coordinate in one pair at most;
+    !> ptn(k, h) = j for the second member k of j's pair, else 0.
+    subroutine check_pairs(keep, pair, ptn, info, errmsg)
+        integer(ip), intent(in) :: keep(:, 0:), pair(:, 0:)
+        integer(ip), allocatable, intent(out) :: ptn(:, :)
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        integer(ip) :: nu, nh, h, j, q, stat
+        info = FRIROM_OK
+        nu = size(keep, 1)
+        nh = size(keep, 2) - 1
+        if (size(pair, 1) /= nu .or. size(pair, 2) /= nh + 1) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'selection: pair must be '// &
+                            '(nonlinear DoFs, H+1)')
+            return
+        end if
+        allocate (ptn(nu, 0:nh), stat=stat)
+        if (stat /= 0) then
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'selection: pairs')
+            return
+        end if
+        ptn = 0
+        if (any(pair(:, 0) /= 0)) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: pair at harmonic 0 '// &
+                            '(it has no sine)')
+            return
+        end if
+        do h = 1, nh
+            do j = 1, nu
+                q = abs(pair(j, h))
+                if (q == 0) cycle
+                if (q > nu .or. q == j) then
+                    call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: pair names '// &
+                                    'no other coordinate')
+                else if (keep(j, h) == 0 .or. keep(q, h) == 0) then
+                    call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: pair of a '// &
+                                    'coordinate and harmonic left out')
+                else if (pair(q, h) /= 0 .or. ptn(q, h) /= 0 .or. ptn(j, h) /= 0) then
+                    call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: a '// &
+                                    'coordinate in two pairs')
+                end if
+                if (info /= 0) return
+                ptn(q, h) = j
+            end do
+        end do
+    end subroutine check_pairs
+
+    module procedure hbm_sel_expand
+        integer(ip) :: i
+        real(wp), allocatable :: yk(:)
+        select type (sys => sysc)
+        type is (hbm_condensed)
+            if (.not. allocated(sys%sel)) then
+                yf = y
+                return
+            end if
+            yf = 0.0_wp
+            if (allocated(sys%tk)) then
+                allocate (yk(size(sys%sel)))
+                call pair_expand(sys, y, yk)
+                yf(sys%sel) = yk
+            else
+                do i = 1, size(sys%sel)
+                    yf(sys%sel(i)) = y(i)
+                end do
+            end if
+        class default
+            yf = y
+        end select
+    end procedure hbm_sel_expand
+
+    module procedure hbm_sel_reduce
+        select type (sys => sysc)
+        type is (hbm_condensed)
+            if (.not. allocated(sys%sel)) then
+                y = yf
+            else if (allocated(sys%tk)) then
+                call pair_reduce(sys, yf(sys%sel), y)
+            else
+                y = yf(sys%sel)
+            end if
+        class default
+            y = yf
+        end select
+    end procedure hbm_sel_reduce
+
+    !> yk = T z (kept layout; hbm_condensed%tk).
+    pure subroutine pair_expand(sys, z, yk)
+        type(hbm_condensed), intent(in) :: sys
+        real(wp), intent(in) :: z(:)
+        real(wp), intent(out) :: yk(:)
+        integer(ip) :: i
+        yk = 0.0_wp
+        do i = 1, size(sys%tk, 2)
+            yk(sys%tk(1, i)) = sys%tw(1, i)*z(i)
+            if (sys%tk(2, i) > 0) yk(sys%tk(2, i)) = sys%tw(2, i)*z(i)
+        end do
+    end subroutine pair_expand
+
+    !> z = T^T yk (kept layout; hbm_condensed%tk).
+    pure subroutine pair_reduce(sys, yk, z)
+        type(hbm_condensed), intent(in) :: sys
+        real(wp), intent(in) :: yk(:)
+        real(wp), intent(out) :: z(:)
+        integer(ip) :: i
+        do i = 1, size(sys%tk, 2)
+            z(i) = sys%tw(1, i)*yk(sys%tk(1, i))
+            if (sys%tk(2, i) > 0) z(i) = z(i) + sys%tw(2, i)*yk(sys%tk(2, i))
+        end do
+    end subroutine pair_reduce
+
     module procedure cond_leak
         integer(ip) :: c
         real(wp) :: on, off
@@ -165,8 +332,32 @@ contains
             on = on + sum(sys%fd(:, c)**2, mask=sys%kmask(:, c/2))
             off = off + sum(sys%fd(:, c)**2, mask=.not. sys%kmask(:, c/2))
         end do
+        ! the pairs: the other travelling direction counts as off the selection too
+        if (allocated(sys%tk)) then
+            do c = 1, sys%nh
+                off = off + pair_off(sys, c, sys%fd(:, 2*c), sys%fd(:, 2*c + 1))
+            end do
+        end if
         leak = max(ratio(off, on), sys%c0_leak, sys%xe_leak)
     end procedure cond_leak
+
+    !> The part of harmonic h (cosines a, sines b by coordinate) against its pairs
+    !> (hbm_condensed%kpair), squared: sum over the pairs (j, k, s) of
+    !> ((a_j - s b_k)^2 + (b_j + s a_k)^2) / 2, the wave in the other direction.
+    pure real(wp) function pair_off(sys, h, a, b) result(off)
+        type(hbm_condensed), intent(in) :: sys
+        integer(ip), intent(in) :: h
+        real(wp), intent(in) :: a(:), b(:)
+        integer(ip) :: j, k
+        real(wp) :: s
+        off = 0.0_wp
+        do j = 1, sys%nnl
+            k = abs(sys%kpair(j, h))
+            if (k == 0) cycle
+            s = real(sign(1_ip, sys%kpair(j, h)), wp)
+            off = off + 0.5_wp*((a(j) - s*b(k))**2 + (b(j) + s*a(k))**2)
+        end do
+    end function pair_off
 
     !> sqrt(off / on) for two sums of squares: 0 when both are 0, huge when only on is.
     pure real(wp) function ratio(off, on)
@@ -295,9 +486,9 @@ contains
         if (allocated(this%sel)) then
             ! the kept rows (hbm_set_selection); y holds no harmonic 0 after its kept rows
             rf = reshape(r2, [nnl*nc])
-            r = rf(this%sel)
+            call hbm_sel_reduce(this, rf, r)
             rf = reshape(rl2, [nnl*nc])
-            rlam = rf(this%sel)
+            call hbm_sel_reduce(this, rf, rlam)
             nhd0 = this%kptr(2) - this%kptr(1)
         else
             r = reshape(r2, [n])
@@ -511,22 +702,23 @@ contains
                 ca = nnl*(2*h - 1) + 1
                 cb = nnl*(2*h) + 1
             end if
-            call harm_rows(nnl, n, sys%ar(:, :, h), sys%ai(:, :, h), kc, ca, cb, jm)
+            call harm_rows(nnl, n, n, sys%ar(:, :, h), sys%ai(:, :, h), kc, ca, cb, jm)
         end do
     end subroutine jac_dense
 
-    !> One harmonic's rows of J - I = R_h kc, R_h = a + i b on k coordinates: harmonic 0
-    !> (cb = 0) jm(ca.., :) = a kc(ca.., :); else a-rows A Kc_a + B Kc_b and b-rows
-    !> -B Kc_a + A Kc_b (kc's and jm's rows of the cosine block from ca, the sine from cb).
-    subroutine harm_rows(k, n, a, b, kc, ca, cb, jm)
-        integer(ip), intent(in) :: k, n, ca, cb
-        real(wp), intent(in) :: a(k, k), b(k, k), kc(n, n)
-        real(wp), intent(inout) :: jm(n, n)
-        call dgemm('N', 'N', k, n, k, 1.0_wp, a, k, kc(ca, 1), n, 0.0_wp, jm(ca, 1), n)
+    !> One harmonic's rows of J - I = R_h kc, R_h = a + i b on k coordinates, for kc's m
+    !> columns: harmonic 0 (cb = 0) jm(ca.., :) = a kc(ca.., :); else a-rows A Kc_a + B Kc_b
+    !> and b-rows -B Kc_a + A Kc_b (kc's and jm's rows of the cosine block from ca, the sine
+    !> from cb).
+    subroutine harm_rows(k, n, m, a, b, kc, ca, cb, jm)
+        integer(ip), intent(in) :: k, n, m, ca, cb
+        real(wp), intent(in) :: a(k, k), b(k, k), kc(n, m)
+        real(wp), intent(inout) :: jm(n, m)
+        call dgemm('N', 'N', k, m, k, 1.0_wp, a, k, kc(ca, 1), n, 0.0_wp, jm(ca, 1), n)
         if (cb == 0) return
-        call dgemm('N', 'N', k, n, k, 1.0_wp, b, k, kc(cb, 1), n, 1.0_wp, jm(ca, 1), n)
-        call dgemm('N', 'N', k, n, k, -1.0_wp, b, k, kc(ca, 1), n, 0.0_wp, jm(cb, 1), n)
-        call dgemm('N', 'N', k, n, k, 1.0_wp, a, k, kc(cb, 1), n, 1.0_wp, jm(cb, 1), n)
+        call dgemm('N', 'N', k, m, k, 1.0_wp, b, k, kc(cb, 1), n, 1.0_wp, jm(ca, 1), n)
+        call dgemm('N', 'N', k, m, k, -1.0_wp, b, k, kc(ca, 1), n, 0.0_wp, jm(cb, 1), n)
+        call dgemm('N', 'N', k, m, k, 1.0_wp, a, k, kc(cb, 1), n, 1.0_wp, jm(cb, 1), n)
     end subroutine harm_rows
 
     !> Modal route, a selection: b(rows, :) = A_h(rows, :) x, the other rows of b zero.
@@ -568,21 +760,32 @@ contains
         type(hbm_condensed), intent(inout) :: sys
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
-        integer(ip) :: n, nu, nc, g, h, c, kh, ca, cb, stat, i
-        integer(ip), allocatable :: at(:), off(:)
-        real(wp), allocatable :: kc(:, :), kf(:, :), a(:, :), b(:, :)
+        integer(ip) :: n, nu, nc, g, h, c, kh, ca, cb, stat, i, nk
+        integer(ip), allocatable :: at(:), off(:), zc(:)
+        real(wp), allocatable :: kc(:, :), kf(:, :), a(:, :), b(:, :), zw(:), kz(:, :)
+        logical :: paired
         real(wp) :: t0
         logical :: dense
         info = FRIROM_OK
         t0 = wtime()
         n = sys%n
+        nk = size(sys%sel)
         nu = sys%nnl
         nc = sys%nc
+        paired = allocated(sys%tk)
         stat = 0
+        dense = .true.
+        do g = 1, size(sys%cs%grp)
+            if (sys%cs%grp(g)%asm_mode == 0) call choose_dense(sys%cs%grp(g), sys%cs%g)
+            dense = dense .and. sys%cs%grp(g)%asm_mode == 2
+        end do
+        ! kc on the kept columns, or with pairs and dense rows straight on T's (kc T)
+        i = nk
+        if (paired .and. dense) i = n
         if (allocated(sys%kcw)) then
-            if (size(sys%kcw, 1) /= n) deallocate (sys%kcw)
+            if (size(sys%kcw, 2) /= i) deallocate (sys%kcw)
         end if
-        if (.not. allocated(sys%kcw)) allocate (sys%kcw(n, n), stat=stat)
+        if (.not. allocated(sys%kcw)) allocate (sys%kcw(nk, i), stat=stat)
         if (stat /= 0) then
             call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: Jacobian')
             return
@@ -590,23 +793,37 @@ contains
         call move_alloc(sys%kcw, kc)
         ! at: position j + nu (c-1) -> its index in y (0: left out); off(c): y's entries
         ! before coefficient c
-        allocate (at(nu*nc), off(nc + 1))
+        allocate (at(nu*nc), off(nc + 1), zc(nk), zw(nk), stat=stat)
+        if (stat /= 0) then
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: Jacobian')
+            call move_alloc(kc, sys%kcw)
+            return
+        end if
         at = 0
-        at(sys%sel) = [(i, i=1, n)]
+        at(sys%sel) = [(i, i=1, nk)]
+        ! zc(k), zw(k): T's column that holds kept unknown k, and its weight there
+        if (paired) then
+            do i = 1, n
+                do c = 1, 2
+                    if (sys%tk(c, i) == 0) cycle
+                    zc(sys%tk(c, i)) = i
+                    zw(sys%tk(c, i)) = sys%tw(c, i)
+                end do
+            end do
+        end if
         off(1) = 0
         do c = 1, nc
             h = c/2
             off(c + 1) = off(c) + sys%kptr(h + 2) - sys%kptr(h + 1)
         end do
         kc = 0.0_wp
-        dense = .true.
-        do g = 1, size(sys%cs%grp)
-            if (sys%cs%grp(g)%asm_mode == 0) call choose_dense(sys%cs%grp(g), sys%cs%g)
-            dense = dense .and. sys%cs%grp(g)%asm_mode == 2
-        end do
         if (dense) then
             do g = 1, size(sys%cs%grp)
-                call kc_dense_sel(sys%cs%grp(g), nu, nc, at, kc)
+                if (paired) then
+                    call kc_dense_sel(sys%cs%grp(g), nu, nc, at, kc, zc, zw)
+                else
+                    call kc_dense_sel(sys%cs%grp(g), nu, nc, at, kc)
+                end if
             end do
         else
             ! sparse rows (physical contact DoFs, not what a selection is for): the element
@@ -624,6 +841,20 @@ contains
                 return
             end if
         end if
+        if (paired .and. .not. dense) then
+            ! kz = kc T: R_h's products then on T's columns only
+            allocate (kz(nk, n), stat=stat)
+            if (stat /= 0) then
+                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: Jacobian')
+                call move_alloc(kc, sys%kcw)
+                return
+            end if
+            kz = 0.0_wp
+            do i = 1, nk
+                kz(:, zc(i)) = kz(:, zc(i)) + zw(i)*kc(:, i)
+            end do
+            call move_alloc(kz, kc)
+        end if
         sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
         do h = 0, sys%nh
             kh = sys%kptr(h + 2) - sys%kptr(h + 1)
@@ -636,15 +867,37 @@ contains
                 ca = off(2*h) + 1
                 cb = off(2*h + 1) + 1
             end if
-            call harm_rows(kh, n, a, b, kc, ca, cb, sys%jm)
+            if (paired) then
+                call harm_rows(kh, nk, n, a, b, kc, ca, cb, sys%jk)
+            else
+                call harm_rows(kh, nk, n, a, b, kc, ca, cb, sys%jm)
+            end if
             sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
         end do
+        call move_alloc(kc, sys%kcw)
+        ! pairs: J_z = T^T (J T) (I stays I, T orthonormal)
+        if (paired) call pair_rows(sys)
         do i = 1, n
             sys%jm(i, i) = sys%jm(i, i) + 1.0_wp
         end do
-        call move_alloc(kc, sys%kcw)
         call cond_factor(sys, info, errmsg)
     end subroutine cond_jacobian_sel
+
+    !> jm = T^T jk for a selection with pairs (hbm_condensed%tk; jk = J T): the rows.
+    subroutine pair_rows(sys)
+        type(hbm_condensed), intent(inout) :: sys
+        integer(ip) :: i, j
+        real(wp) :: t0
+        t0 = wtime()
+        do j = 1, sys%n
+            do i = 1, sys%n
+                sys%jm(i, j) = sys%tw(1, i)*sys%jk(sys%tk(1, i), j)
+                if (sys%tk(2, i) > 0) sys%jm(i, j) = sys%jm(i, j) + &
+                                                     sys%tw(2, i)*sys%jk(sys%tk(2, i), j)
+            end do
+        end do
+        sys%timers(T_ASM) = sys%timers(T_ASM) + wtime() - t0
+    end subroutine pair_rows
 
     !> R_h = a + i b on the coordinates rows (both sides), at the Jacobian's frequency:
     !> from the modes (A_h(rows) diag(g_h) A_h(rows)^H, only these rows) or read from the
@@ -725,18 +978,23 @@ contains
     !> by direction over the columns that direction's rows read. Those are a range: each
     !> coefficient's columns are ordered by the directions that read them (an MS
     !> coordinate is one cylindrical component: a normal or a tangential row reads a third).
-    subroutine kc_dense_sel(gr, nu, nc, at, kc)
+    subroutine kc_dense_sel(gr, nu, nc, at, kc, zc, zw)
         type(contact_group), intent(in) :: gr
         integer(ip), intent(in) :: nu, nc, at(:)
         real(wp), intent(inout) :: kc(:, :)
+        !> a selection's pairs: kc is then (kept, T's columns) and gets kc T
+        !> (kc_dense_pairs); zc(k) the column of T that holds kept unknown k, zw(k) its
+        !> weight there
+        integer(ip), intent(in), optional :: zc(:)
+        real(wp), intent(in), optional :: zw(:)
         integer(ip), allocatable :: ls(:, :), py(:, :), ln(:), qoff(:), key(:), ord(:), &
-                                    lo(:, :), hi(:, :)
+                                    lo(:, :), hi(:, :), pq(:)
         real(wp), allocatable :: yt(:, :, :), gs(:, :, :), kt(:, :)
         logical, allocatable :: rd(:, :)
         !> two directions, by the mask of those that read a column: d1 only, both, d2 only,
         !> none (each direction's columns are then one range)
         integer(ip), parameter :: ORDER2(0:3) = [3, 0, 2, 1]
-        integer(ip) :: ns, nd, ne, nrg, c, c1, c2, d1, d2, e, s, q, m1, nq, p, k, a, b
+        integer(ip) :: ns, nd, ne, nrg, c, c1, c2, d1, d2, e, s, m1, nq, p, k, a, b
         real(wp) :: v
         nd = gr%ndir
         ne = gr%ne
@@ -786,11 +1044,19 @@ contains
         nq = qoff(nc + 1)
         if (nq == 0) return
         ! gs(q, e, d): Gd^T on Q (the kept columns of every coefficient stacked), by direction
-        allocate (yt(nq, ne, nd), gs(nq, ne, nd), kt(maxval(ln), nq))
+        allocate (gs(nq, ne, nd))
         do d1 = 1, nd
             do c = 1, nc
                 gs(qoff(c) + 1:qoff(c + 1), :, d1) = gr%gt(ls(1:ln(c), c), d1:nrg:nd)
             end do
+        end do
+        if (present(zc)) then
+            call kc_dense_pairs(gr, nc, ln, qoff, ls, py, lo, hi, rd, key, gs, zc, zw, kc)
+            return
+        end if
+        allocate (yt(nq, ne, nd), kt(maxval(ln), nq), pq(nq))
+        do c = 1, nc
+            pq(qoff(c) + 1:qoff(c + 1)) = py(1:ln(c), c)
         end do
         do c1 = 1, nc
             m1 = ln(c1)
@@ -809,22 +1075,149 @@ contains
                     end do
                 end do
             end do
-            kt(1:m1, :) = 0.0_wp
-            do d1 = 1, nd
-                if (hi(c1, d1) == 0) cycle
-                a = lo(c1, d1)
-                call dgemm('N', 'T', hi(c1, d1) - a + 1, nq, ne, 1.0_wp, &
-                           gs(qoff(c1) + a, 1, d1), nq, yt(1, 1, d1), nq, 1.0_wp, kt(a, 1), &
-                           size(kt, 1))
+            call rows_into(nq, ne, nd, nq, size(kt, 1), gs, c1, m1, lo, hi, qoff, yt, &
+                           py(:, c1), pq, kt, kc)
+        end do
+    end subroutine kc_dense_sel
+
+    !> kc_dense_sel for a selection's pairs: kc(S1 c1, z) += Gd(:, S1)^T Y_z, Y_z = J_loc
+    !> Gd T on T's columns z that touch the group (one or two members in Q, a pair's in
+    !> coefficients c and c + 1), the products then on half the columns. The z are grouped
+    !> by their members' coefficients (ca, cb), so that J_loc's two entries are the same
+    !> for a group, and ordered within it by the directions that read them: Y_z is formed
+    !> from gs1 = zw Gd^T on the first members and gs2 on the second, range by range.
+    subroutine kc_dense_pairs(gr, nc, ln, qoff, ls, py, lo, hi, rd, key, gs, zc, zw, kc)
+        type(contact_group), intent(in) :: gr
+        integer(ip), intent(in) :: nc, ln(:), qoff(:), ls(:, :), py(:, :), lo(:, :), &
+                                   hi(:, :), key(:), zc(:)
+        logical, intent(in) :: rd(:, :)
+        real(wp), intent(in) :: gs(qoff(nc + 1), gr%ne, gr%ndir), zw(:)
+        real(wp), intent(inout) :: kc(:, :)
+        integer(ip), allocatable :: zl(:), zm(:, :), zco(:, :), zs(:, :), perm(:), zcs(:), &
+                                    bca(:), bcb(:), blo(:, :), bhi(:, :)
+        real(wp), allocatable :: zwt(:, :), gs1(:, :, :), gs2(:, :, :), yz(:, :, :), kt(:, :)
+        integer(ip) :: nd, ne, nq, nz, nb, c, t, p, i, k, ca, cb, d1, d2, e, c1, m1, a, b, &
+                       ib, iz
+        real(wp) :: v1, v2
+        nd = gr%ndir
+        ne = gr%ne
+        nq = qoff(nc + 1)
+        ! the columns z: members zm (stacked index in Q, 0: none), their coefficients zco,
+        ! group columns zs (index into gcols) and weights zwt; zl: T's column -> z
+        allocate (zl(size(kc, 2)), zm(2, nq), zco(2, nq), zs(2, nq), zwt(2, nq), zcs(nq))
+        zl = 0
+        nz = 0
+        do c = 1, nc
+            do t = 1, ln(c)
+                p = zc(py(t, c))
+                i = zl(p)
+                if (i == 0) then
+                    nz = nz + 1
+                    zl(p) = nz
+                    zcs(nz) = p
+                    zm(:, nz) = [qoff(c) + t, 0_ip]
+                    zco(:, nz) = [c, 0_ip]
+                    zs(:, nz) = [ls(t, c), 0_ip]
+                    zwt(:, nz) = [zw(py(t, c)), 0.0_wp]
+                else
+                    zm(2, i) = qoff(c) + t
+                    zco(2, i) = c
+                    zs(2, i) = ls(t, c)
+                    zwt(2, i) = zw(py(t, c))
+                end if
             end do
-            do c2 = 1, nc
-                do q = 1, ln(c2)
-                    kc(py(1:m1, c1), py(q, c2)) = kc(py(1:m1, c1), py(q, c2)) + &
-                                                  kt(1:m1, qoff(c2) + q)
+        end do
+        ! order: by (ca, cb), then by the first member's reading directions; the blocks
+        ! of one (ca, cb) and their ranges per direction (either member read)
+        allocate (perm(nz), bca(2*nc), bcb(2*nc), blo(2*nc, nd), bhi(2*nc, nd))
+        k = 0
+        nb = 0
+        do ca = 1, nc
+            do cb = 0, nc
+                i = k
+                do p = 0, maxval(key)
+                    do iz = 1, nz
+                        if (zco(1, iz) /= ca .or. zco(2, iz) /= cb) cycle
+                        if (key(zs(1, iz)) /= p) cycle
+                        k = k + 1
+                        perm(k) = iz
+                    end do
+                end do
+                if (k == i) cycle
+                nb = nb + 1
+                bca(nb) = ca
+                bcb(nb) = cb
+                blo(nb, :) = 1
+                bhi(nb, :) = 0
+                do iz = i + 1, k
+                    do d2 = 1, nd
+                        if (.not. (rd(zs(1, perm(iz)), d2) .or. (cb > 0 .and. &
+                                   rd(max(zs(2, perm(iz)), 1_ip), d2)))) cycle
+                        if (bhi(nb, d2) == 0) blo(nb, d2) = iz
+                        bhi(nb, d2) = iz
+                    end do
                 end do
             end do
         end do
-    end subroutine kc_dense_sel
+        allocate (gs1(nz, ne, nd), gs2(nz, ne, nd), yz(nz, ne, nd), kt(maxval(ln), nz))
+        gs2 = 0.0_wp
+        do iz = 1, nz
+            i = perm(iz)
+            gs1(iz, :, :) = zwt(1, i)*gs(zm(1, i), :, :)
+            if (zm(2, i) > 0) gs2(iz, :, :) = zwt(2, i)*gs(zm(2, i), :, :)
+        end do
+        zcs(1:nz) = zcs(perm)
+        do c1 = 1, nc
+            m1 = ln(c1)
+            if (m1 == 0) cycle
+            yz = 0.0_wp
+            do d1 = 1, nd
+                do e = 1, ne
+                    do ib = 1, nb
+                        do d2 = 1, nd
+                            if (bhi(ib, d2) == 0) cycle
+                            v1 = gr%jac(c1 + nc*(d1 - 1), bca(ib) + nc*(d2 - 1), e)
+                            v2 = 0.0_wp
+                            if (bcb(ib) > 0) v2 = gr%jac(c1 + nc*(d1 - 1), bcb(ib) + &
+                                                         nc*(d2 - 1), e)
+                            if (v1 == 0.0_wp .and. v2 == 0.0_wp) cycle
+                            a = blo(ib, d2)
+                            b = bhi(ib, d2)
+                            yz(a:b, e, d1) = yz(a:b, e, d1) + v1*gs1(a:b, e, d2) + &
+                                             v2*gs2(a:b, e, d2)
+                        end do
+                    end do
+                end do
+            end do
+            call rows_into(nq, ne, nd, nz, size(kt, 1), gs, c1, m1, lo, hi, qoff, yz, &
+                           py(:, c1), zcs(1:nz), kt, kc)
+        end do
+    end subroutine kc_dense_pairs
+
+    !> kc(rows, cols) += the rows S1 of coefficient c1 (m1 of them, direction d's from
+    !> lo(c1, d) to hi(c1, d)) of Gd^T on Q (gs: nq stacked columns, ne elements, nd
+    !> directions) times y(:, :, d)^T (ny columns), direction by direction: Gd(:, S1)^T Y;
+    !> kt the work (ldk >= m1, ny). Element by element into kc: a vector subscript on both
+    !> sides made a temporary each.
+    subroutine rows_into(nq, ne, nd, ny, ldk, gs, c1, m1, lo, hi, qoff, y, rows, cols, kt, kc)
+        integer(ip), intent(in) :: nq, ne, nd, ny, ldk
+        real(wp), intent(in) :: gs(nq, ne, nd), y(ny, ne, nd)
+        integer(ip), intent(in) :: c1, m1, lo(:, :), hi(:, :), qoff(:), rows(:), cols(:)
+        real(wp), intent(inout) :: kt(ldk, ny), kc(:, :)
+        integer(ip) :: d, a, j, k
+        kt(1:m1, :) = 0.0_wp
+        do d = 1, nd
+            if (hi(c1, d) == 0) cycle
+            a = lo(c1, d)
+            call dgemm('N', 'T', hi(c1, d) - a + 1, ny, ne, 1.0_wp, gs(qoff(c1) + a, 1, d), &
+                       nq, y(1, 1, d), ny, 1.0_wp, kt(a, 1), ldk)
+        end do
+        do j = 1, ny
+            do k = 1, m1
+                kc(rows(k), cols(j)) = kc(rows(k), cols(j)) + kt(k, j)
+            end do
+        end do
+    end subroutine rows_into
 
     !> LU of J (jm := jcur first in Krylov mode). Systems that hold their LU
     !> (cond_lu_holds) factorise a single-precision copy into jms: half the flops of the LU
@@ -1407,6 +1800,9 @@ contains
             end if
             on = on + sum(abs(xe)**2, mask=sys%kmask(:, h))
             off = off + sum(abs(xe)**2, mask=.not. sys%kmask(:, h))
+            ! harm_col: cosine real(xe), sine -aimag(xe)
+            if (allocated(sys%tk) .and. h > 0) off = off + pair_off(sys, h, real(xe, wp), &
+                                                                     -aimag(xe))
         end do
         sys%xe_leak = ratio(off, on)
     end subroutine load_leak

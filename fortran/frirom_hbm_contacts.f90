@@ -363,6 +363,7 @@ contains
 
     module procedure hbm_contact_forces
         integer(ip) :: i, nc
+        real(wp), allocatable :: yf(:)
         real(wp) :: t0
         logical :: count
         count = .false.
@@ -370,7 +371,12 @@ contains
         nc = sys%nc
         select type (sys)
         type is (hbm_condensed)
-            if (allocated(sys%sel)) then
+            if (allocated(sys%tk)) then
+                ! a selection with pairs: the kept unknowns are T y
+                allocate (yf(size(sys%xd)))
+                call hbm_sel_expand(sys, y, yf)
+                sys%xd = reshape(yf, [sys%nnl, nc])
+            else if (allocated(sys%sel)) then
                 ! a selection (hbm_set_selection): the pairs left out are zero
                 sys%xd = 0.0_wp
                 do i = 1, size(sys%sel)

@@ -7,13 +7,16 @@ program test_hbm
     use frirom_check, only: check, check_done, fixed_seed
     use frirom_newton, only: cont_options, newton_correct
     use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
-                          hbm_set_modes_harmonic, hbm_set_selection
+                          hbm_set_modes_harmonic, hbm_set_selection, hbm_sel_expand, &
+                          hbm_sel_reduce
     implicit none
     integer(ip), parameter :: ndof = 4, nh = 3, nc = 2*nh + 1
     type(hbm_condensed) :: sc, scl
     type(hbm_full), target :: sf
     type(hbm_full) :: sfl, sbad, sfn
-    type(hbm_condensed) :: scn, scm, sch, sct, sctl, sctn, sctm, scd
+    type(hbm_condensed) :: scn, scm, sch, sct, sctl, sctn, sctm, scd, scp
+    integer(ip) :: keep(3, 0:nh), pair(3, 0:nh)
+    real(wp) :: zp(3*nc - 4), zq(3*nc - 4), yfp(3*nc)
     type(hbm_full) :: sfd
     complex(wp) :: psi(ndof, ndof, 0:nh)
     real(wp) :: yr(3*nc), r1(3*nc), r2(3*nc), rl1(3*nc), rl2(3*nc), rr1, rr2
@@ -159,6 +162,40 @@ program test_hbm
     call hbm_set_modes_harmonic(sch, psi, 0.0_wp*spread(sqrt(wev), 2, nh + 1), &
                                 spread([(0.02_wp, i = 1, ndof)], 2, nh + 1), info, msg)
     call check(info /= 0 .and. index(msg, 'omega > 0') > 0, 'zero frequency reported')
+    ! a selection with pairs (hbm_set_selection's pair): keep everything, tie harmonic 1
+    ! of nonlinear DoF 1 to DoF 2 (s = +1) and harmonic 2 of DoF 3 to DoF 1 (s = -1): the
+    ! Jacobian T^T J T of the 4 fewer unknowns against finite differences of T^T R(T z)
+    call hbm_setup(scp, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
+                   fe1, 1, 0.0_wp, ginfo, gp, gi, gx, params, w0, outd, info, msg)
+    keep = 1
+    pair = 0
+    pair(2, 1) = 2
+    call hbm_set_selection(scp, keep, info, msg, pair=pair)
+    call check(info /= 0 .and. index(msg, 'no other coordinate') > 0 .and. scp%n == 3*nc &
+               .and. .not. allocated(scp%sel), 'a failed selection leaves the system as it was')
+    pair = 0
+    pair(1, 1) = 2
+    pair(3, 2) = -1
+    call hbm_set_selection(scp, keep, info, msg, pair=pair)
+    call check(info == 0 .and. scp%n == 3*nc - 4, 'selection with two pairs: '//trim(msg))
+    pair(1, 0) = 2
+    call hbm_set_selection(scp, keep, info, msg, pair=pair)
+    call check(info /= 0 .and. index(msg, 'harmonic 0') > 0 .and. scp%n == 3*nc - 4, &
+               'a failed selection keeps the pairs set before')
+    call fd_check(scp, 'condensed paired')
+    ! the same on the element loops' path (sparse rows: kc T from the full assembly)
+    call check(scp%cs%grp(1)%asm_mode == 2, 'the chain takes the dense rows')
+    scp%cs%grp(1)%asm_mode = 1
+    call fd_check(scp, 'condensed paired, element loops')
+    ! T^T T = I, and T z has the pairs' relations (full layout j + 3 (c - 1), c = 2 h
+    ! the cosine): y(k, sin) = s y(j, cos), y(k, cos) = -s y(j, sin)
+    call random_number(zp)
+    call hbm_sel_expand(scp, zp, yfp)
+    call hbm_sel_reduce(scp, yfp, zq)
+    call check(maxval(abs(zq - zp)) < 1.0e-15_wp, 'pairs: T^T T = I')
+    call check(maxval(abs([yfp(2 + 3*2) - yfp(1 + 3*1), yfp(2 + 3*1) + yfp(1 + 3*2), &
+                           yfp(1 + 3*4) + yfp(3 + 3*3), yfp(1 + 3*3) - yfp(3 + 3*4)])) &
+               < 1.0e-15_wp, 'pairs: the relations of T z')
     ! bad input is reported, not crashed on
     perm = [1, 1, 2, 3]
     call hbm_setup(sbad, nh, 32, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &

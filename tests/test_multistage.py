@@ -345,3 +345,22 @@ def test_harmonic_content_of_one_index_field(rotor, h):
     v[ms2.interface] += ms2.basis @ b
     e2 = harmonic_content(xyz, v[rotor["dofs"][nodes]], 7, ORIGIN, AXIS)[:, 0]
     assert abs(e2[3] - b @ b) < 1e-12 * (b @ b) and abs(e2[h] - a @ a) < 1e-12 * (a @ a)
+
+
+def test_travelling_wave_pairs_by_hand():
+    """travelling_wave_pairs on hand-made labels, N = 6, EO 2, H = 3 (expected values
+    written out, not computed by the function): index 2 moves forward at h = 1 (2 = +2)
+    and backward at h = 2 (2 = -4 mod 6); index 4 the reverse; index 0 and 3 have no
+    sine column (3 is NZ/2 of 6 segments); at h = 3 (2 h EO = 12 = 0 mod 6) no pair; a
+    cosine column without its sine (another node) stays single."""
+    from frirom.reduction.multistage import travelling_wave_pairs
+    labels = ["cb 1", "s1:ms h=0 0 node0 r", "s1:ms h=2 c node0 r", "s1:ms h=2 s node0 r",
+              "s1:ms h=4 c node1 t", "s1:ms h=4 s node1 t", "s1:ms h=3 n node0 r",
+              "s1:ms h=2 c node2 a"]
+    got = travelling_wave_pairs(labels, 2, 6, 3)
+    want = np.zeros((8, 4), dtype=int)
+    want[2, 1], want[2, 2] = 4, -4           # cosine DoF 2 with sine DoF 3 (1-based 4)
+    want[4, 1], want[4, 2] = -6, 6           # cosine DoF 4 with sine DoF 5
+    assert np.array_equal(got, want)
+    with pytest.raises(InputError, match="no DoF is a multi-stage"):
+        travelling_wave_pairs(["cb 1"], 2, 6, 3)

@@ -23,7 +23,8 @@ import paper_flange as pf  # noqa: E402
 
 from frirom import InputError, ParameterError  # noqa: E402
 from frirom.deck import load_deck  # noqa: E402
-from frirom.reduction.multistage import travelling_wave_selection  # noqa: E402
+from frirom.reduction.multistage import (travelling_wave_pairs,  # noqa: E402
+                                        travelling_wave_selection)
 from frirom.results import FRF, FRFWriter  # noqa: E402
 from frirom.solver import LEAK_TOL, frf, kept_unknowns, solve_point  # noqa: E402
 
@@ -154,13 +155,27 @@ def fam(work):
     return d1, d, sel
 
 
-def _run(d, f0, selection=None, contacts=None, **kw):
+def _run(d, f0, selection=None, contacts=None, pairs=None, **kw):
     model, exc = (dataclasses.replace(d, contacts=contacts) if contacts else d).model(), \
         d.excitation()
     exc.F[:, 1:] *= f0 / pf.F0_DECK
     o = dataclasses.replace(d.options(), stability=False, coordinates="dofs",
-                            selection=selection)
+                            selection=selection, pairs=pairs)
     return frf(model, exc, d.omega_start, d.omega_end, o, outputs=d.outputs, **kw)
+
+
+@pytest.fixture(scope="module")
+def selected(fam):
+    """The selected family ROM_II's FRF at F0 (computed once per F0 for the tests below)."""
+    runs = {}
+
+    def get(f0):
+        if f0 not in runs:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")      # no leak warning for the tuned rotor
+                runs[f0] = _run(fam[1], f0, fam[2])
+        return runs[f0]
+    return get
 
 
 def test_selection_counts(fam):
@@ -179,7 +194,7 @@ def test_selection_counts(fam):
 
 
 @pytest.mark.parametrize("f0", [1.0, 300.0])
-def test_selected_equals_unselected_point_for_point(fam, f0):
+def test_selected_equals_unselected_point_for_point(fam, selected, f0):
     """Same unknowns (coordinates 'dofs'), with and without the selection: the same number
     of points, every output harmonic within 1e-7 of the largest and the peaks within 1e-8
     relative. Not bits: both runs converge each point to Newton's 1e-8 (tol_residual,
@@ -192,9 +207,7 @@ def test_selected_equals_unselected_point_for_point(fam, f0):
     closed-cycle iteration of the slipping elements)."""
     _, d, sel = fam
     full = _run(d, f0)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")          # no leak warning for the tuned rotor
-        part = _run(d, f0, sel)
+    part = selected(f0)
     assert full.complete and part.complete and len(full) == len(part)
     if f0 > 100:
         assert full.state_fractions[:, 0, 2].max() > 0.2     # lifts off
@@ -218,6 +231,87 @@ def test_selected_equals_unselected_point_for_point(fam, f0):
 
 def full_nl(d):
     return d.model().nonlinear_dofs()
+
+
+def _pairing(d, U, pairs):
+    """Per point, the largest |x_k,sin - s x_j,cos| and |x_k,cos + s x_j,sin| over the
+    pairs (j, k, s) of ``pairs``, over |unknowns| (U: (n_pts, nnl (2H+1)), the condensed
+    unknowns coefficient by coefficient)."""
+    nl = full_nl(d)
+    pos = {int(dof): i for i, dof in enumerate(nl)}
+    col = U.reshape(len(U), 2 * pf.H + 1, nl.size)
+    worst = np.zeros(len(U))
+    for j, dof in enumerate(nl):
+        for h in range(1, pf.H + 1):
+            if pairs[dof, h] == 0:
+                continue
+            k, s = pos[abs(int(pairs[dof, h])) - 1], np.sign(pairs[dof, h])
+            worst = np.maximum(worst, np.maximum(
+                np.abs(col[:, 2 * h, k] - s * col[:, 2 * h - 1, j]),
+                np.abs(col[:, 2 * h - 1, k] + s * col[:, 2 * h, j])))
+    return worst / np.linalg.norm(U, axis=1)
+
+
+@pytest.mark.parametrize("f0", [1.0, 300.0])
+def test_selected_solution_travels_one_way(fam, selected, f0):
+    """The sign convention of travelling_wave_pairs, shown on the selected solution
+    (solved without pairs): each MS index p's sine column at harmonic h is its cosine
+    column a quarter period on, with the sign of p = +-h EO (mod N): within 1e-8 of
+    |unknowns| at every point (measured median 2.9e-10 / 2.0e-10, largest 1.3e-9 /
+    2.1e-9 at 1 / 300 N: the model's own cyclic round-off, as its leak; Newton's
+    tolerance at 1e-12 changes nothing). The opposite direction misses by more than 0.3
+    of |unknowns| everywhere (measured at least 0.71 at 1 N: the pairing's two terms
+    add), so the sign is tested, not assumed."""
+    _, d, _ = fam
+    pairs = travelling_wave_pairs(d.reduced.labels, pf.QUICK.eo, pf.QUICK.sectors, pf.H)
+    # 6 sectors, EO 2: indices 2 (p = +2h at h = 1, -2h at h = 2) and 4 (the reverse), not
+    # 0, 6 (no sine column; 2h EO = 0 mod 6 at h = 3): 2 x 2 stages x 3 components x 2
+    assert np.count_nonzero(pairs) == 24 and not pairs[:, [0, 3]].any()
+    U = selected(f0).unknowns
+    assert _pairing(d, U, pairs).max() < 1e-8
+    assert _pairing(d, U, -pairs).min() > 0.3
+
+
+@pytest.mark.parametrize("f0", [1.0, 300.0])
+def test_paired_equals_selected_point_for_point(fam, selected, f0):
+    """The selection with the wave's direction (SolverOptions.pairs: 84 unknowns of 132,
+    J_z = T^T J T) against the selection alone: the same points and Newton evaluations, X
+    within 1e-7 of its largest and the peaks within 1e-8 relative (measured 1.3e-9 / 4.0e-8
+    and 4.4e-10 / 3.0e-10 at 1 / 300 N: both converge to Newton's 1e-8 on Jacobians
+    rounded differently, and at 300 N the steep flanks near lift-off amplify the
+    frequencies' 1e-8 differences in X compared index by index, as selected against
+    unselected above); the leak stays at round-off (below 1e-8) and each pair's members
+    hold the pairing exactly."""
+    _, d, sel = fam
+    pairs = travelling_wave_pairs(d.reduced.labels, pf.QUICK.eo, pf.QUICK.sectors, pf.H)
+    part = selected(f0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        two = _run(d, f0, sel, pairs=pairs)
+    assert "132 of 252 unknowns, 84 in one direction" in two.solver_info
+    assert two.complete and len(two) == len(part)
+    assert two.timings["evaluations"] == part.timings["evaluations"]
+    if f0 > 100:
+        assert two.state_fractions[:, 0, 2].max() > 0.2     # lifts off
+        assert two.state_fractions[:, 0, 1].max() > 0.1     # slips
+    assert np.abs(two.X - part.X).max() < 1e-7 * np.abs(part.X).max()
+    for k in range(2):
+        a, b = part.peak(k), two.peak(k)
+        assert abs(b.amplitude / a.amplitude - 1) < 1e-8
+        assert abs(b.omega / a.omega - 1) < 1e-8
+    assert two.leak.max() < 1e-8
+    assert _pairing(d, two.unknowns, pairs).max() == 0.0
+
+
+def test_pairs_of_the_wrong_direction_leak(fam):
+    """Pairs of the other direction (every sign flipped) force a wave the load does not
+    make: the leak, which counts the forces in the other direction, says so at every
+    point (measured 1.0) with the warning."""
+    _, d, sel = fam
+    pairs = travelling_wave_pairs(d.reduced.labels, pf.QUICK.eo, pf.QUICK.sectors, pf.H)
+    with pytest.warns(RuntimeWarning, match="travelling-wave selection leaks"):
+        r = _run(d, 1.0, sel, pairs=-pairs)
+    assert r.leak.min() > 0.1
 
 
 @pytest.mark.parametrize("what", ["stiffness", "preload"])
@@ -411,6 +505,9 @@ def test_deck_key_builds_the_selection(work, fam):
             want[i] = [p in _WAVE[h] for h in range(pf.H + 1)]
     assert pf.H == 3 and (~want).any() and want.any(axis=1).all()
     assert np.array_equal(got, want) and np.array_equal(sel, want)
+    # and the wave's direction (the key always pairs: exact under the same assumptions)
+    assert np.array_equal(d.options().pairs, travelling_wave_pairs(
+        d.dof_labels, pf.QUICK.eo, pf.QUICK.sectors, pf.H))
     assert "travelling_wave" in d.result_meta()["solver_settings"]
 
 
@@ -492,3 +589,17 @@ def test_bad_options_name_their_field(fam):
         frf(model, exc, d.omega_start, d.omega_end, o, outputs=d.outputs)
     with pytest.raises(InputError, match="no DoF is a multi-stage"):
         travelling_wave_selection(["cb 1", "N3:UX"], 2, 6, 3)
+    pairs = travelling_wave_pairs(d.reduced.labels, pf.QUICK.eo, pf.QUICK.sectors, pf.H)
+    with pytest.raises(ParameterError, match="options.pairs: needs options.selection"):
+        dataclasses.replace(d.options(), selection=None, pairs=pairs).check()
+    bad = pairs.copy()
+    bad[:, 0] = bad[:, 1]
+    o = dataclasses.replace(d.options(), stability=False, selection=sel, pairs=bad)
+    with pytest.raises(ParameterError, match="options.pairs: no pair at harmonic 0"):
+        frf(model, d.excitation(), d.omega_start, d.omega_end, o, outputs=d.outputs)
+    bad = pairs.copy()
+    j = np.flatnonzero(pairs[:, 1])[0]
+    bad[j, 1] = np.sign(bad[j, 1]) * (j + 1)                  # to itself: Fortran refuses
+    o = dataclasses.replace(d.options(), stability=False, selection=sel, pairs=bad)
+    with pytest.raises(ParameterError, match="pair names no other coordinate"):
+        frf(model, d.excitation(), d.omega_start, d.omega_end, o, outputs=d.outputs)

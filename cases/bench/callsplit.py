@@ -6,7 +6,10 @@ evaluations' untimed products), and the Python time outside the calls; every par
 a fraction of the FRF's wall time measured in the same run (min over --repeat runs).
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python cases/bench/callsplit.py \
-        --flange WORK F0 | --hooks WORK F0 [--repeat 3]
+        --flange WORK F0 | --hooks WORK F0 [--repeat 3] [--no-pairs]
+
+--no-pairs: the flange's travelling-wave ROM_II with its selection only (both directions
+of the wave; before SolverOptions.pairs), for a before/after comparison.
 
 WORK is a case's work folder made by its make script (paper_flange.py: the folder with
 rom1.toml, whose travelling-wave ROM_II is built from ROM_I; paper_hooks: the folder with
@@ -47,6 +50,8 @@ def _problem(args):
         model, exc = d.model(), d.excitation()
         exc.F[:, 1:] *= f0 / pf.F0_DECK
         opts = dataclasses.replace(d.options(), stability=False)
+        if getattr(args, "no_pairs", False):
+            opts = dataclasses.replace(opts, pairs=None)
         return ("flange TW ROM_II", f0, (model, exc, d.omega_start, d.omega_end, opts),
                 dict(outputs=d.outputs))
     import paper_hooks as ph
@@ -64,10 +69,12 @@ def main(argv=None) -> None:
     g.add_argument("--flange", nargs=2, metavar=("WORK", "F0"))
     g.add_argument("--hooks", nargs=2, metavar=("WORK", "F0"))
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--no-pairs", action="store_true")
     args = ap.parse_args(argv)
     name, f0, fargs, fkw = _problem(args)
     slots = _pack._TIMER_SLOTS
-    stats = collections.defaultdict(lambda: np.zeros(5))  # n, wall, fortran, timed, evals
+    # n, wall, fortran, timed, evals, LUs
+    stats = collections.defaultdict(lambda: np.zeros(6))
     call = _pack._Packed.call
 
     def counted(self, y0, lam0, tan0, start_mode, ds, *rest):
@@ -77,7 +84,7 @@ def main(argv=None) -> None:
                 "peak solve" if self.opts.ds_max == 1e3 else "continuation")
         stats[kind] += [1, time.perf_counter() - t0, r.timings[slots["fortran_total"]],
                         sum(r.timings[slots[k]] for k in TIMED),
-                        r.timings[slots["evaluations"]]]
+                        r.timings[slots["evaluations"]], r.timings[slots["factorizations"]]]
         return r
 
     best = None
@@ -94,9 +101,13 @@ def main(argv=None) -> None:
         _pack._Packed.call = call
     wall, st, npts = best
     print(f"{name} at F0 = {f0:g}: {npts} points, {wall:.3f} s (min of {args.repeat})")
+    print(r.solver_info)
+    print("peaks (amplitude m, frequency Hz): " + ", ".join(
+        f"{r.peak(k).amplitude:.10e} at {r.peak(k).omega / (2 * np.pi):.8f}"
+        for k in range(r.X.shape[1])))
     print(f"{'call kind':<14}{'calls':>6}{'evals':>7}{'wall s':>9}{'timers s':>10}"
           f"{'other F s':>10}{'ms/call':>9}{'of FRF':>8}")
-    tot = np.zeros(5)
+    tot = np.zeros(6)
     for kind, v in sorted(st.items()):
         tot += v
         print(f"{kind:<14}{v[0]:6.0f}{v[4]:7.0f}{v[1]:9.3f}{v[3]:10.3f}{v[2] - v[3]:10.3f}"
@@ -105,7 +116,7 @@ def main(argv=None) -> None:
     print(f"{'all calls':<14}{tot[0]:6.0f}{tot[4]:7.0f}{tot[1]:9.3f}{tot[3]:10.3f}"
           f"{tot[2] - tot[3]:10.3f}{1e3 * tot[1] / tot[0]:9.1f}{tot[1] / wall:8.1%}")
     print(f"python outside the calls: {py:.3f} s ({py / wall:.1%}); untimed Fortran per "
-          f"evaluation {1e3 * (tot[2] - tot[3]) / tot[4]:.2f} ms")
+          f"evaluation {1e3 * (tot[2] - tot[3]) / tot[4]:.2f} ms; {tot[5]:.0f} Jacobians")
 
 
 if __name__ == "__main__":

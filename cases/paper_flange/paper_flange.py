@@ -310,12 +310,14 @@ def derived(d1, rom: str, spec):
 def unknowns(d) -> int:
     """The condensed solver's unknowns for a deck's model (its LU is that size): the
     nonlinear DoFs or the contact coordinates, whichever is fewer ('auto'), times 2H+1;
-    with a travelling-wave selection, the pairs it keeps."""
+    with a travelling-wave selection, the pairs it keeps, two fewer for each pair of
+    its direction (SolverOptions.pairs)."""
     from frirom.solver import kept_unknowns
     m, o = d.model(), d.options()
     nl = m.nonlinear_dofs()
     if o.selection is not None:
-        return kept_unknowns(o.selection[nl])
+        n = kept_unknowns(o.selection[nl])
+        return n - (0 if o.pairs is None else 2 * int(np.count_nonzero(o.pairs[nl])))
     rows = sum(g.G.shape[0] for g in m.contacts)
     return min(rows, nl.size) * (2 * o.harmonics + 1)
 

@@ -351,6 +351,8 @@ class _Packed:
     #: (nnl, H+1) bool: the travelling-wave selection over the nonlinear DoFs nl
     #: (SolverOptions.selection), None: every unknown
     keep: np.ndarray | None = None
+    #: (nnl, H+1) int32: SolverOptions.pairs over nl (s (position in nl + 1)), None: none
+    pair: np.ndarray | None = None
 
     @property
     def nc(self) -> int:
@@ -414,9 +416,11 @@ class _Packed:
             netot=max(self.ne_tot, 1), ntim=len(_TIMER_SLOTS), nh=self.H, ndof=self.n_dof,
             nnl=self.nl.size or 1, tcontact=int(self.tcontact),
             krylov=int(o.krylov), sparse=int(self.sparse), lu=lu, lupiv=piv, lustate=lust,
-            selected=int(self.keep is not None),
+            selected=0 if self.keep is None else 1 if self.pair is None else 2,
             keep=np.asfortranarray(np.zeros((max(self.nl.size, 1), self.H + 1), np.int32)
-                                   if self.keep is None else self.keep.astype(np.int32)))
+                                   if self.keep is None else self.keep.astype(np.int32)),
+            pair=np.asfortranarray(np.zeros((max(self.nl.size, 1), self.H + 1), np.int32)
+                                   if self.pair is None else self.pair))
         *head, msg, leak = res
         r = _CallResult(*head, msg=msg.decode(errors="replace"), leak=leak)
         if r.npts > 0 and self.nw and o.history:
@@ -540,11 +544,11 @@ def pack(model: Model | CyclicModel, excitation: Excitation, opts: SolverOptions
     if P is not None:
         packed.out_map, packed.outputs = P, _map_dofs(P, packed.outputs)
     if opts.selection is not None:
-        _select(packed, model, opts.selection)
+        _select(packed, model, opts.selection, opts.pairs)
     return packed
 
 
-def _select(packed: _Packed, model, selection) -> None:
+def _select(packed: _Packed, model, selection, pairs=None) -> None:
     """Check SolverOptions.selection against the packed model and set packed.keep: the
     rows of the nonlinear DoFs; loads on them outside the selection are refused (a
     travelling wave of the selection's engine order has none)."""
@@ -570,8 +574,11 @@ def _select(packed: _Packed, model, selection) -> None:
                     f"{int(packed.nl[np.argmax(off)])} at harmonic {h}, outside the "
                     "selection (not a travelling wave of the selection's engine order)")
     packed.keep = keep
-    packed.info += (f"; travelling-wave selection: {kept_unknowns(keep)} of {packed.ny} "
-                    "unknowns")
+    n = kept_unknowns(keep)
+    packed.info += f"; travelling-wave selection: {n} of {packed.ny} unknowns"
+    if pairs is not None:
+        packed.pair = _pairs_on_nl(packed, pairs)
+        packed.info += f", {n - 2 * int(np.count_nonzero(packed.pair))} in one direction"
 
 
 def kept_unknowns(keep) -> int:
@@ -580,6 +587,28 @@ def kept_unknowns(keep) -> int:
     harmonic 0 is one coefficient, a kept harmonic h >= 1 two (cos, sin)."""
     keep = np.asarray(keep, dtype=bool)
     return int(keep[:, 0].sum() + 2 * keep[:, 1:].sum())
+
+
+def _pairs_on_nl(packed: _Packed, pairs) -> np.ndarray:
+    """SolverOptions.pairs (model DoFs) on the nonlinear DoFs nl: (nnl, H+1) int32,
+    s (position in nl + 1)."""
+    pr = np.asarray(pairs)
+    if pr.shape != (packed.n_dof, packed.H + 1) or not np.issubdtype(pr.dtype, np.integer):
+        raise SizeError(f"options.pairs: expected (n_dof, H+1) = ({packed.n_dof}, "
+                        f"{packed.H + 1}) integers, got {pr.shape} {pr.dtype}")
+    pos = np.full(packed.n_dof + 1, -1, dtype=np.int64)
+    pos[packed.nl + 1] = np.arange(packed.nl.size)
+    off_nl = np.ones(packed.n_dof, bool)
+    off_nl[packed.nl] = False
+    k = np.abs(pr)
+    if np.any(pr[off_nl]) or k.max() > packed.n_dof or np.any(pos[k[k > 0]] < 0):
+        raise ParameterError("options.pairs: pairs only between nonlinear DoFs")
+    if np.any(pr[:, 0]):
+        raise ParameterError("options.pairs: no pair at harmonic 0 (it has no sine)")
+    sub = pr[packed.nl]
+    out = np.sign(sub) * (pos[np.abs(sub)] + 1)
+    out[sub == 0] = 0
+    return out.astype(np.int32)
 
 
 def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed:

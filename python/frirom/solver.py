@@ -152,6 +152,13 @@ class SolverOptions:
         fewer unknowns. Each point reports its leak (``FRFPoint.leak``: contact forces off
         the selection over those on it); a run warns above :data:`LEAK_TOL`. Needs the
         condensed formulation in the nonlinear DoFs, no Krylov solves and no stability.
+    pairs : ndarray or None
+        (n_dof, H+1) int, with ``selection``: the wave's direction, ``pairs[j, h] = s (k +
+        1)`` ties harmonic h of nonlinear DoF j to that of k by x_k,sin = s x_j,cos and
+        x_k,cos = -s x_j,sin, and each pair's four unknowns become two
+        (:func:`frirom.reduction.multistage.travelling_wave_pairs`); 0: no pair. Exact
+        when the selection is, for one travelling direction; the leak then also counts
+        the other direction.
     """
 
     harmonics: int = 3
@@ -176,6 +183,7 @@ class SolverOptions:
     receptances: str = "auto"
     krylov: bool = False
     selection: np.ndarray | None = field(default=None, repr=False)
+    pairs: np.ndarray | None = field(default=None, repr=False)
 
     def check(self) -> None:
         """Raise ParameterError naming the first invalid field."""
@@ -221,6 +229,8 @@ class SolverOptions:
                 if bad:
                     raise ParameterError(f"options.selection: a travelling-wave selection "
                                          f"needs {why}")
+        if self.pairs is not None and self.selection is None:
+            raise ParameterError("options.pairs: needs options.selection")
         for nm, allowed in (("coordinates", ("auto", "dofs", "contact")),
                             ("receptances", ("auto", "modes", "factorization", "sparse"))):
             if getattr(self, nm) not in allowed:

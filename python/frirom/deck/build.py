@@ -23,7 +23,8 @@ from ..contact import LAWS
 from ..io import DIRECTION_NAMES, read_mtx
 from ..io._common import read_text
 from ..model import ContactGroup, CyclicModel, Damping, Excitation, Model, check_definite
-from ..reduction.multistage import cylindrical_frame, travelling_wave_selection
+from ..reduction.multistage import (cylindrical_frame, travelling_wave_pairs,
+                                     travelling_wave_selection)
 from ..reduction.rom import (PairSpec, build_reduced_model, cache_file, rom_key,
                              same_reduction)
 from ..solver import SolverOptions
@@ -113,8 +114,9 @@ class Deck:
 
         from .. import __version__
         opts = dataclasses.asdict(self.options())
-        if opts["selection"] is not None:       # the deck key that made it, not the array
-            opts["selection"] = "travelling_wave"
+        for key in ("selection", "pairs"):
+            if opts[key] is not None:           # the deck key that made it, not the array
+                opts[key] = "travelling_wave"
         return {"deck_path": str(self.path.resolve()), "deck_text": self.path.read_text(),
                 "solver_settings": json.dumps(opts, sort_keys=True, default=str),
                 "model_fingerprint": self.fingerprint(), "frirom_version": __version__}
@@ -157,10 +159,18 @@ class Deck:
         """``[reduction.interface_modes] travelling_wave = true``: (n_dof, H+1) bool, the
         (coordinate, harmonic) pairs the deck's engine-order travelling wave moves
         (:func:`frirom.reduction.multistage.travelling_wave_selection`)."""
+        return travelling_wave_selection(self.dof_labels, self._eo(),
+                                         self.settings.reduction.sectors, self.harmonics)
+
+    def travelling_wave_pairs(self) -> np.ndarray:
+        """``travelling_wave = true``: (n_dof, H+1) int, the wave's direction on the
+        selection (:func:`frirom.reduction.multistage.travelling_wave_pairs`)."""
+        return travelling_wave_pairs(self.dof_labels, self._eo(),
+                                     self.settings.reduction.sectors, self.harmonics)
+
+    def _eo(self) -> int:
         eos = self.raw["excitation"]["engine_order"]
-        eo = int((eos if isinstance(eos, dict) else eos[0])["eo"])
-        return travelling_wave_selection(self.dof_labels, eo, self.settings.reduction.sectors,
-                                         self.harmonics)
+        return int((eos if isinstance(eos, dict) else eos[0])["eo"])
 
     def options(self) -> SolverOptions:
         """The solver's SolverOptions from the [solver] and [continuation] tables."""
@@ -177,6 +187,7 @@ class Deck:
         red = self.settings.reduction if self.settings is not None else None
         if red is not None and red.travelling_wave:
             kw["selection"] = self.travelling_wave_selection()
+            kw["pairs"] = self.travelling_wave_pairs()
         opts = SolverOptions(**kw)
         if opts.ds_min > opts.ds_max or not opts.ds_min <= opts.ds <= opts.ds_max:
             # keep the user's steps consistent with the solver's defaults for the others

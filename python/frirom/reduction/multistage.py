@@ -34,7 +34,7 @@ from .interface import InterfaceReduction
 
 __all__ = ["RadialSegments", "MultistageInterface", "cylindrical_frame", "fourier_matrix",
            "fourier_columns", "harmonic_indices", "stage_indices", "shared_indices",
-           "radial_line_segments", "travelling_wave_selection",
+           "radial_line_segments", "travelling_wave_selection", "travelling_wave_pairs",
            "ms_basis", "harmonic_content",
            "stage_contact_matrix", "assemble"]
 
@@ -196,6 +196,47 @@ def travelling_wave_selection(labels, engine_order: int, n_sectors: int,
                          "coordinate (labels 'ms h=<index>'); the selection needs an MS "
                          "interface reduction")
     return sel
+
+
+_MS_KIND = re.compile(r"\bms h=(\d+) ([0ncs]) ")
+
+
+def travelling_wave_pairs(labels, engine_order: int, n_sectors: int,
+                          harmonics: int) -> np.ndarray:
+    """The direction of a tuned rotor's travelling wave: pairs of the selection's unknowns.
+
+    The EO ``engine_order`` (e) load of sector s has the phase exp(-2 pi i e s / N)
+    (:func:`frirom.reduction.cyclic.engine_order_loads`), so time harmonic h of the
+    response is a wave cos(h w t - q phi) with q = h e (mod N), phi the MS angle (sectors
+    numbered the way the MS angle grows). On an MS index p with cosine column c and sine
+    column s (labels ``"ms h=p c ..."``, ``"ms h=p s ..."``, same stage, node and
+    component), that is a(s, sin) = sigma a(c, cos) and a(s, cos) = -sigma a(c, sin), with
+    sigma = +1 where p = +h e (mod N) and -1 where p = -h e: two unknowns of four. No pair
+    at h = 0, for p = 0 or NZ/2 (no sine column) or where p = h e and p = -h e both hold
+    (2 h e = 0 mod N: a standing wave is possible).
+
+    Returns (n_dof, H+1) int, for :class:`frirom.solver.SolverOptions` ``pairs``:
+    ``pairs[c, h] = sigma (k + 1)`` for the cosine DoF c and its sine DoF k, 0 elsewhere.
+    Raises InputError when no label is an MS coordinate.
+    """
+    n = int(n_sectors)
+    e = int(engine_order)
+    travelling_wave_selection(labels, e, n, harmonics)        # the same checks
+    out = np.zeros((len(labels), int(harmonics) + 1), dtype=np.int64)
+    where = {str(lab): i for i, lab in enumerate(labels)}
+    for i, lab in enumerate(labels):
+        m = _MS_KIND.search(str(lab))
+        if m is None or m.group(2) != "c":
+            continue
+        k = where.get(str(lab)[:m.start(2)] + "s" + str(lab)[m.end(2):])
+        if k is None:
+            continue
+        p = int(m.group(1))
+        for h in range(1, int(harmonics) + 1):
+            fwd, bwd = (p - h * e) % n == 0, (p + h * e) % n == 0
+            if fwd != bwd:
+                out[i, h] = (1 if fwd else -1) * (k + 1)
+    return out
 
 
 # --------------------------------------------------------------------------------------------
