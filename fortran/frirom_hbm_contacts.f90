@@ -32,7 +32,7 @@ contains
     end procedure csr_matvec_add_cplx
 
     module procedure csr_set
-        integer(ip) :: nnz
+        integer(ip) :: nnz, k, bad
         info = FRIROM_OK
         if (size(p) /= nrow + 1) then
             call set_status(info, FRIROM_ERR_SIZE, errmsg, name//': row pointer length')
@@ -44,21 +44,27 @@ contains
             call set_status(info, FRIROM_ERR_SIZE, errmsg, name//': malformed CSR pointers')
             return
         end if
-        if (nnz > 0) then
-            if (any(i(:nnz) < 1) .or. any(i(:nnz) > ncol)) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, name//': column out of range')
-                return
-            end if
-            if (.not. all(abs(x(:nnz)) <= huge(1.0_wp))) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, name//': non-finite value')
-                return
-            end if
+        ! one pass that checks and copies (a reduced model's K, M, C are dense, and set once
+        ! per call into Fortran)
+        allocate (a%i(nnz), a%x(nnz))
+        bad = 0
+        do k = 1, nnz
+            a%i(k) = i(k)
+            a%x(k) = x(k)
+            if (i(k) < 1 .or. i(k) > ncol) bad = ior(bad, 1)
+            if (.not. abs(x(k)) <= huge(1.0_wp)) bad = ior(bad, 2)
+        end do
+        if (iand(bad, 1) /= 0) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, name//': column out of range')
+            return
+        end if
+        if (bad /= 0) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, name//': non-finite value')
+            return
         end if
         a%nrow = nrow
         a%ncol = ncol
         a%p = p
-        a%i = i(:nnz)
-        a%x = x(:nnz)
     end procedure csr_set
 
     module procedure contact_eval
@@ -359,7 +365,9 @@ contains
             pos = 0
             do e = 1, gr%ne
                 r = gr%row0 + (e - 1)*nd + d
-                pos(gg%i(gg%p(r):gg%p(r + 1) - 1)) = 1
+                do k = gg%p(r), gg%p(r + 1) - 1
+                    pos(gg%i(k)) = 1
+                end do
             end do
             n = n + count(pos /= 0)
         end do
@@ -374,7 +382,9 @@ contains
             pos = 0
             do e = 1, gr%ne
                 r = gr%row0 + (e - 1)*nd + d
-                pos(gg%i(gg%p(r):gg%p(r + 1) - 1)) = 1
+                do k = gg%p(r), gg%p(r + 1) - 1
+                    pos(gg%i(k)) = 1
+                end do
             end do
             do k = 1, gg%ncol       ! the columns ascending; pos(col) = their row in gdt
                 if (pos(k) == 0) cycle
