@@ -362,13 +362,7 @@ contains
         if (nd < 1 .or. gr%ne < 1) return
         n = 0
         do d = 1, nd
-            pos = 0
-            do e = 1, gr%ne
-                r = gr%row0 + (e - 1)*nd + d
-                do k = gg%p(r), gg%p(r + 1) - 1
-                    pos(gg%i(k)) = 1
-                end do
-            end do
+            call mark(d)
             n = n + count(pos /= 0)
         end do
         if (real(n, wp)*real(gr%ne, wp) > 2.0_wp*real(nnz, wp)) return
@@ -379,13 +373,7 @@ contains
         n = 0
         m = 0
         do d = 1, nd
-            pos = 0
-            do e = 1, gr%ne
-                r = gr%row0 + (e - 1)*nd + d
-                do k = gg%p(r), gg%p(r + 1) - 1
-                    pos(gg%i(k)) = 1
-                end do
-            end do
+            call mark(d)
             do k = 1, gg%ncol       ! the columns ascending; pos(col) = their row in gdt
                 if (pos(k) == 0) cycle
                 n = n + 1
@@ -408,6 +396,21 @@ contains
             return
         end if
         gr%gx_mode = 3
+
+    contains
+
+        !> pos = 1 on the columns direction d's rows read, 0 elsewhere.
+        subroutine mark(d)
+            integer(ip), intent(in) :: d
+            integer(ip) :: ee, kk, rr
+            pos = 0
+            do ee = 1, gr%ne
+                rr = gr%row0 + (ee - 1)*nd + d
+                do kk = gg%p(rr), gg%p(rr + 1) - 1
+                    pos(gg%i(kk)) = 1
+                end do
+            end do
+        end subroutine mark
     end subroutine choose_dir
 
     !> gr%gcols (the columns the group's rows read, ascending; pos(col) /= 0 marks them on
