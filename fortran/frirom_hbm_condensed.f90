@@ -609,7 +609,7 @@ contains
         integer(ip), intent(out) :: nuse
         real(wp), intent(out) :: skip(3)
         real(wp), allocatable :: w(:, :)
-        real(wp) :: nf2, q2, t(3)
+        real(wp) :: nf2, q2, g2, t(3)
         integer(ip) :: r, nm
         nm = size(sys%phr, 2)
         if (allocated(use)) then
@@ -620,14 +620,15 @@ contains
         nf2 = sum(real(fc, wp)**2 + aimag(fc)**2)
         ! squared bounds
         do r = 1, nm
-            q2 = abs(q(r))**2
-            w(r, 1) = sys%pamx(r, h)*abs(sys%g(r, h))**2*q2
-            w(r, 2) = sys%pamx(r, h)*abs(sys%g(r, h))**2*sys%pan(r)*nf2
+            q2 = sq(q(r))
+            g2 = sys%pamx(r, h)*sq(sys%g(r, h))
+            w(r, 1) = g2*q2
+            w(r, 2) = g2*sys%pan(r)*nf2
             if (sys%mode == HBM_FREQUENCY) then
                 ! (|q| + |v|)^2 <= 2 (|q|^2 + |v|^2)
-                w(r, 3) = sys%pamx(r, h)*abs(sys%dg(r, h))**2*2.0_wp*(q2 + sys%pan(r)*nf2)
+                w(r, 3) = sys%pamx(r, h)*sq(sys%dg(r, h))*2.0_wp*(q2 + sys%pan(r)*nf2)
             else
-                w(r, 3) = sys%pamx(r, h)*abs(sys%g(r, h)*sys%qf1(r, h))**2
+                w(r, 3) = g2*sq(sys%qf1(r, h))
             end if
         end do
         t = (PROJ_SKIP/nm)**2*maxval(w, dim=1)
@@ -646,6 +647,14 @@ contains
             nuse = nuse + 1
             use(nuse) = r
         end do
+
+    contains
+
+        !> |z|^2 without the square root
+        pure real(wp) function sq(z)
+            complex(wp), intent(in) :: z
+            sq = real(z, wp)**2 + aimag(z)**2
+        end function sq
     end subroutine sel_modes
 
     !> Whether the modes sel_modes left out are negligible against the terms computed:
