@@ -31,12 +31,15 @@ submodule (frirom_hbm) frirom_hbm_condensed
     !> above WB_FLOOR times the most sensitive
     integer(ip), parameter :: WB_PAIRS = 96
     real(wp), parameter :: WB_FLOOR = 1.0e-4_wp
+    !> A selected residual leaves out the modes whose terms on the kept rows sum to at most
+    !> this fraction of the largest term (sel_modes, proj_safe)
+    real(wp), parameter :: PROJ_SKIP = 1.0e-15_wp
 
 contains
 
     module procedure cond_init
         integer(ip) :: nu, n, stat, g, e, r, k, ne_tot, ie, nk
-        integer(ip), allocatable :: cols(:)
+        integer(ip), allocatable :: cols(:), seen(:)
         info = FRIROM_OK
         nu = sys%t%nrow
         sys%nnl = nu
@@ -52,7 +55,10 @@ contains
         end if
         ! the coordinates each contact element reads (columns of its rows of cs%g)
         ne_tot = sum([(sys%cs%grp(g)%ne, g=1, size(sys%cs%grp))])
-        allocate (sys%ecp(ne_tot + 1), cols(size(sys%cs%g%i)))
+        ! seen(col): the last element that read col (each element's columns once, in the
+        ! order its rows first read them)
+        allocate (sys%ecp(ne_tot + 1), cols(size(sys%cs%g%i)), seen(sys%cs%g%ncol))
+        seen = 0
         sys%ecp(1) = 1
         ie = 0
         nk = 0
@@ -62,7 +68,8 @@ contains
                     ie = ie + 1
                     do r = gr%row0 + (e - 1)*gr%ndir + 1, gr%row0 + e*gr%ndir
                         do k = gg%p(r), gg%p(r + 1) - 1
-                            if (any(cols(sys%ecp(ie):nk) == gg%i(k))) cycle
+                            if (seen(gg%i(k)) == ie) cycle
+                            seen(gg%i(k)) = ie
                             nk = nk + 1
                             cols(nk) = gg%i(k)
                         end do
@@ -379,7 +386,9 @@ contains
 
     module procedure cond_eval
         real(wp) :: w, s, nx, nxe, nhf, nxd, nhd
-        integer(ip) :: nnl, nc, h, n, nm, nhd0
+        integer(ip) :: nnl, nc, h, n, nm, nhd0, nuse
+        integer(ip), allocatable :: use(:)
+        logical :: sel
         complex(wp), allocatable :: fc(:), z(:), dz(:), rh(:), xe(:), v(:), x3(:, :), b3(:, :)
         real(wp), allocatable :: r2(:, :), rl2(:, :)   !! (nnl, nc) r and rlam by harmonic
         real(wp), allocatable :: rf(:)                 !! (nnl nc) all rows (a selection)
@@ -425,11 +434,16 @@ contains
                 end if
             end if
         end if
+        sel = this%modal .and. allocated(this%sel) .and. allocated(this%phr)
         do h = 0, this%nh
             fc = harm_col(this%fd, h)
             if (this%modal) then
                 ! T x = A g (q - A^H fc): forced part, contact part, d/dw (one product)
-                call modal_project(this, h, fc, v)
+                if (sel) then
+                    call sel_project(this, h, s, fc, v, use, nuse)
+                else
+                    call modal_project(this, h, fc, v)
+                end if
                 associate (g => this%g(:, h), q => this%qf(:, h) + s*this%qf1(:, h))
                     x3(:, 1) = g*q
                     x3(:, 2) = g*v
@@ -439,9 +453,11 @@ contains
                         x3(:, 3) = -this%dg(:, h)*(q - v)
                     end if
                 end associate
-                if (allocated(this%sel)) then
+                if (sel) then
                     ! the kept rows only (the others are dropped; cond_outputs measures the
-                    ! loads' leak)
+                    ! loads' leak), over the modes that reach them
+                    call rows_some(this, h, use(1:nuse), x3, b3)
+                else if (allocated(this%sel)) then
                     call modal_rows(this, h, this%kpt(this%kptr(h + 1):this%kptr(h + 2) - 1), &
                                     x3, b3)
                 else
@@ -720,6 +736,186 @@ contains
         call dgemm('N', 'N', k, m, k, -1.0_wp, b, k, kc(ca, 1), n, 0.0_wp, jm(cb, 1), n)
         call dgemm('N', 'N', k, m, k, 1.0_wp, a, k, kc(cb, 1), n, 1.0_wp, jm(cb, 1), n)
     end subroutine harm_rows
+
+    !> v = A^H fc (the modal route with a selection, real modes) on the modes use(1:nuse)
+    !> that reach harmonic h's kept rows (sel_modes), or on all when the terms left out
+    !> are not negligible against those computed (proj_safe); v is zero on the others.
+    subroutine sel_project(sys, h, s, fc, v, use, nuse)
+        type(hbm_condensed), intent(inout) :: sys
+        integer(ip), intent(in) :: h
+        real(wp), intent(in) :: s
+        complex(wp), intent(in) :: fc(:)
+        complex(wp), intent(out) :: v(:)
+        integer(ip), allocatable, intent(inout) :: use(:)
+        integer(ip), intent(out) :: nuse
+        real(wp) :: skip(3)
+        integer(ip) :: k
+        call sel_rows(sys)
+        call sel_modes(sys, h, sys%qf(:, h) + s*sys%qf1(:, h), fc, use, nuse, skip)
+        call project_some(sys, fc, use(1:nuse), v)
+        if (proj_safe(sys, h, sys%qf(:, h) + s*sys%qf1(:, h), use(1:nuse), v, skip)) return
+        nuse = size(v)
+        use = [(k, k=1, nuse)]
+        call project_some(sys, fc, use, v)
+    end subroutine sel_project
+
+    !> The cache of a selection's kept mode rows (prow, pamx, pan; see hbm_condensed),
+    !> (re)built when missing or made for other modes or another selection.
+    subroutine sel_rows(sys)
+        type(hbm_condensed), intent(inout) :: sys
+        integer(ip) :: h, r, nm, a, b
+        logical :: ok
+        nm = size(sys%phr, 2)
+        ok = allocated(sys%prow) .and. allocated(sys%prow_kpt)
+        if (ok) ok = size(sys%prow_kpt) == size(sys%kpt) .and. size(sys%prow, 2) == nm
+        if (ok) ok = all(sys%prow_kpt == sys%kpt)
+        if (ok) return
+        sys%prow = sys%phr(sys%kpt, :)
+        sys%prow_kpt = sys%kpt
+        if (allocated(sys%pamx)) deallocate (sys%pamx, sys%pan)
+        allocate (sys%pamx(nm, 0:sys%nh), sys%pan(nm))
+        do r = 1, nm
+            sys%pan(r) = sum(sys%phr(1:sys%nnl, r)**2)
+            do h = 0, sys%nh
+                a = sys%kptr(h + 1)
+                b = sys%kptr(h + 2) - 1
+                sys%pamx(r, h) = 0.0_wp
+                if (b >= a) sys%pamx(r, h) = maxval(sys%prow(a:b, r)**2)
+            end do
+        end do
+    end subroutine sel_rows
+
+    !> The modes r a selected residual needs at harmonic h: those whose terms on the kept
+    !> rows, A_h(rows, r) x3(r, k) for the three columns of cond_eval (g q, g v, dg (q - v)
+    !> or -g qf1; v = A^H fc), can exceed PROJ_SKIP / nm times the largest. A term is
+    !> bounded by max|A(rows, r)| |g_r| |v_r| with |v_r| <= |A(:, r)| |fc| (Cauchy-
+    !> Schwarz over every row: the forces off the selection count, so a mistuned rotor,
+    !> whose forces there are large, keeps the modes they drive). skip(k): the sum of
+    !> the left-out terms' bounds in column k, which proj_safe compares with the largest
+    !> term actually computed. Every mode when a bound is not finite.
+    subroutine sel_modes(sys, h, q, fc, use, nuse, skip)
+        type(hbm_condensed), intent(in) :: sys
+        integer(ip), intent(in) :: h
+        complex(wp), intent(in) :: q(:), fc(:)
+        integer(ip), allocatable, intent(inout) :: use(:)
+        integer(ip), intent(out) :: nuse
+        real(wp), intent(out) :: skip(3)
+        real(wp), allocatable :: w(:, :)
+        real(wp) :: nf2, q2, g2, t(3)
+        integer(ip) :: r, nm
+        nm = size(sys%phr, 2)
+        if (allocated(use)) then
+            if (size(use) /= nm) deallocate (use)
+        end if
+        if (.not. allocated(use)) allocate (use(nm))
+        allocate (w(nm, 3))
+        nf2 = sum(real(fc, wp)**2 + aimag(fc)**2)
+        ! squared bounds
+        do r = 1, nm
+            q2 = sq(q(r))
+            g2 = sys%pamx(r, h)*sq(sys%g(r, h))
+            w(r, 1) = g2*q2
+            w(r, 2) = g2*sys%pan(r)*nf2
+            if (sys%mode == HBM_FREQUENCY) then
+                ! (|q| + |v|)^2 <= 2 (|q|^2 + |v|^2)
+                w(r, 3) = sys%pamx(r, h)*sq(sys%dg(r, h))*2.0_wp*(q2 + sys%pan(r)*nf2)
+            else
+                w(r, 3) = g2*sq(sys%qf1(r, h))
+            end if
+        end do
+        t = (PROJ_SKIP/nm)**2*maxval(w, dim=1)
+        skip = 0.0_wp
+        nuse = 0
+        if (.not. all(t < huge(1.0_wp))) then
+            nuse = nm
+            use = [(r, r=1, nm)]
+            return
+        end if
+        do r = 1, nm
+            if (all(w(r, :) <= t)) then
+                skip = skip + sqrt(w(r, :))
+                cycle
+            end if
+            nuse = nuse + 1
+            use(nuse) = r
+        end do
+
+    contains
+
+        !> |z|^2 without the square root
+        pure real(wp) function sq(z)
+            complex(wp), intent(in) :: z
+            sq = real(z, wp)**2 + aimag(z)**2
+        end function sq
+    end subroutine sel_modes
+
+    !> Whether the modes sel_modes left out are negligible against the terms computed:
+    !> skip(k) <= PROJ_SKIP times the largest |A(rows, r) x3(r, k)| over r in use (a few
+    !> units of round-off of that term, below the round-off of the sum over all modes).
+    !> The columns that do not hold v (g q; -g qf1) had exact bounds: sel_modes's
+    !> threshold alone keeps them. Else cond_eval takes every mode.
+    logical function proj_safe(sys, h, q, use, v, skip)
+        type(hbm_condensed), intent(in) :: sys
+        integer(ip), intent(in) :: h, use(:)
+        complex(wp), intent(in) :: q(:), v(:)
+        real(wp), intent(in) :: skip(3)
+        real(wp) :: big(3), a
+        integer(ip) :: k, r
+        big = 0.0_wp
+        do k = 1, size(use)
+            r = use(k)
+            a = sqrt(sys%pamx(r, h))
+            big(2) = max(big(2), a*abs(sys%g(r, h)*v(r)))
+            big(3) = max(big(3), a*abs(sys%dg(r, h)*(q(r) - v(r))))
+        end do
+        proj_safe = skip(2) <= PROJ_SKIP*big(2)
+        if (sys%mode == HBM_FREQUENCY) proj_safe = proj_safe .and. skip(3) <= PROJ_SKIP*big(3)
+    end function proj_safe
+
+    !> v(use) = A^H fc over the rows T (real modes phr), v zero elsewhere: the columns
+    !> use of phr gathered, one product.
+    subroutine project_some(sys, fc, use, v)
+        type(hbm_condensed), intent(in) :: sys
+        complex(wp), intent(in) :: fc(:)
+        integer(ip), intent(in) :: use(:)
+        complex(wp), intent(out) :: v(:)
+        real(wp), allocatable :: pg(:, :), fr(:, :), vr(:, :)
+        integer(ip) :: nu, k
+        nu = sys%nnl
+        k = size(use)
+        v = (0.0_wp, 0.0_wp)
+        if (k == 0) return
+        allocate (fr(nu, 2), vr(k, 2))
+        pg = sys%phr(1:nu, use)
+        fr(:, 1) = real(fc, wp)
+        fr(:, 2) = aimag(fc)
+        call dgemm('T', 'N', k, 2, nu, 1.0_wp, pg, nu, fr, nu, 0.0_wp, vr, k)
+        v(use) = cmplx(vr(:, 1), vr(:, 2), wp)
+    end subroutine project_some
+
+    !> modal_rows over the modes use only: b(kept rows at h, :) = A_h(those rows, use)
+    !> x(use, :) from the cached rows prow; the other rows of b zero.
+    subroutine rows_some(sys, h, use, x, b)
+        type(hbm_condensed), intent(in) :: sys
+        integer(ip), intent(in) :: h, use(:)
+        complex(wp), intent(in) :: x(:, :)     !! (nm, k)
+        complex(wp), intent(out) :: b(:, :)    !! (nnl, k)
+        real(wp), allocatable :: pk(:, :), xr(:, :), br(:, :)
+        integer(ip) :: nu, k, nr, lo, hi
+        k = size(x, 2)
+        nu = size(use)
+        lo = sys%kptr(h + 1)
+        hi = sys%kptr(h + 2) - 1
+        nr = hi - lo + 1
+        b = (0.0_wp, 0.0_wp)
+        if (nr <= 0 .or. nu == 0) return
+        pk = sys%prow(lo:hi, use)
+        allocate (xr(nu, 2*k), br(nr, 2*k))
+        xr(:, 1:k) = real(x(use, :), wp)
+        xr(:, k + 1:) = aimag(x(use, :))
+        call dgemm('N', 'N', nr, 2*k, nu, 1.0_wp, pk, nr, xr, nu, 0.0_wp, br, nr)
+        b(sys%kpt(lo:hi), :) = cmplx(br(:, 1:k), br(:, k + 1:), wp)
+    end subroutine rows_some
 
     !> Modal route, a selection: b(rows, :) = A_h(rows, :) x, the other rows of b zero.
     subroutine modal_rows(sys, h, rows, x, b)
@@ -1784,16 +1980,32 @@ contains
         type(hbm_condensed), intent(inout) :: sys
         real(wp), intent(in) :: s
         complex(wp), allocatable :: x1(:, :), b1(:, :), xe(:)
+        real(wp), allocatable :: xr(:, :), br(:, :)
         real(wp) :: on, off
-        integer(ip) :: h
+        integer(ip) :: h, nm, nu
         on = 0.0_wp
         off = 0.0_wp
-        allocate (xe(sys%nnl))
-        if (sys%modal) allocate (x1(size(sys%g, 1), 1), b1(sys%nnl, 1))
+        nu = sys%nnl
+        allocate (xe(nu))
+        if (allocated(sys%phr)) then
+            ! every harmonic in one product (phr is the same for all)
+            nm = size(sys%phr, 2)
+            allocate (xr(nm, 2*(sys%nh + 1)), br(nu, 2*(sys%nh + 1)))
+            do h = 0, sys%nh
+                xr(:, 2*h + 1) = real(sys%g(:, h)*(sys%qf(:, h) + s*sys%qf1(:, h)), wp)
+                xr(:, 2*h + 2) = aimag(sys%g(:, h)*(sys%qf(:, h) + s*sys%qf1(:, h)))
+            end do
+            call dgemm('N', 'N', nu, 2*(sys%nh + 1), nm, 1.0_wp, sys%phr, size(sys%phr, 1), &
+                       xr, nm, 0.0_wp, br, nu)
+        else if (sys%modal) then
+            allocate (x1(size(sys%g, 1), 1), b1(nu, 1))
+        end if
         do h = 0, sys%nh
-            if (sys%modal) then
+            if (allocated(sys%phr)) then
+                xe = cmplx(br(:, 2*h + 1), br(:, 2*h + 2), wp)
+            else if (sys%modal) then
                 x1(:, 1) = sys%g(:, h)*(sys%qf(:, h) + s*sys%qf1(:, h))
-                call modal_apply(sys, h, 1, sys%nnl, x1, b1)
+                call modal_apply(sys, h, 1, nu, x1, b1)
                 xe = b1(:, 1)
             else
                 xe = sys%tye0(:, h) + s*sys%tye1(:, h)
@@ -1809,8 +2021,9 @@ contains
 
     module procedure cond_outputs
         real(wp) :: w, s
-        integer(ip) :: h, j, o, nu, nout
+        integer(ip) :: h, j, o, nu, nout, nm
         complex(wp), allocatable :: fc(:), z(:), v(:), x1(:, :), b1(:, :)
+        real(wp), allocatable :: fr(:, :), vr(:, :)
         info = FRIROM_OK
         call freq_load(this, lam, w, s)
         if (w /= this%w_cache) then
@@ -1823,12 +2036,30 @@ contains
         nout = size(this%outdofs)
         if (allocated(this%sel)) call load_leak(this, s)
         allocate (fc(nu), z(nout))
-        if (this%modal) allocate (v(size(this%g, 1)), x1(size(this%g, 1), 1), b1(nout, 1))
+        if (this%modal) then
+            nm = size(this%g, 1)
+            allocate (v(nm), x1(nm, 1), b1(nout, 1))
+        end if
+        if (allocated(this%phr)) then
+            ! A^T fc of every harmonic in one product (phr is the same for all)
+            allocate (fr(nu, 2*(this%nh + 1)), vr(nm, 2*(this%nh + 1)))
+            do h = 0, this%nh
+                fc = harm_col(this%fd, h)
+                fr(:, 2*h + 1) = real(fc, wp)
+                fr(:, 2*h + 2) = aimag(fc)
+            end do
+            call dgemm('T', 'N', nm, 2*(this%nh + 1), nu, 1.0_wp, this%phr, &
+                       size(this%phr, 1), fr, nu, 0.0_wp, vr, nm)
+        end if
         do h = 0, this%nh
             fc = harm_col(this%fd, h)
             if (this%modal) then
                 ! x_o = Phi_o g (q - A^H fc)
-                call modal_project(this, h, fc, v)
+                if (allocated(this%phr)) then
+                    v = cmplx(vr(:, 2*h + 1), vr(:, 2*h + 2), wp)
+                else
+                    call modal_project(this, h, fc, v)
+                end if
                 x1(:, 1) = this%g(:, h)*(this%qf(:, h) + s*this%qf1(:, h) - v)
                 call modal_apply(this, h, nu + 1, nu + nout, x1, b1)
                 z = b1(:, 1)

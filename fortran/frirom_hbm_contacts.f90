@@ -32,7 +32,7 @@ contains
     end procedure csr_matvec_add_cplx
 
     module procedure csr_set
-        integer(ip) :: nnz
+        integer(ip) :: nnz, k, bad
         info = FRIROM_OK
         if (size(p) /= nrow + 1) then
             call set_status(info, FRIROM_ERR_SIZE, errmsg, name//': row pointer length')
@@ -44,21 +44,27 @@ contains
             call set_status(info, FRIROM_ERR_SIZE, errmsg, name//': malformed CSR pointers')
             return
         end if
-        if (nnz > 0) then
-            if (any(i(:nnz) < 1) .or. any(i(:nnz) > ncol)) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, name//': column out of range')
-                return
-            end if
-            if (.not. all(abs(x(:nnz)) <= huge(1.0_wp))) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, name//': non-finite value')
-                return
-            end if
+        ! one pass that checks and copies (a reduced model's K, M, C are dense, and set once
+        ! per call into Fortran)
+        allocate (a%i(nnz), a%x(nnz))
+        bad = 0
+        do k = 1, nnz
+            a%i(k) = i(k)
+            a%x(k) = x(k)
+            if (i(k) < 1 .or. i(k) > ncol) bad = ior(bad, 1)
+            if (.not. abs(x(k)) <= huge(1.0_wp)) bad = ior(bad, 2)
+        end do
+        if (iand(bad, 1) /= 0) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, name//': column out of range')
+            return
+        end if
+        if (bad /= 0) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, name//': non-finite value')
+            return
         end if
         a%nrow = nrow
         a%ncol = ncol
         a%p = p
-        a%i = i(:nnz)
-        a%x = x(:nnz)
     end procedure csr_set
 
     module procedure contact_eval
@@ -71,11 +77,24 @@ contains
         if (present(carry)) upd = carry
         nc = cs%nc
         fd = 0.0_wp
+        if (present(keep)) then
+            if (size(keep, 1) /= size(xd, 1) .or. 2*size(keep, 2) - 1 /= nc) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'contact_eval: keep must be '// &
+                                '(columns, H+1)')
+                return
+            end if
+        end if
         do g = 1, size(cs%grp)
             associate (gr => cs%grp(g), gg => cs%g)
                 if (gr%gx_mode == 0) call choose_gx(gr, gg, nc)
                 nrg = gr%ne*gr%ndir
-                if (gr%gx_mode == 2) then
+                if (gr%gx_mode == 3) then
+                    if (present(keep)) then
+                        call gx_dir_kept(gr, xd, keep)
+                    else
+                        call gx_dir(gr, xd)
+                    end if
+                else if (gr%gx_mode == 2) then
                     ! x(c, r) = sum_s xd(col_s, c) G(r, col_s): one product
                     ns = size(gr%gcols)
                     do c = 1, nc
@@ -112,7 +131,9 @@ contains
                                   states=gr%states, relative=.true.)
                 end if
                 if (info /= 0) return
-                if (gr%gx_mode == 2) then
+                if (gr%gx_mode == 3) then
+                    call gtf_dir(gr, fd)
+                else if (gr%gx_mode == 2) then
                     ! fd(col_s, c) += sum_r G(r, col_s) f(c, r)
                     call dgemm('N', 'T', ns, nc, nrg, 1.0_wp, gr%gt, ns, gr%f, nc, 0.0_wp, &
                                gr%gxs, ns)
@@ -132,6 +153,109 @@ contains
             end associate
         end do
     end procedure contact_eval
+
+    !> gx_mode 3: x(:, d, :) = G_d xd by one product per direction d over the columns its
+    !> rows read (gr%dcols, gr%gdt).
+    subroutine gx_dir(gr, xd)
+        type(contact_group), intent(inout) :: gr
+        real(wp), intent(in) :: xd(:, :)           !! (ncol, nc)
+        integer(ip) :: d, k1, m, nc
+        nc = size(xd, 2)
+        do d = 1, gr%ndir
+            k1 = gr%dptr(d)
+            m = gr%dptr(d + 1) - k1
+            if (m == 0) then
+                gr%x(:, d, :) = 0.0_wp
+                cycle
+            end if
+            gr%gxs(1:m, :) = xd(gr%dcols(k1:k1 + m - 1), :)
+            call dgemm('T', 'N', nc, gr%ne, m, 1.0_wp, gr%gxs, size(gr%gxs, 1), &
+                       gr%gdt(k1, 1), size(gr%gdt, 1), 0.0_wp, gr%x(1, d, 1), nc*gr%ndir)
+        end do
+    end subroutine gx_dir
+
+    !> gx_dir for an xd that is zero off keep (a selection): per harmonic and direction
+    !> only the kept columns (the terms left out are exact zeros: the same x to rounding).
+    subroutine gx_dir_kept(gr, xd, keep)
+        type(contact_group), intent(inout) :: gr
+        real(wp), intent(in) :: xd(:, :)           !! (ncol, nc)
+        logical, intent(in) :: keep(:, 0:)         !! (ncol, 0:H)
+        integer(ip) :: h, d, b, k1, m, c0, nch, nd
+        logical :: same
+        nd = gr%ndir
+        same = allocated(gr%ksel)
+        if (same) same = all(shape(gr%ksel) == shape(keep))
+        if (same) same = all(gr%ksel .eqv. keep)
+        if (.not. same) call kept_plan(gr, keep)
+        do h = 0, size(keep, 2) - 1
+            c0 = max(1, 2*h)
+            nch = merge(1, 2, h == 0)
+            do d = 1, nd
+                b = d + nd*h
+                k1 = gr%kptr(b)
+                m = gr%kptr(b + 1) - k1
+                if (m == 0) then
+                    gr%x(c0:c0 + nch - 1, d, :) = 0.0_wp
+                    cycle
+                end if
+                gr%gxs(1:m, 1:nch) = xd(gr%kcols(k1:k1 + m - 1), c0:c0 + nch - 1)
+                call dgemm('T', 'N', nch, gr%ne, m, 1.0_wp, gr%gxs, size(gr%gxs, 1), &
+                           gr%gkt(k1, 1), size(gr%gkt, 1), 0.0_wp, gr%x(c0, d, 1), &
+                           size(gr%x, 1)*nd)
+            end do
+        end do
+    end subroutine gx_dir_kept
+
+    !> gx_mode 3: fd += G^T f by one product per direction (every column: fd off a
+    !> selection is what cond_leak measures).
+    subroutine gtf_dir(gr, fd)
+        type(contact_group), intent(inout) :: gr
+        real(wp), intent(inout) :: fd(:, :)        !! (ncol, nc)
+        integer(ip) :: d, k1, m, nc, c
+        nc = size(fd, 2)
+        do d = 1, gr%ndir
+            k1 = gr%dptr(d)
+            m = gr%dptr(d + 1) - k1
+            if (m == 0) cycle
+            call dgemm('N', 'T', m, nc, gr%ne, 1.0_wp, gr%gdt(k1, 1), size(gr%gdt, 1), &
+                       gr%f(1, d, 1), nc*gr%ndir, 0.0_wp, gr%gxs, size(gr%gxs, 1))
+            do c = 1, nc        ! a direction's columns are distinct
+                fd(gr%dcols(k1:k1 + m - 1), c) = fd(gr%dcols(k1:k1 + m - 1), c) + &
+                                                 gr%gxs(1:m, c)
+            end do
+        end do
+    end subroutine gtf_dir
+
+    !> gr%kcols / kptr / gkt: gx_mode 3's columns and rows restricted, per harmonic h and
+    !> direction d, to the columns kept at h (keep), and gr%ksel = keep.
+    subroutine kept_plan(gr, keep)
+        type(contact_group), intent(inout) :: gr
+        logical, intent(in) :: keep(:, 0:)
+        integer(ip) :: h, d, k, n, nd
+        nd = gr%ndir
+        if (allocated(gr%kcols)) deallocate (gr%kcols, gr%kptr, gr%gkt)
+        n = 0
+        do h = 0, size(keep, 2) - 1
+            do d = 1, nd
+                n = n + count(keep(gr%dcols(gr%dptr(d):gr%dptr(d + 1) - 1), h))
+            end do
+        end do
+        allocate (gr%kcols(n), gr%kptr(nd*size(keep, 2) + 1), gr%gkt(max(n, 1), gr%ne))
+        n = 0
+        gr%kptr(1) = 1
+        do h = 0, size(keep, 2) - 1
+            do d = 1, nd
+                do k = gr%dptr(d), gr%dptr(d + 1) - 1
+                    if (.not. keep(gr%dcols(k), h)) cycle
+                    n = n + 1
+                    gr%kcols(n) = gr%dcols(k)
+                    gr%gkt(n, :) = gr%gdt(k, :)
+                end do
+                gr%kptr(d + nd*h + 1) = n + 1
+            end do
+        end do
+        gr%ksel = keep
+    end subroutine kept_plan
 
     module procedure contact_assemble
         integer(ip) :: g, e, d1, d2, r1, r2, k1, k2, c1, c2, ncol, nc, i1, i2, m1, m2
@@ -213,13 +337,81 @@ contains
             pos(gg%i(k)) = 1
         end do
         ns = count(pos /= 0)
-        if (real(ns, wp)*real(nrg, wp) > 2.0_wp*real(k2 - k1 + 1, wp)) return
+        if (real(ns, wp)*real(nrg, wp) > 2.0_wp*real(k2 - k1 + 1, wp)) then
+            call choose_dir(gr, gg, nc, pos, k2 - k1 + 1)
+            return
+        end if
         if (.not. allocated(gr%gt)) call group_gt(gr, gg, pos)
         if (.not. allocated(gr%gt)) return
         allocate (gr%gxs(ns, nc), stat=stat)
         if (stat /= 0) return
         gr%gx_mode = 2
     end subroutine choose_gx
+
+    !> gx_mode 3 when the rows of each direction are dense over the columns that direction
+    !> reads (sum_d ns_d ne <= 2 nnz: MS coordinates, each one cylindrical component, read
+    !> by a third of the rows), with gr%dcols / dptr / gdt / gxs built; else the group keeps
+    !> its sparse rows (mode 1). pos: (ncol) work.
+    subroutine choose_dir(gr, gg, nc, pos, nnz)
+        type(contact_group), intent(inout) :: gr
+        type(csr_matrix), intent(in) :: gg
+        integer(ip), intent(in) :: nc, nnz
+        integer(ip), intent(inout) :: pos(:)
+        integer(ip) :: nd, d, e, k, r, n, m, stat
+        nd = gr%ndir
+        if (nd < 1 .or. gr%ne < 1) return
+        n = 0
+        do d = 1, nd
+            call mark(d)
+            n = n + count(pos /= 0)
+        end do
+        if (real(n, wp)*real(gr%ne, wp) > 2.0_wp*real(nnz, wp)) return
+        allocate (gr%dcols(n), gr%dptr(nd + 1), gr%gdt(max(n, 1), gr%ne), stat=stat)
+        if (stat /= 0) return
+        gr%gdt = 0.0_wp
+        gr%dptr(1) = 1
+        n = 0
+        m = 0
+        do d = 1, nd
+            call mark(d)
+            do k = 1, gg%ncol       ! the columns ascending; pos(col) = their row in gdt
+                if (pos(k) == 0) cycle
+                n = n + 1
+                pos(k) = n
+                gr%dcols(n) = k
+            end do
+            gr%dptr(d + 1) = n + 1
+            m = max(m, gr%dptr(d + 1) - gr%dptr(d))
+            do e = 1, gr%ne
+                r = gr%row0 + (e - 1)*nd + d
+                do k = gg%p(r), gg%p(r + 1) - 1
+                    gr%gdt(pos(gg%i(k)), e) = gr%gdt(pos(gg%i(k)), e) + gg%x(k)
+                end do
+            end do
+        end do
+        if (allocated(gr%gxs)) deallocate (gr%gxs)
+        allocate (gr%gxs(max(m, 1), nc), stat=stat)
+        if (stat /= 0) then
+            deallocate (gr%dcols, gr%dptr, gr%gdt)
+            return
+        end if
+        gr%gx_mode = 3
+
+    contains
+
+        !> pos = 1 on the columns direction d's rows read, 0 elsewhere.
+        subroutine mark(d)
+            integer(ip), intent(in) :: d
+            integer(ip) :: ee, kk, rr
+            pos = 0
+            do ee = 1, gr%ne
+                rr = gr%row0 + (ee - 1)*nd + d
+                do kk = gg%p(rr), gg%p(rr + 1) - 1
+                    pos(gg%i(kk)) = 1
+                end do
+            end do
+        end subroutine mark
+    end subroutine choose_dir
 
     !> gr%gcols (the columns the group's rows read, ascending; pos(col) /= 0 marks them on
     !> entry, becomes the index in gcols) and gr%gt = those rows over gcols, transposed.
@@ -391,7 +583,17 @@ contains
             end do
         end select
         t0 = wtime()
-        call contact_eval(sys%cs, sys%plan, sys%xd, sys%fd, jac, info, errmsg, carry)
+        select type (sys)
+        type is (hbm_condensed)
+            if (allocated(sys%sel)) then
+                call contact_eval(sys%cs, sys%plan, sys%xd, sys%fd, jac, info, errmsg, carry, &
+                                  keep=sys%kmask)
+            else
+                call contact_eval(sys%cs, sys%plan, sys%xd, sys%fd, jac, info, errmsg, carry)
+            end if
+        class default
+            call contact_eval(sys%cs, sys%plan, sys%xd, sys%fd, jac, info, errmsg, carry)
+        end select
         if (.not. count) return
         sys%timers(T_AFT) = sys%timers(T_AFT) + wtime() - t0
         sys%timers(N_EVAL) = sys%timers(N_EVAL) + 1

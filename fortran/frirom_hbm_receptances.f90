@@ -59,7 +59,8 @@ contains
         character(len=*), intent(inout) :: errmsg
         real(wp), intent(in), optional :: phi(:, :)         !! (ndof, nm)
         complex(wp), intent(in), optional :: psi(:, :, 0:)  !! (ndof, nm, 0:nh)
-        integer(ip) :: h, r, nr, nu, stat
+        integer(ip) :: h, r, nr, nu, stat, nld
+        integer(ip), allocatable :: ld(:)
         real(wp), allocatable :: fr(:, :), q(:, :)
         info = FRIROM_OK
         ! checked before the system's current modes are given up
@@ -74,6 +75,7 @@ contains
             nu = sys%nnl
             nr = nu + size(sys%outdofs)
             if (allocated(sys%phr)) deallocate (sys%phr)
+            if (allocated(sys%prow)) deallocate (sys%prow)
             if (allocated(sys%psi)) deallocate (sys%psi)
             if (allocated(sys%wm)) deallocate (sys%wm, sys%zm, sys%g, sys%dg, sys%qf, sys%qf1)
             sys%gm_worth = 0.0_wp     ! gm_cost depends on the number of modes
@@ -108,8 +110,16 @@ contains
                     fr(:, 4*h + 3) = real(harm_col(sys%fe1, h), wp)
                     fr(:, 4*h + 4) = aimag(harm_col(sys%fe1, h))
                 end do
-                call dgemm('T', 'N', nm, 4*(sys%nh + 1), sys%ndof, 1.0_wp, phi, sys%ndof, fr, &
-                           sys%ndof, 0.0_wp, q, nm)
+                ! over the loaded DoFs only (the others' terms are exact zeros; a few per cent
+                ! of a reduced model's DoFs are loaded)
+                ld = pack([(r, r=1, sys%ndof)], any(fr /= 0.0_wp, dim=2))
+                nld = size(ld)
+                if (nld == 0) then
+                    q = 0.0_wp
+                else
+                    call dgemm('T', 'N', nm, 4*(sys%nh + 1), nld, 1.0_wp, phi(ld, :), nld, &
+                               fr(ld, :), nld, 0.0_wp, q, nm)
+                end if
                 do h = 0, sys%nh
                     sys%qf(:, h) = cmplx(q(:, 4*h + 1), q(:, 4*h + 2), wp)
                     sys%qf1(:, h) = cmplx(q(:, 4*h + 3), q(:, 4*h + 4), wp)

@@ -5,12 +5,16 @@
 !> column map and a wider harmonic stride), and sparse rows (where the loops are kept).
 !> Tolerance 1e-12 relative: the same sums in another order, ~50 terms of size ~1.
 !> The same for contact_eval's G x and G^T f (matrix products over a dense group's columns
-!> against the sparse rows, gx_mode = 1), through a cubic spring's AFT.
+!> against the sparse rows, gx_mode = 1), through a cubic spring's AFT; and for a group
+!> whose rows are dense only over the columns their direction reads (MS coordinates: the
+!> products per direction, gx_mode 3), through normal1d's AFT, with and without a
+!> selection (keep: G x over the kept columns only, xd zero elsewhere; two masks, so the
+!> kept plan is rebuilt). Same tolerance: the same sums in another order.
 program test_assemble
     use frirom_kinds, only: wp, ip
     use frirom_check, only: check, check_done
     use frirom_hbm, only: contact_set, contact_assemble, contact_eval
-    use frirom_aft, only: aft_plan, aft_plan_create, LAW_CUBIC
+    use frirom_aft, only: aft_plan, aft_plan_create, LAW_CUBIC, LAW_NORMAL1D
     implicit none
     call compare('dense, 40 columns, normal1d, H = 1', ne=30, nd=2, nh=1, ncol=40, &
                  per_row=40, stride=0)
@@ -18,6 +22,7 @@ program test_assemble
                  ncol=30, per_row=12, stride=5)
     call compare('sparse rows (element loops kept), 60 columns, H = 2', ne=20, nd=2, nh=2, &
                  ncol=60, per_row=3, stride=0)
+    call compare_dir()
     call check_done('test_assemble')
 
 contains
@@ -126,6 +131,77 @@ contains
                    1.0e-12_wp*maxval(abs(loops%grp(1)%x)), name//': G x')
         call check(maxval(abs(f1 - f2)) <= 1.0e-12_wp*maxval(abs(f2)), name//': G^T f')
     end subroutine compare_eval
+
+    !> normal1d elements whose tangential rows read 20 of columns 1..24 and normal rows 20
+    !> of 21..44 (dense per direction, not over the group: gx_mode 3), H = 2:
+    !> contact_eval against the sparse rows, without and with two selections.
+    subroutine compare_dir()
+        integer(ip), parameter :: ne = 25, nd = 2, nh = 2, ncol = 44, per_row = 20
+        character(len=*), parameter :: name = 'dense per direction, normal1d, H = 2'
+        type(contact_set) :: cs, loops
+        type(aft_plan) :: plan
+        real(wp), allocatable :: xd(:, :), f1(:, :), f2(:, :)
+        real(wp) :: u(ncol, 0:nh), pool(24)
+        logical :: keep(ncol, 0:nh)
+        integer(ip) :: nc, nr, r, d, j, info, pass
+        character(len=200) :: msg
+        nc = 2*nh + 1
+        nr = ne*nd
+        cs%nc = nc
+        cs%g%nrow = nr
+        cs%g%ncol = ncol
+        allocate (cs%g%p(nr + 1), cs%g%i(nr*per_row), cs%g%x(nr*per_row))
+        do r = 1, nr
+            d = mod(r - 1, nd) + 1
+            cs%g%p(r) = (r - 1)*per_row + 1
+            call random_number(pool)
+            cs%g%i(cs%g%p(r):cs%g%p(r) + per_row - 1) = sort_idx(pool, per_row) + 20*(d - 1)
+        end do
+        cs%g%p(nr + 1) = nr*per_row + 1
+        call random_number(cs%g%x)
+        cs%g%x = cs%g%x - 0.5_wp
+        allocate (cs%grp(1))
+        cs%grp(1)%law = LAW_NORMAL1D
+        cs%grp(1)%ne = ne
+        cs%grp(1)%ndir = nd
+        cs%grp(1)%row0 = 0
+        allocate (cs%grp(1)%params(4, ne), cs%grp(1)%w0(1, ne), cs%grp(1)%x(nc, nd, ne), &
+                  cs%grp(1)%f(nc, nd, ne), cs%grp(1)%states(3, ne))
+        cs%grp(1)%params(1, :) = 1.0e3_wp   ! kt, N/m
+        cs%grp(1)%params(2, :) = 2.0e3_wp   ! kn, N/m
+        cs%grp(1)%params(3, :) = 0.3_wp     ! mu
+        cs%grp(1)%params(4, :) = 2.0_wp     ! n0, N: slip and lift-off at |x| ~ 1e-3
+        cs%grp(1)%w0 = 0.0_wp
+        loops = cs
+        loops%grp(1)%gx_mode = 1
+        allocate (xd(ncol, nc), f1(ncol, nc), f2(ncol, nc))
+        call aft_plan_create(plan, nh, 4*nc, info, msg)
+        call check(info == 0, name//': plan: '//trim(msg))
+        do pass = 0, 2
+            call random_number(xd)
+            xd = 2.0e-3_wp*(xd - 0.5_wp)
+            if (pass == 0) then
+                call contact_eval(cs, plan, xd, f1, .false., info, msg)
+            else
+                call random_number(u)
+                keep = u < 0.5_wp
+                do j = 1, nc
+                    where (.not. keep(:, j/2)) xd(:, j) = 0.0_wp
+                end do
+                call contact_eval(cs, plan, xd, f1, .false., info, msg, keep=keep)
+            end if
+            call check(info == 0, name//': contact_eval: '//trim(msg))
+            call check(cs%grp(1)%gx_mode == 3, name//': G x by products per direction')
+            call contact_eval(loops, plan, xd, f2, .false., info, msg)
+            call check(info == 0, name//': contact_eval (rows): '//trim(msg))
+            print '(a,a,i2,a,es10.2)', name, ', selection', pass, &
+                ': contact_eval max |products - rows| / max |rows| =', &
+                maxval(abs(f1 - f2))/maxval(abs(f2))
+            call check(maxval(abs(cs%grp(1)%x - loops%grp(1)%x)) <= &
+                       1.0e-12_wp*maxval(abs(loops%grp(1)%x)), name//': G x')
+            call check(maxval(abs(f1 - f2)) <= 1.0e-12_wp*maxval(abs(f2)), name//': G^T f')
+        end do
+    end subroutine compare_dir
 
     !> Indices of the m smallest entries of u, ascending by index (a random m-subset).
     function sort_idx(u, m) result(idx)
