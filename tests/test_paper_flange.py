@@ -222,7 +222,8 @@ def full_nl(d):
 def test_mistuned_rotor_leaks_and_warns(fam, what):
     """One flange pair's contact stiffness (kt, kn) or preload 1.5 x the others': the
     rotor is no longer cyclic, the selection drops real coupling, and the leak says so
-    (measured 0.04-0.08 at 1 N) with the warning."""
+    (measured 0.04-0.08 at 1 N) with the warning, for the run's points and for the peak
+    solved between them (refine_peak's points are checked the same way)."""
     _, d, sel = fam
     c = d.contacts[0]
     p = c.params.copy()
@@ -230,9 +231,11 @@ def test_mistuned_rotor_leaks_and_warns(fam, what):
         p[0, :2] *= 1.5
     else:
         p[0, 3] *= 1.5
-    with pytest.warns(RuntimeWarning, match="travelling-wave selection leaks"):
+    with pytest.warns(RuntimeWarning, match="travelling-wave selection leaks") as rec:
         r = _run(d, 1.0, sel, contacts=[dataclasses.replace(c, params=p)])
     assert r.leak.max() > 100 * LEAK_TOL and r.leak.min() > 1e-3
+    assert r.peak(0).method == "solve"
+    assert any("a peak solved between points" in str(w.message) for w in rec)
 
 
 def test_keeping_everything_equals_no_selection(fam):

@@ -104,7 +104,8 @@ class SolverOptions:
         resumed run may start); the points themselves do not depend on it.
     refine_peak : bool
         Frequency runs: solve each output's peak on the curve between the points around
-        the largest one (FRF.peaks, FRF.peak; about ten corrector solves per output).
+        the largest one (FRF.peaks, FRF.peak; per resonance one to three corrector solves
+        on a smooth peak, about ten at a corner, shared by the outputs peaking there).
     coordinates : {'auto', 'dofs', 'contact'}
         Condensed formulation: unknowns are the harmonics of the contact DoFs ('dofs') or
         of the contact elements' local relative displacements G x ('contact'); 'auto' takes
@@ -413,18 +414,8 @@ class _Continuation:
         out.timings = self.timings
         out.solver_info = p.info
         if p.keep is not None and pts:
-            worst = float(np.max(out.leak))
-            out.solver_info += f"; leak max {worst:.1e}"
-            if worst > LEAK_TOL:
-                at = pts[int(np.argmax(out.leak))].omega
-                warnings.warn(f"frirom: the travelling-wave selection leaks: contact forces off "
-                              f"the selection reach {worst:.2g} of those on it at "
-                              f"{at / 2 / np.pi:.6g} Hz (tolerance {LEAK_TOL:g}); the rotor, its "
-                              "contacts, its load or the contact history carried from point "
-                              "to point (sliders frozen at different phases) are not a "
-                              "travelling wave there, and the selected solution is not the "
-                              "full one (solve without the selection to see how far)",
-                              RuntimeWarning, stacklevel=4)
+            out.solver_info += f"; leak max {float(np.max(out.leak)):.1e}"
+            _warn_leak(pts, stacklevel=5)
         if keep_unknowns and pts:
             out._last_unknowns = pts[-1].unknowns
             out._last_slider = pts[-1].slider
@@ -488,8 +479,30 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
     complete, message = run.batches()
     out = run.finish(complete, message, keep_unknowns)
     if packed.opts.refine_peak and packed.opts.parameter == "frequency" and run.points:
-        out.peaks = refine_peaks(packed, run.points, lam_end, run.lam_lo, run.lscale)
+        out.peaks, solved = refine_peaks(packed, run.points, lam_end, run.lam_lo, run.lscale)
+        if packed.keep is not None:
+            _warn_leak(solved, stacklevel=4, what="a peak solved between points")
     return out
+
+
+def _warn_leak(points: list, stacklevel: int, what: str = "") -> None:
+    """RuntimeWarning when the largest leak (FRFPoint.leak) of a travelling-wave selection's
+    points exceeds LEAK_TOL, naming the frequency (stacklevel: that of the caller of frf,
+    counted from here); `what` names the points when they are not the run's."""
+    if not points:
+        return
+    k = int(np.argmax([p.leak for p in points]))
+    worst, at = points[k].leak, points[k].omega
+    if worst > LEAK_TOL:
+        warnings.warn(f"frirom: the travelling-wave selection leaks: contact forces off "
+                      f"the selection reach {worst:.2g} of those on it at "
+                      f"{at / 2 / np.pi:.6g} Hz{f' ({what})' if what else ''} (tolerance "
+                      f"{LEAK_TOL:g}); the rotor, its "
+                      "contacts, its load or the contact history carried from point "
+                      "to point (sliders frozen at different phases) are not a "
+                      "travelling wave there, and the selected solution is not the "
+                      "full one (solve without the selection to see how far)",
+                      RuntimeWarning, stacklevel=stacklevel)
 
 
 def _homotopy_start(packed: _Packed, omega: float):
