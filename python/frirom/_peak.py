@@ -104,8 +104,16 @@ def refine_peaks(packed: _Packed, points: list, lam_end: float, lam_lo: float,
     for j, (_, inner) in enumerate(cands):
         for k in inner:
             users.setdefault(int(k), []).append(j)
+    # a candidate whose points stay NEAR below the peak an earlier search solved for that
+    # output is not searched (the margin NEAR puts it among the candidates in the first
+    # place; the points' own largest may be that far below the peak between them)
+    best = amp.max(axis=0)
     for k, js in users.items():
-        _search_peak(solve, points, k, js, lscale)
+        if cache:
+            best = np.maximum(best, np.max([p.amp_max for p in cache.values()], axis=0))
+        js = [j for j in js if amp[k, j] >= (1.0 - NEAR) * best[j]]
+        if js:
+            _search_peak(solve, points, k, js, lscale)
     solved = {}   # candidate k -> the points solved between its neighbours
     for (b, _), p in cache.items():
         solved.setdefault(b + 1, []).append(p)
