@@ -45,6 +45,9 @@ XTOL = 2e-3
 #: predicts the best solution and a further gain to this (the corrector's own accuracy,
 #: tol_update 1e-8 on the unknowns, moves the amplitude by about as much)
 GAIN_TOL = 1e-9
+#: the amplitude's noise, relative, from the corrector's tolerances (tol_update 1e-8 on the
+#: unknowns): a step whose solve misses its prediction by less is not taken for a corner
+NOISE = 1e-8
 #: solves per search at most (a safeguard; a corner takes ~10, a smooth peak 1-3)
 MAX_SOLVES = 16
 _GOLDEN = 0.5 * (3.0 - math.sqrt(5.0))
@@ -236,7 +239,7 @@ def _climb(amp_at, known: dict, j: int, tol_s: float) -> None:
         verified = hit = False
         if last is not None:
             verified = abs(known[last[0]][1][j] - last[1]) <= GAIN_TOL * am
-            hit = abs(known[last[0]][1][j] - last[1]) <= 0.5 * last[2] + GAIN_TOL * am
+            hit = abs(known[last[0]][1][j] - last[1]) <= 0.5 * last[2] + NOISE * am
             if misses < 2:
                 misses = 0 if hit else misses + 1
         v, top = math.nan, math.inf
@@ -260,7 +263,12 @@ def _climb(amp_at, known: dict, j: int, tol_s: float) -> None:
         if hit and min(abs(v - s)) < 0.01 * tol_s:
             return              # the vertex is a solved point: located well within tol_s
         last = None
-        if l < v < r and min(abs(v - s)) >= 0.01 * tol_s and abs(v - m) < 0.5 * steps[0]:
+        near, far = sorted((m - l, r - m))
+        if misses < 2 and far > 10.0 * near and v == v and abs(v - m) < near:
+            # one neighbour far: a point on its side as close as the other first (a model
+            # through the far one is biased, the steps creep towards the peak)
+            v = m + math.copysign(max(2.0 * abs(v - m), near), (r - m) - (m - l))
+        elif l < v < r and min(abs(v - s)) >= 0.01 * tol_s and abs(v - m) < 0.5 * steps[0]:
             last = (float(v), top, top - am, misses < 2)
         else:
             v = m + _GOLDEN * (r - m) if r - m > m - l else m - _GOLDEN * (m - l)
