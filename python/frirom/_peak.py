@@ -16,12 +16,18 @@ next to a fold. It stops when the amplitude has converged: the same model throug
 solution's neighbours alone predicts the best solution to GAIN_TOL of the amplitude, and
 the model through it predicts a further gain below GAIN_TOL. On a smooth peak that takes
 one to three solves, and an output peaking with an earlier one (the same solves) none.
+While one neighbour of the best solution is more than 10x farther than the other, a
+solve on its side comes first (a model through the far point is biased and creeps).
 Where the model twice misses its prediction by more than half the gain predicted, the peak
 is a corner (a contact state appearing there): the corner model (two lines meeting) takes
 over, with Brent's safeguard (golden sections where a step would not shrink the bracket
 fast enough), until the peak is bracketed to XTOL of two steps in s, the test of the
 search it replaced (at a corner the amplitude is then off by about XTOL times its change
 over a step, ~1e-5; measured 10-100x less).
+
+A further candidate of an output (another local maximum of its points within NEAR of
+their largest) is skipped once its points lie NEAR below the peak already solved for it:
+NEAR is the gain over the points the candidates' rule allows for.
 """
 
 from __future__ import annotations
@@ -42,8 +48,8 @@ MAX_CANDIDATES = 3
 #: stops (at a corner the amplitude error is about this times its change over a step)
 XTOL = 2e-3
 #: amplitude tolerance of the smooth model, relative: the search stops when the model
-#: predicts the best solution and a further gain to this (the corrector's own accuracy,
-#: tol_update 1e-8 on the unknowns, moves the amplitude by about as much)
+#: predicts the best solution and a further gain to this (below NOISE: the corrector
+#: converges its points well past tol_update, and neighbouring solves share their error)
 GAIN_TOL = 1e-9
 #: the amplitude's noise, relative, from the corrector's tolerances (tol_update 1e-8 on the
 #: unknowns): a step whose solve misses its prediction by less is not taken for a corner
