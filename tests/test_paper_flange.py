@@ -318,7 +318,8 @@ def test_pairs_of_the_wrong_direction_leak(fam):
 def test_mistuned_rotor_leaks_and_warns(fam, what):
     """One flange pair's contact stiffness (kt, kn) or preload 1.5 x the others': the
     rotor is no longer cyclic, the selection drops real coupling, and the leak says so
-    (measured 0.04-0.08 at 1 N) with the warning."""
+    (measured 0.04-0.08 at 1 N) with the warning, for the run's points and for the peak
+    solved between them (refine_peak's points are checked the same way)."""
     _, d, sel = fam
     c = d.contacts[0]
     p = c.params.copy()
@@ -334,6 +335,8 @@ def test_mistuned_rotor_leaks_and_warns(fam, what):
     at = first + next(i for i, line in enumerate(src) if "frf(" in line)
     assert all((w.filename, w.lineno) == (__file__, at) for w in got
                if "leaks" in str(w.message))
+    assert r.peak(0).method == "solve"
+    assert any("a peak solved between points" in str(w.message) for w in got)
 
 
 def test_keeping_everything_equals_no_selection(fam):

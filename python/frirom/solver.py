@@ -50,14 +50,15 @@ FORMULATIONS = ("condensed", "banded")
 LEAK_TOL = 1e-6
 
 
-def warn_leak(leak: float, omega: float, stacklevel: int) -> None:
+def warn_leak(leak: float, omega: float, stacklevel: int, what: str = "") -> None:
     """Warn (RuntimeWarning) when a travelling-wave selection's leak (FRFPoint.leak) is
     above LEAK_TOL; omega: rad/s, where; stacklevel: 1 = the caller of warn_leak, 2 = its
-    caller, and so on."""
+    caller, and so on; what: names the point when it is not one of the run's."""
     if leak > LEAK_TOL:
         warnings.warn(f"frirom: the travelling-wave selection leaks: contact forces off "
                       f"the selection reach {leak:.2g} of those on it at "
-                      f"{omega / 2 / np.pi:.6g} Hz (tolerance {LEAK_TOL:g}); the rotor, its "
+                      f"{omega / 2 / np.pi:.6g} Hz{f' ({what})' if what else ''} (tolerance "
+                      f"{LEAK_TOL:g}); the rotor, its "
                       "contacts, its load or the contact history carried from point "
                       "to point (sliders frozen at different phases) are not a "
                       "travelling wave there, and the selected solution is not the "
@@ -119,7 +120,8 @@ class SolverOptions:
         resumed run may start); the points themselves do not depend on it.
     refine_peak : bool
         Frequency runs: solve each output's peak on the curve between the points around
-        the largest one (FRF.peaks, FRF.peak; about ten corrector solves per output).
+        the largest one (FRF.peaks, FRF.peak; per resonance one to three corrector solves
+        on a smooth peak, about ten at a corner, shared by the outputs peaking there).
     coordinates : {'auto', 'dofs', 'contact'}
         Condensed formulation: unknowns are the harmonics of the contact DoFs ('dofs') or
         of the contact elements' local relative displacements G x ('contact'); 'auto' takes
@@ -510,7 +512,12 @@ def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
     complete, message = run.batches()
     out = run.finish(complete, message, keep_unknowns)
     if packed.opts.refine_peak and packed.opts.parameter == "frequency" and run.points:
-        out.peaks = refine_peaks(packed, run.points, lam_end, run.lam_lo, run.lscale)
+        out.peaks, solved = refine_peaks(packed, run.points, lam_end, run.lam_lo, run.lscale)
+        if packed.keep is not None:
+            k = int(np.argmax([q.leak for q in solved])) if solved else -1
+            if k >= 0:
+                warn_leak(solved[k].leak, solved[k].omega, stacklevel=3,
+                          what="a peak solved between points")
     return out
 
 
