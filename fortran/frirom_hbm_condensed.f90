@@ -85,8 +85,8 @@ contains
     module procedure hbm_set_selection
         integer(ip) :: nu, nc, h, j, c, k, n, m, i, q, stat
         integer(ip), allocatable :: ksel(:), kpt(:), kptr(:), at(:, :), tk(:, :), ptn(:, :)
-        real(wp), allocatable :: tw(:, :), jm(:, :), jk(:, :)
-        integer(ip), allocatable :: ipiv(:)
+        real(wp), allocatable :: tw(:, :), jm(:, :), jk(:, :), twm(:, :)
+        integer(ip), allocatable :: ipiv(:), tkm(:, :), kpr(:, :)
         logical, allocatable :: kmask(:, :)
         real(wp) :: on, off
         info = FRIROM_OK
@@ -174,6 +174,14 @@ contains
                 allocate (jk(0, 0), stat=stat)
             end if
             if (stat == 0) allocate (jm(m, m), ipiv(m), stat=stat)
+            if (stat == 0 .and. m < n) then
+                allocate (tkm(2, m), twm(2, m), kpr(nu, 0:sys%nh), stat=stat)
+                if (stat == 0) then
+                    tkm = tk(:, 1:m)
+                    twm = tw(:, 1:m)
+                    kpr = pair
+                end if
+            end if
             if (stat /= 0) then
                 call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'selection: Jacobian')
                 return
@@ -185,12 +193,13 @@ contains
             call move_alloc(ipiv, sys%ipiv)
             if (allocated(sys%tk)) deallocate (sys%tk, sys%tw, sys%jk, sys%kpair)
             if (m < n) then
-                sys%tk = tk(:, 1:m)
-                sys%tw = tw(:, 1:m)
-                allocate (sys%kpair(nu, 0:sys%nh))
-                sys%kpair = pair
+                call move_alloc(tkm, sys%tk)
+                call move_alloc(twm, sys%tw)
+                call move_alloc(kpr, sys%kpair)
                 call move_alloc(jk, sys%jk)
             end if
+            ! the residual's mode rows (sel_rows) were cut for the selection before
+            if (allocated(sys%prow)) deallocate (sys%prow)
             kmask = keep /= 0
             call move_alloc(kmask, sys%kmask)
             sys%n = m
@@ -792,7 +801,10 @@ contains
     !> Schwarz over every row: the forces off the selection count, so a mistuned rotor,
     !> whose forces there are large, keeps the modes they drive). skip(k): the sum of
     !> the left-out terms' bounds in column k, which proj_safe compares with the largest
-    !> term actually computed. Every mode when a bound is not finite.
+    !> term actually computed. Every mode when a bound is not finite. The residual is then
+    !> the same norm-wise (to PROJ_SKIP of its largest term), not row by row: a row much
+    !> smaller than the largest may move by more than its own rounding, below rref's. The
+    !> bounds are compared squared: terms below ~1e-154 (in the model's units) count as 0.
     subroutine sel_modes(sys, h, q, fc, use, nuse, skip)
         type(hbm_condensed), intent(in) :: sys
         integer(ip), intent(in) :: h
