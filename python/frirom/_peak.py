@@ -37,15 +37,14 @@ def _offset(base: FRFPoint, p: FRFPoint, lscale: float) -> float:
 
 
 def refine_peaks(packed: _Packed, points: list, lam_end: float, lam_lo: float,
-                 lscale: float, omega_fix: float = 0.0) -> list:
+                 lscale: float, omega_fix: float = 0.0) -> tuple[list, list]:
     """Peak per output of a frequency continuation's points (FRFPoint list, in order).
 
-    Returns (peaks, solved): peaks a list of :class:`frirom.results.Peak` (n_out,): the
-    largest of the solved
-    local maxima (``method`` 'solve'; the interior local maxima of the points within NEAR
-    of the largest are solved for, at most MAX_CANDIDATES), or the largest point itself
-    when none is larger (an end of the curve, or a failed solve); solved the FRFPoints
-    the searches solved (their leak is checked like the run's points)."""
+    Returns (peaks, solved). peaks: a list of :class:`frirom.results.Peak` (n_out,), the
+    largest of the solved local maxima (``method`` 'solve'; the interior local maxima of
+    the points within NEAR of the largest are solved for, at most MAX_CANDIDATES), or the
+    largest point itself when none is larger (an end of the curve, or a failed solve).
+    solved: the FRFPoints the searches solved (their leak is checked like the run's)."""
     opts = dataclasses.replace(packed.opts, ds_max=1.0e3, ds_min=1e-12)
     quiet = dataclasses.replace(packed, opts=opts, stability=False, w0=packed.w0.copy())
     cache = {}
