@@ -124,14 +124,15 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
                         maxpts, netot, ntim, ys, lams, tans, iters, xo, states, hill_re, &
                         sliders, yscales, npts, finished, ds_out, timings, info, msg, &
                         tcontact, krylov, sparse, nlu, lu, lupiv, lustate, selected, keep, pair, &
-                        leak)
+                        leak, orbtol, orbinfo)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options, cont_options_from, N_RCONT, N_ICONT, RCONT_DS, &
                              RCONT_LAM_LO
     use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
                           hbm_set_modes_harmonic, hbm_run, hbm_lu_import, hbm_lu_export, &
-                          hbm_set_selection, hbm_sel_expand, hbm_sel_reduce, HBM_FREQUENCY, HBM_LOAD, N_TIMERS
+                          hbm_set_selection, hbm_sel_expand, hbm_sel_reduce, hbm_set_orbits, &
+                          HBM_FREQUENCY, HBM_LOAD, N_TIMERS
     implicit none
     character(len=*), intent(in) :: formulation  !! 'condensed' (Eq. 5-9) or 'banded'
     character(len=*), intent(in) :: lam_kind     !! the parameter lam: 'frequency' or 'load'
@@ -200,13 +201,19 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     !> (hbm_set_selection's pair; 0: none); the points keep both members of a pair
     integer(4), intent(in) :: pair(nnl, nh + 1)
     real(8), intent(out) :: leak(maxpts)     !! per point: frirom_hbm cond_leak
+    !> selected = 3: pairs, and Newton's evaluations run the AFT on one contact element per
+    !> orbit (hbm_set_orbits, elements matched to orbtol); orbinfo = the elements the AFT
+    !> runs on, the largest misfit accepted
+    real(8), intent(in) :: orbtol
+    real(8), intent(out) :: orbinfo(2)
     class(hbm_system), allocatable :: sys
     integer(ip), allocatable :: sel(:)
     real(wp), allocatable :: ysel(:, :), tsel(:, :)
     type(cont_options) :: opts
     real(wp), allocatable :: y(:), t(:)
     real(wp) :: lam, dsl
-    integer(ip) :: linfo, np, itl(maxpts), mode, n, k
+    integer(ip) :: linfo, np, itl(maxpts), mode, n, k, nrep
+    real(wp) :: mis
     integer(8) :: c0, c1, rate
     logical :: fin
     call system_clock(c0, rate)
@@ -226,6 +233,7 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     yscales = 0.0d0
     hill_re = 0.0d0
     leak = 0.0d0
+    orbinfo = 0.0d0
     linfo = 0
     if (nropt /= N_RCONT .or. niopt /= N_ICONT .or. ntim /= N_TIMERS) then
         call set_status(linfo, FRIROM_ERR_SIZE, msg, 'hbm_continue: ropt, iopt and timings '// &
@@ -265,8 +273,12 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
             call set_status(linfo, FRIROM_ERR_PARAM, msg, 'selection: Hill stability would '// &
                             'see only perturbations inside the selection; not with stability')
         else
-            if (selected == 2) then
+            if (selected >= 2) then
                 call hbm_set_selection(sys, int(keep, ip), linfo, msg, sel, int(pair, ip))
+                if (linfo == 0 .and. selected == 3) then
+                    call hbm_set_orbits(sys, orbtol, nrep, mis, linfo, msg)
+                    orbinfo = [real(nrep, 8), mis]
+                end if
             else
                 call hbm_set_selection(sys, int(keep, ip), linfo, msg, sel)
             end if

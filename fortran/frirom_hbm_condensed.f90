@@ -200,6 +200,11 @@ contains
             end if
             ! the residual's mode rows (sel_rows) were cut for the selection before
             if (allocated(sys%prow)) deallocate (sys%prow)
+            ! orbits hold blocks of the old T (hbm_set_orbits again)
+            sys%orbits = .false.
+            sys%orb_leak = 0.0_wp
+            if (allocated(sys%orb)) deallocate (sys%orb)
+            if (allocated(sys%kz)) deallocate (sys%kz)
             kmask = keep /= 0
             call move_alloc(kmask, sys%kmask)
             sys%n = m
@@ -354,7 +359,7 @@ contains
                 off = off + pair_off(sys, c, sys%fd(:, 2*c), sys%fd(:, 2*c + 1))
             end do
         end if
-        leak = max(ratio(off, on), sys%c0_leak, sys%xe_leak)
+        leak = max(ratio(off, on), sys%c0_leak, sys%xe_leak, sys%orb_leak)
     end procedure cond_leak
 
     !> The part of harmonic h (cosines a, sines b by coordinate) against its pairs
@@ -410,7 +415,7 @@ contains
             call cond_receptance(this, w, info, errmsg)
             if (info /= 0) return
         end if
-        call hbm_contact_forces(this, y, jac, info, errmsg, timed=.true.)
+        call hbm_contact_forces(this, y, jac, info, errmsg, timed=.true., orbits=.true.)
         if (info /= 0) return
         allocate (fc(nnl), rh(nnl), xe(nnl), r2(nnl, nc), rl2(nnl, nc))
         if (this%modal) then
@@ -987,9 +992,10 @@ contains
             if (sys%cs%grp(g)%asm_mode == 0) call choose_dense(sys%cs%grp(g), sys%cs%g)
             dense = dense .and. sys%cs%grp(g)%asm_mode == 2
         end do
-        ! kc on the kept columns, or with pairs and dense rows straight on T's (kc T)
+        ! kc on the kept columns, or with pairs and dense rows (or orbits) straight on T's
+        ! (kc T)
         i = nk
-        if (paired .and. dense) i = n
+        if (paired .and. (dense .or. sys%orbits)) i = n
         if (allocated(sys%kcw)) then
             if (size(sys%kcw, 2) /= i) deallocate (sys%kcw)
         end if
@@ -1025,7 +1031,15 @@ contains
             off(c + 1) = off(c) + sys%kptr(h + 2) - sys%kptr(h + 1)
         end do
         kc = 0.0_wp
-        if (dense) then
+        if (sys%orbits) then
+            ! the orbits' T^T dF_c/dU T (kz): kc T = T kz, the wave's forces staying on it
+            do i = 1, n
+                do c = 1, 2
+                    if (sys%tk(c, i) == 0) cycle
+                    kc(sys%tk(c, i), :) = sys%tw(c, i)*sys%kz(i, :)
+                end do
+            end do
+        else if (dense) then
             do g = 1, size(sys%cs%grp)
                 if (paired) then
                     call kc_dense_sel(sys%cs%grp(g), nu, nc, at, kc, zc, zw)
@@ -1049,7 +1063,7 @@ contains
                 return
             end if
         end if
-        if (paired .and. .not. dense) then
+        if (paired .and. .not. (dense .or. sys%orbits)) then
             ! kz = kc T: R_h's products then on T's columns only
             allocate (kz(nk, n), stat=stat)
             if (stat /= 0) then
@@ -2031,6 +2045,21 @@ contains
         sys%xe_leak = ratio(off, on)
     end subroutine load_leak
 
+    !> orb_leak at y, after a contact_eval of every element there (sys%fd): |T^T fd - the
+    !> orbits' forces| / |the orbits' forces|, what Newton's evaluations left out.
+    subroutine orbit_leak(sys, y, info, errmsg)
+        type(hbm_condensed), intent(inout) :: sys
+        real(wp), intent(in) :: y(:)
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        real(wp), allocatable :: fz(:), fa(:)
+        allocate (fz(sys%n), fa(sys%n))
+        call orbit_forces(sys, y, .false., fz, info, errmsg)
+        if (info /= 0) return
+        call hbm_sel_reduce(sys, reshape(sys%fd, [size(sys%fd)]), fa)
+        sys%orb_leak = ratio(sum((fa - fz)**2), sum(fz**2))
+    end subroutine orbit_leak
+
     module procedure cond_outputs
         real(wp) :: w, s
         integer(ip) :: h, j, o, nu, nout, nm
@@ -2047,6 +2076,10 @@ contains
         nu = this%nnl
         nout = size(this%outdofs)
         if (allocated(this%sel)) call load_leak(this, s)
+        if (this%orbits) then
+            call orbit_leak(this, y, info, errmsg)
+            if (info /= 0) return
+        end if
         allocate (fc(nu), z(nout))
         if (this%modal) then
             nm = size(this%g, 1)

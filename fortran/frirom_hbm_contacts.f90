@@ -555,11 +555,14 @@ contains
 
     module procedure hbm_contact_forces
         integer(ip) :: i, nc
-        real(wp), allocatable :: yf(:)
+        real(wp), allocatable :: yf(:), fz(:)
         real(wp) :: t0
-        logical :: count
+        logical :: count, orb
         count = .false.
         if (present(timed)) count = timed
+        orb = .false.
+        if (present(orbits)) orb = orbits
+        if (present(carry)) orb = orb .and. .not. carry
         nc = sys%nc
         select type (sys)
         type is (hbm_condensed)
@@ -585,7 +588,15 @@ contains
         t0 = wtime()
         select type (sys)
         type is (hbm_condensed)
-            if (allocated(sys%sel)) then
+            if (orb .and. sys%orbits) then
+                ! one element per orbit; fd = T (T^T G^T f), the wave's forces
+                allocate (fz(sys%n))
+                call orbit_forces(sys, y, jac, fz, info, errmsg)
+                if (info == 0) then
+                    call hbm_sel_expand(sys, fz, yf)
+                    sys%fd = reshape(yf, [sys%nnl, nc])
+                end if
+            else if (allocated(sys%sel)) then
                 call contact_eval(sys%cs, sys%plan, sys%xd, sys%fd, jac, info, errmsg, carry, &
                                   keep=sys%kmask)
             else

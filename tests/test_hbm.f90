@@ -8,7 +8,7 @@ program test_hbm
     use frirom_newton, only: cont_options, newton_correct
     use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
                           hbm_set_modes_harmonic, hbm_set_selection, hbm_sel_expand, &
-                          hbm_sel_reduce
+                          hbm_sel_reduce, hbm_set_orbits, cond_leak
     implicit none
     integer(ip), parameter :: ndof = 4, nh = 3, nc = 2*nh + 1
     type(hbm_condensed) :: sc, scl
@@ -203,6 +203,7 @@ program test_hbm
     call check(info /= 0 .and. index(msg, 'perm') > 0, 'bad perm reported')
     perm = [3, 1, 4, 2]
     call roundoff_selection()
+    call orbits_check()
     call check_done('test_hbm')
 
 contains
@@ -281,6 +282,86 @@ contains
         call check(errj < 1.0e-6_wp, name//' Jacobian vs finite differences')
         call check(errl < 1.0e-6_wp, name//' dR/dlam vs finite differences')
     end subroutine fd_check
+
+    !> hbm_set_orbits on a ring of 5 cubic springs, u_s = cos(2 pi s/5) q_c + sin(2 pi s/5)
+    !> q_s, under its EO 1 travelling wave (harmonic 1 of q_c and q_s kept, paired s = +1):
+    !> the elements are one orbit (one AFT), and with 32 samples the cubic's harmonics up to
+    !> 9 are sampled without aliasing, so the orbits' residual, dR/dlam and Jacobian equal
+    !> those of every element to round-off; the Jacobian also against finite differences.
+    !> One element's k3 changed: it is an orbit of its own and the rest still agree.
+    subroutine orbits_check()
+        integer(ip), parameter :: ne = 5
+        type(hbm_condensed), target :: sos(2), sas(2)
+        type(hbm_condensed), pointer :: so, sa
+        integer(ip) :: rkp(3), rki(2), rperm(2), rnl(2), rgi(2*ne), rgp(ne + 1), rginfo(3, 1)
+        integer(ip) :: rkeep(2, 0:nh), rpair(2, 0:nh), nrep, s, n
+        real(wp) :: rkx(2), rmx(2), rcx(2), rfe0(2, nc), rfe1(2, nc), rgx(2*ne), &
+                    rpar(2*ne), rw0(1), mis, xo(2, nc)
+        real(wp), allocatable :: y(:), ro(:), ra(:), lo(:), la(:)
+        real(wp) :: rro, rra
+        rkp = [1, 2, 3]
+        rki = [1, 2]
+        rkx = [1.0_wp, 1.0_wp]
+        rmx = [1.0_wp, 1.0_wp]
+        rcx = 0.02_wp*rkx
+        rperm = [1, 2]
+        rnl = [1, 2]
+        rfe0 = 0.0_wp
+        rfe0(1, 2) = 0.3_wp            ! q_c cos, q_s sin: the wave cos(w t - 2 pi s/5)
+        rfe0(2, 3) = 0.3_wp
+        rfe1 = 0.0_wp
+        rginfo(:, 1) = [4, ne, 1]
+        do s = 0, ne - 1
+            rgp(s + 1) = 2*s + 1
+            rgi(2*s + 1:2*s + 2) = [1, 2]
+            rgx(2*s + 1:2*s + 2) = [cos(2*acos(-1.0_wp)*s/ne), sin(2*acos(-1.0_wp)*s/ne)]
+            rpar(2*s + 1:2*s + 2) = [0.3_wp, 2.0_wp]
+        end do
+        rgp(ne + 1) = 2*ne + 1
+        rw0 = 0.0_wp
+        rkeep = 0
+        rkeep(:, 1) = 1
+        rpair = 0
+        rpair(1, 1) = 2
+        do k = 1, 2
+            if (k == 2) rpar(2*3 + 2) = 3.0_wp          ! element 4's k3
+            so => sos(k)
+            sa => sas(k)
+            call hbm_setup(so, nh, 32, 2, rkp, rki, rkx, rkp, rki, rmx, rkp, rki, rcx, rperm, &
+                           rnl, rfe0, rfe1, 1, 0.0_wp, rginfo, rgp, rgi, rgx, rpar, rw0, rnl, &
+                           info, msg)
+            call check(info == 0, 'ring setup: '//trim(msg))
+            call hbm_setup(sa, nh, 32, 2, rkp, rki, rkx, rkp, rki, rmx, rkp, rki, rcx, rperm, &
+                           rnl, rfe0, rfe1, 1, 0.0_wp, rginfo, rgp, rgi, rgx, rpar, rw0, rnl, &
+                           info, msg)
+            call hbm_set_selection(so, rkeep, info, msg, pair=rpair)
+            call hbm_set_selection(sa, rkeep, info, msg, pair=rpair)
+            call check(info == 0 .and. so%n == 2, 'ring: pairs: '//trim(msg))
+            call hbm_set_orbits(so, 1.0e-9_wp, nrep, mis, info, msg)
+            print '(a, i0, a, i0, a, es9.2)', 'ring orbits: AFT on ', nrep, ' of ', ne, &
+                ' elements, misfit ', mis
+            call check(info == 0 .and. nrep == k .and. so%orbits .and. mis < 1.0e-14_wp, &
+                       'ring: the orbits found')
+            n = so%n
+            allocate (y(n), ro(n), ra(n), lo(n), la(n))
+            y = [0.8_wp, -0.3_wp]
+            call so%eval(y, 0.9_wp, ro, rro, .true., lo, info, msg)
+            call sa%eval(y, 0.9_wp, ra, rra, .true., la, info, msg)
+            call check(maxval(abs(ro - ra)) < 1.0e-13_wp*rra .and. &
+                       maxval(abs(lo - la)) < 1.0e-13_wp*maxval(abs(la)) .and. &
+                       maxval(abs(so%jm - sa%jm)) < 1.0e-13_wp*maxval(abs(sa%jm)), &
+                       'ring: the orbits give every element''s residual and Jacobian')
+            ! the points' check, every element at y: the orbits' forces agree; the mistuned
+            ! ring leaks off the wave (the selection's own leak, not the orbits')
+            call so%outputs(y, 0.9_wp, xo, info, msg)
+            call check(info == 0 .and. so%orb_leak < 1.0e-14_wp, &
+                       'ring: the orbits'' leak at round-off')
+            call check(merge(cond_leak(so) < 1.0e-12_wp, cond_leak(so) > 1.0e-3_wp, k == 1), &
+                       'ring: the selection leaks when mistuned')
+            call fd_check(so, 'condensed paired, orbits')
+            deallocate (y, ro, ra, lo, la)
+        end do
+    end subroutine orbits_check
 
     !> Both formulations solved at the same frequency give the same output harmonics.
     subroutine agree(sc, name, sfo)

@@ -285,6 +285,12 @@ def _check_outputs(outputs, n: int) -> np.ndarray:
     return out
 
 
+#: SolverOptions.orbits: an element joins an orbit when its motion on the wave is the
+#: representative's turned in time to this fraction (Frobenius, over every unknown). The
+#: mesh's own symmetry is far finer (coarse flange 2e-15, paper flange 1e-13, matrices
+#: from ccx's text files); a misfit d moves the forces by about d.
+ORBIT_TOL = 1e-9
+
 class _CallResult(NamedTuple):
     """What one hbm_continue call returns (maxpts columns, the first npts filled)."""
 
@@ -353,6 +359,9 @@ class _Packed:
     keep: np.ndarray | None = None
     #: (nnl, H+1) int32: SolverOptions.pairs over nl (s (position in nl + 1)), None: none
     pair: np.ndarray | None = None
+    #: SolverOptions.orbits as the first call found them: (elements the AFT runs on,
+    #: largest misfit), None before it
+    orbits: tuple | None = None
 
     @property
     def nc(self) -> int:
@@ -416,13 +425,19 @@ class _Packed:
             netot=max(self.ne_tot, 1), ntim=len(_TIMER_SLOTS), nh=self.H, ndof=self.n_dof,
             nnl=self.nl.size or 1, tcontact=int(self.tcontact),
             krylov=int(o.krylov), sparse=int(self.sparse), lu=lu, lupiv=piv, lustate=lust,
-            selected=0 if self.keep is None else 1 if self.pair is None else 2,
+            selected=(0 if self.keep is None else 1 if self.pair is None else
+                      3 if o.orbits else 2), orbtol=ORBIT_TOL,
             keep=np.asfortranarray(np.zeros((max(self.nl.size, 1), self.H + 1), np.int32)
                                    if self.keep is None else self.keep.astype(np.int32)),
             pair=np.asfortranarray(np.zeros((max(self.nl.size, 1), self.H + 1), np.int32)
                                    if self.pair is None else self.pair))
-        *head, msg, leak = res
+        *head, msg, leak, orbinfo = res
         r = _CallResult(*head, msg=msg.decode(errors="replace"), leak=leak)
+        if self.pair is not None and o.orbits and self.orbits is None and r.info == 0:
+            self.orbits = (int(orbinfo[0]), float(orbinfo[1]))
+            self.info += (f"; AFT of Newton's evaluations on {self.orbits[0]} of "
+                          f"{self.ne_tot} contact elements (orbits on the wave, misfit "
+                          f"{self.orbits[1]:.1e})")
         if r.npts > 0 and self.nw and o.history:
             self.w0 = r.sliders[:self.nw, r.npts - 1].copy()
         return r
