@@ -124,7 +124,7 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
                         maxpts, netot, ntim, ys, lams, tans, iters, xo, states, hill_re, &
                         sliders, yscales, npts, finished, ds_out, timings, info, msg, &
                         tcontact, krylov, sparse, nlu, lu, lupiv, lustate, selected, keep, pair, &
-                        leak, orbtol, orbinfo)
+                        leak, orbtol, orbinfo, orbmap)
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
     use frirom_newton, only: cont_options, cont_options_from, N_RCONT, N_ICONT, RCONT_DS, &
@@ -206,8 +206,11 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
     !> runs on, the largest misfit accepted
     real(8), intent(in) :: orbtol
     real(8), intent(out) :: orbinfo(2)
+    !> each element's orbit representative (hbm_set_orbits' map): 0 on the first call of
+    !> a run, which writes it; later calls of the run pass it back
+    integer(4), intent(inout) :: orbmap(netot)
     class(hbm_system), allocatable :: sys
-    integer(ip), allocatable :: sel(:)
+    integer(ip), allocatable :: sel(:), omap(:)
     real(wp), allocatable :: ysel(:, :), tsel(:, :)
     type(cont_options) :: opts
     real(wp), allocatable :: y(:), t(:)
@@ -276,7 +279,10 @@ subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx
             if (selected >= 2) then
                 call hbm_set_selection(sys, int(keep, ip), linfo, msg, sel, int(pair, ip))
                 if (linfo == 0 .and. selected == 3) then
-                    call hbm_set_orbits(sys, orbtol, nrep, mis, linfo, msg)
+                    allocate (omap(netot))
+                    omap = orbmap
+                    call hbm_set_orbits(sys, orbtol, nrep, mis, linfo, msg, omap)
+                    orbmap = int(omap, 4)
                     orbinfo = [real(nrep, 8), mis]
                 end if
             else

@@ -399,7 +399,7 @@ contains
     end function use_krylov
 
     module procedure cond_eval
-        real(wp) :: w, s, nx, nxe, nhf, nxd, nhd
+        real(wp) :: w, s, nx, nxe, nhf, nxd, nhd, t2(2)
         integer(ip) :: nnl, nc, h, n, nm, nhd0, nuse
         integer(ip), allocatable :: use(:)
         logical :: sel
@@ -486,11 +486,13 @@ contains
                            matmul(this%ar(:, :, h), aimag(fc)) + &
                            matmul(this%ai(:, :, h), real(fc, wp)), wp)
             end if
-            nhf = nhf + sum(abs(rh)**2)
-            nxe = nxe + sum(abs(xe)**2)
+            ! |z|^2 without the square root (abs: hypot per entry)
+            t2 = [sum(real(rh, wp)**2 + aimag(rh)**2), sum(real(xe, wp)**2 + aimag(xe)**2)]
+            nhf = nhf + t2(1)
+            nxe = nxe + t2(2)
             if (h > 0) then
-                nhd = nhd + sum(abs(rh)**2)
-                nxd = nxd + sum(abs(xe)**2)
+                nhd = nhd + t2(1)
+                nxd = nxd + t2(2)
             end if
             rh = rh - xe + harm_col(this%xd, h)
             call harm_set(r2, h, rh)
@@ -766,12 +768,39 @@ contains
         integer(ip) :: k
         call sel_rows(sys)
         call sel_modes(sys, h, sys%qf(:, h) + s*sys%qf1(:, h), fc, use, nuse, skip)
-        call project_some(sys, fc, use(1:nuse), v)
+        if (sys%orbits) then
+            call project_kept(sys, h, fc, v)
+        else
+            call project_some(sys, fc, use(1:nuse), v)
+        end if
         if (proj_safe(sys, h, sys%qf(:, h) + s*sys%qf1(:, h), use(1:nuse), v, skip)) return
         nuse = size(v)
         use = [(k, k=1, nuse)]
-        call project_some(sys, fc, use, v)
+        if (.not. sys%orbits) call project_some(sys, fc, use, v)
     end subroutine sel_project
+
+    !> v = A^H fc on every mode when fc is zero off harmonic h's kept rows (the orbits'
+    !> forces, T fz): over those rows only, from the cached prow, without gathering.
+    subroutine project_kept(sys, h, fc, v)
+        type(hbm_condensed), intent(in) :: sys
+        integer(ip), intent(in) :: h
+        complex(wp), intent(in) :: fc(:)
+        complex(wp), intent(out) :: v(:)
+        real(wp), allocatable :: fr(:, :), vr(:, :)
+        integer(ip) :: lo, hi, nr, nm
+        lo = sys%kptr(h + 1)
+        hi = sys%kptr(h + 2) - 1
+        nr = hi - lo + 1
+        nm = size(sys%prow, 2)
+        v = (0.0_wp, 0.0_wp)
+        if (nr <= 0) return
+        allocate (fr(nr, 2), vr(nm, 2))
+        fr(:, 1) = real(fc(sys%kpt(lo:hi)), wp)
+        fr(:, 2) = aimag(fc(sys%kpt(lo:hi)))
+        call dgemm('T', 'N', nm, 2, nr, 1.0_wp, sys%prow(lo, 1), size(sys%prow, 1), fr, nr, &
+                   0.0_wp, vr, nm)
+        v = cmplx(vr(:, 1), vr(:, 2), wp)
+    end subroutine project_kept
 
     !> The cache of a selection's kept mode rows (prow, pamx, pan; see hbm_condensed),
     !> (re)built when missing or made for other modes or another selection.

@@ -11,16 +11,18 @@
 !> (a shift of a fraction of a sample), and a carried contact history need not be a
 !> travelling wave (sliders frozen at different phases when a slipping flange sticks).
 submodule (frirom_hbm) frirom_hbm_orbits
-    use frirom_status, only: FRIROM_OK, FRIROM_ERR_ALLOC, set_status
+    use frirom_status, only: FRIROM_OK, FRIROM_ERR_ALLOC, FRIROM_ERR_SIZE, set_status
     use frirom_aft, only: aft_eval, law_nslider
     implicit none
 
 contains
 
     module procedure hbm_set_orbits
-        integer(ip) :: g, e, r, q, n, nc, nrg, stat, ntot
-        integer(ip), allocatable :: rep(:), zc(:, :), zh(:, :)
-        real(wp), allocatable :: b(:, :), br(:, :, :), sig(:, :), mult(:), gv(:)
+        integer(ip) :: g, e, r, q, n, nc, nrg, stat, ntot, e0
+        integer(ip), allocatable :: rep(:), zc(:, :), zh(:, :), slot(:)
+        logical :: known
+        real(wp), allocatable :: b(:, :), br(:, :, :), sig(:, :), mult(:), gv(:), nbr(:), &
+                                 sb(:)
         real(wp) :: mis, nb
         logical :: found
         type(orbit_group), allocatable :: orb(:)
@@ -32,6 +34,17 @@ contains
             ntot = sum([(sys%cs%grp(g)%ne, g=1, size(sys%cs%grp))])
             nrep = ntot
             if (.not. allocated(sys%tk) .or. size(sys%cs%grp) == 0) return
+            known = .false.
+            if (present(map)) then
+                if (size(map) /= ntot) then
+                    call set_status(info, FRIROM_ERR_SIZE, errmsg, 'orbits: map must have '// &
+                                    'one entry per contact element')
+                    return
+                end if
+                known = map(1) /= 0
+                if (known) known = map_valid(map, sys%cs)
+                if (.not. known) map = 0
+            end if
             n = sys%n
             nc = sys%nc
             call t_entries(sys, zc, zh)
@@ -42,35 +55,46 @@ contains
             end if
             gv = 0.0_wp
             nrep = 0
+            e0 = 0
             do g = 1, size(sys%cs%grp)
                 associate (gr => sys%cs%grp(g))
                     q = nc*gr%ndir
                     nrg = 0
                     allocate (b(q, n), br(q, n, 4), sig(gr%ndir*(sys%nh + 1), 4), rep(4), &
-                              mult(4), stat=stat)
+                              mult(4), nbr(4), sb(gr%ndir*(sys%nh + 1)), slot(gr%ne), &
+                              stat=stat)
                     if (stat /= 0) then
                         call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'orbits: work arrays')
                         return
                     end if
                     do e = 1, gr%ne
+                        if (known) then
+                            ! the orbits an earlier call of this run found: the blocks of
+                            ! the representatives only
+                            if (map(e0 + e) /= e0 + e) then
+                                r = slot(map(e0 + e) - e0)
+                                mult(r) = mult(r) + 1.0_wp
+                                cycle
+                            end if
+                        end if
                         call element_block(sys, gr, e, zc, zh, gv, b)
                         nb = norm2(b)
+                        sb = block_norms(b, gr%ndir, nc, sys%nh)
                         found = .false.
-                        do r = 1, nrg
+                        do r = 1, merge(0_ip, nrg, known)
                             if (any(gr%params(:, e) /= gr%params(:, rep(r)))) cycle
-                            call misfit(b, br(:, :, r), gr%ndir, nc, sys%nh, &
-                                        block_norms(b, gr%ndir, nc, sys%nh), sig(:, r), &
-                                        tol*max(nb, norm2(br(:, :, r))), mis, found)
+                            call misfit(b, br(:, :, r), gr%ndir, nc, sys%nh, sb, sig(:, r), &
+                                        tol*max(nb, nbr(r)), mis, found)
                             if (.not. found) cycle
                             mult(r) = mult(r) + 1.0_wp
-                            if (mis > 0.0_wp) mismatch = max(mismatch, &
-                                                             mis/max(nb, norm2(br(:, :, r))))
+                            if (mis > 0.0_wp) mismatch = max(mismatch, mis/max(nb, nbr(r)))
+                            if (present(map)) map(e0 + e) = e0 + rep(r)
                             exit
                         end do
                         if (found) cycle
                         nrg = nrg + 1
                         if (nrg > size(rep)) then
-                            call grow(br, sig, rep, mult, stat)
+                            call grow(br, sig, rep, mult, nbr, stat)
                             if (stat /= 0) then
                                 call set_status(info, FRIROM_ERR_ALLOC, errmsg, &
                                                 'orbits: representatives')
@@ -78,13 +102,17 @@ contains
                             end if
                         end if
                         br(:, :, nrg) = b
-                        sig(:, nrg) = block_norms(b, gr%ndir, nc, sys%nh)
+                        sig(:, nrg) = sb
+                        nbr(nrg) = nb
                         rep(nrg) = e
                         mult(nrg) = 1.0_wp
+                        slot(e) = nrg
+                        if (present(map)) map(e0 + e) = e0 + e
                     end do
                     call orbit_store(orb(g), gr, br(:, :, 1:nrg), rep(1:nrg), mult(1:nrg), &
                                      nc, stat)
-                    deallocate (b, br, sig, rep, mult)
+                    deallocate (b, br, sig, rep, mult, nbr, sb, slot)
+                    e0 = e0 + gr%ne
                     if (stat /= 0) then
                         call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'orbits: groups')
                         return
@@ -127,6 +155,25 @@ contains
             end do
         end do
     end subroutine t_entries
+
+    !> Whether map can be an orbit map of cs: every element's representative in its own
+    !> group, not after it, and a representative of itself.
+    pure logical function map_valid(map, cs)
+        integer(ip), intent(in) :: map(:)
+        type(contact_set), intent(in) :: cs
+        integer(ip) :: g, e, e0, r
+        map_valid = .false.
+        e0 = 0
+        do g = 1, size(cs%grp)
+            do e = e0 + 1, e0 + cs%grp(g)%ne
+                r = map(e)
+                if (r <= e0 .or. r > e) return
+                if (map(r) /= r) return
+            end do
+            e0 = e0 + cs%grp(g)%ne
+        end do
+        map_valid = .true.
+    end function map_valid
 
     !> b (nc ndir, n) = G_e T: row c + nc (d-1) is coefficient c of direction d.
     subroutine element_block(sys, gr, e, zc, zh, gv, b)
@@ -184,28 +231,35 @@ contains
         ok = .false.
         mis = huge(1.0_wp)
         if (norm2(s - sr) > lim) return
+        ! harmonic 0 (not turned) first, then harmonic by harmonic; out at the first excess
+        mis = 0.0_wp
+        do d = 1, ndir
+            mis = mis + sum((b(nc*(d - 1) + 1, :) - br(nc*(d - 1) + 1, :))**2)
+        end do
+        if (mis > lim**2 .or. nh == 0) then
+            mis = sqrt(mis)
+            ok = mis <= lim
+            return
+        end if
         m11 = 0.0_wp
         m12 = 0.0_wp
         m21 = 0.0_wp
         m22 = 0.0_wp
-        if (nh >= 1) then
-            do d = 1, ndir
-                c0 = nc*(d - 1)
-                m11 = m11 + dot_product(b(c0 + 2, :), br(c0 + 2, :))
-                m12 = m12 + dot_product(b(c0 + 2, :), br(c0 + 3, :))
-                m21 = m21 + dot_product(b(c0 + 3, :), br(c0 + 2, :))
-                m22 = m22 + dot_product(b(c0 + 3, :), br(c0 + 3, :))
-            end do
-        end if
-        th = 0.0_wp
-        if (abs(m12 - m21) + abs(m11 + m22) > 0.0_wp) th = atan2(m12 - m21, m11 + m22)
-        mis = 0.0_wp
         do d = 1, ndir
             c0 = nc*(d - 1)
-            mis = mis + sum((b(c0 + 1, :) - br(c0 + 1, :))**2)
-            do h = 1, nh
-                cs = cos(h*th)
-                sn = sin(h*th)
+            m11 = m11 + dot_product(b(c0 + 2, :), br(c0 + 2, :))
+            m12 = m12 + dot_product(b(c0 + 2, :), br(c0 + 3, :))
+            m21 = m21 + dot_product(b(c0 + 3, :), br(c0 + 2, :))
+            m22 = m22 + dot_product(b(c0 + 3, :), br(c0 + 3, :))
+        end do
+        th = 0.0_wp
+        if (abs(m12 - m21) + abs(m11 + m22) > 0.0_wp) th = atan2(m12 - m21, m11 + m22)
+        do h = 1, nh
+            if (mis > lim**2) exit
+            cs = cos(h*th)
+            sn = sin(h*th)
+            do d = 1, ndir
+                c0 = nc*(d - 1)
                 mis = mis + sum((b(c0 + 2*h, :) - cs*br(c0 + 2*h, :) - &
                                  sn*br(c0 + 2*h + 1, :))**2) + &
                       sum((b(c0 + 2*h + 1, :) - cs*br(c0 + 2*h + 1, :) + &
@@ -217,25 +271,27 @@ contains
     end subroutine misfit
 
     !> Twice the room for representatives.
-    subroutine grow(br, sig, rep, mult, stat)
-        real(wp), allocatable, intent(inout) :: br(:, :, :), sig(:, :), mult(:)
+    subroutine grow(br, sig, rep, mult, nbr, stat)
+        real(wp), allocatable, intent(inout) :: br(:, :, :), sig(:, :), mult(:), nbr(:)
         integer(ip), allocatable, intent(inout) :: rep(:)
         integer(ip), intent(out) :: stat
-        real(wp), allocatable :: br2(:, :, :), sig2(:, :), mult2(:)
+        real(wp), allocatable :: br2(:, :, :), sig2(:, :), mult2(:), nbr2(:)
         integer(ip), allocatable :: rep2(:)
         integer(ip) :: k
         k = size(rep)
         allocate (br2(size(br, 1), size(br, 2), 2*k), sig2(size(sig, 1), 2*k), rep2(2*k), &
-                  mult2(2*k), stat=stat)
+                  mult2(2*k), nbr2(2*k), stat=stat)
         if (stat /= 0) return
         br2(:, :, 1:k) = br
         sig2(:, 1:k) = sig
         rep2(1:k) = rep
         mult2(1:k) = mult
+        nbr2(1:k) = nbr
         call move_alloc(br2, br)
         call move_alloc(sig2, sig)
         call move_alloc(rep2, rep)
         call move_alloc(mult2, mult)
+        call move_alloc(nbr2, nbr)
     end subroutine grow
 
     !> An orbit group from its representatives' blocks br (q, n, nrep).

@@ -291,8 +291,9 @@ contains
     !> One element's k3 changed: it is an orbit of its own and the rest still agree.
     subroutine orbits_check()
         integer(ip), parameter :: ne = 5
-        type(hbm_condensed), target :: sos(2), sas(2)
-        type(hbm_condensed), pointer :: so, sa
+        type(hbm_condensed), target :: sos(2), sas(2), sms(2)
+        type(hbm_condensed), pointer :: so, sa, sm
+        integer(ip) :: map(ne), map2(ne)
         integer(ip) :: rkp(3), rki(2), rperm(2), rnl(2), rgi(2*ne), rgp(ne + 1), rginfo(3, 1)
         integer(ip) :: rkeep(2, 0:nh), rpair(2, 0:nh), nrep, s, n
         real(wp) :: rkx(2), rmx(2), rcx(2), rfe0(2, nc), rfe1(2, nc), rgx(2*ne), &
@@ -327,6 +328,7 @@ contains
             if (k == 2) rpar(2*3 + 2) = 3.0_wp          ! element 4's k3
             so => sos(k)
             sa => sas(k)
+            sm => sms(k)
             call hbm_setup(so, nh, 32, 2, rkp, rki, rkx, rkp, rki, rmx, rkp, rki, rcx, rperm, &
                            rnl, rfe0, rfe1, 1, 0.0_wp, rginfo, rgp, rgi, rgx, rpar, rw0, rnl, &
                            info, msg)
@@ -337,11 +339,28 @@ contains
             call hbm_set_selection(so, rkeep, info, msg, pair=rpair)
             call hbm_set_selection(sa, rkeep, info, msg, pair=rpair)
             call check(info == 0 .and. so%n == 2, 'ring: pairs: '//trim(msg))
-            call hbm_set_orbits(so, 1.0e-9_wp, nrep, mis, info, msg)
+            map = 0
+            call hbm_set_orbits(so, 1.0e-9_wp, nrep, mis, info, msg, map)
             print '(a, i0, a, i0, a, es9.2)', 'ring orbits: AFT on ', nrep, ' of ', ne, &
                 ' elements, misfit ', mis
             call check(info == 0 .and. nrep == k .and. so%orbits .and. mis < 1.0e-14_wp, &
                        'ring: the orbits found')
+            call check(all(map == merge([1, 1, 1, 4, 1], [1, 1, 1, 1, 1], k == 2)), &
+                       'ring: the orbit map')
+            ! a later call of the run takes the map back; a map that cannot be one (a
+            ! representative after its element) is searched again
+            call hbm_setup(sm, nh, 32, 2, rkp, rki, rkx, rkp, rki, rmx, rkp, rki, rcx, rperm, &
+                           rnl, rfe0, rfe1, 1, 0.0_wp, rginfo, rgp, rgi, rgx, rpar, rw0, rnl, &
+                           info, msg)
+            call hbm_set_selection(sm, rkeep, info, msg, pair=rpair)
+            map2 = [2, 2, 2, 2, 2]
+            call hbm_set_orbits(sm, 1.0e-9_wp, nrep, mis, info, msg, map2)
+            call check(info == 0 .and. nrep == k .and. all(map2 == map), &
+                       'ring: a bad map is searched again')
+            call hbm_set_orbits(sm, 1.0e-9_wp, nrep, mis, info, msg, map2)
+            call check(info == 0 .and. nrep == k .and. mis == 0.0_wp .and. &
+                       all(sm%orb(1)%mult == so%orb(1)%mult) .and. &
+                       all(sm%orb(1)%gz == so%orb(1)%gz), 'ring: the map taken back')
             n = so%n
             allocate (y(n), ro(n), ra(n), lo(n), la(n))
             y = [0.8_wp, -0.3_wp]

@@ -362,6 +362,8 @@ class _Packed:
     #: SolverOptions.orbits as the first call found them: (elements the AFT runs on,
     #: largest misfit), None before it
     orbits: tuple | None = None
+    #: (ne_tot,) int32, hbm_continue's orbmap: written by the first call, read by the others
+    orbit_map: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def nc(self) -> int:
@@ -426,7 +428,7 @@ class _Packed:
             nnl=self.nl.size or 1, tcontact=int(self.tcontact),
             krylov=int(o.krylov), sparse=int(self.sparse), lu=lu, lupiv=piv, lustate=lust,
             selected=(0 if self.keep is None else 1 if self.pair is None else
-                      3 if o.orbits else 2), orbtol=ORBIT_TOL,
+                      3 if o.orbits else 2), orbtol=ORBIT_TOL, orbmap=self._orbit_map(),
             keep=np.asfortranarray(np.zeros((max(self.nl.size, 1), self.H + 1), np.int32)
                                    if self.keep is None else self.keep.astype(np.int32)),
             pair=np.asfortranarray(np.zeros((max(self.nl.size, 1), self.H + 1), np.int32)
@@ -441,6 +443,13 @@ class _Packed:
         if r.npts > 0 and self.nw and o.history:
             self.w0 = r.sliders[:self.nw, r.npts - 1].copy()
         return r
+
+    def _orbit_map(self) -> np.ndarray:
+        """SolverOptions.orbits' map of this run (each element's representative), which
+        the first call finds and the later calls take back (zeros: find it)."""
+        if self.orbit_map is None:
+            self.orbit_map = np.zeros(max(self.ne_tot, 1), np.int32)
+        return self.orbit_map
 
     def _held_lu(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The arrays of the LU carried between calls (allocated at the first call), or
