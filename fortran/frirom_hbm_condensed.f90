@@ -1152,7 +1152,9 @@ contains
 
     !> R_h = a + i b on the coordinates rows (both sides), at the Jacobian's frequency:
     !> from the modes (A_h(rows) diag(g_h) A_h(rows)^H, only these rows) or read from the
-    !> factorised receptances ar, ai.
+    !> factorised receptances ar, ai. With real modes rows must be harmonic h's kept rows
+    !> (kpt(kptr(h+1):kptr(h+2)-1)): their mode rows come from the selection's cache
+    !> (sel_rows' prow and pamx) instead of being gathered from phr.
     subroutine rec_block(sys, h, rows, a, b)
         type(hbm_condensed), intent(inout) :: sys
         integer(ip), intent(in) :: h, rows(:)
@@ -1171,8 +1173,9 @@ contains
         else if (allocated(sys%phr)) then
             ! only the modes that reach these rows (a tuned rotor's family ROM: about a
             ! quarter at each harmonic), the others' terms below the products' round-off
-            call modes_on_rows(sys%phr(rows, :), sys%gj(:, h), use, nm)
-            p = sys%phr(rows, use(1:nm))
+            call sel_rows(sys)
+            call modes_on_rows(sys%pamx(:, h), sys%gj(:, h), use, nm)
+            p = sys%prow(sys%kptr(h + 1):sys%kptr(h + 2) - 1, use(1:nm))
             allocate (pd(k, 2*nm + 1))
             do r = 1, nm
                 pd(:, r) = p(:, r)*real(sys%gj(use(r), h), wp)
@@ -1195,12 +1198,13 @@ contains
         sys%timers(T_REC) = sys%timers(T_REC) + wtime() - t0
     end subroutine rec_block
 
-    !> The modes r whose term g_r p_r p_r^T of R = P diag(g) P^T on these rows (p: (k, nm))
-    !> exceeds REC_SKIP times the largest term (max |p_r|^2 |g_r|): use(1:nu). A term left
-    !> out is below the round-off of the sum over all nm modes (~nm eps the largest term),
-    !> so R is the same to round-off; rows a mode does not reach at all are zero.
-    subroutine modes_on_rows(p, g, use, nu)
-        real(wp), intent(in) :: p(:, :)
+    !> The modes r whose term g_r p_r p_r^T of R = P diag(g) P^T on some rows exceeds
+    !> REC_SKIP times the largest term (pm2(r) |g_r|, pm2(r) = max over the rows of p_r^2):
+    !> use(1:nu). A term left out is below the round-off of the sum over all nm modes (~nm
+    !> eps the largest term), so R is the same to round-off; rows a mode does not reach at
+    !> all are zero.
+    subroutine modes_on_rows(pm2, g, use, nu)
+        real(wp), intent(in) :: pm2(:)
         complex(wp), intent(in) :: g(:)
         integer(ip), allocatable, intent(out) :: use(:)
         integer(ip), intent(out) :: nu
@@ -1208,15 +1212,15 @@ contains
         real(wp), allocatable :: w(:)
         real(wp) :: wmin
         integer(ip) :: r
-        allocate (w(size(p, 2)), use(size(p, 2)))
-        do r = 1, size(p, 2)
-            w(r) = maxval(abs(p(:, r)))**2*abs(g(r))
+        allocate (w(size(pm2)), use(size(pm2)))
+        do r = 1, size(pm2)
+            w(r) = pm2(r)*abs(g(r))
         end do
         wmin = REC_SKIP*maxval(w)
         ! a non-finite term (an undamped mode at resonance) gives no scale: every mode
         if (.not. wmin < huge(1.0_wp)) wmin = -1.0_wp
         nu = 0
-        do r = 1, size(p, 2)
+        do r = 1, size(pm2)
             if (w(r) <= wmin .or. (w(r) == 0.0_wp .and. wmin >= 0.0_wp)) cycle
             nu = nu + 1
             use(nu) = r
