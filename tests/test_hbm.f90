@@ -377,6 +377,12 @@ contains
                        'ring: the orbits'' leak at round-off')
             call check(merge(cond_leak(so) < 1.0e-12_wp, cond_leak(so) > 1.0e-3_wp, k == 1), &
                        'ring: the selection leaks when mistuned')
+            ! orbits that no longer stand for their elements (the representative's k3 in
+            ! the orbits' copy changed): the points' leak says so
+            so%orb(1)%params(2, 1) = 1.1_wp*so%orb(1)%params(2, 1)
+            call so%outputs(y, 0.9_wp, xo, info, msg)
+            call check(so%orb_leak > 1.0e-3_wp .and. cond_leak(so) >= so%orb_leak, &
+                       'ring: the orbits'' leak when they differ from every element')
             call fd_check(so, 'condensed paired, orbits')
             deallocate (y, ro, ra, lo, la)
         end do
