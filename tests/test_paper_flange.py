@@ -272,6 +272,18 @@ def test_selected_solution_travels_one_way(fam, selected, f0):
     assert _pairing(d, U, -pairs).min() > 0.3
 
 
+def _same_steps(ref, new, x_tol, peak_tol):
+    """new took ref's steps: complete, the same points and Newton evaluations, X within
+    x_tol of its largest, both outputs' peaks within peak_tol relative."""
+    assert new.complete and len(new) == len(ref)
+    assert new.timings["evaluations"] == ref.timings["evaluations"]
+    assert np.abs(new.X - ref.X).max() < x_tol * np.abs(ref.X).max()
+    for k in range(2):
+        a, b = ref.peak(k), new.peak(k)
+        assert abs(b.amplitude / a.amplitude - 1) < peak_tol
+        assert abs(b.omega / a.omega - 1) < peak_tol
+
+
 @pytest.mark.parametrize("f0", [1.0, 300.0])
 def test_paired_equals_selected_point_for_point(fam, selected, f0):
     """The selection with the wave's direction (SolverOptions.pairs: 84 unknowns of 132,
@@ -289,16 +301,10 @@ def test_paired_equals_selected_point_for_point(fam, selected, f0):
         warnings.simplefilter("error")
         two = _run(d, f0, sel, pairs=pairs)
     assert "132 of 252 unknowns, 84 in one direction" in two.solver_info
-    assert two.complete and len(two) == len(part)
-    assert two.timings["evaluations"] == part.timings["evaluations"]
     if f0 > 100:
         assert two.state_fractions[:, 0, 2].max() > 0.2     # lifts off
         assert two.state_fractions[:, 0, 1].max() > 0.1     # slips
-    assert np.abs(two.X - part.X).max() < 1e-7 * np.abs(part.X).max()
-    for k in range(2):
-        a, b = part.peak(k), two.peak(k)
-        assert abs(b.amplitude / a.amplitude - 1) < 1e-8
-        assert abs(b.omega / a.omega - 1) < 1e-8
+    _same_steps(part, two, 1e-7, 1e-8)
     assert two.leak.max() < 1e-8
     assert _pairing(d, two.unknowns, pairs).max() == 0.0
 
@@ -320,13 +326,7 @@ def test_orbits_equal_every_element_point_for_point(fam, f0):
         orb = _run(d, f0, sel, pairs=pairs)
     assert "AFT of Newton's evaluations on 2 of 12 contact elements" in orb.solver_info
     assert "AFT of Newton" not in every.solver_info
-    assert orb.complete and len(orb) == len(every)
-    assert orb.timings["evaluations"] == every.timings["evaluations"]
-    assert np.abs(orb.X - every.X).max() < 1e-8 * np.abs(every.X).max()
-    for k in range(2):
-        a, b = every.peak(k), orb.peak(k)
-        assert abs(b.amplitude / a.amplitude - 1) < 1e-10
-        assert abs(b.omega / a.omega - 1) < 1e-10
+    _same_steps(every, orb, 1e-8, 1e-10)
     assert orb.leak.max() < 1e-8
 
 
