@@ -379,7 +379,7 @@ class _Packed:
     n_dof: int                # rows
     fe0: np.ndarray           # (n_dof, 2H+1) N: fixed excitation
     fe1: np.ndarray           # (n_dof, 2H+1) N: excitation scaled by a load parameter
-    K: tuple                  # CSR, 1-based, (n_dof, n_dof), N/m
+    K: tuple                  # CSR, 1-based, (n_dof, n_dof), N/m; empty: modal route
     M: tuple                  # kg
     C: tuple                  # N s/m
     perm: np.ndarray          # (n_dof,) int32, RCM order (natural: modal route), 1-based
@@ -693,12 +693,17 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
         info = (f"condensed: {nu * (2 * H + 1)} unknowns, "
                 + (f"{nu} contact coordinates G x" if tcontact else f"{nu} contact DoFs")
                 + f"; {route}")
-    # modal receptances without Hill's method: Fortran reads no order (hbm_setup checks
-    # that perm is a permutation), so the natural one
-    perm = (np.arange(1, n + 1, dtype=np.int32) if modes.nmodes and not opts.stability
-            else band.perm)
+    if modes.nmodes and not opts.stability:
+        # modal receptances without Hill's method: Fortran reads neither K, M, C nor the
+        # order (frirom_hbm_receptances, _condensed; hbm_setup checks that perm is a
+        # permutation), so empty matrices, as for a cyclic sector, and the natural order:
+        # no copy and check of the model's matrices at every call into Fortran
+        K = M = C = _csr(sp.csr_matrix((n, n)))
+        perm = np.arange(1, n + 1, dtype=np.int32)
+    else:
+        K, M, C, perm = _csr(model.K), _csr(model.M), _csr(model.C), band.perm
     return _Packed(opts=opts, H=H, n_dof=n, fe0=fe0, fe1=fe1,
-                   K=_csr(model.K), M=_csr(model.M), C=_csr(model.C), perm=perm, nl=nl,
+                   K=K, M=M, C=C, perm=perm, nl=nl,
                    G=_csr(c.G), ginfo=c.ginfo, params=c.params, w0=c.w0, nw=c.nw,
                    group_names=c.names, group_sizes=c.sizes, outputs=out, out_f=out,
                    stability=bool(opts.stability), modes=modes, tcontact=tcontact, sparse=sparse,
