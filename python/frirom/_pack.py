@@ -155,8 +155,7 @@ def _all_modes(model: Model, H: int, need_diagonal: bool) -> _Modes | str:
     """All modes of the model (dense eigh of K, M) with the damping ratios that make the
     modal receptances exact: diag(Phi^T C Phi) / (2 w) when Phi^T C Phi is diagonal
     (modal, Rayleigh or no damping). Otherwise the reason they do not apply (a str)."""
-    K, M, C = (a.toarray() for a in (model.K, model.M, model.C))
-    w2, phi = sla.eigh(K, M)
+    w2, phi = sla.eigh(model.K.toarray(), model.M.toarray())
     if np.any(w2 <= 0):
         return "rigid-body (zero-frequency) modes"
     if model.damping.kind == "rayleigh":
@@ -165,7 +164,7 @@ def _all_modes(model: Model, H: int, need_diagonal: bool) -> _Modes | str:
         # couples them at ~1e-10 of their eigenvalue)
         d = model.damping.alpha + model.damping.beta * w2
     else:
-        cm = phi.T @ C @ phi
+        cm = phi.T @ model.C.toarray() @ phi
         d = np.diag(cm).copy()
         off = cm - np.diag(d)
         scale = np.sqrt(np.outer(np.abs(d), np.abs(d))) + 1e-13 * max(np.abs(d).max(), 1e-300)
