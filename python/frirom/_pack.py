@@ -155,8 +155,7 @@ def _all_modes(model: Model, H: int, need_diagonal: bool) -> _Modes | str:
     """All modes of the model (dense eigh of K, M) with the damping ratios that make the
     modal receptances exact: diag(Phi^T C Phi) / (2 w) when Phi^T C Phi is diagonal
     (modal, Rayleigh or no damping). Otherwise the reason they do not apply (a str)."""
-    K, M, C = (a.toarray() for a in (model.K, model.M, model.C))
-    w2, phi = sla.eigh(K, M)
+    w2, phi = sla.eigh(model.K.toarray(), model.M.toarray())
     if np.any(w2 <= 0):
         return "rigid-body (zero-frequency) modes"
     if model.damping.kind == "rayleigh":
@@ -165,7 +164,7 @@ def _all_modes(model: Model, H: int, need_diagonal: bool) -> _Modes | str:
         # couples them at ~1e-10 of their eigenvalue)
         d = model.damping.alpha + model.damping.beta * w2
     else:
-        cm = phi.T @ C @ phi
+        cm = phi.T @ model.C.toarray() @ phi
         d = np.diag(cm).copy()
         off = cm - np.diag(d)
         scale = np.sqrt(np.outer(np.abs(d), np.abs(d))) + 1e-13 * max(np.abs(d).max(), 1e-300)
@@ -175,6 +174,60 @@ def _all_modes(model: Model, H: int, need_diagonal: bool) -> _Modes | str:
     m = _Modes.none(model.n_dof, H)
     m.nmodes, m.phi, m.omega, m.zeta = w.size, np.asfortranarray(phi), w, d / (2.0 * w)
     return m
+
+
+class _Band:
+    """The RCM order of a model (K, M, C and the contact couplings G^T G) and its
+    half-bandwidth under it, computed at the first use: the banded formulation, Hill's
+    method and the factorised receptances need them, the modal receptances do not."""
+
+    def __init__(self, model: Model, G: sp.csr_matrix):
+        self._model, self._G = model, G
+        self._perm: np.ndarray | None = None
+        self._bw = 0
+
+    @property
+    def perm(self) -> np.ndarray:
+        """(n_dof,) int32, the RCM order, 1-based."""
+        if self._perm is None:
+            self._order()
+        return self._perm
+
+    @property
+    def bw(self) -> int:
+        """Half-bandwidth of the pattern under perm."""
+        if self._perm is None:
+            self._order()
+        return self._bw
+
+    def _order(self) -> None:
+        model, G, n = self._model, self._G, self._model.n_dof
+        pat = (abs(model.K) + abs(model.M) + abs(model.C)).tocsr()
+        if model.contacts:
+            pat = pat + (abs(G).T @ abs(G))
+        pat = (pat + pat.T + sp.identity(n)).tocsr()
+        pat.sort_indices()
+        perm, info, msg = _kernels.hbm_rcm(pat.indptr.astype(np.int32) + 1,
+                                           pat.indices.astype(np.int32) + 1)
+        raise_for_status(info, msg.decode(errors="replace"))
+        iperm = np.empty(n, dtype=np.int64)
+        iperm[perm - 1] = np.arange(n)
+        pc = pat.tocoo()
+        self._perm, self._bw = perm, int(np.abs(iperm[pc.row] - iperm[pc.col]).max())
+
+
+def _bw_floor(model: Model) -> int:
+    """A lower bound of the half-bandwidth of K's and M's pattern under any order: a row
+    with d entries off the diagonal reaches at least ceil(d / 2) from it on one side. 0
+    when a matrix is not in canonical CSR (duplicates would be counted twice)."""
+    d = 0
+    for a in (model.K, model.M):
+        if a.format != "csr" or not a.has_canonical_format:
+            return 0
+        if a.nnz:
+            nz = np.concatenate(([0], np.cumsum(a.data != 0)))
+            d = max(d, int(np.diff(nz[a.indptr]).max()) - 1)
+    return (d + 1) // 2
 
 
 #: carry the held LU from call to call (False: each call factorises its first Jacobian,
@@ -187,9 +240,10 @@ SPARSE_FLOPS = 5e8
 
 
 def _receptance_route(model: Model, opts: SolverOptions, H: int,
-                      bw: int) -> tuple[_Modes, str, bool]:
+                      band: _Band) -> tuple[_Modes, str, bool]:
     """Modes, a description of how the condensed receptances are found (see
-    SolverOptions.receptances) and whether D_h is factorised by sparse LU."""
+    SolverOptions.receptances) and whether D_h is factorised by sparse LU. The RCM
+    half-bandwidth (band.bw) is computed only when the choice needs it."""
     n = model.n_dof
     if opts.modes:
         return (_lowest_modes(model, int(opts.modes), H),
@@ -208,17 +262,20 @@ def _receptance_route(model: Model, opts: SolverOptions, H: int,
         # (n bw^2 per harmonic, some EIG_EVALS evaluations of an FRF): a Craig-Bampton
         # model (a dense interface block beside a diagonal modal block) takes the modes,
         # a lumped chain or an FE mesh keeps its narrow band
-        dense = 10.0 * n ** 3 <= EIG_EVALS * (H + 1) * n * float(bw) ** 2
-        if n <= MODES_MAX and dense:
+        # a lower bound of the half-bandwidth under any order decides as the RCM one
+        # would whenever it passes the test already (a reduced model's dense rows)
+        def dense(b: int) -> bool:
+            return 10.0 * n ** 3 <= EIG_EVALS * (H + 1) * n * float(b) ** 2
+        if n <= MODES_MAX and (dense(_bw_floor(model)) or dense(band.bw)):
             m = _all_modes(model, H, True)
             if not isinstance(m, str):
                 return m, f"receptances from all {n} modes (exact; reduced model)", False
             why = f" ({m})"
         else:
             why = " (sparse or large model)"
-        if n * float(bw) ** 2 > SPARSE_FLOPS:
+        if n * float(band.bw) ** 2 > SPARSE_FLOPS:
             return (_Modes.none(n, H), f"receptances by sparse LU (MUMPS) per harmonic "
-                    f"(half-bandwidth {bw} of {n} DoFs{why})", True)
+                    f"(half-bandwidth {band.bw} of {n} DoFs{why})", True)
     return (_Modes.none(n, H), f"receptances by banded LU per harmonic{why}", False)
 
 
@@ -327,10 +384,10 @@ class _Packed:
     n_dof: int                # rows
     fe0: np.ndarray           # (n_dof, 2H+1) N: fixed excitation
     fe1: np.ndarray           # (n_dof, 2H+1) N: excitation scaled by a load parameter
-    K: tuple                  # CSR, 1-based, (n_dof, n_dof), N/m
+    K: tuple                  # CSR, 1-based, (n_dof, n_dof), N/m; empty: modal route
     M: tuple                  # kg
     C: tuple                  # N s/m
-    perm: np.ndarray          # (n_dof,) int32, RCM order, 1-based
+    perm: np.ndarray          # (n_dof,) int32, RCM order (natural: modal route), 1-based
     nl: np.ndarray            # (nnl,) contact DoFs (rows), 0-based
     G: tuple                  # CSR, 1-based, (contact rows, n_dof)
     ginfo: np.ndarray         # (3, n_groups) int32: law code, n_elem, n_dir
@@ -643,36 +700,33 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
                              "no contact group (use 'banded')")
     groups = model.contacts
     c = _pack_contacts(groups, n)
-    # RCM over K, M, C and the contact couplings
-    pat = (abs(model.K) + abs(model.M) + abs(model.C)).tocsr()
-    if groups:
-        pat = pat + (abs(c.G).T @ abs(c.G))
-    pat = (pat + pat.T + sp.identity(n)).tocsr()
-    pat.sort_indices()
-    perm, info, msg = _kernels.hbm_rcm(pat.indptr.astype(np.int32) + 1,
-                                       pat.indices.astype(np.int32) + 1)
-    raise_for_status(info, msg.decode(errors="replace"))
+    band = _Band(model, c.G)
     out = _check_outputs((np.arange(n) if n <= 100 else nl) if outputs is None else outputs, n)
     tcontact, sparse, info = False, False, f"banded: {n * (2 * H + 1)} unknowns"
     modes = _Modes.none(n, H)
-    iperm = np.empty(n, dtype=np.int64)
-    iperm[perm - 1] = np.arange(n)
-    pc = pat.tocoo()
-    bw = int(np.abs(iperm[pc.row] - iperm[pc.col]).max())
     if opts.stability:
-        _check_hill_memory(n, H, bw)
+        _check_hill_memory(n, H, band.bw)
     if opts.formulation == "condensed":
         nrows = c.G.shape[0]
         tcontact = opts.coordinates == "contact" or (
             opts.coordinates == "auto" and nrows < nl.size and not opts.stability
             and opts.selection is None)
-        modes, route, sparse = _receptance_route(model, opts, H, bw)
+        modes, route, sparse = _receptance_route(model, opts, H, band)
         nu = nrows if tcontact else nl.size
         info = (f"condensed: {nu * (2 * H + 1)} unknowns, "
                 + (f"{nu} contact coordinates G x" if tcontact else f"{nu} contact DoFs")
                 + f"; {route}")
+    if modes.nmodes and not opts.stability:
+        # modal receptances without Hill's method: Fortran reads neither K, M, C nor the
+        # order (frirom_hbm_receptances, _condensed; hbm_setup checks that perm is a
+        # permutation), so empty matrices, as for a cyclic sector, and the natural order:
+        # no copy and check of the model's matrices at every call into Fortran
+        K = M = C = _csr(sp.csr_matrix((n, n)))
+        perm = np.arange(1, n + 1, dtype=np.int32)
+    else:
+        K, M, C, perm = _csr(model.K), _csr(model.M), _csr(model.C), band.perm
     return _Packed(opts=opts, H=H, n_dof=n, fe0=fe0, fe1=fe1,
-                   K=_csr(model.K), M=_csr(model.M), C=_csr(model.C), perm=perm, nl=nl,
+                   K=K, M=M, C=C, perm=perm, nl=nl,
                    G=_csr(c.G), ginfo=c.ginfo, params=c.params, w0=c.w0, nw=c.nw,
                    group_names=c.names, group_sizes=c.sizes, outputs=out, out_f=out,
                    stability=bool(opts.stability), modes=modes, tcontact=tcontact, sparse=sparse,
