@@ -293,6 +293,9 @@ contains
         integer(ip), parameter :: ne = 5
         type(hbm_condensed), target :: sos(2), sas(2), sms(2)
         type(hbm_condensed), pointer :: so, sa, sm
+        type(hbm_condensed) :: smo, smu
+        real(wp) :: phi2(2, 2), xou(2, nc)
+        real(wp), allocatable :: yfu(:)
         integer(ip) :: map(ne), map2(ne)
         integer(ip) :: rkp(3), rki(2), rperm(2), rnl(2), rgi(2*ne), rgp(ne + 1), rginfo(3, 1)
         integer(ip) :: rkeep(2, 0:nh), rpair(2, 0:nh), nrep, s, n
@@ -386,6 +389,32 @@ contains
             call fd_check(so, 'condensed paired, orbits')
             deallocate (y, ro, ra, lo, la)
         end do
+        ! the outputs of a modal ring (phi = I, omega 1, zeta 0.01: the same receptances),
+        ! selected (its forces off the kept rows at round-off: A^T fc over the kept rows)
+        ! against the ring unselected at the same point (every row)
+        rpar(2*3 + 2) = 2.0_wp
+        call hbm_setup(smo, nh, 32, 2, rkp, rki, rkx, rkp, rki, rmx, rkp, rki, rcx, rperm, &
+                       rnl, rfe0, rfe1, 1, 0.0_wp, rginfo, rgp, rgi, rgx, rpar, rw0, rnl, &
+                       info, msg)
+        call hbm_setup(smu, nh, 32, 2, rkp, rki, rkx, rkp, rki, rmx, rkp, rki, rcx, rperm, &
+                       rnl, rfe0, rfe1, 1, 0.0_wp, rginfo, rgp, rgi, rgx, rpar, rw0, rnl, &
+                       info, msg)
+        phi2 = reshape([1.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [2, 2])
+        call hbm_set_modes(smo, phi2, [1.0_wp, 1.0_wp], [0.01_wp, 0.01_wp], info, msg)
+        call hbm_set_modes(smu, phi2, [1.0_wp, 1.0_wp], [0.01_wp, 0.01_wp], info, msg)
+        call hbm_set_selection(smo, rkeep, info, msg, pair=rpair)
+        call hbm_set_orbits(smo, 1.0e-9_wp, nrep, mis, info, msg)
+        allocate (y(smo%n), ro(smo%n), lo(smo%n), ra(smu%n), la(smu%n), yfu(smu%n))
+        y = [0.8_wp, -0.3_wp]
+        call hbm_sel_expand(smo, y, yfu)
+        call smo%eval(y, 0.9_wp, ro, rro, .false., lo, info, msg)
+        call smo%outputs(y, 0.9_wp, xo, info, msg)
+        call smu%eval(yfu, 0.9_wp, ra, rra, .false., la, info, msg)
+        call smu%outputs(yfu, 0.9_wp, xou, info, msg)
+        print '(a, es9.2)', 'ring outputs, selected vs every row: ', &
+            maxval(abs(xo - xou))/maxval(abs(xou))
+        call check(info == 0 .and. maxval(abs(xo - xou)) < 1.0e-13_wp*maxval(abs(xou)), &
+                   'ring: the selected outputs over the kept rows')
     end subroutine orbits_check
 
     !> Both formulations solved at the same frequency give the same output harmonics.
