@@ -31,6 +31,8 @@ contains
         mismatch = 0.0_wp
         select type (sys => sysc)
         type is (hbm_condensed)
+            ! off until orbits are found again (a failed or fruitless call leaves none)
+            sys%orbits = .false.
             ntot = sum([(sys%cs%grp(g)%ne, g=1, size(sys%cs%grp))])
             nrep = ntot
             if (.not. allocated(sys%tk) .or. size(sys%cs%grp) == 0) return
