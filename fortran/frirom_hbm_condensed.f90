@@ -347,12 +347,7 @@ contains
         leak = 0.0_wp
         if (.not. allocated(sys%sel) .or. .not. allocated(sys%fd)) return
         ! each part summed on its own: a leak at round-off is not lost to cancellation
-        on = 0.0_wp
-        off = 0.0_wp
-        do c = 1, sys%nc
-            on = on + sum(sys%fd(:, c)**2, mask=sys%kmask(:, c/2))
-            off = off + sum(sys%fd(:, c)**2, mask=.not. sys%kmask(:, c/2))
-        end do
+        call fd_split(sys, on, off)
         ! the pairs: the other travelling direction counts as off the selection too
         if (allocated(sys%tk)) then
             do c = 1, sys%nh
@@ -361,6 +356,20 @@ contains
         end if
         leak = max(ratio(off, on), sys%c0_leak, sys%xe_leak, sys%orb_leak)
     end procedure cond_leak
+
+    !> The squares of the contact forces sys%fd summed on the kept rows (on) and off them
+    !> (off), harmonic by harmonic (a selected system).
+    pure subroutine fd_split(sys, on, off)
+        type(hbm_condensed), intent(in) :: sys
+        real(wp), intent(out) :: on, off
+        integer(ip) :: c
+        on = 0.0_wp
+        off = 0.0_wp
+        do c = 1, sys%nc
+            on = on + sum(sys%fd(:, c)**2, mask=sys%kmask(:, c/2))
+            off = off + sum(sys%fd(:, c)**2, mask=.not. sys%kmask(:, c/2))
+        end do
+    end subroutine fd_split
 
     !> The part of harmonic h (cosines a, sines b by coordinate) against its pairs
     !> (hbm_condensed%kpair), squared: sum over the pairs (j, k, s) of
@@ -2102,15 +2111,9 @@ contains
         type(hbm_condensed), intent(inout) :: sys
         real(wp), parameter :: OUT_SKIP = 1.0e-12_wp
         real(wp) :: on, off
-        integer(ip) :: c
         sel_only = .false.
         if (.not. allocated(sys%sel)) return
-        on = 0.0_wp
-        off = 0.0_wp
-        do c = 1, sys%nc
-            on = on + sum(sys%fd(:, c)**2, mask=sys%kmask(:, c/2))
-            off = off + sum(sys%fd(:, c)**2, mask=.not. sys%kmask(:, c/2))
-        end do
+        call fd_split(sys, on, off)
         sel_only = off <= OUT_SKIP**2*on
         if (sel_only) call sel_rows(sys)
     end function sel_only
