@@ -25,22 +25,23 @@ enum frirom_law {
  * DoFs' harmonics (banded LU). */
 enum frirom_formulation { FRIROM_CONDENSED = 1, FRIROM_BANDED = 2 };
 
-/* Solver settings of frirom_frf; frirom_settings_default fills the defaults of
- * frirom.solver.SolverOptions. Steps are dimensionless (unknowns / |first point|,
- * frequency / range). */
+/* Solver settings (Fortran frirom_run run_settings, the one place their defaults are
+ * written; frirom.solver.SolverOptions reads the same): call frirom_settings_default
+ * first. Steps are dimensionless (unknowns / |first point|, frequency / range). */
 struct frirom_settings {
-    int harmonics;        /* H: harmonics 0..H (default 3) */
+    int harmonics;        /* H: harmonics 0..H */
     int samples;          /* AFT samples per period; 0: the default for H (512 up to H 15) */
     int formulation;      /* FRIROM_CONDENSED (default) or FRIROM_BANDED */
-    int max_points;       /* points of the curve at most (2000) */
-    int max_iter;         /* Newton iterations per corrector (25) */
-    int batch;            /* points per internal call; the points do not depend on it (10) */
-    int reuse_jacobian;   /* 1: keep a factorisation while Newton contracts (1) */
-    int history;          /* 1: carry the contact sliders along the curve (1) */
-    double tol_residual;  /* 1e-8 */
-    double tol_update;    /* 1e-8 */
-    double tol_stall;     /* 0 */
-    double ds, ds_min, ds_max;  /* first, smallest, largest arc-length step (0.02, 1e-6, 0.1) */
+    int max_points;       /* points of the curve at most */
+    int max_iter;         /* Newton iterations per corrector */
+    int batch;            /* points per segment of frirom_frf (a checkpoint after each) */
+    int reuse_jacobian;   /* 1: keep a factorisation while Newton contracts */
+    int history;          /* 1: carry the contact sliders along the curve */
+    int stability;        /* 1: Hill's method at every point */
+    double tol_residual;  /* Newton's relative residual test */
+    double tol_update;    /* ... and update test */
+    double tol_stall;     /* a corrector stalled below this after max_iter is accepted */
+    double ds, ds_min, ds_max;  /* first, smallest, largest arc-length step */
 };
 
 /* Text of a status code. */
@@ -83,6 +84,57 @@ int frirom_frf(int n, int nk, const int *kr, const int *kc, const double *kv,
                int nout, const int *outdofs, const struct frirom_settings *s,
                int maxpts, int *npts, int *complete, double *omega, double *xo, double *amp,
                int nycap, int *ny, double *y, char *msg, int msglen);
+
+/* The run object: the one continuation driver of frirom (module frirom_run), which Python
+ * and Fortran callers drive through the same calls. A run lives across calls and owns
+ * its system (set up once), its continuation state and its held factorisation:
+ *
+ *   frirom_run_open      the model, as frirom_frf takes it (without the range and the
+ *                        results); sparse = 1: condensed receptances by sparse LU (MUMPS)
+ *   frirom_run_set_modes receptances by nmodes real mass-normalised modes phi (n, nmodes),
+ *                        omega (rad/s), zeta: instead of factorisations (optional)
+ *   frirom_run_set_selection  a travelling-wave selection keep (nnl, H+1) of the contact
+ *                        DoFs' harmonics (1 = kept), its direction pair (nnl, H+1) or
+ *                        NULL, orbits = 1: AFT on one element per orbit (optional)
+ *   frirom_run_start     from omega_start to omega_end (rad/s): solves the first point
+ *   frirom_run_advance   up to k more points into omega (k+1), xo (nout, 2H+1, k+1), amp
+ *                        (nout, k+1) and y (ny, k+1) or NULL; status: 0 going, 1 done
+ *                        (reached omega_end), 2 max_points made, 3 the curve turned back
+ *                        and left the range, 4 a corrector failed (the return value is its
+ *                        code, msg says why; the points made are kept)
+ *   frirom_run_solve_at  one solve at omega from y0 (ny) or from the linear solution
+ *                        (y0 NULL), the continuation state untouched
+ *   frirom_run_checkpoint  after an advance, everything exact resume needs: nck doubles
+ *   frirom_run_restore   on a run opened on the same model (instead of start): its next
+ *                        advances make the points the checkpointed run made after it
+ *   frirom_run_close     frees the run, *run = NULL
+ *
+ * frirom_run_sizes gives the unknowns per point ny, sliders nw, contact elements ne and
+ * the checkpoint length nck. frirom_frf is a loop over these calls. */
+typedef struct frirom_run frirom_run;
+
+int frirom_run_open(frirom_run **run, int n, int nk, const int *kr, const int *kc,
+                    const double *kv, int nm, const int *mr, const int *mc, const double *mv,
+                    int ncd, const int *cr, const int *cc, const double *cv,
+                    double alpha, double beta, int nzeta, const double *zeta,
+                    int ngroup, const int *ginfo, int ng, const int *gr, const int *gc,
+                    const double *gv, int npar, const double *params, int nw,
+                    const double *w0, const double *fe, int nout, const int *outdofs,
+                    const struct frirom_settings *s, int sparse, char *msg, int msglen);
+int frirom_run_sizes(const frirom_run *run, int *ny, int *nw, int *ne, int *nck);
+int frirom_run_set_modes(frirom_run *run, int nmodes, const double *phi,
+                         const double *omega, const double *zeta, char *msg, int msglen);
+int frirom_run_set_selection(frirom_run *run, int nnl, const int *keep, const int *pair,
+                             int orbits, char *msg, int msglen);
+int frirom_run_start(frirom_run *run, double omega_start, double omega_end, char *msg,
+                     int msglen);
+int frirom_run_advance(frirom_run *run, int k, int *npts, double *omega, double *xo,
+                       double *amp, double *y, int *status, char *msg, int msglen);
+int frirom_run_solve_at(frirom_run *run, double omega, const double *y0, double *y,
+                        double *xo, double *amp, char *msg, int msglen);
+int frirom_run_checkpoint(const frirom_run *run, int nck, double *ck, char *msg, int msglen);
+int frirom_run_restore(frirom_run *run, int nck, const double *ck, char *msg, int msglen);
+int frirom_run_close(frirom_run **run);
 
 #ifdef __cplusplus
 }

@@ -6,10 +6,18 @@ module frirom_capi
     use frirom_kinds, only: wp, ip
     use frirom_status
     use frirom_aft
-    use frirom_solve, only: frf_settings, frf_result, frf_solve
+    use frirom_solve, only: frf_settings, frf_result, frf_solve, frf_open, peak_amplitude
+    use frirom_run, only: run_t, run_points, run_handle, run_from_handle, run_start, &
+                          run_advance, run_solve, run_close, run_set_modes, run_set_selection, &
+                          run_checkpoint, run_restore, run_checkpoint_size, RUN_START_COLD, &
+                          RUN_SOLVE_FIXED
     implicit none
     private
     public :: frirom_aft_eval_c, frirom_status_message_c, frirom_settings_default_c, frirom_frf_c
+    public :: frirom_run_open_c, frirom_run_sizes_c, frirom_run_set_modes_c, &
+              frirom_run_set_selection_c, frirom_run_start_c, frirom_run_advance_c, &
+              frirom_run_solve_at_c, frirom_run_checkpoint_c, frirom_run_restore_c, &
+              frirom_run_close_c
 
 contains
 
@@ -136,9 +144,11 @@ contains
         nc = 2*s%harmonics + 1
         text = ''
         st = FRIROM_OK
-        if (min(n, nk, nm, ncd, nzeta, ngroup, ng, npar, nw, nout, maxpts, nycap) < 0 .or. &
-            s%harmonics < 0) then
-            call set_status(st, FRIROM_ERR_SIZE, text, 'frirom_frf: negative count')
+        call check_counts('frirom_frf', [n, nk, nm, ncd, nzeta, ngroup, ng, npar, nw, nout, &
+                                         maxpts, nycap, s%harmonics], 'n nk nm ncd nzeta '// &
+                          'ngroup ng npar nw nout maxpts nycap settings.harmonics', st, text)
+        if (st /= FRIROM_OK) then
+            continue
         else if (maxpts < s%max_points) then
             call set_status(st, FRIROM_ERR_SIZE, text, 'frirom_frf: maxpts (the room in '// &
                             'omega, xo, amp, y) must be >= settings.max_points')
@@ -182,4 +192,339 @@ contains
         call to_c_string(text, msg, msglen)
         info = int(st, c_int)
     end function frirom_frf_c
+    !> int frirom_run_open(frirom_run **run, ... as frirom_frf without the range and the
+    !> results ..., int sparse, char *msg, int msglen): a run on the model (frirom_solve
+    !> frf_open); *run is NULL when it fails.
+    function frirom_run_open_c(run, n, nk, kr, kc, kv, nm, mr, mc, mv, ncd, cr, cc, cv, &
+                               alpha, beta, nzeta, zeta, ngroup, ginfo, ng, gr, gc, gv, npar, &
+                               params, nw, w0, fe, nout, outdofs, s, sparse, msg, msglen) &
+        result(info) bind(c, name='frirom_run_open')
+        type(c_ptr), intent(out) :: run
+        integer(c_int), value :: n, nk, nm, ncd, nzeta, ngroup, ng, npar, nw, nout, sparse, &
+                                 msglen
+        real(c_double), value :: alpha, beta
+        integer(c_int), intent(in) :: kr(*), kc(*), mr(*), mc(*), cr(*), cc(*), ginfo(*), &
+                                      gr(*), gc(*), outdofs(*)
+        real(c_double), intent(in) :: kv(*), mv(*), cv(*), zeta(*), gv(*), params(*), w0(*), &
+                                      fe(*)
+        type(frf_settings), intent(in) :: s
+        type(c_ptr), value :: msg
+        integer(c_int) :: info
+        type(run_t), pointer :: r
+        integer(ip) :: st, nc
+        character(len=512) :: text
+        run = c_null_ptr
+        text = ''
+        st = FRIROM_OK
+        nc = 2*s%harmonics + 1
+        call check_counts('frirom_run_open', [n, nk, nm, ncd, nzeta, ngroup, ng, npar, nw, &
+                                              nout, s%harmonics], &
+                          'n nk nm ncd nzeta ngroup ng npar nw nout settings.harmonics', &
+                          st, text)
+        if (st == FRIROM_OK) then
+            allocate (r)
+            call frf_open(r, int(n, ip), kr(:nk) + 1, kc(:nk) + 1, kv(:nk), mr(:nm) + 1, &
+                          mc(:nm) + 1, mv(:nm), cr(:ncd) + 1, cc(:ncd) + 1, cv(:ncd), alpha, &
+                          beta, zeta(:nzeta), reshape(ginfo(:3*ngroup), [3, ngroup]), &
+                          gr(:ng) + 1, gc(:ng) + 1, gv(:ng), params(:npar), &
+                          reshape(fe(:n*nc), [n, nc]), outdofs(:nout) + 1, s, st, text, &
+                          w0=w0(:nw), sparse=sparse /= 0)
+            if (st == FRIROM_OK) then
+                run = transfer(run_handle(r), run)
+            else
+                call run_close(r)
+                deallocate (r)
+            end if
+        end if
+        call to_c_string(text, msg, msglen)
+        info = int(st, c_int)
+    end function frirom_run_open_c
+
+    !> int frirom_run_sizes(const frirom_run *run, int *ny, int *nw, int *ne, int *nck)
+    function frirom_run_sizes_c(run, ny, nw, ne, nck) result(info) &
+        bind(c, name='frirom_run_sizes')
+        type(c_ptr), value :: run
+        integer(c_int), intent(out) :: ny, nw, ne, nck
+        integer(c_int) :: info
+        type(run_t), pointer :: r
+        integer(ip) :: st
+        character(len=512) :: text
+        ny = 0
+        nw = 0
+        ne = 0
+        nck = 0
+        text = ''
+        call get_run(run, 'frirom_run_sizes', r, st, text)
+        if (st == FRIROM_OK) then
+            ny = int(r%ny, c_int)
+            nw = int(r%nw, c_int)
+            ne = int(r%netot, c_int)
+            nck = int(run_checkpoint_size(r), c_int)
+        end if
+        info = int(st, c_int)
+    end function frirom_run_sizes_c
+
+    !> int frirom_run_set_modes(frirom_run *run, int nmodes, const double *phi,
+    !>                          const double *omega, const double *zeta, char *msg, int msglen)
+    function frirom_run_set_modes_c(run, nmodes, phi, omega, zeta, msg, msglen) result(info) &
+        bind(c, name='frirom_run_set_modes')
+        type(c_ptr), value :: run, msg
+        integer(c_int), value :: nmodes, msglen
+        real(c_double), intent(in) :: phi(*), omega(*), zeta(*)
+        integer(c_int) :: info
+        type(run_t), pointer :: r
+        integer(ip) :: st, n
+        character(len=512) :: text
+        text = ''
+        call get_run(run, 'frirom_run_set_modes', r, st, text)
+        if (st == FRIROM_OK .and. nmodes < 1) call set_status(st, FRIROM_ERR_SIZE, text, &
+            'frirom_run_set_modes: nmodes: expected >= 1')
+        if (st == FRIROM_OK) then
+            n = r%m%ndof
+            call run_set_modes(r, reshape(phi(:n*nmodes), [n, int(nmodes, ip)]), &
+                               omega(:nmodes), zeta(:nmodes), st, text)
+        end if
+        call to_c_string(text, msg, msglen)
+        info = int(st, c_int)
+    end function frirom_run_set_modes_c
+
+    !> int frirom_run_set_selection(frirom_run *run, int nnl, const int *keep,
+    !>                              const int *pair, int orbits, char *msg, int msglen)
+    function frirom_run_set_selection_c(run, nnl, keep, pair, orbits, msg, msglen) &
+        result(info) bind(c, name='frirom_run_set_selection')
+        type(c_ptr), value :: run, pair, msg
+        integer(c_int), value :: nnl, orbits, msglen
+        integer(c_int), intent(in) :: keep(*)
+        integer(c_int) :: info
+        type(run_t), pointer :: r
+        integer(c_int), pointer :: pp(:)
+        integer(ip) :: st, h1
+        character(len=512) :: text
+        text = ''
+        call get_run(run, 'frirom_run_set_selection', r, st, text)
+        if (st == FRIROM_OK .and. nnl < 1) call set_status(st, FRIROM_ERR_SIZE, text, &
+            'frirom_run_set_selection: nnl: expected >= 1')
+        if (st == FRIROM_OK) then
+            h1 = r%m%nh + 1
+            if (c_associated(pair)) then
+                call c_f_pointer(pair, pp, [nnl*h1])
+                call run_set_selection(r, reshape(int(keep(:nnl*h1), ip), [int(nnl, ip), h1]), &
+                                       st, text, pair=reshape(int(pp, ip), [int(nnl, ip), h1]), &
+                                       orbits=orbits /= 0)
+            else
+                call run_set_selection(r, reshape(int(keep(:nnl*h1), ip), [int(nnl, ip), h1]), &
+                                       st, text)
+            end if
+        end if
+        call to_c_string(text, msg, msglen)
+        info = int(st, c_int)
+    end function frirom_run_set_selection_c
+
+    !> int frirom_run_start(frirom_run *run, double omega_start, double omega_end,
+    !>                      char *msg, int msglen): the first point (pending)
+    function frirom_run_start_c(run, omega_start, omega_end, msg, msglen) result(info) &
+        bind(c, name='frirom_run_start')
+        type(c_ptr), value :: run, msg
+        real(c_double), value :: omega_start, omega_end
+        integer(c_int), value :: msglen
+        integer(c_int) :: info
+        type(run_t), pointer :: r
+        integer(ip) :: st
+        character(len=512) :: text
+        text = ''
+        call get_run(run, 'frirom_run_start', r, st, text)
+        if (st == FRIROM_OK) call run_start(r, RUN_START_COLD, omega_start, omega_end, st, text)
+        call to_c_string(text, msg, msglen)
+        info = int(st, c_int)
+    end function frirom_run_start_c
+
+    !> int frirom_run_advance(frirom_run *run, int k, int *npts, double *omega, double *xo,
+    !>                        double *amp, double *y, int *status, char *msg, int msglen)
+    !> Up to k points; omega (k+1), xo (nout, 2H+1, k+1), amp (nout, k+1) and y (ny, k+1)
+    !> or NULL have room for k + 1 (the first point comes with the first call).
+    function frirom_run_advance_c(run, k, npts, omega, xo, amp, y, status, msg, msglen) &
+        result(info) bind(c, name='frirom_run_advance')
+        type(c_ptr), value :: run, y, msg
+        integer(c_int), value :: k, msglen
+        integer(c_int), intent(out) :: npts, status
+        real(c_double), intent(out) :: omega(*), xo(*), amp(*)
+        integer(c_int) :: info
+        type(run_t), pointer :: r
+        type(run_points) :: p
+        real(c_double), pointer :: yp(:, :)
+        integer(ip) :: st, nout, nc, j, o
+        character(len=512) :: text
+        text = ''
+        npts = 0
+        status = 0
+        call get_run(run, 'frirom_run_advance', r, st, text)
+        if (st == FRIROM_OK) call run_advance(r, int(k, ip), p, st, text)
+        if (st == FRIROM_OK) then
+            nout = r%nout
+            nc = 2*r%m%nh + 1
+            npts = int(p%npts, c_int)
+            status = int(r%status, c_int)
+            if (npts > 0) then
+                omega(:npts) = p%lam
+                xo(:nout*nc*npts) = reshape(p%xo, [nout*nc*npts])
+                do j = 1, npts
+                    do o = 1, nout
+                        amp(o + nout*(j - 1)) = peak_amplitude(p%xo(o, :, j))
+                    end do
+                end do
+                if (c_associated(y)) then
+                    call c_f_pointer(y, yp, [r%ny, int(npts, ip)])
+                    yp = p%y
+                end if
+            end if
+            text = r%message
+            if (r%status == 4) st = r%fail_info
+        end if
+        call to_c_string(text, msg, msglen)
+        info = int(st, c_int)
+    end function frirom_run_advance_c
+
+    !> int frirom_run_solve_at(frirom_run *run, double omega, const double *y0, double *y,
+    !>                         double *xo, double *amp, char *msg, int msglen)
+    !> One solve at omega from y0 (ny), or from the linear solution when y0 is NULL (with
+    !> the homotopy start if Newton fails there); y (ny) or NULL, xo (nout, 2H+1), amp (nout).
+    function frirom_run_solve_at_c(run, omega, y0, y, xo, amp, msg, msglen) result(info) &
+        bind(c, name='frirom_run_solve_at')
+        type(c_ptr), value :: run, y0, y, msg
+        real(c_double), value :: omega
+        integer(c_int), value :: msglen
+        real(c_double), intent(out) :: xo(*), amp(*)
+        integer(c_int) :: info
+        type(run_t), pointer :: r
+        type(run_points) :: p
+        real(c_double), pointer :: yv(:)
+        real(wp), allocatable :: ys(:)
+        integer(ip) :: st, nout, nc, o
+        character(len=512) :: text
+        text = ''
+        call get_run(run, 'frirom_run_solve_at', r, st, text)
+        if (st == FRIROM_OK) then
+            allocate (ys(r%ny))
+            ys = 0.0_wp
+            if (c_associated(y0)) then
+                call c_f_pointer(y0, yv, [r%ny])
+                ys = yv
+            end if
+            call run_solve(r, RUN_SOLVE_FIXED, omega, ys, p, st, text, &
+                           cold=.not. c_associated(y0))
+        end if
+        if (st == FRIROM_OK) then
+            nout = r%nout
+            nc = 2*r%m%nh + 1
+            xo(:nout*nc) = reshape(p%xo(:, :, 1), [nout*nc])
+            do o = 1, nout
+                amp(o) = peak_amplitude(p%xo(o, :, 1))
+            end do
+            if (c_associated(y)) then
+                call c_f_pointer(y, yv, [r%ny])
+                yv = p%y(:, 1)
+            end if
+        end if
+        call to_c_string(text, msg, msglen)
+        info = int(st, c_int)
+    end function frirom_run_solve_at_c
+
+    !> int frirom_run_checkpoint(const frirom_run *run, int nck, double *ck, char *msg,
+    !>                           int msglen): nck = frirom_run_sizes' nck
+    function frirom_run_checkpoint_c(run, nck, ck, msg, msglen) result(info) &
+        bind(c, name='frirom_run_checkpoint')
+        type(c_ptr), value :: run, msg
+        integer(c_int), value :: nck, msglen
+        real(c_double), intent(out) :: ck(*)
+        integer(c_int) :: info
+        type(run_t), pointer :: r
+        integer(ip) :: st
+        character(len=512) :: text
+        call run_and_ck(run, nck, 'frirom_run_checkpoint', r, st, text)
+        if (st == FRIROM_OK) call run_checkpoint(r, ck(:nck), st, text)
+        call to_c_string(text, msg, msglen)
+        info = int(st, c_int)
+    end function frirom_run_checkpoint_c
+
+    !> int frirom_run_restore(frirom_run *run, int nck, const double *ck, char *msg,
+    !>                        int msglen): continue from a checkpoint (instead of start)
+    function frirom_run_restore_c(run, nck, ck, msg, msglen) result(info) &
+        bind(c, name='frirom_run_restore')
+        type(c_ptr), value :: run, msg
+        integer(c_int), value :: nck, msglen
+        real(c_double), intent(in) :: ck(*)
+        integer(c_int) :: info
+        type(run_t), pointer :: r
+        integer(ip) :: st
+        character(len=512) :: text
+        call run_and_ck(run, nck, 'frirom_run_restore', r, st, text)
+        if (st == FRIROM_OK) call run_restore(r, ck(:nck), st, text)
+        call to_c_string(text, msg, msglen)
+        info = int(st, c_int)
+    end function frirom_run_restore_c
+
+    !> The run behind a C pointer and a checkpoint length that fits it (FRIROM_ERR_SIZE
+    !> naming nck otherwise).
+    subroutine run_and_ck(run, nck, who, r, st, text)
+        type(c_ptr), intent(in) :: run
+        integer(c_int), intent(in) :: nck
+        character(len=*), intent(in) :: who
+        type(run_t), pointer, intent(out) :: r
+        integer(ip), intent(out) :: st
+        character(len=*), intent(out) :: text
+        text = ''
+        call get_run(run, who, r, st, text)
+        if (st /= FRIROM_OK) return
+        if (nck /= run_checkpoint_size(r)) call set_status(st, FRIROM_ERR_SIZE, text, &
+            who//': nck: expected frirom_run_sizes'' nck')
+    end subroutine run_and_ck
+
+    !> int frirom_run_close(frirom_run **run): free the run, *run = NULL (NULL: nothing)
+    function frirom_run_close_c(run) result(info) bind(c, name='frirom_run_close')
+        type(c_ptr), intent(inout) :: run
+        integer(c_int) :: info
+        type(run_t), pointer :: r
+        integer(ip) :: st
+        character(len=512) :: text
+        info = 0
+        if (.not. c_associated(run)) return
+        text = ''
+        call get_run(run, 'frirom_run_close', r, st, text)
+        if (st == FRIROM_OK) then
+            call run_close(r)
+            deallocate (r)
+        end if
+        run = c_null_ptr
+        info = int(st, c_int)
+    end function frirom_run_close_c
+
+    !> The run behind a C pointer (FRIROM_ERR_PARAM naming `who` for NULL or a closed run).
+    subroutine get_run(run, who, r, st, text)
+        type(c_ptr), intent(in) :: run
+        character(len=*), intent(in) :: who
+        type(run_t), pointer, intent(out) :: r
+        integer(ip), intent(out) :: st
+        character(len=*), intent(inout) :: text
+        call run_from_handle(transfer(run, 0_c_intptr_t), r, who, st, text)
+    end subroutine get_run
+
+    !> FRIROM_ERR_SIZE naming the first negative count (names: blank-separated, in order).
+    subroutine check_counts(who, counts, names, st, text)
+        character(len=*), intent(in) :: who, names
+        integer(c_int), intent(in) :: counts(:)
+        integer(ip), intent(out) :: st
+        character(len=*), intent(inout) :: text
+        integer :: k, a, b
+        st = FRIROM_OK
+        a = 1
+        do k = 1, size(counts)
+            b = index(names(a:)//' ', ' ') + a - 2
+            if (counts(k) < 0) then
+                call set_status(st, FRIROM_ERR_SIZE, text, who//': '//names(a:b)// &
+                                ': expected a count >= 0')
+                return
+            end if
+            a = b + 2
+        end do
+    end subroutine check_counts
 end module frirom_capi

@@ -102,245 +102,326 @@ subroutine hbm_rcm(n, nnz, indptr, indices, perm, info, msg)
     info = linfo
 end subroutine hbm_rcm
 
-!> Harmonic balance solve and pseudo-arc-length continuation (frirom_hbm hbm_run).
-!> formulation: 'condensed' or 'banded'; lam_kind: 'frequency' (lam = omega) or 'load'
-!> (lam scales fe1 at omega_fix). K, M, C: CSR, 1-based, ndof x ndof, symmetric.
-!> perm: RCM order of the DoFs. nl: nonlinear DoFs (condensed); tcontact: condensed
-!> unknowns in contact coordinates (G x) instead. fe0, fe1: real harmonic
-!> excitation (ndof, 2H+1) (frequency: fe0; load: fe0 + lam fe1).
-!> ginfo(3, ngroup): law, n_elem, n_dir; G rows group by group, element, direction (CSR over
-!> the full DoFs); params (npar, ne) and w0 (nslider, ne) per group, concatenated.
-!> start_mode (HBM_START_*): solve at lam0 from y0 then continue, resume from (y0, lam0,
-!> tan0), or solve at lam0 only. ropt, iopt: Newton and continuation settings by slot
-!> (RCONT_*, ICONT_* of frirom_newton; Python reads all of these names with int_constant).
-!> Outputs: npts points; timings(T_*): AFT, assembly, factorisation, solve, receptances (s),
-!> residual evaluations, factorisations, GMRES iterations, double-precision fall-back
-!> factorisations (N_DOUBLE); timings(N_TIMERS): total (s).
-subroutine hbm_continue(formulation, lam_kind, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, &
-                        mi, mx, nnzc, cp, ci, cx, perm, nnl, nl, fe0, fe1, omega_fix, ngroup, &
-                        ginfo, nrows, nnzg, gp, gi, gx, npart, params, nw0, w0, nout, outdofs, &
-                        nmodes, phi, wmodes, zmodes, hmodes, psi, wharm, zharm, ny, y0, lam0, &
-                        tan0, start_mode, nropt, ropt, niopt, iopt, stability, history, &
-                        maxpts, netot, ntim, ys, lams, tans, iters, xo, states, hill_re, &
-                        sliders, yscales, npts, finished, ds_out, timings, info, msg, &
-                        tcontact, krylov, sparse, nlu, lu, lupiv, lustate, selected, keep, pair, &
-                        leak, orbtol, orbinfo, orbmap)
+!> Open a run on a model (frirom_run run_open; Python's frirom.solver drives it): the
+!> model as plain arrays. formulation: 1 condensed (Eq. 5-9), 2 banded; mode: 1 frequency
+!> (lam = omega, excitation fe0), 2 load (fe0 + lam fe1 at omega_fix). K, M, C: CSR,
+!> 1-based, ndof x ndof, symmetric; perm: RCM order of the DoFs; nl: nonlinear DoFs
+!> (condensed); tcontact: condensed unknowns in contact coordinates G x; krylov: GMRES
+!> solves preconditioned by an older LU; sparse: receptances by MUMPS. ginfo(3, ngroup):
+!> law, n_elem, n_dir; G rows group by group, element, direction; params and w0 per group,
+!> concatenated. iset, rset: the settings (settings_defaults' layout). Out: the handle
+!> (0 when info /= 0), unknowns per point ny, sliders nw, contact elements netot.
+subroutine frun_open(formulation, mode, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm, mp, mi, mx, &
+                    nnzc, cp, ci, cx, perm, nnl, nl, fe0, fe1, omega_fix, ngroup, ginfo, &
+                    nrows, nnzg, gp, gi, gx, npart, params, nw0, w0, nout, outdofs, &
+                    tcontact, krylov, sparse, niset, iset, nrset, rset, handle, ny, nw, &
+                    netot, info, msg)
     use frirom_kinds, only: wp, ip
-    use frirom_status, only: FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
-    use frirom_newton, only: cont_options, cont_options_from, N_RCONT, N_ICONT, RCONT_DS, &
-                             RCONT_LAM_LO
-    use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
-                          hbm_set_modes_harmonic, hbm_run, hbm_lu_import, hbm_lu_export, &
-                          hbm_set_selection, hbm_sel_expand, hbm_sel_reduce, hbm_set_orbits, &
-                          HBM_FREQUENCY, HBM_LOAD, N_TIMERS
+    use frirom_status, only: FRIROM_ERR_SIZE, set_status
+    use frirom_run, only: run_t, fr_open => run_open, run_handle, settings_unpack, N_ISET, &
+                          N_RSET
     implicit none
-    character(len=*), intent(in) :: formulation  !! 'condensed' (Eq. 5-9) or 'banded'
-    character(len=*), intent(in) :: lam_kind     !! the parameter lam: 'frequency' or 'load'
-    integer(4), intent(in) :: nh, nsamp, ndof, nnzk, nnzm, nnzc
+    integer(4), intent(in) :: formulation, mode, nh, nsamp, ndof, nnzk, nnzm, nnzc
     integer(4), intent(in) :: kp(ndof + 1), ki(nnzk), mp(ndof + 1), mi(nnzm), cp(ndof + 1), &
                               ci(nnzc)
     real(8), intent(in) :: kx(nnzk), mx(nnzm), cx(nnzc)
     integer(4), intent(in) :: perm(ndof), nnl, nl(nnl)
-    !> condensed: 1 = unknowns in contact coordinates u = G x (nrows per harmonic), 0 = the
-    !> nl DoFs (nnl per harmonic)
-    integer(4), intent(in) :: tcontact
-    !> condensed: 1 = linear solves by GMRES preconditioned by an older LU, 0 or -1 = a
-    !> new LU for every Jacobian
-    integer(4), intent(in) :: krylov
-    integer(4), intent(in) :: sparse   !! condensed: 1 = receptances by sparse LU (MUMPS)
-    real(8), intent(in) :: fe0(ndof, 2*nh + 1), fe1(ndof, 2*nh + 1)
-    real(8), intent(in) :: omega_fix     !! rad/s, the frequency of a load continuation
+    real(8), intent(in) :: fe0(ndof, 2*nh + 1), fe1(ndof, 2*nh + 1), omega_fix
     integer(4), intent(in) :: ngroup, ginfo(3, ngroup), nrows, nnzg, gp(nrows + 1), gi(nnzg)
     real(8), intent(in) :: gx(nnzg)
-    integer(4), intent(in) :: npart, nw0
+    integer(4), intent(in) :: npart, nw0, nout, outdofs(nout)
     real(8), intent(in) :: params(npart), w0(nw0)
-    integer(4), intent(in) :: nout, outdofs(nout)
-    integer(4), intent(in) :: nmodes       !! > 0: condensed receptances by modal superposition
-    real(8), intent(in) :: phi(ndof, max(nmodes, 1)), wmodes(max(nmodes, 1)), &
-                           zmodes(max(nmodes, 1))
-    !> > 0: modes of their own for every harmonic h (cyclic sectors: nodal diameter h EO
-    !> mod N), psi(:, :, h + 1) complex shapes on all DoFs, omega and zeta per harmonic
-    integer(4), intent(in) :: hmodes
-    complex(8), intent(in) :: psi(ndof, max(hmodes, 1), nh + 1)
-    real(8), intent(in) :: wharm(max(hmodes, 1), nh + 1), zharm(max(hmodes, 1), nh + 1)
-    integer(4), intent(in) :: ny
-    real(8), intent(in) :: y0(ny), lam0, tan0(ny + 1)
-    integer(4), intent(in) :: start_mode   !! one of HBM_START_*
-    integer(4), intent(in) :: nropt, niopt
-    real(8), intent(in) :: ropt(nropt)     !! (N_RCONT) real settings by RCONT_* slot
-    integer(4), intent(in) :: iopt(niopt)  !! (N_ICONT) integer settings by ICONT_* slot
-    integer(4), intent(in) :: stability    !! 1: Hill stability of every point
-    integer(4), intent(in) :: history      !! 1: carry contact sliders from point to point
-    integer(4), intent(in) :: maxpts, netot, ntim   !! ntim = N_TIMERS
-    real(8), intent(out) :: ys(ny, maxpts), lams(maxpts), tans(ny + 1, maxpts)
-    integer(4), intent(out) :: iters(maxpts)
-    real(8), intent(out) :: xo(nout, 2*nh + 1, maxpts), states(3, netot, maxpts)
-    real(8), intent(out) :: hill_re(maxpts)   !! max real part of the Floquet exponents, 1/s
-    !> contact history each point leaves: the sliders its closed cycles start with, in the
-    !> layout of w0 (the w0 to restart a run from that point)
-    real(8), intent(out) :: sliders(nw0, maxpts)
-    !> the arc-length scale of the unknowns each point's tangent is in (grown with the
-    !> solution after every point): resume from a point with its tangent and this
-    real(8), intent(out) :: yscales(maxpts)
-    integer(4), intent(out) :: npts, finished
-    real(8), intent(out) :: ds_out, timings(ntim)
+    integer(4), intent(in) :: tcontact, krylov, sparse
+    integer(4), intent(in) :: niset, iset(niset), nrset
+    real(8), intent(in) :: rset(nrset)
+    integer(8), intent(out) :: handle
+    integer(4), intent(out) :: ny, nw, netot, info
+    character(len=512), intent(out) :: msg
+    type(run_t), pointer :: r
+    integer(ip) :: linfo, is(N_ISET)
+    msg = ''
+    handle = 0
+    ny = 0
+    nw = 0
+    netot = 0
+    if (niset /= N_ISET .or. nrset /= N_RSET .or. iset(1) /= nh) then
+        call set_status(linfo, FRIROM_ERR_SIZE, msg, 'run_open: iset, rset need the '// &
+                        'settings_defaults layout, iset(1) = nh')
+        info = linfo
+        return
+    end if
+    is = iset
+    allocate (r)
+    call fr_open(r, settings_unpack(is, rset), int(formulation, ip), int(mode, ip), &
+                 int(nsamp, ip), int(ndof, ip), int(kp, ip), int(ki, ip), kx, int(mp, ip), &
+                 int(mi, ip), mx, int(cp, ip), int(ci, ip), cx, int(perm, ip), int(nl, ip), &
+                 fe0, fe1, omega_fix, int(ginfo, ip), int(gp, ip), int(gi, ip), gx, params, &
+                 w0, int(outdofs, ip), tcontact == 1, int(krylov, ip), sparse == 1, linfo, msg)
+    info = linfo
+    if (linfo /= 0) then
+        deallocate (r)
+        return
+    end if
+    ny = r%ny
+    nw = r%nw
+    netot = r%netot
+    handle = run_handle(r)
+end subroutine frun_open
+
+!> Receptances of an open run by modal superposition: harmonic = 0, nmodes real
+!> mass-normalised modes phi with wmodes (rad/s) and zmodes (ratios); harmonic = 1,
+!> modes of their own per harmonic (a cyclic sector): psi(:, :, h + 1) complex shapes of
+!> harmonic h's nodal diameter, wmodes and zmodes (nmodes, nh1) (the unused kind's arrays
+!> may be 1 x 1 dummies).
+subroutine frun_set_modes(handle, harmonic, ndof, nmodes, nh1, phi, psi, npsi, wmodes, &
+                          zmodes, info, msg)
+    use frirom_kinds, only: ip
+    use frirom_run, only: run_t, run_from_handle, fr_modes => run_set_modes, &
+                          fr_hmodes => run_set_modes_harmonic
+    implicit none
+    integer(8), intent(in) :: handle
+    integer(4), intent(in) :: harmonic, ndof, nmodes, nh1, npsi
+    real(8), intent(in) :: phi(ndof, nmodes), wmodes(nmodes, nh1), zmodes(nmodes, nh1)
+    complex(8), intent(in) :: psi(npsi, nmodes, nh1)
     integer(4), intent(out) :: info
     character(len=512), intent(out) :: msg
-    !> the LU carried from run to run of the same model (hbm_lu_holds; nlu = 0 or 1 and a
-    !> dummy when it is not): dgetrf (lustate(1) = 1) or sgetrf (2) factors and pivots,
-    !> lustate(1) = 0 when invalid, lustate(2) the GMRES iterations spent on it; read at
-    !> the start, written at the end
-    integer(4), intent(in) :: nlu
-    real(8), intent(inout) :: lu(nlu, nlu), lustate(2)
-    integer(4), intent(inout) :: lupiv(nlu)
-    !> selected = 1: solve only for the (nonlinear DoF, harmonic) pairs with keep(j, h+1)
-    !> = 1, the others zero (hbm_set_selection); y0, tan0, ys and tans keep the full
-    !> layout (zeros where left out)
-    integer(4), intent(in) :: selected, keep(nnl, nh + 1)
-    !> selected = 2: also pair(j, h+1) = s k, the pairs of one travelling direction
-    !> (hbm_set_selection's pair; 0: none); the points keep both members of a pair
-    integer(4), intent(in) :: pair(nnl, nh + 1)
-    real(8), intent(out) :: leak(maxpts)     !! per point: frirom_hbm cond_leak
-    !> selected = 3: pairs, and Newton's evaluations run the AFT on one contact element per
-    !> orbit (hbm_set_orbits, elements matched to orbtol); orbinfo = the elements the AFT
-    !> runs on, the largest misfit accepted
+    type(run_t), pointer :: r
+    integer(ip) :: linfo
+    msg = ''
+    call run_from_handle(handle, r, 'run_set_modes', linfo, msg)
+    if (linfo == 0 .and. harmonic == 1) then
+        call fr_hmodes(r, psi, wmodes, zmodes, linfo, msg)
+    else if (linfo == 0) then
+        call fr_modes(r, phi, wmodes(:, 1), zmodes(:, 1), linfo, msg)
+    end if
+    info = linfo
+end subroutine frun_set_modes
+
+!> A travelling-wave selection keep(j, h + 1) = 1 of the nonlinear DoFs' harmonics; with
+!> haspair = 1 its direction pair (0: none); with orbits = 1 Newton's evaluations on one
+!> element per orbit (matched to orbtol). orbinfo: elements the AFT runs on, misfit.
+subroutine frun_set_selection(handle, nnl, nh1, keep, pair, haspair, orbits, orbtol, orbinfo, &
+                             info, msg)
+    use frirom_kinds, only: ip
+    use frirom_run, only: run_t, run_from_handle, fr_select => run_set_selection
+    implicit none
+    integer(8), intent(in) :: handle
+    integer(4), intent(in) :: nnl, nh1, keep(nnl, nh1), pair(nnl, nh1), haspair, orbits
     real(8), intent(in) :: orbtol
     real(8), intent(out) :: orbinfo(2)
-    !> each element's orbit representative (hbm_set_orbits' map): 0 on the first call of
-    !> a run, which writes it; later calls of the run pass it back
-    integer(4), intent(inout) :: orbmap(netot)
-    class(hbm_system), allocatable :: sys
-    integer(ip), allocatable :: sel(:), omap(:)
-    real(wp), allocatable :: ysel(:, :), tsel(:, :)
-    type(cont_options) :: opts
-    real(wp), allocatable :: y(:), t(:)
-    real(wp) :: lam, dsl
-    integer(ip) :: linfo, np, itl(maxpts), mode, n, k, nrep
-    real(wp) :: mis
-    integer(8) :: c0, c1, rate
-    logical :: fin
-    call system_clock(c0, rate)
+    integer(4), intent(out) :: info
+    character(len=512), intent(out) :: msg
+    type(run_t), pointer :: r
+    integer(ip) :: linfo
     msg = ''
-    info = 0
-    npts = 0
-    finished = 0
-    ds_out = 0.0d0
+    orbinfo = 0.0d0
+    call run_from_handle(handle, r, 'run_set_selection', linfo, msg)
+    if (linfo == 0) then
+        if (haspair == 1) then
+            call fr_select(r, int(keep, ip), linfo, msg, pair=int(pair, ip), &
+                           orbits=orbits == 1, orbtol=orbtol)
+        else
+            call fr_select(r, int(keep, ip), linfo, msg)
+        end if
+    end if
+    if (linfo == 0) orbinfo = [real(r%orb_nrep, 8), r%orb_mis]
+    info = linfo
+end subroutine frun_set_selection
+
+!> Start a continuation of an open run from lam_start to lam_end (frirom_run run_start):
+!> kind 0 cold, 1 from the point y0 at lam0 (solved first), 2 resumed from y0 at lam0 with
+!> tangent tan0 in scale yscale (a checkpoint: ds > 0 its step, lscale_old > 0 the range
+!> of the run that wrote it, n_before its points). hassliders = 1: start from the history
+!> sliders. timings (N_TIMERS) of the call.
+subroutine frun_start(handle, kind, lam_start, lam_end, lam0, ny, y0, tan0, yscale, ds, &
+                     lscale_old, n_before, nw, sliders, hassliders, ntim, timings, info, msg)
+    use frirom_kinds, only: ip
+    use frirom_run, only: run_t, run_from_handle, fr_start => run_start
+    implicit none
+    integer(8), intent(in) :: handle
+    integer(4), intent(in) :: kind, ny, n_before, nw, hassliders, ntim
+    real(8), intent(in) :: lam_start, lam_end, lam0, y0(ny), tan0(ny + 1), yscale, ds, &
+                           lscale_old, sliders(nw)
+    real(8), intent(out) :: timings(ntim)
+    integer(4), intent(out) :: info
+    character(len=512), intent(out) :: msg
+    type(run_t), pointer :: r
+    integer(ip) :: linfo
+    msg = ''
     timings = 0.0d0
-    ys = 0.0d0
-    lams = 0.0d0
-    tans = 0.0d0
-    iters = 0
+    call run_from_handle(handle, r, 'run_start', linfo, msg)
+    if (linfo == 0 .and. hassliders == 1) then
+        call fr_start(r, int(kind, ip), lam_start, lam_end, linfo, msg, lam0=lam0, y0=y0, &
+                      tan0=tan0, yscale=yscale, ds=ds, lscale_old=lscale_old, &
+                      n_before=int(n_before, ip), sliders=sliders)
+    else if (linfo == 0) then
+        call fr_start(r, int(kind, ip), lam_start, lam_end, linfo, msg, lam0=lam0, y0=y0, &
+                      tan0=tan0, yscale=yscale, ds=ds, lscale_old=lscale_old, &
+                      n_before=int(n_before, ip))
+    end if
+    if (associated(r)) timings(1:min(ntim, size(r%timers))) = r%timers(1:min(ntim, size(r%timers)))
+    info = linfo
+end subroutine frun_start
+
+!> Up to k more points of a started run (frirom_run run_advance) into arrays of room
+!> maxpts >= k + 1: npts points; status (RUN_*: 0 going, 1 done, 2 max_points, 3 left the
+!> range, 4 failed), fail_info the failure's code and message its text (or why it
+!> stopped); advice (ADVISE_* bits) and stalled (|R|/rref, -1: none) of a failure at ds_min;
+!> fold(k) = 1 where the tangent turned; ds_next(k) > 0 at a checkpoint.
+subroutine frun_advance(handle, k, maxpts, ny, nout, nc, netot, nw, ys, lams, tans, iters, &
+                       xo, states, hill_re, sliders, yscales, leak, ds_next, fold, npts, &
+                       status, fail_info, message, advice, stalled, ntim, timings, info, msg)
+    use frirom_kinds, only: ip, wp
+    use frirom_status, only: FRIROM_ERR_SIZE, set_status
+    use frirom_run, only: run_t, run_points, run_from_handle, fr_advance => run_advance, &
+                          run_advice
+    implicit none
+    integer(8), intent(in) :: handle
+    integer(4), intent(in) :: k, maxpts, ny, nout, nc, netot, nw, ntim
+    real(8), intent(out) :: ys(ny, maxpts), lams(maxpts), tans(ny + 1, maxpts)
+    integer(4), intent(out) :: iters(maxpts), fold(maxpts)
+    real(8), intent(out) :: xo(nout, nc, maxpts), states(3, netot, maxpts), hill_re(maxpts)
+    real(8), intent(out) :: sliders(nw, maxpts), yscales(maxpts), leak(maxpts), &
+                           ds_next(maxpts)
+    integer(4), intent(out) :: npts, status, fail_info, advice
+    character(len=512), intent(out) :: message
+    real(8), intent(out) :: stalled, timings(ntim)
+    integer(4), intent(out) :: info
+    character(len=512), intent(out) :: msg
+    type(run_t), pointer :: r
+    type(run_points) :: p
+    integer(ip) :: linfo, bits
+    real(wp) :: st
+    msg = ''
+    message = ''
+    npts = 0
+    status = 0
+    fail_info = 0
+    advice = 0
+    stalled = -1.0d0
+    timings = 0.0d0
+    call run_from_handle(handle, r, 'run_advance', linfo, msg)
+    if (linfo == 0) then
+        if (maxpts < k + 1 .or. ny /= r%ny .or. nout /= r%nout .or. &
+            nc /= 2*r%m%nh + 1 .or. netot /= max(r%netot, 1) .or. nw /= max(r%nw, 1)) &
+            call set_status(linfo, FRIROM_ERR_SIZE, msg, 'run_advance: array sizes do '// &
+                            'not match the run (maxpts >= k + 1)')
+    end if
+    if (linfo == 0) call fr_advance(r, int(k, ip), p, linfo, msg)
+    if (associated(r)) then
+        npts = int(p%npts, 4)
+        if (npts > 0) then
+            ys(:, 1:npts) = p%y
+            lams(1:npts) = p%lam
+            tans(:, 1:npts) = p%tan
+            iters(1:npts) = int(p%iters, 4)
+            xo(:, :, 1:npts) = p%xo
+            states(:, :, 1:npts) = p%states
+            hill_re(1:npts) = p%hill
+            sliders(:, 1:npts) = p%sliders
+            yscales(1:npts) = p%yscale
+            leak(1:npts) = p%leak
+            ds_next(1:npts) = p%ds_next
+            fold(1:npts) = int(p%fold, 4)
+        end if
+        status = int(r%status, 4)
+        fail_info = int(r%fail_info, 4)
+        message = r%message
+        call run_advice(r, bits, st)
+        advice = int(bits, 4)
+        stalled = st
+        timings(1:min(ntim, size(r%timers))) = r%timers(1:min(ntim, size(r%timers)))
+    end if
+    info = linfo
+end subroutine frun_advance
+
+!> One corrector on an open run's system (frirom_run run_solve), its continuation state
+!> untouched: kind 1 at lam0 from y0 (cold = 1: from the linear solution, with the
+!> homotopy start when Newton fails); kind 2 a step ds along tan0 (scale yscale) from the
+!> point (y0, lam0) of a started run. hassliders = 1: from the history sliders.
+!> stability = 1: Hill's method at the point. Out: the point.
+subroutine frun_solve(handle, kind, lam0, ny, y0, tan0, yscale, ds, nw, sliders, hassliders, &
+                     stability, cold, nout, nc, netot, y, lam, tan, iters, xo, states, &
+                     hill_re, slider_out, yscale_out, leak, ntim, timings, info, msg)
+    use frirom_kinds, only: ip
+    use frirom_status, only: FRIROM_ERR_SIZE, set_status
+    use frirom_run, only: run_t, run_points, run_from_handle, fr_solve => run_solve
+    implicit none
+    integer(8), intent(in) :: handle
+    integer(4), intent(in) :: kind, ny, nw, hassliders, stability, cold, nout, nc, netot, ntim
+    real(8), intent(in) :: lam0, y0(ny), tan0(ny + 1), yscale, ds, sliders(nw)
+    real(8), intent(out) :: y(ny), lam, tan(ny + 1), xo(nout, nc), states(3, netot), &
+                            hill_re, slider_out(nw), yscale_out, leak, timings(ntim)
+    integer(4), intent(out) :: iters, info
+    character(len=512), intent(out) :: msg
+    type(run_t), pointer :: r
+    type(run_points) :: p
+    integer(ip) :: linfo
+    msg = ''
+    y = 0.0d0
+    lam = 0.0d0
+    tan = 0.0d0
     xo = 0.0d0
     states = 0.0d0
-    sliders = 0.0d0
-    yscales = 0.0d0
     hill_re = 0.0d0
+    slider_out = 0.0d0
+    yscale_out = 0.0d0
     leak = 0.0d0
-    orbinfo = 0.0d0
-    linfo = 0
-    if (nropt /= N_RCONT .or. niopt /= N_ICONT .or. ntim /= N_TIMERS) then
-        call set_status(linfo, FRIROM_ERR_SIZE, msg, 'hbm_continue: ropt, iopt and timings '// &
-                        'need N_RCONT, N_ICONT and N_TIMERS entries')
-    else if (lam_kind == 'frequency') then
-        mode = HBM_FREQUENCY
-    else if (lam_kind == 'load') then
-        mode = HBM_LOAD
-    else
-        call set_status(linfo, FRIROM_ERR_PARAM, msg, "lam_kind must be 'frequency' or 'load'")
-    end if
+    iters = 0
+    timings = 0.0d0
+    call run_from_handle(handle, r, 'run_solve', linfo, msg)
     if (linfo == 0) then
-        if (formulation == 'condensed') then
-            allocate (hbm_condensed :: sys)
-        else if (formulation == 'banded') then
-            allocate (hbm_full :: sys)
-        else
-            call set_status(linfo, FRIROM_ERR_PARAM, msg, "formulation must be 'condensed' "// &
-                            "or 'banded'")
-        end if
+        if (ny /= r%ny .or. nout /= r%nout .or. nc /= 2*r%m%nh + 1 .or. &
+            netot /= max(r%netot, 1) .or. nw /= max(r%nw, 1)) &
+            call set_status(linfo, FRIROM_ERR_SIZE, msg, 'run_solve: array sizes do not '// &
+                            'match the run')
     end if
-    if (linfo /= 0) then
-        info = linfo
-        return
+    if (linfo == 0 .and. hassliders == 1) then
+        call fr_solve(r, int(kind, ip), lam0, y0, p, linfo, msg, tan0=tan0, yscale=yscale, &
+                      ds=ds, sliders=sliders(1:r%nw), stability=stability == 1, &
+                      cold=cold == 1)
+    else if (linfo == 0) then
+        call fr_solve(r, int(kind, ip), lam0, y0, p, linfo, msg, tan0=tan0, yscale=yscale, &
+                      ds=ds, stability=stability == 1, cold=cold == 1)
     end if
-    call hbm_setup(sys, nh, nsamp, ndof, kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe0, &
-                   fe1, mode, omega_fix, ginfo, gp, gi, gx, params, w0, outdofs, linfo, msg, &
-                   contact_coords=tcontact == 1, krylov=int(krylov, ip), sparse_lu=sparse == 1)
-    if (linfo == 0 .and. (sys%n /= ny .or. sum(ginfo(2, :)) /= netot)) &
-        call set_status(linfo, FRIROM_ERR_SIZE, msg, 'hbm_continue: ny or netot does not '// &
-                        'match the model')
-    if (linfo == 0 .and. nmodes > 0) call hbm_set_modes(sys, phi, wmodes, zmodes, linfo, msg)
-    if (linfo == 0 .and. hmodes > 0) call hbm_set_modes_harmonic(sys, psi, wharm, zharm, &
-                                                                 linfo, msg)
-    if (linfo == 0 .and. selected /= 0) then
-        if (stability /= 0) then
-            call set_status(linfo, FRIROM_ERR_PARAM, msg, 'selection: Hill stability would '// &
-                            'see only perturbations inside the selection; not with stability')
-        else
-            if (selected >= 2) then
-                call hbm_set_selection(sys, int(keep, ip), linfo, msg, sel, int(pair, ip))
-                if (linfo == 0 .and. selected == 3) then
-                    allocate (omap(netot))
-                    omap = orbmap
-                    call hbm_set_orbits(sys, orbtol, nrep, mis, linfo, msg, omap)
-                    orbmap = int(omap, 4)
-                    orbinfo = [real(nrep, 8), mis]
-                end if
-            else
-                call hbm_set_selection(sys, int(keep, ip), linfo, msg, sel)
-            end if
-        end if
+    if (linfo == 0 .and. p%npts /= 1) call set_status(linfo, FRIROM_ERR_SIZE, msg, &
+                                                      'run_solve: no point')
+    if (linfo == 0) then
+        y = p%y(:, 1)
+        lam = p%lam(1)
+        tan = p%tan(:, 1)
+        iters = int(p%iters(1), 4)
+        xo = p%xo(:, :, 1)
+        states = p%states(:, :, 1)
+        hill_re = p%hill(1)
+        slider_out = p%sliders(:, 1)
+        yscale_out = p%yscale(1)
+        leak = p%leak(1)
     end if
-    if (linfo /= 0) then
-        info = linfo
-        return
-    end if
-    sys%carry = history /= 0
-    call hbm_lu_import(sys, lu, lupiv, lustate)
-    opts = cont_options_from(ropt, iopt)
-    opts%max_points = maxpts
-    y = y0
-    t = tan0
-    lam = lam0
-    dsl = ropt(RCONT_DS)
-    if (allocated(sel)) then
-        ! the run in the kept unknowns; the points back in the full layout
-        n = sys%n
-        deallocate (y, t)
-        allocate (y(n), t(n + 1), ysel(n, maxpts), tsel(n + 1, maxpts))
-        call hbm_sel_reduce(sys, y0, y)
-        call hbm_sel_reduce(sys, tan0(1:ny), t(1:n))
-        t(n + 1) = tan0(ny + 1)
-        call hbm_run(sys, start_mode, y, lam, t, dsl, ropt(RCONT_LAM_LO), opts, ysel, lams, &
-                     tsel, itl, xo, states, np, fin, linfo, msg, sliders=sliders, &
-                     yscales=yscales, leak=leak)
-        do k = 1, np
-            call hbm_sel_expand(sys, ysel(:, k), ys(:, k))
-            call hbm_sel_expand(sys, tsel(1:n, k), tans(1:ny, k))
-        end do
-        tans(ny + 1, 1:np) = tsel(n + 1, 1:np)
-    else if (stability /= 0) then
-        call hbm_run(sys, start_mode, y, lam, t, dsl, ropt(RCONT_LAM_LO), opts, ys, lams, &
-                     tans, itl, xo, states, np, fin, linfo, msg, hill_re, sliders=sliders, &
-                     yscales=yscales)
-    else
-        call hbm_run(sys, start_mode, y, lam, t, dsl, ropt(RCONT_LAM_LO), opts, ys, lams, &
-                     tans, itl, xo, states, np, fin, linfo, msg, sliders=sliders, &
-                     yscales=yscales)
-    end if
-    call hbm_lu_export(sys, lu, lupiv, lustate)
-    npts = np
-    iters = itl
-    finished = merge(1, 0, fin)
-    ds_out = dsl
+    if (associated(r)) timings(1:min(ntim, size(r%timers))) = r%timers(1:min(ntim, size(r%timers)))
     info = linfo
-    timings(1:N_TIMERS - 1) = sys%timers(1:N_TIMERS - 1)
-    call system_clock(c1)
-    timings(N_TIMERS) = real(c1 - c0, 8)/real(rate, 8)
-end subroutine hbm_continue
+end subroutine frun_solve
 
-!> Whether hbm_continue carries the LU from run to run (hold = 1, then pass nlu = n arrays)
-!> for a condensed modal system in direct mode of nnl unknowns per harmonic coefficient,
-!> nh harmonics and nmodes modes (frirom_hbm cond_lu_holds).
+!> Close a run (frirom_run run_close) and free it; a handle of no open run is ignored.
+subroutine frun_close(handle)
+    use frirom_kinds, only: ip
+    use frirom_run, only: run_t, run_from_handle, fr_close => run_close
+    implicit none
+    integer(8), intent(in) :: handle
+    type(run_t), pointer :: r
+    integer(ip) :: linfo
+    character(len=512) :: msg
+    msg = ''
+    call run_from_handle(handle, r, 'run_close', linfo, msg)
+    if (linfo /= 0) return
+    call fr_close(r)
+    deallocate (r)
+end subroutine frun_close
+
+!> Whether a condensed modal system in direct mode of nnl unknowns per harmonic
+!> coefficient, nh harmonics and nmodes modes holds an LU as GMRES preconditioner of later
+!> Jacobians (hold = 1; frirom_hbm cond_lu_holds): a run then keeps it from one
+!> corrector to the next, and forgets it at every run_advance segment (exact resume).
 subroutine hbm_lu_holds(nh, nnl, nmodes, hold)
     use frirom_kinds, only: ip
     use frirom_hbm, only: cond_lu_holds
@@ -350,32 +431,68 @@ subroutine hbm_lu_holds(nh, nnl, nmodes, hold)
     hold = merge(1, 0, cond_lu_holds(int(nh, ip), int(nnl, ip), int(nmodes, ip)))
 end subroutine hbm_lu_holds
 
-!> Value of a named integer constant of this interface, so that Python reads slots, modes
-!> and codes from Fortran instead of typing their numbers: RCONT_*, N_RCONT, ICONT_*,
-!> N_ICONT (option slots of hbm_continue, frirom_newton), HBM_START_* (start modes),
-!> T_*, N_EVAL, N_FACT, N_KRYLOV, N_DOUBLE, N_TIMERS (timings slots, frirom_hbm) and the FRIROM_*
-!> status codes.
-!> An unknown name returns info = FRIROM_ERR_PARAM.
-!> The default AFT samples per period for nh harmonics (frirom_solve's rule, the one place
+!> Whether the condensed unknowns are the contact coordinates (tcontact = 1) for a
+!> coordinates choice (COORD_AUTO 0, COORD_DOFS 1, COORD_CONTACT 2), nrows contact rows,
+!> nnl contact DoFs, stability and a selection (1: yes): frirom_run run_contact_coords.
+subroutine contact_coords(coordinates, nrows, nnl, stability, selected, tcontact)
+    use frirom_kinds, only: ip
+    use frirom_run, only: run_contact_coords
+    implicit none
+    integer(4), intent(in) :: coordinates, nrows, nnl, stability, selected
+    integer(4), intent(out) :: tcontact
+    tcontact = merge(1, 0, run_contact_coords(int(coordinates, ip), int(nrows, ip), &
+                                              int(nnl, ip), stability == 1, selected == 1))
+end subroutine contact_coords
+
+!> The solver settings' defaults (frirom_run run_settings, the one place they are
+!> written): iset integers and rset reals in the order of `names` (blank-separated).
+subroutine settings_defaults(niset, iset, nrset, rset, names)
+    use frirom_kinds, only: ip
+    use frirom_run, only: run_settings, settings_pack, run_settings_names, N_ISET, N_RSET
+    implicit none
+    integer(4), intent(in) :: niset, nrset
+    integer(4), intent(out) :: iset(niset)
+    real(8), intent(out) :: rset(nrset)
+    character(len=160), intent(out) :: names
+    type(run_settings) :: s
+    integer(ip) :: iv(N_ISET)
+    real(8) :: rv(N_RSET)
+    call settings_pack(s, iv, rv)
+    iset = 0
+    rset = 0.0d0
+    iset(1:min(niset, N_ISET)) = int(iv(1:min(niset, N_ISET)), 4)
+    rset(1:min(nrset, N_RSET)) = rv(1:min(nrset, N_RSET))
+    names = run_settings_names()
+end subroutine settings_defaults
+
+!> The default AFT samples per period for nh harmonics (frirom_run's rule, the one place
 !> it is written; frirom.harmonics.default_samples reads it).
 subroutine default_samples(nh, ns)
     use frirom_kinds, only: ip
-    use frirom_solve, only: frf_default_samples
+    use frirom_run, only: run_default_samples
     implicit none
     integer(4), intent(in) :: nh
     integer(4), intent(out) :: ns
-    ns = int(frf_default_samples(int(nh, ip)), 4)
+    ns = int(run_default_samples(int(nh, ip)), 4)
 end subroutine default_samples
 
+!> Value of a named integer constant of this interface, so that Python reads slots, modes
+!> and codes from Fortran instead of typing their numbers: RUN_* (formulations, parameter
+!> kinds, start kinds, stop reasons, solve kinds of frirom_run), ADVISE_* (advice bits),
+!> N_ISET, N_RSET (settings layout), T_*, N_EVAL, N_FACT, N_KRYLOV, N_DOUBLE, N_TIMERS
+!> (timings slots, frirom_hbm), HILL_DENSE_MAX and the FRIROM_* status codes.
+!> An unknown name returns info = FRIROM_ERR_PARAM.
 subroutine int_constant(name, value, info, msg)
     use frirom_kinds, only: ip
     use frirom_status, only: FRIROM_ERR_PARAM, frirom_status_code, set_status
-    use frirom_newton, only: RCONT_TOL_R, RCONT_TOL_X, RCONT_TOL_STALL, RCONT_YSCALE, &
-                             RCONT_LSCALE, RCONT_DS, RCONT_DS_MIN, RCONT_DS_MAX, RCONT_LAM_END, &
-                             RCONT_LAM_LO, N_RCONT, ICONT_MAX_ITER, ICONT_REUSE_JAC, N_ICONT
+    use frirom_run, only: RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_LOAD, &
+                          RUN_START_COLD, RUN_START_POINT, RUN_START_RESUME, RUN_GOING, &
+                          RUN_DONE, RUN_MAX_POINTS, RUN_LEFT_RANGE, RUN_FAILED, &
+                          RUN_SOLVE_FIXED, RUN_SOLVE_STEP, ADVISE_TOL_STALL, ADVISE_MAX_ITER, &
+                          ADVISE_DS_MIN, ADVISE_SAMPLES, N_ISET, N_RSET, COORD_AUTO, COORD_DOFS, &
+                          COORD_CONTACT
     use frirom_hbm, only: T_AFT, T_ASM, T_FACT, T_SOLVE, T_REC, N_EVAL, N_FACT, N_KRYLOV, &
-                          N_DOUBLE, N_TIMERS, HILL_DENSE_MAX, &
-                          HBM_START_CONTINUE, HBM_START_RESUME, HBM_START_SOLVE_ONLY
+                          N_DOUBLE, N_TIMERS, HILL_DENSE_MAX
     implicit none
     character(len=*), intent(in) :: name
     integer(4), intent(out) :: value
@@ -385,40 +502,52 @@ subroutine int_constant(name, value, info, msg)
     msg = ''
     info = 0
     select case (name)
-    case ('RCONT_TOL_R')
-        value = RCONT_TOL_R
-    case ('RCONT_TOL_X')
-        value = RCONT_TOL_X
-    case ('RCONT_TOL_STALL')
-        value = RCONT_TOL_STALL
-    case ('RCONT_YSCALE')
-        value = RCONT_YSCALE
-    case ('RCONT_LSCALE')
-        value = RCONT_LSCALE
-    case ('RCONT_DS')
-        value = RCONT_DS
-    case ('RCONT_DS_MIN')
-        value = RCONT_DS_MIN
-    case ('RCONT_DS_MAX')
-        value = RCONT_DS_MAX
-    case ('RCONT_LAM_END')
-        value = RCONT_LAM_END
-    case ('RCONT_LAM_LO')
-        value = RCONT_LAM_LO
-    case ('N_RCONT')
-        value = N_RCONT
-    case ('ICONT_MAX_ITER')
-        value = ICONT_MAX_ITER
-    case ('ICONT_REUSE_JAC')
-        value = ICONT_REUSE_JAC
-    case ('N_ICONT')
-        value = N_ICONT
-    case ('HBM_START_CONTINUE')
-        value = HBM_START_CONTINUE
-    case ('HBM_START_RESUME')
-        value = HBM_START_RESUME
-    case ('HBM_START_SOLVE_ONLY')
-        value = HBM_START_SOLVE_ONLY
+    case ('RUN_CONDENSED')
+        value = RUN_CONDENSED
+    case ('RUN_BANDED')
+        value = RUN_BANDED
+    case ('RUN_FREQUENCY')
+        value = RUN_FREQUENCY
+    case ('RUN_LOAD')
+        value = RUN_LOAD
+    case ('RUN_START_COLD')
+        value = RUN_START_COLD
+    case ('RUN_START_POINT')
+        value = RUN_START_POINT
+    case ('RUN_START_RESUME')
+        value = RUN_START_RESUME
+    case ('RUN_GOING')
+        value = RUN_GOING
+    case ('RUN_DONE')
+        value = RUN_DONE
+    case ('RUN_MAX_POINTS')
+        value = RUN_MAX_POINTS
+    case ('RUN_LEFT_RANGE')
+        value = RUN_LEFT_RANGE
+    case ('RUN_FAILED')
+        value = RUN_FAILED
+    case ('RUN_SOLVE_FIXED')
+        value = RUN_SOLVE_FIXED
+    case ('RUN_SOLVE_STEP')
+        value = RUN_SOLVE_STEP
+    case ('ADVISE_TOL_STALL')
+        value = ADVISE_TOL_STALL
+    case ('ADVISE_MAX_ITER')
+        value = ADVISE_MAX_ITER
+    case ('ADVISE_DS_MIN')
+        value = ADVISE_DS_MIN
+    case ('ADVISE_SAMPLES')
+        value = ADVISE_SAMPLES
+    case ('COORD_AUTO')
+        value = COORD_AUTO
+    case ('COORD_DOFS')
+        value = COORD_DOFS
+    case ('COORD_CONTACT')
+        value = COORD_CONTACT
+    case ('N_ISET')
+        value = N_ISET
+    case ('N_RSET')
+        value = N_RSET
     case ('HILL_DENSE_MAX')
         value = HILL_DENSE_MAX
     case ('T_AFT')

@@ -1,61 +1,38 @@
-!> A whole forced-response solve from plain arrays, for legacy Fortran programs (this
-!> module, `use frirom_solve`) and for C (frirom_capi's frirom_frf, declared in frirom.h).
+!> The whole forced response from plain arrays, for legacy Fortran programs (this module,
+!> `use frirom_solve`) and for C (frirom_capi, declared in frirom.h): frf_open opens a run
+!> of frirom_run (the one continuation driver) on a model given as coordinate triplets,
+!> and frf_solve is a convenience loop over that run (open, start, advance until it
+!> stops, close) that collects its points.
 !>
 !> In: the model's K, M (and C) as coordinate triplets, linear damping (a matrix, Rayleigh
 !> alpha M + beta K, modal ratios of the lowest modes, or their sum), contact groups (law,
 !> elements, directions; the rows of G as triplets; parameters), the harmonic excitation,
-!> the solver settings (frf_settings) and a frequency range. Out (frf_result): the
-!> frequencies, the output DoFs' harmonics and peak amplitudes, the unknowns, the contact
-!> states per point, whether the range was covered, a status code and its message.
-!>
-!> The continuation follows frirom.solver.frf step for step: a first solve at the start
-!> frequency with a purely relative update test, arc length scaled by the largest solution
-!> so far (rescaled after every point, in hbm_run), the run complete only when it reaches
-!> the end frequency. Receptances are factorised per harmonic (Python's receptances =
-!> 'factorization'); condensed unknowns are the contact coordinates G x when they are
-!> fewer than the contact DoFs (Python's coordinates = 'auto').
+!> the solver settings (frf_settings, frirom_run's run_settings) and a frequency range.
+!> Out (frf_result): the frequencies, the output DoFs' harmonics and peak amplitudes, the
+!> unknowns, the contact states per point, whether the range was covered, a status code
+!> and its message. Condensed unknowns are the contact coordinates G x when they are
+!> fewer than the contact DoFs (Python's coordinates = 'auto'); receptances are factorised
+!> per harmonic (banded LU, or MUMPS with sparse), or by modes after frirom_run's
+!> run_set_modes on an opened run.
 module frirom_solve
-    use, intrinsic :: iso_c_binding, only: c_int, c_double
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, FRIROM_ERR_LAPACK, &
                              FRIROM_ERR_ALLOC, set_status
     use frirom_lapack, only: dsygv
     use frirom_banded, only: rcm_order
-    use frirom_newton, only: cont_options, cont_options_from, YSCALE_RELATIVE, N_RCONT, &
-                             N_ICONT, RCONT_TOL_R, RCONT_TOL_X, RCONT_TOL_STALL, RCONT_YSCALE, &
-                             RCONT_LSCALE, RCONT_DS, RCONT_DS_MIN, RCONT_DS_MAX, &
-                             RCONT_LAM_END, RCONT_LAM_LO, ICONT_MAX_ITER, ICONT_REUSE_JAC
-    use frirom_hbm, only: hbm_system, hbm_condensed, hbm_full, hbm_setup, hbm_run, &
-                          HBM_FREQUENCY, HBM_START_CONTINUE, HBM_START_RESUME, &
-                          HBM_START_SOLVE_ONLY
+    use frirom_run, only: run_t, run_points, frf_settings => run_settings, run_open, &
+                          run_start, run_advance, run_close, run_default_samples, &
+                          RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_START_COLD, RUN_GOING, &
+                          RUN_DONE, RUN_FAILED, run_contact_coords, COORD_AUTO
     implicit none
     private
-    public :: frf_settings, frf_result, frf_solve, frf_default_samples, peak_amplitude
+    public :: frf_settings, frf_result, frf_open, frf_solve, frf_default_samples, &
+              peak_amplitude
     public :: FRF_CONDENSED, FRF_BANDED
 
     !> frf_settings%formulation: unknowns are the contact DoFs' harmonics (Eq. 5-9) or
     !> all DoFs' harmonics (banded LU in RCM order).
-    integer(ip), parameter :: FRF_CONDENSED = 1, FRF_BANDED = 2
-
-    !> Solver settings (struct frirom_settings in frirom.h); the defaults are those of
-    !> frirom.solver.SolverOptions. Steps are dimensionless (unknowns / |first point|,
-    !> frequency / range).
-    type, bind(c) :: frf_settings
-        integer(c_int) :: harmonics = 3        !! H: harmonics 0..H
-        integer(c_int) :: samples = 0          !! AFT samples per period; 0: the default
-        integer(c_int) :: formulation = FRF_CONDENSED
-        integer(c_int) :: max_points = 2000    !! points of the curve at most
-        integer(c_int) :: max_iter = 25        !! Newton iterations per corrector
-        integer(c_int) :: batch = 10           !! points per hbm_run call
-        integer(c_int) :: reuse_jacobian = 1   !! 1: keep a factorisation while it contracts
-        integer(c_int) :: history = 1          !! 1: carry the contact sliders along the curve
-        real(c_double) :: tol_residual = 1.0e-8_c_double
-        real(c_double) :: tol_update = 1.0e-8_c_double
-        real(c_double) :: tol_stall = 0.0_c_double
-        real(c_double) :: ds = 0.02_c_double   !! first arc-length step
-        real(c_double) :: ds_min = 1.0e-6_c_double
-        real(c_double) :: ds_max = 0.1_c_double
-    end type frf_settings
+    integer(ip), parameter :: FRF_CONDENSED = RUN_CONDENSED, FRF_BANDED = RUN_BANDED
 
     !> The forced response: npts points, in the order of the continuation.
     type :: frf_result
@@ -74,15 +51,11 @@ module frirom_solve
 
 contains
 
-    !> AFT samples per period by default for H harmonics (also frirom.harmonics.default_samples):
-    !> 512, or 16 per period of harmonic H rounded up to a power of two when more.
+    !> AFT samples per period by default for H harmonics (frirom_run run_default_samples).
     pure function frf_default_samples(nh) result(ns)
         integer(ip), intent(in) :: nh
         integer(ip) :: ns
-        ns = 512
-        do while (ns < 16*(2*nh + 1))
-            ns = 2*ns
-        end do
+        ns = run_default_samples(nh)
     end function frf_default_samples
 
     !> max over one period of |x(t)|, x(t) = a0 + sum_h a_h cos(h t) + b_h sin(h t): the
@@ -269,18 +242,20 @@ contains
         end subroutine dense
     end subroutine modal_c
 
-    !> Forced response from omega_start to omega_end (rad/s, either direction) by
-    !> pseudo-arc-length continuation through turning points. Indices are 1-based. The
+    !> Open a run (frirom_run) on a model given as triplets. Indices are 1-based. The
     !> matrices list every entry (both triangles of a symmetric matrix; duplicates add).
     !> Damping: the matrix C (cr, cc, cv; may be empty) plus alpha M + beta K plus modal
     !> ratios zeta of the lowest size(zeta) modes. Contact group g (ginfo(:, g) = law code
     !> (frirom_aft LAW_*), elements, directions) owns the next ne*ndir rows of G, element by
     !> element; G(row, col) = gv from the triplets (gr, gc, gv) over all groups; params the
     !> groups' (npar, ne) parameters concatenated; w0 their initial sliders (default zero).
-    !> A failure to start, or bad input, is res%info /= 0 with no point; a run that stops
-    !> later keeps its points, with res%complete false and res%message saying why.
-    subroutine frf_solve(n, kr, kc, kv, mr, mc, mv, cr, cc, cv, alpha, beta, zeta, ginfo, &
-                         gr, gc, gv, params, fe, omega_start, omega_end, outdofs, s, res, w0)
+    !> fe (n, 2H+1) the excitation; outdofs the DoFs whose response is kept; sparse:
+    !> condensed receptances by sparse LU (MUMPS); krylov: GMRES solves preconditioned by an
+    !> older LU. Then run_start, run_advance, ... on run; run_close frees it.
+    subroutine frf_open(run, n, kr, kc, kv, mr, mc, mv, cr, cc, cv, alpha, beta, zeta, &
+                        ginfo, gr, gc, gv, params, fe, outdofs, s, info, msg, w0, sparse, &
+                        krylov)
+        type(run_t), intent(inout) :: run
         integer(ip), intent(in) :: n                   !! DoFs
         integer(ip), intent(in) :: kr(:), kc(:)        !! K entries' rows and columns
         real(wp), intent(in) :: kv(:)                  !! K values, N/m
@@ -295,34 +270,24 @@ contains
         real(wp), intent(in) :: gv(:)
         real(wp), intent(in) :: params(:)              !! contact parameters (law units)
         real(wp), intent(in) :: fe(:, :)               !! (n, 2H+1) excitation harmonics, N
-        real(wp), intent(in) :: omega_start, omega_end !! rad/s
         integer(ip), intent(in) :: outdofs(:)          !! DoFs whose response is kept
         type(frf_settings), intent(in) :: s
-        type(frf_result), intent(out) :: res
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: msg
         real(wp), intent(in), optional :: w0(:)        !! initial sliders, groups concatenated
-        class(hbm_system), allocatable :: sys
+        logical, intent(in), optional :: sparse
+        logical, intent(in), optional :: krylov
         integer(ip), allocatable :: kp(:), ki(:), mp(:), mi(:), cp(:), ci(:), gp(:), gi(:), &
                                     perm(:), nl(:)
         real(wp), allocatable :: kx(:), mx(:), cx(:), gx(:), cd(:, :), wsl(:)
-        real(wp), allocatable :: y0(:), t0(:), ys(:, :), lams(:), tans(:, :), xo(:, :, :), &
-                                 st(:, :, :), tan_last(:), yscs(:)
-        integer(ip), allocatable :: itb(:)
-        integer(ip) :: nh, nc, nrows, ne, info, i, j, k, nout, cap, maxpts, np, k0, start
-        real(wp) :: lscale, lam_lo, yscale, lam0, ds, ysc_last, rv(N_RCONT)
-        integer(ip) :: iv(N_ICONT)
-        logical :: fin, pending, tcontact
-        character(len=512) :: msg
-        type(cont_options) :: opts
-
-        msg = ''
+        integer(ip) :: nh, nc, nrows, i, nout
+        logical :: tcontact, sp
+        info = FRIROM_OK
         nh = s%harmonics
         nc = 2*nh + 1
         nout = size(outdofs)
         call check_input(info, msg)
-        if (info /= 0) then
-            call fail(info, msg)
-            return
-        end if
+        if (info /= 0) return
         ! K, M, C as CSR (C: matrix + Rayleigh + modal)
         call coo_csr(n, n, kr, kc, kv, 'K', kp, ki, kx, info, msg)
         if (info == 0) call coo_csr(n, n, mr, mc, mv, 'M', mp, mi, mx, info, msg)
@@ -342,15 +307,8 @@ contains
         end if
         nrows = sum(ginfo(2, :)*ginfo(3, :))
         if (info == 0) call coo_csr(nrows, n, gr, gc, gv, 'G', gp, gi, gx, info, msg)
-        if (info /= 0) then
-            call fail(info, msg)
-            return
-        end if
-        call rcm_pattern(info, msg)
-        if (info /= 0) then
-            call fail(info, msg)
-            return
-        end if
+        if (info == 0) call rcm_pattern(info, msg)
+        if (info /= 0) return
         ! the contact DoFs: G's columns, sorted
         block
             logical :: used(n)
@@ -358,95 +316,20 @@ contains
             if (gp(nrows + 1) > 1) used(gi(1:gp(nrows + 1) - 1)) = .true.
             nl = pack([(i, i=1, n)], used)
         end block
-        tcontact = s%formulation == FRF_CONDENSED .and. nrows < size(nl)
-        if (s%formulation == FRF_CONDENSED) then
-            allocate (hbm_condensed :: sys)
-        else
-            allocate (hbm_full :: sys)
-        end if
-        ne = sum(ginfo(2, :))
+        if (size(nl) == 0) nl = [1_ip]
+        tcontact = s%formulation == FRF_CONDENSED .and. &
+                   run_contact_coords(COORD_AUTO, nrows, size(nl, kind=ip), s%stability /= 0, &
+                                      .false.)
         allocate (wsl(max(size(params), 1)))    ! sliders: at most one per parameter
         wsl = 0.0_wp
         if (present(w0)) wsl(1:min(size(w0), size(wsl))) = w0(1:min(size(w0), size(wsl)))
-        call hbm_setup(sys, nh, merge(s%samples, frf_default_samples(nh), s%samples > 0), n, &
-                       kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe, 0.0_wp*fe, &
-                       HBM_FREQUENCY, 0.0_wp, ginfo, gp, gi, gx, params, wsl, outdofs, info, &
-                       msg, contact_coords=tcontact, krylov=0_ip, sparse_lu=.false.)
-        if (info /= 0) then
-            call fail(info, msg)
-            return
-        end if
-        res%ny = sys%n
-        cap = 0                 ! the result arrays grow as points come (keep)
-        allocate (res%omega(0), res%xo(nout, nc, 0), res%amp(nout, 0), res%y(sys%n, 0), &
-                  res%states(3, max(ne, 1), 0), res%iters(0))
-        lscale = abs(omega_end - omega_start)
-        if (lscale == 0.0_wp) lscale = 1.0_wp
-        lam_lo = omega_start - 0.02_wp*(omega_end - omega_start)
-        ! the first point, at fixed frequency with a purely relative update test
-        allocate (y0(sys%n), t0(sys%n + 1), tan_last(sys%n + 1))
-        y0 = 0.0_wp
-        t0 = 0.0_wp
-        lam0 = omega_start
-        ds = s%ds
-        call run_call(HBM_START_SOLVE_ONLY, YSCALE_RELATIVE, 1_ip)
-        if (info /= 0) then
-            call fail(info, msg)
-            return
-        end if
-        call keep(1_ip)
-        if (info /= 0) then
-            call fail(info, msg)
-            return
-        end if
-        y0 = ys(:, 1)
-        yscale = norm2(y0)
-        if (yscale == 0.0_wp) yscale = 1.0_wp
-        pending = .true.
-        start = HBM_START_CONTINUE
-        res%complete = .false.
-        fin = .false.
-        do while (res%npts < s%max_points)
-            maxpts = min(s%batch, s%max_points - res%npts) + merge(1, 0, pending)
-            call run_call(start, yscale, maxpts)
-            k0 = 1
-            if (pending .and. np > 0) k0 = 2     ! the first point again: its tangent only
-            if (pending .and. np > 0) tan_last = tans(:, 1)
-            if (pending .and. np > 0) ysc_last = yscs(1)
-            pending = .false.
-            do k = k0, np
-                call keep(k)
-            end do
-            if (info /= 0) then
-                res%info = info
-                res%message = msg
-                exit
-            end if
-            ! continue from the last point, in the arc-length scale of its tangent
-            j = res%npts
-            y0 = res%y(:, j)
-            lam0 = res%omega(j)
-            t0 = tan_last
-            yscale = ysc_last
-            start = HBM_START_RESUME
-            if (fin) then
-                res%complete = .true.
-                exit
-            end if
-        end do
-        if (info == 0 .and. .not. fin) write (res%message, '(a,i0,a)') &
-            'stopped after max_points = ', s%max_points, ' points'
-        if (res%complete .and. res%omega(res%npts) /= omega_end) then
-            res%complete = .false.
-            write (res%message, '(a,es14.7,a)') 'the solution curve turned back and left '// &
-                'the range through omega = ', res%omega(res%npts), ' rad/s'
-        end if
-        res%omega = res%omega(1:res%npts)
-        res%xo = res%xo(:, :, 1:res%npts)
-        res%amp = res%amp(:, 1:res%npts)
-        res%y = res%y(:, 1:res%npts)
-        res%states = res%states(:, :, 1:res%npts)
-        res%iters = res%iters(1:res%npts)
+        sp = .false.
+        if (present(sparse)) sp = sparse
+        i = 0
+        if (present(krylov)) i = merge(1_ip, 0_ip, krylov)
+        call run_open(run, s, int(s%formulation, ip), RUN_FREQUENCY, int(s%samples, ip), n, &
+                      kp, ki, kx, mp, mi, mx, cp, ci, cx, perm, nl, fe, 0.0_wp*fe, 0.0_wp, &
+                      ginfo, gp, gi, gx, params, wsl, outdofs, tcontact, i, sp, info, msg)
 
     contains
 
@@ -455,53 +338,28 @@ contains
             character(len=*), intent(inout) :: m
             st = FRIROM_OK
             if (n < 1 .or. nh < 0 .or. nh > 200) then
-                call set_status(st, FRIROM_ERR_PARAM, m, 'frf_solve: need n >= 1 and '// &
-                                'settings%harmonics in 0..200')
+                call set_status(st, FRIROM_ERR_PARAM, m, 'frf: n: expected >= 1 DoF, '// &
+                                'settings.harmonics in 0..200')
             else if (size(fe, 1) /= n .or. size(fe, 2) /= nc) then
-                call set_status(st, FRIROM_ERR_SIZE, m, 'frf_solve: fe must be (n, 2H+1)')
+                call set_status(st, FRIROM_ERR_SIZE, m, 'frf: fe: expected (n, 2H+1)')
             else if (size(ginfo, 1) /= 3) then
-                call set_status(st, FRIROM_ERR_SIZE, m, 'frf_solve: ginfo must be (3, ngroup)')
+                call set_status(st, FRIROM_ERR_SIZE, m, 'frf: ginfo: expected (3, ngroup)')
             else if (any(ginfo(2:3, :) < 1)) then
-                call set_status(st, FRIROM_ERR_PARAM, m, 'frf_solve: ginfo: every group needs '// &
+                call set_status(st, FRIROM_ERR_PARAM, m, 'frf: ginfo: every group needs '// &
                                 '>= 1 element and direction')
             else if (nout < 1 .or. any(outdofs < 1) .or. any(outdofs > n)) then
-                call set_status(st, FRIROM_ERR_PARAM, m, 'frf_solve: outdofs must name '// &
-                                'DoFs 1..n (at least one)')
-            else if (s%formulation /= FRF_CONDENSED .and. s%formulation /= FRF_BANDED) then
-                call set_status(st, FRIROM_ERR_PARAM, m, 'frf_solve: settings%formulation '// &
-                                'must be FRF_CONDENSED (1) or FRF_BANDED (2)')
-            else if (s%max_points < 1 .or. s%max_iter < 1 .or. s%batch < 1 .or. &
-                     (s%samples /= 0 .and. s%samples < nc)) then
-                call set_status(st, FRIROM_ERR_PARAM, m, 'frf_solve: settings max_points, '// &
-                                'max_iter, batch must be >= 1 and samples 0 or >= 2H+1')
-            else if (.not. (s%tol_residual > 0 .and. s%tol_update > 0 .and. s%ds > 0 .and. &
-                            s%ds_min > 0 .and. s%ds_min <= s%ds_max .and. &
-                            s%tol_stall >= 0)) then
-                call set_status(st, FRIROM_ERR_PARAM, m, 'frf_solve: settings tol_residual, '// &
-                                'tol_update, ds, ds_min must be > 0, ds_min <= ds_max')
+                call set_status(st, FRIROM_ERR_PARAM, m, 'frf: outdofs: expected DoFs '// &
+                                '1..n (at least one)')
             else if (.not. (alpha >= 0 .and. beta >= 0 .and. all(zeta >= 0) .and. &
-                            all(zeta < 1) .and. size(zeta) <= n)) then
-                call set_status(st, FRIROM_ERR_PARAM, m, 'frf_solve: damping alpha, beta '// &
-                                'must be >= 0 and zeta at most n ratios in [0, 1)')
-            else if (.not. (abs(omega_start) <= huge(1.0_wp) .and. &
-                            abs(omega_end) <= huge(1.0_wp) .and. all(abs(fe) <= huge(1.0_wp)))) &
-                then
-                call set_status(st, FRIROM_ERR_PARAM, m, 'frf_solve: omega or fe is NaN or Inf')
+                            all(zeta < 1) .and. size(zeta) <= n .and. &
+                            alpha <= huge(1.0_wp) .and. beta <= huge(1.0_wp))) then
+                call set_status(st, FRIROM_ERR_PARAM, m, 'frf: damping: alpha, beta '// &
+                                'finite and >= 0, zeta at most n ratios in [0, 1) expected')
             else if (s%formulation == FRF_CONDENSED .and. size(gr) == 0) then
-                call set_status(st, FRIROM_ERR_PARAM, m, "frf_solve: the condensed "// &
+                call set_status(st, FRIROM_ERR_PARAM, m, "frf: the condensed "// &
                                 "formulation needs contacts (use FRF_BANDED)")
             end if
         end subroutine check_input
-
-        subroutine fail(st, m)
-            integer(ip), intent(in) :: st
-            character(len=*), intent(in) :: m
-            res%info = st
-            res%message = m
-            res%npts = 0
-            allocate (res%omega(0), res%xo(nout, nc, 0), res%amp(nout, 0), res%y(res%ny, 0), &
-                      res%states(3, 0, 0), res%iters(0))
-        end subroutine fail
 
         !> Rows, columns and f times the values of a CSR matrix's entries (none if f = 0).
         pure function rows_of(p, f) result(r)
@@ -563,58 +421,84 @@ contains
             allocate (perm(n))
             call rcm_order(ap, ai, perm, st, m)
         end subroutine rcm_pattern
-        !> One hbm_run call of at most mx points from (y0, lam0, t0) with step ds.
-        subroutine run_call(mode, ysc, mx)
-            integer(ip), intent(in) :: mode, mx
-            real(wp), intent(in) :: ysc
-            real(wp) :: y(sys%n), t(sys%n + 1), lam, dsl
-            rv(RCONT_TOL_R) = s%tol_residual
-            rv(RCONT_TOL_X) = s%tol_update
-            rv(RCONT_TOL_STALL) = s%tol_stall
-            rv(RCONT_YSCALE) = ysc
-            rv(RCONT_LSCALE) = lscale
-            rv(RCONT_DS) = ds
-            rv(RCONT_DS_MIN) = s%ds_min
-            rv(RCONT_DS_MAX) = s%ds_max
-            rv(RCONT_LAM_END) = omega_end
-            rv(RCONT_LAM_LO) = lam_lo
-            iv(ICONT_MAX_ITER) = s%max_iter
-            iv(ICONT_REUSE_JAC) = s%reuse_jacobian
-            opts = cont_options_from(rv, iv)
-            opts%max_points = mx
-            if (allocated(ys)) deallocate (ys, lams, tans, itb, xo, st, yscs)
-            allocate (ys(sys%n, mx), lams(mx), tans(sys%n + 1, mx), itb(mx), &
-                      xo(nout, nc, mx), st(3, max(ne, 1), mx), yscs(mx))
-            sys%carry = s%history /= 0
-            y = y0
-            t = t0
-            lam = lam0
-            dsl = ds
-            call hbm_run(sys, mode, y, lam, t, dsl, lam_lo, opts, ys, lams, tans, itb, xo, st, &
-                         np, fin, info, msg, yscales=yscs)
-            ds = dsl
-        end subroutine run_call
+    end subroutine frf_open
 
-        !> Keep point k of the last call (info = FRIROM_ERR_ALLOC if there is no room).
+    !> Forced response from omega_start to omega_end (rad/s, either direction) by
+    !> pseudo-arc-length continuation through turning points: frf_open, then the run's
+    !> points settings%batch at a time until it stops. Arguments as frf_open's. A failure
+    !> to start, or bad input, is res%info /= 0 with no point; a run that stops later
+    !> keeps its points, with res%complete false and res%message saying why.
+    subroutine frf_solve(n, kr, kc, kv, mr, mc, mv, cr, cc, cv, alpha, beta, zeta, ginfo, &
+                         gr, gc, gv, params, fe, omega_start, omega_end, outdofs, s, res, w0)
+        integer(ip), intent(in) :: n, kr(:), kc(:), mr(:), mc(:), cr(:), cc(:)
+        real(wp), intent(in) :: kv(:), mv(:), cv(:), alpha, beta, zeta(:)
+        integer(ip), intent(in) :: ginfo(:, :), gr(:), gc(:)
+        real(wp), intent(in) :: gv(:), params(:), fe(:, :)
+        real(wp), intent(in) :: omega_start, omega_end !! rad/s
+        integer(ip), intent(in) :: outdofs(:)
+        type(frf_settings), intent(in) :: s
+        type(frf_result), intent(out) :: res
+        real(wp), intent(in), optional :: w0(:)
+        type(run_t) :: run
+        type(run_points) :: pts
+        integer(ip) :: info, nout, nc, k, cap
+        character(len=512) :: msg
+        msg = ''
+        nout = size(outdofs)
+        nc = 2*s%harmonics + 1
+        allocate (res%omega(0), res%xo(nout, max(nc, 1), 0), res%amp(nout, 0), &
+                  res%y(0, 0), res%states(3, 0, 0), res%iters(0))
+        call frf_open(run, n, kr, kc, kv, mr, mc, mv, cr, cc, cv, alpha, beta, zeta, ginfo, &
+                      gr, gc, gv, params, fe, outdofs, s, info, msg, w0)
+        if (info == 0) then
+            res%ny = run%ny
+            deallocate (res%y, res%states)
+            allocate (res%y(run%ny, 0), res%states(3, max(run%netot, 1), 0))
+            call run_start(run, RUN_START_COLD, omega_start, omega_end, info, msg)
+        end if
+        cap = 0
+        do while (info == 0 .and. run%status == RUN_GOING)
+            call run_advance(run, int(s%batch, ip), pts, info, msg)
+            do k = 1, pts%npts
+                call keep(k)
+            end do
+        end do
+        res%info = info
+        res%message = msg
+        if (info == 0) then
+            res%complete = run%status == RUN_DONE
+            res%message = run%message
+            if (run%status == RUN_FAILED) res%info = run%fail_info
+        end if
+        call run_close(run)
+        res%omega = res%omega(1:res%npts)
+        res%xo = res%xo(:, :, 1:res%npts)
+        res%amp = res%amp(:, 1:res%npts)
+        res%y = res%y(:, 1:res%npts)
+        res%states = res%states(:, :, 1:res%npts)
+        res%iters = res%iters(1:res%npts)
+
+    contains
+
+        !> Keep point kk of the last advance (info = FRIROM_ERR_ALLOC if there is no room).
         subroutine keep(kk)
             integer(ip), intent(in) :: kk
-            integer(ip) :: o
+            integer(ip) :: o, j
             if (res%npts == cap) then
                 if (.not. grown(min(max(2*cap, 16_ip), int(s%max_points, ip)))) return
             end if
             res%npts = res%npts + 1
             j = res%npts
-            res%omega(j) = lams(kk)
-            res%xo(:, :, j) = xo(:, :, kk)
+            res%omega(j) = pts%lam(kk)
+            res%xo(:, :, j) = pts%xo(:, :, kk)
             do o = 1, nout
-                res%amp(o, j) = peak_amplitude(xo(o, :, kk))
+                res%amp(o, j) = peak_amplitude(pts%xo(o, :, kk))
             end do
-            res%y(:, j) = ys(:, kk)
-            res%states(:, :, j) = st(:, :, kk)
-            res%iters(j) = itb(kk)
-            tan_last = tans(:, kk)
-            ysc_last = yscs(kk)
+            res%y(:, j) = pts%y(:, kk)
+            res%states(:, :, j) = pts%states(:, :, kk)
+            res%iters(j) = pts%iters(kk)
         end subroutine keep
+
         !> Room for nn points in the result arrays (the npts kept are copied); false, with
         !> info = FRIROM_ERR_ALLOC and the message, when memory runs out.
         logical function grown(nn)

@@ -281,19 +281,19 @@ def test_ill_conditioned_j_falls_back_to_a_double_lu():
         assert np.abs(p.X - ref.X).max() / np.abs(ref.X).max() < 1e-7, kw
 
 
-def test_held_lu_carried_from_call_to_call():
-    """The LU a large system holds is carried from one hbm_continue call to the next of
-    the same run (the FRF's batches and its peak solves: each call builds a new system).
-    A call given that LU solves its first Jacobians by GMRES preconditioned by it, and
-    factorises none while the LU stays worth its iterations. The LU only preconditions:
-    the answer is that of a fresh system (its own LU) to TOL, and of the dense path
-    (unknowns on the contact DoFs, receptances by banded LU) to TOL; a useless carried LU
-    (the identity) or one of the wrong size costs a factorisation, never the answer.
-    Tolerance as above: Newton converges to 1e-10 of the residual, GMRES solves to 1e-8."""
+def test_held_lu_carried_from_solve_to_solve():
+    """The LU a large system holds stays in the Fortran run from one corrector solve to
+    the next (run_solve: the FRF's peak solves, solve_point's): a solve after the first
+    solves its Jacobians by GMRES preconditioned by that LU and factorises none while the
+    LU stays worth its iterations; a continuation segment (run_advance) forgets it, as a
+    restored run starts without one. The LU only preconditions: the answer is that of a
+    fresh run (its own LU) to TOL, and of the dense path (unknowns on the contact DoFs,
+    receptances by banded LU) to TOL. Tolerance as above: Newton converges to 1e-10 of
+    the residual, GMRES solves to 1e-8."""
     import sys
     from pathlib import Path
-    from frirom import _kernels
-    from frirom._pack import START_SOLVE_ONLY, YSCALE_RELATIVE, add_timings, pack
+    from frirom import _kernels, _run
+    from frirom._pack import add_timings, pack
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "bench"))
     from condensed import reduced_model
     model, ex = reduced_model(n=600, nc=80, seed=3)   # 160 coordinates: 1 120 unknowns
@@ -301,39 +301,31 @@ def test_held_lu_carried_from_call_to_call():
     o = SolverOptions(harmonics=3, samples=64, tol_residual=1e-10, tol_update=1e-10)
     assert _kernels.hbm_lu_holds(3, 160, 600) == 1 and _kernels.hbm_lu_holds(3, 10, 30) == 0
     p = pack(model, ex, o, out)
+    run = p.run
 
-    def call(w, y0):
-        r = p.call(y0, w, np.zeros(p.ny + 1), START_SOLVE_ONLY, 0.1, w, 0.0,
-                   YSCALE_RELATIVE, 1.0, 1)
+    def solve(w, y0, sliders):
+        r = run.solve(_run.SOLVE_FIXED, w, y0, sliders=sliders)
         assert r.info == 0 and r.npts == 1, r.msg
         t = {}
         add_timings(t, r.timings)
-        return r.ys[:, 0], r.xo[:, :, 0], dict(fact=t["factorizations"],
-                                               its=t["krylov_iterations"])
+        return r.ys[:, 0], r.xo[:, :, 0], r.sliders[:p.nw, 0], dict(
+            fact=t["factorizations"], its=t["krylov_iterations"])
 
-    w1, w2, w3 = 2 * np.pi * np.array([519.0, 519.1, 519.5])
-    y1, _, t1 = call(w1, np.zeros(p.ny))
-    # state 2: the LU held is single precision (only a GMRES preconditioner)
-    assert t1["fact"] >= 1 and p.lu_hold[2][0] == 2.0 and p.lu_hold[0].shape == (1120, 1120)
-    w0 = p.w0.copy()
-    y2, x2, t2 = call(w2, y1)                 # the LU of w1 carried: no new LU
+    w1, w2 = 2 * np.pi * np.array([519.0, 519.1])
+    y1, _, s1, t1 = solve(w1, np.zeros(p.ny), None)
+    assert t1["fact"] >= 1
+    y2, x2, _, t2 = solve(w2, y1, s1)             # the LU of w1 kept: no new LU
     assert t2["fact"] == 0 and t2["its"] > 0
     for kw in ({}, dict(coordinates="dofs", receptances="factorization")):
-        start = {"slider": w0} if kw else {"slider": w0, "unknowns": y1}
+        start = {"slider": s1} if kw else {"slider": s1, "unknowns": y1}
         ref = solve_point(model, ex, w2, dataclasses.replace(o, **kw), outputs=out,
                           start=start)
         assert np.abs(x2 - ref.X).max() / np.abs(ref.X).max() < TOL
-    # a useless carried LU: GMRES gives up, J is factorised, the answer is the same
-    lu, piv, st = p.lu_hold
-    lu[:] = np.eye(p.ny)
-    piv[:] = np.arange(1, p.ny + 1)
-    st[1] = 0.0
-    w0 = p.w0.copy()
-    _, x3, t3 = call(w3, y2)
-    ref = solve_point(model, ex, w3, o, outputs=out, start={"slider": w0, "unknowns": y2})
-    assert t3["fact"] >= 1
-    assert np.abs(x3 - ref.X).max() / np.abs(ref.X).max() < TOL
-    # a carried LU of another size is ignored
-    p.lu_hold[:] = [np.eye(3, order="F"), np.arange(1, 4, dtype=np.int32), np.array([1.0, 0])]
-    _, x4, t4 = call(w3, y2)
-    assert t4["fact"] >= 1 and np.abs(x4 - x3).max() / np.abs(x3).max() < TOL
+    # a continuation segment starts without the held LU (exact resume)
+    run.start(_run.START_RESUME, w1, w2 * 1.001, lam0=w1, y0=y1,
+              tan0=np.r_[np.zeros(p.ny), 1.0], yscale=float(np.linalg.norm(y1)),
+              sliders=s1)
+    seg = run.advance(1)
+    t3 = {}
+    add_timings(t3, seg.timings)
+    assert seg.npts == 1 and t3["factorizations"] >= 1

@@ -1,9 +1,10 @@
 """Where one ROM_II FRF of the paper cases spends its wall time, call by call into Fortran
-(issue 11's speed-up): per kind of hbm_continue call (first solve, continuation batches,
-peak-refinement solves) the count, wall seconds, the Fortran timers (AFT, assembly, LU,
-solves, receptances) and the rest of the Fortran time (per-call set-up plus the
-evaluations' untimed products), and the Python time outside the calls; every part also as
-a fraction of the FRF's wall time measured in the same run (min over --repeat runs).
+(issue 11's speed-up): per kind of call on the Fortran run object (open: the set-up;
+start: the first solve; advance: continuation segments; solve: peak-refinement solves)
+the count, wall seconds, the Fortran timers (AFT, assembly, LU, solves, receptances) and
+the rest of the Fortran time (the evaluations' untimed products), and the Python time
+outside the calls; every part also as a fraction of the FRF's wall time measured in the
+same run (min over --repeat runs).
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python cases/bench/callsplit.py \
         --flange WORK F0 | --hooks WORK F0 [--repeat 3] [--no-pairs]
@@ -33,7 +34,7 @@ sys.path[:0] = [str(ROOT / "cases" / "paper_flange"), str(ROOT / "cases" / "pape
 
 import numpy as np  # noqa: E402
 
-from frirom import _pack  # noqa: E402
+from frirom import _pack, _run  # noqa: E402
 from frirom.solver import frf  # noqa: E402
 
 TIMED = ("aft", "assembly", "factorization", "solve", "receptance")
@@ -75,20 +76,24 @@ def main(argv=None) -> None:
     slots = _pack._TIMER_SLOTS
     # n, wall, fortran, timed, evals, LUs
     stats = collections.defaultdict(lambda: np.zeros(6))
-    call = _pack._Packed.call
+    methods = {k: getattr(_run.Run, k) for k in ("__init__", "start", "advance", "solve")}
+    zero = np.zeros(len(slots))
 
-    def counted(self, y0, lam0, tan0, start_mode, ds, *rest):
-        t0 = time.perf_counter()
-        r = call(self, y0, lam0, tan0, start_mode, ds, *rest)
-        kind = ("first solve" if start_mode == _pack.START_SOLVE_ONLY else
-                "peak solve" if self.opts.ds_max == 1e3 else "continuation")
-        stats[kind] += [1, time.perf_counter() - t0, r.timings[slots["fortran_total"]],
-                        sum(r.timings[slots[k]] for k in TIMED),
-                        r.timings[slots["evaluations"]], r.timings[slots["factorizations"]]]
-        return r
+    def counted(kind, fn):
+        def wrap(self, *a, **kw):
+            t0 = time.perf_counter()
+            r = fn(self, *a, **kw)
+            tm = zero if r is None else (r if isinstance(r, np.ndarray) else r.timings)
+            dt = time.perf_counter() - t0
+            stats[kind] += [1, dt, dt if r is None else tm[slots["fortran_total"]],
+                            sum(tm[slots[k]] for k in TIMED), tm[slots["evaluations"]],
+                            tm[slots["factorizations"]]]
+            return r
+        return wrap
 
     best = None
-    _pack._Packed.call = counted
+    for k, fn in methods.items():
+        setattr(_run.Run, k, counted(k.strip("_").replace("init", "open"), fn))
     try:
         for _ in range(args.repeat):
             stats.clear()
@@ -98,7 +103,8 @@ def main(argv=None) -> None:
             if best is None or wall < best[0]:
                 best = (wall, {k: v.copy() for k, v in stats.items()}, len(r))
     finally:
-        _pack._Packed.call = call
+        for k, fn in methods.items():
+            setattr(_run.Run, k, fn)
     wall, st, npts = best
     print(f"{name} at F0 = {f0:g}: {npts} points, {wall:.3f} s (min of {args.repeat})")
     print(r.solver_info)

@@ -27,8 +27,7 @@ evaluation (and its split), per point and per FRF (wall and this process's CPU s
 BLAS thread, so CPU seconds are the work, less sensitive to the load of a shared machine),
 the generation time, and the growth exponents (least squares, log-log) of the FRF time
 (over every size, and over the whole FRFs alone, wall and CPU) and of the time per
-evaluation, with the machine load (load averages). --no-carry runs the build before the
-LU carried between Fortran calls (same process, for before/after numbers). Generation on this machine (2 cores shared, load ~6-8): 100
+evaluation, with the machine load (load averages). Generation on this machine (2 cores shared, load ~6-8): 100
 pairs 11 s, 200 pairs 28 s, 400 pairs 90 s, 800 pairs 7-13 min (CB of 63 000 + 66 000 FE
 DoFs with 2 550 masters each), so run the 800-pair size once: it is cached. A size whose
 whole FRF would exceed --budget (predicted from the largest whole one by the n^3 law of a
@@ -84,10 +83,6 @@ def _parse(argv=None):
     ap.add_argument("--short", type=int, default=12,
                     help="points of the short run of a scaling size whose FRF exceeds "
                          "--budget")
-    ap.add_argument("--no-carry", action="store_true",
-                    help="the build before: no LU carried from one Fortran call to the next "
-                         "(each peak solve factorises its first Jacobian; a continuation "
-                         "batch always does, so that resume is exact)")
     ap.add_argument("--mem-limit", type=float, default=2.0,
                     help="GB: a route whose estimated matrices exceed it is skipped")
     return ap.parse_args(argv)
@@ -431,11 +426,8 @@ def main(a):
         return flange.FlangeSpec(sectors=sectors, z_per_sector=p // sectors,
                                  n_modes=n_modes, coarse=quick)
 
-    import frirom._pack
-    frirom._pack.CARRY_LU = not a.no_carry
     print(f"large_interface: OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}, "
-          f"H = {H}, {SAMPLES} samples, work folder {a.work}; LU carried between calls: "
-          f"{'no (--no-carry: the build before)' if a.no_carry else 'yes'}; {_load()}")
+          f"H = {H}, {SAMPLES} samples, work folder {a.work}; {_load()}")
     t0 = time.perf_counter()
     roms = flange.flange_roms(spec_for(pairs), a.work)
     s = roms["sizes"]

@@ -1,9 +1,10 @@
-"""The model as the arrays of the Fortran solver (fortran/frirom_f2py.f90 hbm_continue).
+"""The model as the arrays of the Fortran run object (fortran/frirom_run.f90, opened
+through frirom_f2py's frun_open).
 
 :func:`pack` turns a Model or a CyclicModel, an Excitation and SolverOptions into a
-:class:`_Packed`; :meth:`_Packed.call` makes one hbm_continue call from it. Option slots,
-start modes and timer slots are read from Fortran at import (``int_constant``), so no
-number of the boundary is typed here.
+:class:`_Packed`; :meth:`_Packed.run` opens the Fortran run on it once (frirom._run.Run)
+and :meth:`_Packed.points` turns the run's points into FRFPoints. Timer slots are read
+from Fortran at import (``int_constant``), so no number of the boundary is typed here.
 """
 
 from __future__ import annotations
@@ -43,32 +44,6 @@ EIG_EVALS = 500
 DIAG_TOL = 1e-10
 
 
-def _real_constant(name: str) -> float:
-    value, info, msg = _kernels.real_constant(name)
-    if info != 0:
-        raise ImportError(msg.decode(errors="replace").strip())
-    return float(value)
-
-
-#: hbm_continue's start modes: solve at lam0 then continue, resume from a converged point
-#: and its tangent, or solve at lam0 only.
-START_CONTINUE = int_constant("HBM_START_CONTINUE")
-START_RESUME = int_constant("HBM_START_RESUME")
-START_SOLVE_ONLY = int_constant("HBM_START_SOLVE_ONLY")
-#: yscale of a first solve: a purely relative update test (no solution size known yet).
-YSCALE_RELATIVE = _real_constant("YSCALE_RELATIVE")
-
-#: 0-based slots of the real (RCONT_*) and integer (ICONT_*) option arrays, by the
-#: frirom_newton cont_options field they fill (lam_lo: cont_run's lower bound).
-_RCONT = {f: int_constant("RCONT_" + f.upper()) - 1 for f in (
-    "tol_r", "tol_x", "tol_stall", "yscale", "lscale", "ds", "ds_min", "ds_max", "lam_end",
-    "lam_lo")}
-_ICONT = {f: int_constant("ICONT_" + f.upper()) - 1 for f in ("max_iter", "reuse_jac")}
-if (len(_RCONT) != int_constant("N_RCONT") or len(_ICONT) != int_constant("N_ICONT")):
-    raise ImportError("frirom._pack: hbm_continue has option slots this module does not fill")
-_RCONT_AT = np.array(list(_RCONT.values()))     # slots in the order of the keys above
-_ICONT_AT = np.array(list(_ICONT.values()))
-
 #: Timer/counter names of each run (seconds, counts) by their 0-based slot in `timings`.
 _TIMER_SLOTS = {name: int_constant(slot) - 1 for name, slot in (
     ("aft", "T_AFT"), ("assembly", "T_ASM"), ("factorization", "T_FACT"),
@@ -97,7 +72,7 @@ def _csr(a) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 @dataclass
 class _Modes:
-    """Modes for receptances by superposition, as hbm_continue takes them; arrays of the
+    """Modes for receptances by superposition, as the run takes them (frun_set_modes); arrays of the
     kind not used (count 0) keep one column so that f2py gets their shapes.
 
     Attributes
@@ -230,10 +205,6 @@ def _bw_floor(model: Model) -> int:
     return (d + 1) // 2
 
 
-#: carry the held LU from call to call (False: each call factorises its first Jacobian,
-#: the behaviour before; cases/bench/large_interface.py --no-carry measures that)
-CARRY_LU = True
-
 #: 'auto' factorises D_h by sparse LU (MUMPS) instead of a band when the band LU would
 #: take more than this many flops per harmonic (n_dof bw^2, bw the RCM half-bandwidth).
 SPARSE_FLOPS = 5e8
@@ -346,33 +317,15 @@ def _check_outputs(outputs, n: int) -> np.ndarray:
 #: representative's turned in time to this fraction (Frobenius, over every unknown). The
 #: mesh's own symmetry is far finer (coarse flange 2e-15, paper flange 1e-13, matrices
 #: from ccx's text files); a misfit d moves the forces by about d.
+#: Largest misfit of an element's orbit on the travelling wave (SolverOptions.orbits):
+#: |G_e T - Rot(th) G_r T| <= ORBIT_TOL |G_r T| (frirom_hbm hbm_set_orbits).
 ORBIT_TOL = 1e-9
-
-class _CallResult(NamedTuple):
-    """What one hbm_continue call returns (maxpts columns, the first npts filled)."""
-
-    ys: np.ndarray           # (ny, maxpts) unknowns
-    lams: np.ndarray         # (maxpts,) parameter
-    tans: np.ndarray         # (ny + 1, maxpts) unit tangents in scaled variables
-    iters: np.ndarray        # (maxpts,) Newton iterations
-    xo: np.ndarray           # (n_out, 2H+1, maxpts) output harmonics, m
-    states: np.ndarray       # (3, ne_tot, maxpts) stick/slip/open fractions per element
-    hill_re: np.ndarray      # (maxpts,) max real part of the Floquet exponents, 1/s
-    sliders: np.ndarray      # (nw, maxpts) contact history each point leaves
-    yscales: np.ndarray      # (maxpts,) arc-length scale of the unknowns of each tangent
-    npts: int
-    finished: int            # 1: reached lam_end (or a solve-only call)
-    ds_out: float            # arc-length step to continue with
-    timings: np.ndarray      # (N_TIMERS,) seconds and counts, see TIMER_NAMES
-    info: int
-    msg: str
-    leak: np.ndarray         # (maxpts,) travelling-wave selection's leak (FRFPoint.leak)
 
 
 @dataclass
 class _Packed:
-    """The model as the Fortran arrays of hbm_continue (built once per run by
-    :func:`pack`); w0 is the contact history the next call starts from.
+    """The model as the Fortran arrays of the run object (built once per solve by
+    :func:`pack`); w0 is the model's contact history (the run's first sliders).
 
     Rows are the model's DoFs, or for a cyclic sector the DoFs the solver reads (contact
     DoFs of the sector and of the next one, outputs and loaded DoFs). Index arrays for
@@ -392,7 +345,7 @@ class _Packed:
     G: tuple                  # CSR, 1-based, (contact rows, n_dof)
     ginfo: np.ndarray         # (3, n_groups) int32: law code, n_elem, n_dir
     params: np.ndarray        # contact parameters, groups concatenated
-    w0: np.ndarray            # (max(nw, 1),) sliders the next call starts from
+    w0: np.ndarray            # (max(nw, 1),) the model's sliders
     nw: int
     group_names: list
     group_sizes: list
@@ -406,21 +359,18 @@ class _Packed:
     #: (n_out, len(out_f)) physical outputs from the rows read (outputs given as a
     #: matrix): X = out_map @ x[out_f]; None: X = x[out_f]
     out_map: np.ndarray | None = None
-    #: the LU hbm_continue carries from call to call of this run (lu (ny, ny), pivots
-    #: (ny,), state (2,)), when Fortran holds one (hbm_lu_holds): shared by the copies
-    #: of this object (the peak solves), filled at the first call; forget_lu at every
-    #: continuation call boundary (exact resume)
-    lu_hold: list = field(default_factory=list)
     #: (nnl, H+1) bool: the travelling-wave selection over the nonlinear DoFs nl
     #: (SolverOptions.selection), None: every unknown
     keep: np.ndarray | None = None
     #: (nnl, H+1) int32: SolverOptions.pairs over nl (s (position in nl + 1)), None: none
     pair: np.ndarray | None = None
-    #: SolverOptions.orbits as the first call found them: (elements the AFT runs on,
-    #: largest misfit), None before it
+    #: SolverOptions.orbits as the run found them: (elements the AFT runs on, largest
+    #: misfit), None before the run is opened
     orbits: tuple | None = None
-    #: (ne_tot,) int32, hbm_continue's orbmap: written by the first call, read by the others
-    orbit_map: np.ndarray | None = field(default=None, repr=False)
+    #: the frequency of a load continuation, rad/s (0 for frequency)
+    omega_fix: float = 0.0
+    orbit_tol: float = ORBIT_TOL
+    _run: object = field(default=None, repr=False)
 
     @property
     def nc(self) -> int:
@@ -443,92 +393,33 @@ class _Packed:
     def ne_tot(self) -> int:
         return int(sum(self.group_sizes))
 
-    def set_history(self, slider) -> None:
-        """Initial sliders of all contact elements (the history of the point a run starts
-        from; the layout of FRFPoint.slider); None keeps the model's w0."""
+    def checked_slider(self, slider) -> np.ndarray | None:
+        """Sliders of all contact elements to start from (the layout of FRFPoint.slider),
+        checked; None stays None (the run's history)."""
         if slider is None:
-            return
+            return None
         slider = np.asarray(slider, dtype=float).ravel()
         if slider.size != self.nw:
             raise SizeError(f"start.slider: {slider.size} values, the model's contact "
                             f"elements have {self.nw} sliders")
         if not np.all(np.isfinite(slider)):
             raise ParameterError("start.slider: contains NaN or Inf")
-        if self.nw:
-            self.w0 = slider.copy()
+        return slider if self.nw else None
 
-    def call(self, y0, lam0, tan0, start_mode, ds, lam_end, lam_lo, yscale, lscale, maxpts,
-             omega_fix=0.0) -> _CallResult:
-        """One hbm_continue call from the current contact history self.w0; the history
-        the last point leaves becomes self.w0 for the next call."""
-        o, m = self.opts, self.modes
-        ropt = np.empty(len(_RCONT))
-        ropt[_RCONT_AT] = (o.tol_residual, o.tol_update, o.tol_stall, yscale, lscale, ds,
-                           o.ds_min, o.ds_max, lam_end, lam_lo)
-        iopt = np.empty(len(_ICONT), np.int32)
-        iopt[_ICONT_AT] = (o.max_iter, int(o.reuse_jacobian))
-        nl = (self.nl + 1).astype(np.int32) if self.nl.size else np.ones(1, np.int32)
-        lu, piv, lust = self._held_lu()
-        (kp, ki, kx), (mp, mi, mx), (cp, ci, cx), (gp, gi, gx) = self.K, self.M, self.C, self.G
-        res = _kernels.hbm_continue(
-            formulation=o.formulation, lam_kind=o.parameter, nsamp=o.n_samples,
-            kp=kp, ki=ki, kx=kx, mp=mp, mi=mi, mx=mx, cp=cp, ci=ci, cx=cx, perm=self.perm,
-            nl=nl, fe0=np.asfortranarray(self.fe0), fe1=np.asfortranarray(self.fe1),
-            omega_fix=omega_fix, ginfo=self.ginfo, gp=gp, gi=gi, gx=gx, params=self.params,
-            w0=self.w0, outdofs=(self.out_f + 1).astype(np.int32),
-            nmodes=m.nmodes, phi=np.asfortranarray(m.phi), wmodes=m.omega, zmodes=m.zeta,
-            hmodes=m.hmodes, psi=np.asfortranarray(m.psi),
-            wharm=np.asfortranarray(m.omega_h), zharm=np.asfortranarray(m.zeta_h),
-            y0=y0, lam0=lam0, tan0=tan0, start_mode=start_mode, ropt=ropt, iopt=iopt,
-            stability=int(self.stability), history=int(o.history), maxpts=maxpts,
-            netot=max(self.ne_tot, 1), ntim=len(_TIMER_SLOTS), nh=self.H, ndof=self.n_dof,
-            nnl=self.nl.size or 1, tcontact=int(self.tcontact),
-            krylov=int(o.krylov), sparse=int(self.sparse), lu=lu, lupiv=piv, lustate=lust,
-            selected=(0 if self.keep is None else 1 if self.pair is None else
-                      3 if o.orbits else 2), orbtol=ORBIT_TOL, orbmap=self._orbit_map(),
-            keep=np.asfortranarray(np.zeros((max(self.nl.size, 1), self.H + 1), np.int32)
-                                   if self.keep is None else self.keep.astype(np.int32)),
-            pair=np.asfortranarray(np.zeros((max(self.nl.size, 1), self.H + 1), np.int32)
-                                   if self.pair is None else self.pair))
-        *head, msg, leak, orbinfo = res
-        r = _CallResult(*head, msg=msg.decode(errors="replace"), leak=leak)
-        if self.pair is not None and o.orbits and self.orbits is None and r.info == 0:
-            self.orbits = (int(orbinfo[0]), float(orbinfo[1]))
-            self.info += (f"; AFT of Newton's evaluations on {self.orbits[0]} of "
-                          f"{self.ne_tot} contact elements (orbits on the wave, misfit "
-                          f"{self.orbits[1]:.1e})")
-        if r.npts > 0 and self.nw and o.history:
-            self.w0 = r.sliders[:self.nw, r.npts - 1].copy()
-        return r
-
-    def _orbit_map(self) -> np.ndarray:
-        """SolverOptions.orbits' map of this run (each element's representative), which
-        the first call finds and the later calls take back (zeros: find it)."""
-        if self.orbit_map is None:
-            self.orbit_map = np.zeros(max(self.ne_tot, 1), np.int32)
-        return self.orbit_map
-
-    def _held_lu(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The arrays of the LU carried between calls (allocated at the first call), or
-        1 x 1 dummies when Fortran keeps none for this system (small, banded, Krylov mode
-        or factorised receptances)."""
-        if not self.lu_hold:
-            nm = max(self.modes.nmodes, self.modes.hmodes)
-            hold = (CARRY_LU and self.opts.formulation == "condensed" and nm > 0
-                    and not self.opts.krylov and self.keep is None
-                    and _kernels.hbm_lu_holds(self.H, self.nrow, nm))
-            n = self.ny if hold else 1
-            self.lu_hold.extend([np.zeros((n, n), order="F"), np.zeros(n, np.int32),
-                                 np.zeros(2)])
-        return tuple(self.lu_hold)
-
-    def forget_lu(self) -> None:
-        """Make the next call factorise its first Jacobian (the carried LU is marked
-        invalid). The continuation does this at every call boundary, where a resumed run
-        may start, so that a resumed run computes bit for bit the points of the
-        uninterrupted one; the peak solves after the last call keep the carry."""
-        if self.lu_hold:
-            self.lu_hold[2][0] = 0.0
+    @property
+    def run(self):
+        """The Fortran run on this model (frirom._run.Run), opened at first use: the
+        continuation, its first point, the homotopy start and the peak solves all run
+        on it, set up once."""
+        if self._run is None:
+            from ._run import Run
+            self._run = Run(self, self.omega_fix)
+            if self._run.orbits is not None:
+                self.orbits = self._run.orbits
+                self.info += (f"; AFT of Newton's evaluations on {self.orbits[0]} of "
+                              f"{self.ne_tot} contact elements (orbits on the wave, misfit "
+                              f"{self.orbits[1]:.1e})")
+        return self._run
 
     def pad_start(self, y, H_from: int) -> np.ndarray:
         """Unknowns of a solution with H_from harmonics, extended or cut to this H."""
@@ -552,8 +443,10 @@ class _Packed:
             out.reshape(nrow, self.nc)[:, :m] = y.reshape(nrow, nc_from)[:, :m]
         return out
 
-    def points(self, res: _CallResult, omega_fix, t_call) -> list[FRFPoint]:
-        """The converged points of one call; t_call (s) is shared out among them."""
+    def points(self, res, t_call) -> list[FRFPoint]:
+        """The converged points of one run call (frirom._run.Points); t_call (s) is
+        shared out among them."""
+        omega_fix = self.omega_fix
         pts = []
         # every point's maxima in one batch: (n_out, 2H+1, npts) -> (npts, n_out)
         xo = res.xo[:, :, :res.npts]
@@ -579,15 +472,18 @@ class _Packed:
                                 slider=res.sliders[:self.nw, k].copy(),
                                 yscale=_scale_known(res.yscales[k]),
                                 leak=(float(res.leak[k]) if self.keep is not None
-                                      else None)))
+                                      else None),
+                                fold=bool(res.fold[k]),
+                                ds_next=(float(res.ds_next[k]) if res.ds_next[k] > 0
+                                         else float("nan"))))
         return pts
 
 
 def _scale_known(yscale: float) -> float:
     """A point's arc-length scale, 0 where none is known: a solve at fixed parameter (the
-    first point, solve_point) runs with the purely relative YSCALE_RELATIVE, and its
-    tangent is in no scale a continuation could resume in."""
-    return float(yscale) if yscale > YSCALE_RELATIVE else 0.0
+    first point, solve_point) runs with a purely relative update test (yscale 1e-300),
+    and its tangent is in no scale a continuation could resume in."""
+    return float(yscale) if yscale > 1e-290 else 0.0
 
 
 def _split_load(fe: np.ndarray, part: str) -> tuple[np.ndarray, np.ndarray]:
@@ -601,7 +497,7 @@ def _split_load(fe: np.ndarray, part: str) -> tuple[np.ndarray, np.ndarray]:
 
 def pack(model: Model | CyclicModel, excitation: Excitation, opts: SolverOptions, outputs,
          load_part: str = "dynamic") -> _Packed:
-    """Check the inputs and pack them for hbm_continue; outputs: DoF indices (0-based),
+    """Check the inputs and pack them for the Fortran run; outputs: DoF indices (0-based),
     an (n_out, n_dof) matrix (each output a combination of the DoFs: physical DoFs through
     a reduction basis) or None for the default (all DoFs up to 100, else the contact
     DoFs)."""
@@ -708,9 +604,7 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
         _check_hill_memory(n, H, band.bw)
     if opts.formulation == "condensed":
         nrows = c.G.shape[0]
-        tcontact = opts.coordinates == "contact" or (
-            opts.coordinates == "auto" and nrows < nl.size and not opts.stability
-            and opts.selection is None)
+        tcontact = _contact_coords(opts, nrows, nl.size)
         modes, route, sparse = _receptance_route(model, opts, H, band)
         nu = nrows if tcontact else nl.size
         info = (f"condensed: {nu * (2 * H + 1)} unknowns, "
@@ -731,6 +625,16 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
                    group_names=c.names, group_sizes=c.sizes, outputs=out, out_f=out,
                    stability=bool(opts.stability), modes=modes, tcontact=tcontact, sparse=sparse,
                    info=info)
+
+
+def _contact_coords(opts: SolverOptions, nrows: int, nnl: int) -> bool:
+    """Whether the condensed unknowns are the contact coordinates G x (nrows) rather than
+    the contact DoFs (nnl): SolverOptions.coordinates by Fortran's one rule (frirom_run
+    run_contact_coords: 'auto' takes the shorter unless stability or a selection needs
+    the DoFs)."""
+    code = int_constant("COORD_" + opts.coordinates.upper())
+    return bool(_kernels.contact_coords(code, nrows, nnl, int(opts.stability),
+                                        int(opts.selection is not None)))
 
 
 def hill_bytes(n_dof: int, H: int, bw: int) -> int:
@@ -803,8 +707,7 @@ def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Pa
         modes.psi[nb, :r, h] = m.psi[rows[nb] - n] * np.exp(1j * m.k * alpha)
         modes.omega_h[:r, h], modes.zeta_h[:r, h] = m.omega, m.zeta
     empty = _csr(sp.csr_matrix((nr, nr)))
-    tcontact = o.coordinates == "contact" or (o.coordinates == "auto"
-                                              and G.shape[0] < cols.size)
+    tcontact = _contact_coords(o, G.shape[0], cols.size)
     nu = G.shape[0] if tcontact else cols.size
     return _Packed(opts=o, H=H, n_dof=nr, fe0=fe0_r, fe1=fe1_r,
                    K=empty, M=empty, C=empty, perm=np.arange(1, nr + 1, dtype=np.int32),

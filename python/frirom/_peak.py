@@ -12,12 +12,11 @@ corner of a friction curve (a contact state appearing there), is found like a sm
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import scipy.optimize
 
-from ._pack import START_RESUME, _Packed
+from . import _run
+from ._pack import _Packed
 from .results import FRFPoint, Peak
 
 #: local maxima of the points within this fraction of the largest are solved for too
@@ -36,31 +35,31 @@ def _offset(base: FRFPoint, p: FRFPoint, lscale: float) -> float:
     return float(base.tangent @ d)
 
 
-def refine_peaks(packed: _Packed, points: list, lam_end: float, lam_lo: float,
-                 lscale: float, omega_fix: float = 0.0) -> tuple[list, list]:
+def refine_peaks(packed: _Packed, points: list, lscale: float) -> tuple[list, list]:
     """Peak per output of a frequency continuation's points (FRFPoint list, in order).
 
     Returns (peaks, solved). peaks: a list of :class:`frirom.results.Peak` (n_out,), the
     largest of the solved local maxima (``method`` 'solve'; the interior local maxima of
     the points within NEAR of the largest are solved for, at most MAX_CANDIDATES), or the
     largest point itself when none is larger (an end of the curve, or a failed solve).
-    solved: the FRFPoints the searches solved (their leak is checked like the run's)."""
-    opts = dataclasses.replace(packed.opts, ds_max=1.0e3, ds_min=1e-12)
-    quiet = dataclasses.replace(packed, opts=opts, stability=False, w0=packed.w0.copy())
+    solved: the FRFPoints the searches solved (their leak is checked like the run's).
+    Every solve is one corrector on the run that made the points (frirom_run run_solve:
+    a step of given length along a point's tangent, from the history that point left;
+    no set-up, the held factorisation kept)."""
+    run = packed.run
     cache = {}
 
     def solve(base_k: int, s: float) -> FRFPoint:
         key = (base_k, s)
         if key not in cache:
             base = points[base_k]
-            if base.slider.size:
-                quiet.w0 = base.slider.copy()
-            res = quiet.call(base.unknowns, base.parameter, base.tangent, START_RESUME, s,
-                             lam_end, lam_lo, base.yscale, lscale, 1, omega_fix)
+            res = run.solve(_run.SOLVE_STEP, base.parameter, base.unknowns,
+                            tan0=base.tangent, yscale=base.yscale, ds=s,
+                            sliders=base.slider if base.slider.size else None)
             if res.info != 0 or res.npts != 1:
                 raise RuntimeError(res.msg)
             # the point keeps the yscale Fortran returns: its tangent is in that scale
-            p = quiet.points(res, omega_fix, 0.0)[0]
+            p = packed.points(res, 0.0)[0]
             if abs(_offset(base, p, lscale) - s) > 1e-6 * s:
                 raise RuntimeError("the corrector did not keep the step")
             cache[key] = p

@@ -18,7 +18,6 @@ travelling-wave response of the whole rotor, at the cost of one sector.
 from __future__ import annotations
 
 import dataclasses
-import re
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -30,8 +29,9 @@ from ._errors import (CODES, MAX_HARMONICS, MAX_OMEGA, ParameterError, SizeError
                       check_number, raise_for_status, samples_problem)
 from ._pack import (HILL_MAX, MODES_MAX, ORBIT_TOL, TIMER_NAMES,  # noqa: F401 - public here
                     kept_unknowns)
-from ._pack import (START_CONTINUE, START_RESUME, START_SOLVE_ONLY, YSCALE_RELATIVE, _Packed,
-                    _split_load, add_timings, pack)
+from ._pack import _Packed, add_timings, pack
+from . import _run
+from ._run import DEFAULTS
 from .harmonics import default_samples
 from .model import CyclicModel, Excitation, Model
 from ._peak import refine_peaks
@@ -173,23 +173,25 @@ class SolverOptions:
         be a wave. No effect without pairs.
     """
 
-    harmonics: int = 3
+    # the defaults of Fortran's run_settings (frirom._run.DEFAULTS), the one place they
+    # are written: C callers get the same from frirom_settings_default
+    harmonics: int = DEFAULTS["harmonics"]
     samples: int | None = None
     formulation: str = "condensed"
-    tol_residual: float = 1e-8
-    tol_update: float = 1e-8
-    tol_stall: float = 0.0
-    max_iter: int = 25
-    ds: float = 0.02
-    ds_min: float = 1e-6
-    ds_max: float = 0.1
-    max_points: int = 2000
+    tol_residual: float = DEFAULTS["tol_residual"]
+    tol_update: float = DEFAULTS["tol_update"]
+    tol_stall: float = DEFAULTS["tol_stall"]
+    max_iter: int = DEFAULTS["max_iter"]
+    ds: float = DEFAULTS["ds"]
+    ds_min: float = DEFAULTS["ds_min"]
+    ds_max: float = DEFAULTS["ds_max"]
+    max_points: int = DEFAULTS["max_points"]
     parameter: str = "frequency"
-    reuse_jacobian: bool = True
-    stability: bool = False
-    history: bool = True
+    reuse_jacobian: bool = bool(DEFAULTS["reuse_jacobian"])
+    stability: bool = bool(DEFAULTS["stability"])
+    history: bool = bool(DEFAULTS["history"])
     modes: int | None = None
-    batch: int = 10
+    batch: int = DEFAULTS["batch"]
     refine_peak: bool = True
     coordinates: str = "auto"
     receptances: str = "auto"
@@ -260,26 +262,17 @@ class SolverOptions:
 
 @dataclass
 class _Continuation:
-    """One continuation run from lam_start to lam_end: :meth:`start` reaches the first
-    point, :meth:`batches` asks Fortran for points `batch` at a time and hands each to
-    `sink`, :meth:`finish` makes the FRF. Between calls it holds where the next call
-    starts (y0, lam0, tan0, ds, start_mode) and the arc-length scale of the unknowns."""
+    """The Python side of one continuation run from lam_start to lam_end on the Fortran
+    run object (frirom._run.Run, the one driver): :meth:`start` starts it (the first
+    point, a point or a checkpoint), :meth:`batches` advances it `batch` points at a
+    time and hands each point to `sink`, :meth:`finish` makes the FRF."""
 
     packed: _Packed
     lam_start: float
     lam_end: float
-    omega_fix: float          # rad/s of a load continuation (0 for frequency)
     sink: Callable[[FRFPoint], None] | None
     points: list = field(default_factory=list)
     timings: dict = field(default_factory=dict)
-    y0: np.ndarray | None = None
-    lam0: float = 0.0
-    tan0: np.ndarray | None = None
-    ds: float = 0.0
-    start_mode: int = START_CONTINUE
-    yscale: float = 1.0
-    prev_t: float | None = None   # parameter part of the previous point's tangent
-    pending: bool = False         # points[-1] awaits its tangent from the next call
     n_before: int = 0             # points a resumed run made before (count to max_points)
     leak_before: tuple | None = None  # their largest leak and its omega (FRFWriter file)
     t0: float = 0.0               # perf_counter at the start of the current call
@@ -292,10 +285,6 @@ class _Continuation:
     def lam_lo(self) -> float:
         return self.lam_start - 0.02 * (self.lam_end - self.lam_start)
 
-    def _call(self, y0, start_mode, yscale, maxpts):
-        return self.packed.call(y0, self.lam0, self.tan0, start_mode, self.ds, self.lam_end,
-                                self.lam_lo, yscale, self.lscale, maxpts, self.omega_fix)
-
     def start(self, start, H_start) -> None:
         """From nothing, or from a saved point (FRFPoint or dict): resume from its tangent,
         or solve at its parameter first (no tangent, other H or unknown history). A
@@ -305,19 +294,18 @@ class _Continuation:
         its 'lscale' (parameter range of the run that wrote it) rescales the tangent when
         the range was extended since."""
         p = self.packed
+        run = p.run
         self.t0 = time.perf_counter()
-        self.ds = p.opts.ds
         if start is None:
-            self.y0, self.tan0 = np.zeros(p.ny), np.zeros(p.ny + 1)
-            self.lam0, self.start_mode = self.lam_start, START_CONTINUE
+            timings = run.start(_run.START_COLD, self.lam_start, self.lam_end)
         else:
             if isinstance(start, FRFPoint):
                 start = {"parameter": start.parameter, "unknowns": start.unknowns,
                          "tangent": start.tangent, "yscale": start.yscale,
                          "slider": start.slider}
-            p.set_history(start.get("slider"))
-            self.y0 = p.pad_start(start["unknowns"], H_start if H_start is not None else p.H)
-            self.lam0 = float(start.get("parameter", start.get("omega")))
+            sliders = p.checked_slider(start.get("slider"))
+            y0 = p.pad_start(start["unknowns"], H_start if H_start is not None else p.H)
+            lam0 = float(start.get("parameter", start.get("omega")))
             tan = start.get("tangent")
             # without the history the point was computed with (a file from before it was
             # kept), the saved point need not solve the equations: re-solve it first; a
@@ -326,128 +314,61 @@ class _Continuation:
             unknown_history = p.nw and p.opts.history and start.get("slider") is None
             if tan is None or not start.get("yscale") or H_start not in (None, p.H) or \
                     unknown_history:
-                self.start_mode, self.tan0 = START_CONTINUE, np.zeros(p.ny + 1)
+                timings = run.start(_run.START_POINT, self.lam_start, self.lam_end,
+                                    lam0=lam0, y0=y0, sliders=sliders)
             else:
-                self.start_mode, self.tan0 = START_RESUME, np.asarray(tan, dtype=float)
-                if self.tan0.size != p.ny + 1:
+                tan = np.asarray(tan, dtype=float)
+                if tan.size != p.ny + 1:
                     raise SizeError("start.tangent: size does not match the unknowns")
                 self.n_before = int(start.get("n_points", 0))
+                timings = run.start(_run.START_RESUME, self.lam_start, self.lam_end,
+                                    lam0=lam0, y0=y0, tan0=tan, yscale=float(start["yscale"]),
+                                    ds=float(start.get("ds") or 0.0),
+                                    lscale_old=float(start.get("lscale") or 0.0),
+                                    n_before=self.n_before, sliders=sliders)
             # the stored points' worst leak, whichever way the run goes on from them
             self.leak_before = start.get("leak")
-        if self.start_mode == START_CONTINUE:
-            self._first_point(start is None)
-        self.yscale = float(np.linalg.norm(self.y0)) or 1.0
-        if self.start_mode == START_RESUME:
-            self.prev_t = self.tan0[-1]
-            self.yscale = float(start["yscale"])    # the saved tangent's scaling
-            if start.get("ds") is not None:
-                # a checkpoint: the uninterrupted run's next call, as _advance made it
-                tan = self.tan0
-                old_l = float(start.get("lscale") or self.lscale)
-                if old_l != self.lscale:        # the range changed: same direction
-                    tan = tan.copy()
-                    tan[-1] *= old_l / self.lscale
-                    tan /= np.linalg.norm(tan)
-                self._continue_from(self.y0, self.lam0, tan, float(start["ds"]))
-
-    def _first_point(self, cold: bool) -> None:
-        """Solve at fixed parameter with a purely relative update test; the size of that
-        solution then scales the arc length, and the next call (START_CONTINUE from the
-        converged point, one Newton iteration) computes the tangent in that scaling."""
-        p = self.packed
-        res = self._call(self.y0, START_SOLVE_ONLY, YSCALE_RELATIVE, 1)
-        add_timings(self.timings, res.timings)
-        if res.info != 0 and p.opts.parameter == "frequency" and cold:
-            # Newton from the linear solution failed (strong slip or lift-off): reach the
-            # first point by continuation in the excitation level from the static state.
-            y_h = _homotopy_start(p, self.lam0)
-            if y_h is not None:
-                res = self._call(y_h, START_SOLVE_ONLY, YSCALE_RELATIVE, 1)
-        raise_for_status(res.info, res.msg)
-        first = p.points(res, self.omega_fix, time.perf_counter() - self.t0)[0]
-        self.t0 = time.perf_counter()
-        self.points.append(first)     # handed to sink once its tangent is known
-        self.y0, self.pending = first.unknowns, True
+        add_timings(self.timings, timings)
 
     def _emit(self, p: FRFPoint) -> None:
         if self.sink is not None:
             self.sink(p)
 
-    def _take(self, new: list) -> None:
-        """Keep a call's points: the pending first point gets its tangent from the first
-        of them; a tangent whose parameter part changes sign marks a fold."""
-        if self.pending and new:
-            self.prev_t = new[0].tangent[-1]
-            self.points[-1].tangent = new[0].tangent
-            self.points[-1].yscale = new[0].yscale
-            self.points[-1].ds_next = new[0].ds_next
-            self._emit(self.points[-1])
-            new = new[1:]
-        elif self.pending:
-            self._emit(self.points[-1])
-        self.pending = False
-        for p in new:
-            if self.prev_t is not None and self.prev_t != 0 and \
-                    np.sign(p.tangent[-1]) != np.sign(self.prev_t):
-                p.fold = True
-            self.prev_t = p.tangent[-1]
-            self.points.append(p)
-            self._emit(p)
-
     def batches(self) -> tuple[bool, str]:
-        """Continue until lam_end, a failure or max_points; returns (complete, message)."""
-        o = self.packed.opts
-        while self.n_before + len(self.points) < o.max_points:
-            maxpts = min(o.batch, o.max_points - self.n_before - len(self.points)) + \
-                int(self.pending)
-            self.packed.forget_lu()     # a checkpoint: resume starts here, LU-less
-            res = self._call(self.y0, self.start_mode, self.yscale, maxpts)
+        """Advance until the run stops; returns (complete, message)."""
+        run, o = self.packed.run, self.packed.opts
+        while True:
+            res = run.advance(o.batch)
             t_call = time.perf_counter() - self.t0
             self.t0 = time.perf_counter()
             add_timings(self.timings, res.timings)
-            new = self.packed.points(res, self.omega_fix, t_call)
-            if new and res.info == 0:
-                new[-1].ds_next = res.ds_out      # a checkpoint (FRFWriter.resume_point)
-            self._take(new)
-            if res.info != 0:
-                return False, self._stopped(res.info, res.msg.strip())
-            if not self.points:
+            if res.info != 0:       # no point at all
+                raise_for_status(res.info, res.msg + self._advice(res))
+            for pt in self.packed.points(res, t_call):
+                self.points.append(pt)
+                self._emit(pt)
+            if res.status == _run.GOING:
+                continue
+            if res.status == _run.DONE:
                 return True, ""
-            self._advance(res.ds_out)
-            if res.finished:
-                return True, ""
-        return False, f"stopped after max_points = {o.max_points} points"
+            if res.status == _run.FAILED:
+                return False, self._stopped(res)
+            return False, res.message
 
-    def _stopped(self, info: int, message: str) -> str:
-        """Explain a run Fortran stopped; raise if it made no point at all."""
-        if info == CODES["FRIROM_ERR_CONT"] and self.packed.nw:
-            message += _contact_advice(self.packed.opts, message)
-        if not self.points and not self.n_before:
-            raise_for_status(info, message)
+    def _advice(self, res) -> str:
+        if res.fail_info == CODES["FRIROM_ERR_CONT"] and self.packed.nw:
+            return _contact_advice(self.packed.opts, res.advice, res.stalled)
+        return ""
+
+    def _stopped(self, res) -> str:
+        """Explain a run Fortran stopped, with the advice that would change its outcome."""
+        message = res.message.strip() + self._advice(res)
         warnings.warn(f"frirom: continuation stopped early, {len(self.points)} points kept: "
                       f"{message}", RuntimeWarning, stacklevel=5)
         return message
 
-    def _advance(self, ds_out: float) -> None:
-        """The next call resumes from the last point, in the arc-length scale of its
-        tangent (Fortran grows the scale with the solution after every point, so the path
-        does not depend on `batch`)."""
-        last = self.points[-1]
-        self.yscale = last.yscale
-        self._continue_from(last.unknowns, last.parameter, last.tangent, ds_out)
-
-    def _continue_from(self, y, lam, tan, ds) -> None:
-        """The next call starts from the converged point (y, lam) with tangent tan (in
-        the scale self.yscale) and step ds."""
-        self.y0, self.lam0, self.tan0 = y, lam, tan
-        self.ds, self.start_mode = ds, START_RESUME
-
-    def finish(self, complete: bool, message: str, keep_unknowns: bool) -> FRF:
+    def finish(self, complete: bool, message: str) -> FRF:
         p, pts = self.packed, self.points
-        if complete and pts and pts[-1].parameter != self.lam_end:
-            complete = False
-            message = (f"the solution curve turned back and left the range through "
-                       f"{pts[-1].parameter:.6g} (start {self.lam_start:.6g})")
         name = "omega" if p.opts.parameter == "frequency" else "load"
         out = FRF.from_points(pts, p.outputs, p.group_names, parameter_name=name,
                               complete=complete, message=message,
@@ -461,20 +382,13 @@ class _Continuation:
                 worst, at = self.leak_before      # a point stored before the resume
             out.solver_info += f"; leak max {worst:.1e}"
             warn_leak(worst, at, stacklevel=4)
-        if keep_unknowns and pts:
-            out._last_unknowns = pts[-1].unknowns
-            out._last_slider = pts[-1].slider
         return out
 
 
-#: The stalled residual |R|/rref the Fortran corrector reports when it gives up.
-_STALLED = re.compile(r"\|R\|/rref\s*=\s*([0-9.Ee+-]+)")
-
-
-def _contact_advice(opts: SolverOptions, message: str) -> str:
-    """What to change after a continuation with friction contacts stopped at ds_min: only
-    settings that would change the outcome, computed from the options in use and the
-    failure (the last corrector's |R|/rref in `message`).
+def _contact_advice(opts: SolverOptions, bits: int, stalled: float) -> str:
+    """What to change after a continuation with friction contacts stopped at ds_min: the
+    settings the driver found would change the outcome (frirom_run run_advice's bits,
+    from the options in use and the last corrector's stalled |R|/rref).
 
     The AFT samples the contacts at N points per period; a contact state switching at one
     of them makes the equations piecewise smooth and Newton can stall at a residual below
@@ -487,19 +401,17 @@ def _contact_advice(opts: SolverOptions, message: str) -> str:
     N = opts.n_samples
     default_N = dataclasses.replace(opts, samples=None).n_samples
     tips = []
-    m = _STALLED.search(message)
-    stalled = float(m.group(1)) if m and _is_float(m.group(1)) else None
-    if stalled is not None and opts.tol_stall < stalled <= 1.0 / N**2:
+    if bits & _run.ADVISE["tol_stall"]:
         tips.append(f"tol_stall = {float(f'{2.0 * stalled:.0e}'):g} (now "
                     f"{opts.tol_stall:g}): a corrector stalling below it is accepted (the "
                     f"last one stalled at |R|/rref = {stalled:.2e})")
-    if stalled is not None and stalled <= opts.tol_residual:
+    if bits & _run.ADVISE["max_iter"]:
         tips.append(f"max_iter = {2 * opts.max_iter} (now {opts.max_iter}): the last "
                     "corrector had met tol_residual and missed only the update test")
-    if opts.ds_min > 1e-4:
+    if bits & _run.ADVISE["ds_min"]:
         tips.append(f"ds_min = {opts.ds_min / 100:g} (now {opts.ds_min:g}): the step "
                     "could not shrink further")
-    if N < default_N:
+    if bits & _run.ADVISE["samples"]:
         tips.append(f"samples = {default_N} (the default for H = {opts.harmonics}; now "
                     f"{N}): smaller corners where a contact state switches")
     text = (f" [N = {N} AFT samples per period (samples = {opts.samples}); where a "
@@ -509,46 +421,19 @@ def _contact_advice(opts: SolverOptions, message: str) -> str:
     return text + "]"
 
 
-def _is_float(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
-
-
-def _run(packed: _Packed, lam_start, lam_end, omega_fix, sink, start, H_start,
-         keep_unknowns=False) -> FRF:
-    run = _Continuation(packed, lam_start, lam_end, omega_fix, sink)
+def _run_curve(packed: _Packed, lam_start, lam_end, sink, start, H_start) -> FRF:
+    run = _Continuation(packed, lam_start, lam_end, sink)
     run.start(start, H_start)
     complete, message = run.batches()
-    out = run.finish(complete, message, keep_unknowns)
+    out = run.finish(complete, message)
     if packed.opts.refine_peak and packed.opts.parameter == "frequency" and run.points:
-        out.peaks, solved = refine_peaks(packed, run.points, lam_end, run.lam_lo, run.lscale)
+        out.peaks, solved = refine_peaks(packed, run.points, run.lscale)
         if packed.keep is not None:
             k = int(np.argmax([q.leak for q in solved])) if solved else -1
             if k >= 0:
                 warn_leak(solved[k].leak, solved[k].omega, stacklevel=3,
                           what="a peak solved between points")
     return out
-
-
-def _homotopy_start(packed: _Packed, omega: float):
-    """Unknowns at omega reached by load continuation of the dynamic excitation from 0 to
-    1 (None if that fails too); packed.w0 becomes the contact history that path leaves."""
-    fe0, fe1 = _split_load(packed.fe0, "dynamic")
-    lp = dataclasses.replace(packed, opts=dataclasses.replace(packed.opts, parameter="load"),
-                             fe0=fe0, fe1=fe1, w0=packed.w0.copy(), stability=False)
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            r = _run(lp, 0.0, 1.0, omega, None, None, None, keep_unknowns=True)
-    except Exception:       # noqa: BLE001 - the caller reports the original failure
-        return None
-    if not r.complete or not r.parameter.size or r.parameter[-1] != 1.0:
-        return None
-    packed.set_history(r._last_slider)
-    return r._last_unknowns
 
 
 def frf(model: Model | CyclicModel, excitation: Excitation, omega_start: float,
@@ -594,8 +479,8 @@ def frf(model: Model | CyclicModel, excitation: Excitation, omega_start: float,
     if omega_start == omega_end:
         raise ParameterError("omega_start and omega_end must differ")
     packed = pack(model, excitation, options, outputs)
-    return _run(packed, float(omega_start), float(omega_end), 0.0, sink, start,
-                start_harmonics)
+    return _run_curve(packed, float(omega_start), float(omega_end), sink, start,
+                      start_harmonics)
 
 
 def load_curve(model: Model | CyclicModel, excitation: Excitation, omega: float,
@@ -628,7 +513,8 @@ def load_curve(model: Model | CyclicModel, excitation: Excitation, omega: float,
     if scale_start == scale_end:
         raise ParameterError("scale_start and scale_end must differ")
     packed = pack(model, excitation, options, outputs, load_part=part)
-    return _run(packed, float(scale_start), float(scale_end), float(omega), sink, start, None)
+    packed.omega_fix = float(omega)
+    return _run_curve(packed, float(scale_start), float(scale_end), sink, start, None)
 
 
 def solve_point(model: Model | CyclicModel, excitation: Excitation, omega: float,
@@ -664,23 +550,17 @@ def solve_point(model: Model | CyclicModel, excitation: Excitation, omega: float
     packed = pack(model, excitation, options, outputs)
     if isinstance(start, FRFPoint):
         start = {"unknowns": start.unknowns, "slider": start.slider}
-    if start is not None:
-        packed.set_history(start.get("slider"))
+    sliders = packed.checked_slider(start.get("slider")) if start is not None else None
     cold = start is None or start.get("unknowns") is None
     y0 = np.zeros(packed.ny) if cold else packed.pad_start(
         start["unknowns"], options.harmonics if start_harmonics is None else start_harmonics)
     t0 = time.perf_counter()
-    res = packed.call(y0, float(omega), np.zeros(packed.ny + 1), START_SOLVE_ONLY,
-                      options.ds, float(omega) * 1.1, 0.0, YSCALE_RELATIVE, float(omega), 1)
-    if res.info != 0 and cold:
-        # Newton from the linear solution failed: continuation in the excitation level
-        y_h = _homotopy_start(packed, float(omega))
-        if y_h is not None:
-            res = packed.call(y_h, float(omega), np.zeros(packed.ny + 1), START_SOLVE_ONLY,
-                              options.ds, float(omega) * 1.1, 0.0, YSCALE_RELATIVE,
-                              float(omega), 1)
+    # from the linear solution, a failed Newton is retried from the homotopy start
+    # (continuation in the excitation level, in the same Fortran run)
+    res = packed.run.solve(_run.SOLVE_FIXED, float(omega), y0, sliders=sliders,
+                           stability=packed.stability, cold=cold)
     raise_for_status(res.info, res.msg)
-    pt = packed.points(res, 0.0, time.perf_counter() - t0)[0]
+    pt = packed.points(res, time.perf_counter() - t0)[0]
     if pt.leak is not None:
         warn_leak(pt.leak, pt.omega, stacklevel=2)
     pt.output_dofs = packed.outputs

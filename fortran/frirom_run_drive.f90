@@ -1,0 +1,800 @@
+!> The continuation driver of frirom_run: opening and building a run, its first point and
+!> the homotopy start, segments of points (frirom_hbm hbm_run), fold flags, stop reasons,
+!> and single corrector solves on the run's system.
+submodule (frirom_run) frirom_run_drive
+    use frirom_newton, only: cont_options, YSCALE_RELATIVE
+    use frirom_hbm, only: hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
+                          hbm_set_modes_harmonic, hbm_run, hbm_set_selection, hbm_sel_expand, &
+                          hbm_sel_reduce, hbm_set_orbits, hbm_sliders, HBM_START_CONTINUE, &
+                          HBM_START_RESUME, HBM_START_SOLVE_ONLY, HBM_FREQUENCY, HBM_LOAD
+    use frirom_aft, only: aft_plan_destroy, law_nslider
+    implicit none
+
+    !> Where a segment (one hbm_run call) starts and how far it may go.
+    type :: seg_start
+        integer(ip) :: mode = HBM_START_CONTINUE    !! HBM_START_*
+        integer(ip) :: maxpts = 1
+        real(wp), allocatable :: y(:), t(:)         !! full layout: (ny), (ny+1)
+        real(wp) :: lam = 0.0_wp, ds = 0.0_wp, yscale = 1.0_wp
+        real(wp) :: lam_end = 1.0_wp, lam_lo = 0.0_wp, lscale = 1.0_wp
+        real(wp) :: ds_min = 0.0_wp, ds_max = 0.0_wp
+        logical :: stability = .false.
+    end type seg_start
+
+contains
+
+    module procedure run_open
+        info = FRIROM_OK
+        call run_close(run)
+        call check_settings(s, info, errmsg)
+        if (info /= 0) return
+        if (formulation /= RUN_CONDENSED .and. formulation /= RUN_BANDED) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'formulation: expected 1 '// &
+                            '(condensed) or 2 (banded)')
+        else if (mode /= RUN_FREQUENCY .and. mode /= RUN_LOAD) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'mode: expected 1 (frequency) '// &
+                            'or 2 (load)')
+        else if (ndof < 1) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'ndof: expected at least 1 DoF')
+        else if (nsamp < 0) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nsamp: expected >= 0 (0: default)')
+        else if (size(fe0, 1) /= ndof .or. size(fe0, 2) /= 2*s%harmonics + 1 .or. &
+                 any(shape(fe1) /= shape(fe0))) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'fe0, fe1: expected (ndof, '// &
+                            '2 harmonics + 1) arrays')
+        else if (.not. (all(abs(fe0) <= huge(1.0_wp)) .and. all(abs(fe1) <= huge(1.0_wp)) &
+                        .and. abs(omega_fix) <= huge(1.0_wp))) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'fe0, fe1, omega_fix: NaN or Inf')
+        else if (.not. (all(abs(kx) <= huge(1.0_wp)) .and. all(abs(mx) <= huge(1.0_wp)) &
+                        .and. all(abs(cx) <= huge(1.0_wp)))) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'K, M, C: NaN or Inf entries')
+        else if (.not. (all(abs(gx) <= huge(1.0_wp)) .and. all(abs(params) <= huge(1.0_wp)) &
+                        .and. all(abs(w0) <= huge(1.0_wp)))) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'G, params, w0: NaN or Inf '// &
+                            'entries')
+        end if
+        if (info /= 0) return
+        run%s = s
+        associate (m => run%m)
+            m%formulation = formulation
+            m%mode = mode
+            m%nh = s%harmonics
+            m%nsamp = nsamp
+            if (nsamp == 0) m%nsamp = run_default_samples(m%nh)
+            m%ndof = ndof
+            m%krylov = krylov
+            m%omega_fix = omega_fix
+            m%tcontact = tcontact
+            m%sparse = sparse
+            m%kp = kp
+            m%ki = ki
+            m%kx = kx
+            m%mp = mp
+            m%mi = mi
+            m%mx = mx
+            m%cp = cp
+            m%ci = ci
+            m%cx = cx
+            m%perm = perm
+            m%nl = nl
+            m%fe0 = fe0
+            m%fe1 = fe1
+            m%ginfo = ginfo
+            m%gp = gp
+            m%gi = gi
+            m%gx = gx
+            m%params = params
+            m%w0 = w0
+            m%outdofs = outdofs
+        end associate
+        call run_build(run, info, errmsg)
+        if (info == 0) run%magic = RUN_MAGIC
+    end procedure run_open
+
+    module procedure run_build
+        integer(ip) :: nrep, g
+        integer(ip), allocatable :: omap(:)
+        real(wp) :: mis
+        info = FRIROM_OK
+        if (allocated(run%sys)) then
+            call aft_plan_destroy(run%sys%plan)
+            deallocate (run%sys)
+        end if
+        run%built = .false.
+        associate (m => run%m)
+            if (m%formulation == RUN_CONDENSED) then
+                allocate (hbm_condensed :: run%sys)
+            else
+                allocate (hbm_full :: run%sys)
+            end if
+            call hbm_setup(run%sys, m%nh, m%nsamp, m%ndof, m%kp, m%ki, m%kx, m%mp, m%mi, &
+                           m%mx, m%cp, m%ci, m%cx, m%perm, m%nl, m%fe0, m%fe1, m%mode, &
+                           m%omega_fix, m%ginfo, m%gp, m%gi, m%gx, m%params, m%w0, &
+                           m%outdofs, info, errmsg, contact_coords=m%tcontact, &
+                           krylov=m%krylov, sparse_lu=m%sparse)
+            if (info /= 0) return
+            if (allocated(m%phi)) call hbm_set_modes(run%sys, m%phi, m%wm, m%zm, info, errmsg)
+            if (info /= 0) return
+            if (allocated(m%psi)) call hbm_set_modes_harmonic(run%sys, m%psi, m%wh, m%zh, &
+                                                              info, errmsg)
+            if (info /= 0) return
+            run%netot = sum(m%ginfo(2, :))
+            if (allocated(m%keep)) then
+                if (run%s%stability /= 0) then
+                    call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: Hill '// &
+                                    'stability would see only perturbations inside the '// &
+                                    'selection; not with stability')
+                    return
+                end if
+                if (allocated(m%pair)) then
+                    call hbm_set_selection(run%sys, m%keep, info, errmsg, pair=m%pair)
+                    if (info == 0 .and. m%orbits) then
+                        allocate (omap(max(run%netot, 1)))
+                        omap = 0
+                        call hbm_set_orbits(run%sys, m%orbtol, nrep, mis, info, errmsg, omap)
+                        run%orb_nrep = nrep
+                        run%orb_mis = mis
+                    end if
+                else
+                    call hbm_set_selection(run%sys, m%keep, info, errmsg)
+                end if
+                if (info /= 0) return
+            end if
+            run%nout = size(m%outdofs)
+        end associate
+        select type (sys => run%sys)
+        type is (hbm_condensed)
+            run%ny = sys%nnl*sys%nc
+        class default
+            run%ny = sys%n
+        end select
+        run%nw = 0
+        do g = 1, size(run%sys%cs%grp)
+            run%nw = run%nw + law_nslider(run%sys%cs%grp(g)%law)*run%sys%cs%grp(g)%ne
+        end do
+        run%built = .true.
+    end procedure run_build
+
+    module procedure run_set_modes
+        info = FRIROM_OK
+        if (.not. open_run(run, 'run_set_modes', info, errmsg)) return
+        if (size(phi, 1) /= run%m%ndof .or. size(wm) /= size(phi, 2) .or. &
+            size(zm) /= size(phi, 2) .or. size(phi, 2) < 1) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'modes: phi (ndof, nm), omega '// &
+                            'and zeta (nm) expected, nm >= 1')
+        else if (.not. (all(abs(phi) <= huge(1.0_wp)) .and. good_modes(wm, zm))) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'modes: finite shapes, '// &
+                            'positive frequencies and damping ratios >= 0 expected')
+        end if
+        if (info /= 0) return
+        run%m%phi = phi
+        run%m%wm = wm
+        run%m%zm = zm
+        call apply_modes(run, .false., info, errmsg)
+        if (info /= 0) deallocate (run%m%phi, run%m%wm, run%m%zm)
+    end procedure run_set_modes
+
+    module procedure run_set_modes_harmonic
+        info = FRIROM_OK
+        if (.not. open_run(run, 'run_set_modes_harmonic', info, errmsg)) return
+        if (size(psi, 1) /= run%m%ndof .or. size(psi, 3) /= run%m%nh + 1 .or. &
+            any(shape(wh) /= [size(psi, 2), size(psi, 3)]) .or. &
+            any(shape(zh) /= shape(wh))) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'harmonic modes: psi (ndof, '// &
+                            'nm, H+1), omega and zeta (nm, H+1) expected')
+        else if (.not. (all(abs(psi) <= huge(1.0_wp)) .and. &
+                        good_modes(reshape(wh, [size(wh)]), reshape(zh, [size(zh)])))) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'harmonic modes: finite '// &
+                            'shapes, positive frequencies and damping ratios >= 0 expected')
+        end if
+        if (info /= 0) return
+        run%m%psi = psi
+        run%m%wh = wh
+        run%m%zh = zh
+        call apply_modes(run, .true., info, errmsg)
+        if (info /= 0) deallocate (run%m%psi, run%m%wh, run%m%zh)
+    end procedure run_set_modes_harmonic
+
+    !> Finite positive natural frequencies and finite damping ratios >= 0.
+    pure logical function good_modes(w, z)
+        real(wp), intent(in) :: w(:), z(:)
+        good_modes = all(w > 0.0_wp) .and. all(w <= huge(1.0_wp)) .and. all(z >= 0.0_wp) &
+                     .and. all(z <= huge(1.0_wp))
+    end function good_modes
+
+    !> The system with the model's real (or, harmonic, per-harmonic) modes of run%m: set
+    !> on it, or rebuilt when a selection is set already (the modes come first).
+    subroutine apply_modes(run, harmonic, info, errmsg)
+        type(run_t), intent(inout) :: run
+        logical, intent(in) :: harmonic
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        if (allocated(run%m%keep)) then
+            call run_build(run, info, errmsg)
+        else if (.not. harmonic) then
+            call hbm_set_modes(run%sys, run%m%phi, run%m%wm, run%m%zm, info, errmsg)
+        else
+            call hbm_set_modes_harmonic(run%sys, run%m%psi, run%m%wh, run%m%zh, info, errmsg)
+        end if
+    end subroutine apply_modes
+
+    module procedure run_set_selection
+        integer(ip) :: nrep
+        integer(ip), allocatable :: omap(:)
+        real(wp) :: mis
+        info = FRIROM_OK
+        if (.not. open_run(run, 'run_set_selection', info, errmsg)) return
+        if (run%s%stability /= 0) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: Hill stability '// &
+                            'would see only perturbations inside the selection; not with '// &
+                            'stability')
+            return
+        end if
+        if (allocated(run%m%keep)) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'run_set_selection: the run has '// &
+                            'a selection already (open a new run)')
+            return
+        end if
+        if (present(pair)) then
+            call hbm_set_selection(run%sys, keep, info, errmsg, pair=pair)
+        else
+            call hbm_set_selection(run%sys, keep, info, errmsg)
+        end if
+        if (info /= 0) return
+        run%m%keep = keep
+        if (present(pair)) run%m%pair = pair
+        if (present(pair) .and. present(orbits)) run%m%orbits = orbits
+        if (present(orbtol)) run%m%orbtol = orbtol
+        if (run%m%orbits) then
+            allocate (omap(max(run%netot, 1)))
+            omap = 0
+            call hbm_set_orbits(run%sys, run%m%orbtol, nrep, mis, info, errmsg, omap)
+            if (info /= 0) return
+            run%orb_nrep = nrep
+            run%orb_mis = mis
+        end if
+    end procedure run_set_selection
+
+    module procedure run_start
+        real(wp) :: nt
+        info = FRIROM_OK
+        if (.not. open_run(run, 'run_start', info, errmsg)) return
+        run%timers = 0.0_wp
+        if (.not. (abs(lam_start) <= huge(1.0_wp) .and. abs(lam_end) <= huge(1.0_wp)) &
+            .or. lam_start == lam_end) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'lam_start, lam_end: finite '// &
+                            'and different values expected')
+            return
+        end if
+        if (run%m%mode == RUN_FREQUENCY .and. .not. (lam_start > 0.0_wp .and. &
+                                                     lam_end > 0.0_wp)) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'lam_start, lam_end: positive '// &
+                            'frequencies (rad/s) expected')
+            return
+        end if
+        if (present(y0)) then
+            if (size(y0) /= run%ny .or. .not. all(abs(y0) <= huge(1.0_wp))) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'y0: the run''s unknowns '// &
+                                '(finite) expected')
+                return
+            end if
+        end if
+        if (present(sliders)) then
+            call run_set_sliders(run, sliders, info, errmsg)
+            if (info /= 0) return
+        end if
+        run%lam_start = lam_start
+        run%lam_end = lam_end
+        run%lscale = abs(lam_end - lam_start)
+        run%lam_lo = lam_start - 0.02_wp*(lam_end - lam_start)
+        run%status = RUN_GOING
+        run%fail_info = FRIROM_OK
+        run%message = ''
+        run%pending = .false.
+        run%have_prev = .false.
+        run%prev_t = 0.0_wp
+        run%n_before = 0
+        run%n_made = 0
+        run%ds = run%s%ds
+        run%yscale = 1.0_wp
+        if (allocated(run%y)) deallocate (run%y, run%t)
+        allocate (run%y(run%ny), run%t(run%ny + 1))
+        run%y = 0.0_wp
+        run%t = 0.0_wp
+        run%lam = lam_start
+        if (present(lam0)) run%lam = lam0
+        if (present(y0)) run%y = y0
+        select case (kind)
+        case (RUN_START_COLD, RUN_START_POINT)
+            call first_point(run, kind == RUN_START_COLD .or. .not. present(y0), info, errmsg)
+        case (RUN_START_RESUME)
+            if (.not. (present(y0) .and. present(tan0) .and. present(yscale) .and. &
+                       present(lam0))) then
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'run_start: a resume needs '// &
+                                'the point (y0, lam0), its tangent and its yscale')
+                return
+            end if
+            if (size(tan0) /= run%ny + 1 .or. .not. all(abs(tan0) <= huge(1.0_wp)) .or. &
+                .not. (yscale > 0.0_wp .and. yscale <= huge(1.0_wp))) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'tan0, yscale: a finite '// &
+                                'tangent of ny + 1 entries and a positive scale expected')
+                return
+            end if
+            run%t = tan0
+            run%prev_t = tan0(run%ny + 1)
+            run%have_prev = .true.
+            run%yscale = yscale
+            if (present(n_before)) run%n_before = max(n_before, 0_ip)
+            if (present(ds)) then
+                if (ds > 0.0_wp) then
+                    ! a checkpoint; the range changed since: the same direction
+                    if (present(lscale_old)) then
+                        if (lscale_old > 0.0_wp .and. lscale_old /= run%lscale) then
+                            run%t(run%ny + 1) = run%t(run%ny + 1)*(lscale_old/run%lscale)
+                            nt = norm2(run%t)
+                            run%t = run%t/nt
+                        end if
+                    end if
+                    run%ds = ds
+                end if
+            end if
+            run%start_mode = HBM_START_RESUME
+        case default
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'run_start: kind expected 0 '// &
+                            '(cold), 1 (point) or 2 (resume)')
+        end select
+    end procedure run_start
+
+    !> The first point: solved at the run's lam from run%y with a purely relative update
+    !> test (no scale known yet); from the linear solution (cold) a failed Newton is
+    !> retried from the homotopy start. The point is pending: the next segment continues
+    !> from it and gives its tangent in the scale |y|.
+    subroutine first_point(run, cold, info, errmsg)
+        type(run_t), intent(inout) :: run
+        logical, intent(in) :: cold
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        type(seg_start) :: st
+        type(run_points) :: p1
+        real(wp), allocatable :: yh(:)
+        real(wp) :: dsout
+        logical :: fin, ok
+        call run_seg(run, st, HBM_START_SOLVE_ONLY, 1_ip, YSCALE_RELATIVE)
+        call segment(run, st, p1, fin, dsout, info, errmsg)
+        if (info /= 0 .and. run%m%mode == RUN_FREQUENCY .and. cold) then
+            call homotopy(run, run%lam, yh, ok)
+            if (ok) then
+                st%y = yh
+                call segment(run, st, p1, fin, dsout, info, errmsg)
+            end if
+        end if
+        run%first = p1
+        if (info /= 0) then
+            run%status = RUN_FAILED
+            run%fail_info = info
+            run%message = errmsg
+            return
+        end if
+        run%pending = .true.
+        run%n_made = 1
+        run%y = run%first%y(:, 1)
+        run%t = 0.0_wp
+        run%yscale = norm2(run%y)
+        if (run%yscale == 0.0_wp) run%yscale = 1.0_wp
+        run%start_mode = HBM_START_CONTINUE
+    end subroutine first_point
+
+    !> The unknowns at omega reached by load continuation of the dynamic excitation from 0
+    !> to 1 from the static state (a second run on the same model, from the run's history);
+    !> ok false if that fails too. The run's history becomes the one that path leaves.
+    subroutine homotopy(run, omega, yh, ok)
+        type(run_t), intent(inout) :: run
+        real(wp), intent(in) :: omega
+        real(wp), allocatable, intent(out) :: yh(:)
+        logical, intent(out) :: ok
+        type(run_t), allocatable :: child
+        type(run_points) :: pts
+        real(wp), allocatable :: wlast(:)
+        integer(ip) :: info
+        character(len=512) :: msg
+        ok = .false.
+        allocate (child)
+        child%m = run%m
+        child%s = run%s
+        child%s%stability = 0
+        child%m%mode = RUN_LOAD
+        child%m%omega_fix = omega
+        child%m%fe0(:, 2:) = 0.0_wp
+        child%m%fe1 = run%m%fe0
+        child%m%fe1(:, 1) = 0.0_wp
+        if (run%nw > 0) then
+            allocate (wlast(run%nw))
+            call run_get_sliders(run, wlast)
+            child%m%w0(1:run%nw) = wlast
+        end if
+        msg = ''
+        call run_build(child, info, msg)
+        if (info == 0) child%magic = RUN_MAGIC
+        if (info == 0) call run_start(child, RUN_START_COLD, 0.0_wp, 1.0_wp, info, msg)
+        allocate (yh(run%ny))
+        do while (info == 0 .and. child%status == RUN_GOING)
+            call run_advance(child, int(max(child%s%batch, 1), ip), pts, info, msg)
+            if (pts%npts > 0) then
+                yh = pts%y(:, pts%npts)
+                if (run%nw > 0) wlast = pts%sliders(1:run%nw, pts%npts)
+                ok = pts%lam(pts%npts) == 1.0_wp
+            end if
+        end do
+        ok = ok .and. info == 0 .and. child%status == RUN_DONE
+        call run_close(child)
+        if (ok .and. run%nw > 0) call run_set_sliders(run, wlast, info, msg)
+    end subroutine homotopy
+
+    module procedure run_advance
+        type(seg_start) :: st
+        type(run_points) :: seg
+        integer(ip) :: room, mx, np, j0, i, j, ne
+        real(wp) :: dsout, tl
+        logical :: fin
+        character(len=64) :: buf
+        info = FRIROM_OK
+        call alloc_points(run, pts, 0_ip)
+        if (.not. open_run(run, 'run_advance', info, errmsg)) return
+        if (.not. allocated(run%y)) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'run_advance: call run_start first')
+            return
+        end if
+        if (k < 1) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'run_advance: k, the points to '// &
+                            'make, expected >= 1')
+            return
+        end if
+        run%timers = 0.0_wp
+        if (run%status /= RUN_GOING) return
+        room = run%s%max_points - run%n_before - run%n_made
+        if (room <= 0) then
+            if (run%pending) then
+                call alloc_points(run, pts, 1_ip)
+                call copy_point(run%first, 1_ip, pts, 1_ip)
+                run%pending = .false.
+            end if
+            call stop_max(run)
+            return
+        end if
+        mx = min(k, room) + merge(1_ip, 0_ip, run%pending)
+        call forget_lu(run%sys)
+        call run_seg(run, st, run%start_mode, mx, run%yscale)
+        call segment(run, st, seg, fin, dsout, info, errmsg)
+        np = seg%npts
+        ! the pending first point takes its tangent from the segment's first point
+        ne = np
+        j0 = 1
+        if (run%pending .and. np > 0) then
+            j0 = 2
+        else if (run%pending) then
+            ne = 1
+        end if
+        call alloc_points(run, pts, ne)
+        j = 0
+        if (run%pending) then
+            j = 1
+            call copy_point(run%first, 1_ip, pts, 1_ip)
+            if (np > 0) then
+                pts%tan(:, 1) = seg%tan(:, 1)
+                pts%yscale(1) = seg%yscale(1)
+            end if
+        end if
+        do i = j0, np
+            j = j + 1
+            call copy_point(seg, i, pts, j)
+            tl = seg%tan(run%ny + 1, i)
+            if (run%have_prev .and. run%prev_t /= 0.0_wp) then
+                if (sgn(tl) /= sgn(run%prev_t)) pts%fold(j) = 1
+            end if
+            run%prev_t = tl
+            run%have_prev = .true.
+        end do
+        run%n_made = run%n_made + (np - j0 + 1)
+        if (np > 0 .and. info == 0) pts%ds_next(ne) = dsout
+        run%pending = .false.
+        if (info /= 0) then
+            run%status = RUN_FAILED
+            run%fail_info = info
+            run%message = errmsg
+            ! a run that made no point at all is an error of the call
+            if (run%n_made > 0 .or. run%n_before > 0) then
+                info = FRIROM_OK
+            end if
+            return
+        end if
+        if (run%n_made == 0) then
+            run%status = RUN_DONE
+            return
+        end if
+        ! the next segment starts from the last point, in the scale of its tangent
+        run%y = pts%y(:, ne)
+        run%lam = pts%lam(ne)
+        run%t = pts%tan(:, ne)
+        run%yscale = pts%yscale(ne)
+        run%ds = dsout
+        run%start_mode = HBM_START_RESUME
+        if (fin) then
+            run%status = RUN_DONE
+            if (run%lam /= run%lam_end) then
+                run%status = RUN_LEFT_RANGE
+                write (buf, '(es14.7)') run%lam
+                run%message = 'the solution curve turned back and left the range through '// &
+                              trim(adjustl(buf))
+                write (buf, '(es14.7)') run%lam_start
+                run%message = trim(run%message)//' (start '//trim(adjustl(buf))//')'
+            end if
+        else if (run%n_before + run%n_made >= run%s%max_points) then
+            call stop_max(run)
+        end if
+    end procedure run_advance
+
+    module procedure run_solve
+        type(seg_start) :: st
+        real(wp), allocatable :: wsave(:), yh(:)
+        real(wp) :: dsout
+        integer(ip) :: linfo
+        logical :: fin, ok
+        character(len=512) :: msg
+        info = FRIROM_OK
+        call alloc_points(run, pts, 0_ip)
+        if (.not. open_run(run, 'run_solve', info, errmsg)) return
+        run%timers = 0.0_wp
+        if (size(y0) /= run%ny .or. .not. all(abs(y0) <= huge(1.0_wp)) .or. &
+            .not. abs(lam0) <= huge(1.0_wp)) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'run_solve: y0 (the run''s '// &
+                            'unknowns) and lam0 finite expected')
+            return
+        end if
+        allocate (wsave(max(run%nw, 1)))
+        call run_get_sliders(run, wsave)
+        if (present(sliders)) then
+            call run_set_sliders(run, sliders, info, errmsg)
+            if (info /= 0) return
+        end if
+        st%y = y0
+        st%lam = lam0
+        st%maxpts = 1
+        st%ds_min = run%s%ds_min
+        st%ds_max = run%s%ds_max
+        st%ds = run%s%ds
+        st%stability = .false.
+        if (present(stability)) st%stability = stability
+        allocate (st%t(run%ny + 1))
+        st%t = 0.0_wp
+        select case (kind)
+        case (RUN_SOLVE_FIXED)
+            st%mode = HBM_START_SOLVE_ONLY
+            st%yscale = YSCALE_RELATIVE
+            st%lscale = abs(lam0)
+            if (st%lscale == 0.0_wp) st%lscale = 1.0_wp
+            st%lam_end = lam0 + 0.1_wp*st%lscale
+            st%lam_lo = -huge(1.0_wp)
+        case (RUN_SOLVE_STEP)
+            if (.not. (present(tan0) .and. present(yscale) .and. present(ds))) then
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'run_solve: a step needs '// &
+                                'tan0, yscale and ds')
+                return
+            end if
+            if (size(tan0) /= run%ny + 1 .or. .not. (ds > 0.0_wp .and. yscale > 0.0_wp)) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'run_solve: tan0 (ny + 1), '// &
+                                'ds > 0 and yscale > 0 expected')
+                return
+            end if
+            st%mode = HBM_START_RESUME
+            st%t = tan0
+            st%yscale = yscale
+            st%ds = ds
+            st%ds_min = 1.0e-12_wp
+            st%ds_max = 1.0e3_wp
+            st%lam_end = run%lam_end
+            st%lam_lo = run%lam_lo
+            st%lscale = run%lscale
+        case default
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'run_solve: kind expected 1 '// &
+                            '(fixed parameter) or 2 (step)')
+            return
+        end select
+        call segment(run, st, pts, fin, dsout, info, errmsg)
+        if (info /= 0 .and. kind == RUN_SOLVE_FIXED .and. run%m%mode == RUN_FREQUENCY .and. &
+            present(cold)) then
+            if (cold) then
+                call homotopy(run, lam0, yh, ok)
+                if (ok) then
+                    st%y = yh
+                    call segment(run, st, pts, fin, dsout, info, errmsg)
+                end if
+            end if
+        end if
+        msg = ''
+        call run_set_sliders(run, wsave(1:run%nw), linfo, msg)
+    end procedure run_solve
+
+    !> A segment from the run's continuation state, within its range and settings.
+    subroutine run_seg(run, st, mode, maxpts, yscale)
+        type(run_t), intent(in) :: run
+        type(seg_start), intent(out) :: st
+        integer(ip), intent(in) :: mode, maxpts
+        real(wp), intent(in) :: yscale
+        st%mode = mode
+        st%maxpts = maxpts
+        st%y = run%y
+        st%t = run%t
+        st%lam = run%lam
+        st%ds = run%ds
+        st%yscale = yscale
+        st%lam_end = run%lam_end
+        st%lam_lo = run%lam_lo
+        st%lscale = run%lscale
+        st%ds_min = run%s%ds_min
+        st%ds_max = run%s%ds_max
+        st%stability = run%s%stability /= 0
+    end subroutine run_seg
+
+    !> One hbm_run call from st: its points into pts (full layout), whether it reached
+    !> lam_end, the step it ends with; the run's timers add its time.
+    subroutine segment(run, st, pts, fin, dsout, info, errmsg)
+        type(run_t), intent(inout) :: run
+        type(seg_start), intent(in) :: st
+        type(run_points), intent(inout) :: pts
+        logical, intent(out) :: fin
+        real(wp), intent(out) :: dsout
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        type(cont_options) :: o
+        real(wp), allocatable :: y(:), t(:), ys(:, :), tans(:, :), hill(:), lk(:)
+        real(wp) :: lam
+        integer(ip) :: n, ny, mx, np, k
+        integer(8) :: c0, c1, rate
+        call system_clock(c0, rate)
+        n = run%sys%n
+        ny = run%ny
+        mx = st%maxpts
+        o%tol_r = run%s%tol_residual
+        o%tol_x = run%s%tol_update
+        o%tol_stall = run%s%tol_stall
+        o%max_iter = run%s%max_iter
+        o%reuse_jac = run%s%reuse_jacobian /= 0
+        o%yscale = st%yscale
+        o%lscale = st%lscale
+        o%ds = st%ds
+        o%ds_min = st%ds_min
+        o%ds_max = st%ds_max
+        o%lam_end = st%lam_end
+        o%max_points = mx
+        call alloc_points(run, pts, mx)
+        allocate (y(n), t(n + 1), ys(n, mx), tans(n + 1, mx))
+        call hbm_sel_reduce(run%sys, st%y, y)
+        call hbm_sel_reduce(run%sys, st%t(1:ny), t(1:n))
+        t(n + 1) = st%t(ny + 1)
+        lam = st%lam
+        dsout = st%ds
+        run%sys%carry = run%s%history /= 0
+        run%sys%timers = 0.0_wp
+        if (st%stability) allocate (hill(mx))
+        if (allocated(run%m%keep)) allocate (lk(mx))
+        call hbm_run(run%sys, st%mode, y, lam, t, dsout, st%lam_lo, o, ys, pts%lam, &
+                     tans, pts%iters, pts%xo, pts%states, np, fin, info, errmsg, hill, &
+                     sliders=pts%sliders, yscales=pts%yscale, leak=lk)
+        pts%npts = np
+        do k = 1, np
+            call hbm_sel_expand(run%sys, ys(:, k), pts%y(:, k))
+            call hbm_sel_expand(run%sys, tans(1:n, k), pts%tan(1:ny, k))
+            pts%tan(ny + 1, k) = tans(n + 1, k)
+        end do
+        if (allocated(hill)) pts%hill = hill
+        if (allocated(lk)) pts%leak = lk
+        run%timers(1:N_TIMERS - 1) = run%timers(1:N_TIMERS - 1) + run%sys%timers(1:N_TIMERS - 1)
+        call system_clock(c1)
+        run%timers(N_TIMERS) = run%timers(N_TIMERS) + real(c1 - c0, wp)/real(rate, wp)
+    end subroutine segment
+
+    !> pts with room for n points of this run, zeroed.
+    subroutine alloc_points(run, pts, n)
+        type(run_t), intent(in) :: run
+        type(run_points), intent(inout) :: pts
+        integer(ip), intent(in) :: n
+        integer(ip) :: nc
+        nc = 2*run%m%nh + 1
+        pts = run_points()
+        pts%npts = n
+        allocate (pts%y(run%ny, n), pts%lam(n), pts%tan(run%ny + 1, n), &
+                  pts%xo(run%nout, nc, n), pts%states(3, max(run%netot, 1), n), pts%hill(n), &
+                  pts%sliders(max(run%nw, 1), n), pts%yscale(n), pts%leak(n), &
+                  pts%ds_next(n), source=0.0_wp)
+        allocate (pts%iters(n), pts%fold(n), source=0_ip)
+    end subroutine alloc_points
+
+    !> Point i of a into point j of b.
+    subroutine copy_point(a, i, b, j)
+        type(run_points), intent(in) :: a
+        integer(ip), intent(in) :: i, j
+        type(run_points), intent(inout) :: b
+        b%y(:, j) = a%y(:, i)
+        b%lam(j) = a%lam(i)
+        b%tan(:, j) = a%tan(:, i)
+        b%iters(j) = a%iters(i)
+        b%xo(:, :, j) = a%xo(:, :, i)
+        b%states(:, :, j) = a%states(:, :, i)
+        b%hill(j) = a%hill(i)
+        b%sliders(:, j) = a%sliders(:, i)
+        b%yscale(j) = a%yscale(i)
+        b%leak(j) = a%leak(i)
+        b%ds_next(j) = a%ds_next(i)
+        b%fold(j) = a%fold(i)
+    end subroutine copy_point
+
+    subroutine stop_max(run)
+        type(run_t), intent(inout) :: run
+        character(len=16) :: buf
+        write (buf, '(i0)') run%s%max_points
+        run%status = RUN_MAX_POINTS
+        run%message = 'stopped after max_points = '//trim(buf)//' points'
+    end subroutine stop_max
+
+    !> The next Jacobian is factorised afresh, as in a system just built: a segment
+    !> starts as a run restored from a checkpoint does (the LU a condensed modal system
+    !> holds as GMRES preconditioner is forgotten, its bookkeeping reset).
+    subroutine forget_lu(sys)
+        class(hbm_system), intent(inout) :: sys
+        select type (sys)
+        type is (hbm_condensed)
+            sys%lu_any = .false.
+            sys%lu_fresh = .false.
+            sys%gm_spent = 0.0_wp
+            sys%gm_next = .false.
+            sys%refresh = .false.
+            sys%wb_ok = .false.
+        end select
+    end subroutine forget_lu
+
+    !> -1, 0 or 1 (numpy's sign).
+    pure real(wp) function sgn(x)
+        real(wp), intent(in) :: x
+        sgn = merge(1.0_wp, merge(-1.0_wp, 0.0_wp, x < 0.0_wp), x > 0.0_wp)
+    end function sgn
+
+    !> Whether the run is open and built; else info = FRIROM_ERR_PARAM naming the call.
+    logical function open_run(run, who, info, errmsg)
+        type(run_t), intent(in) :: run
+        character(len=*), intent(in) :: who
+        integer(ip), intent(inout) :: info
+        character(len=*), intent(inout) :: errmsg
+        open_run = run%built .and. run%magic == RUN_MAGIC
+        if (.not. open_run) call set_status(info, FRIROM_ERR_PARAM, errmsg, who// &
+                                            ': the run is not open (run_open first)')
+    end function open_run
+
+    !> Settings in their ranges; else FRIROM_ERR_PARAM naming the first one out.
+    subroutine check_settings(s, info, errmsg)
+        type(run_settings), intent(in) :: s
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        info = FRIROM_OK
+        if (s%harmonics < 0 .or. s%harmonics > 200) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'settings.harmonics: expected '// &
+                            '0..200')
+        else if (s%samples /= 0 .and. s%samples < 2*s%harmonics + 1) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'settings.samples: expected 0 '// &
+                            '(default) or at least 2 harmonics + 1')
+        else if (s%max_points < 1 .or. s%max_iter < 1 .or. s%batch < 1) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'settings.max_points, max_iter, '// &
+                            'batch: expected >= 1')
+        else if (.not. (s%tol_residual > 0.0_wp .and. s%tol_update > 0.0_wp .and. &
+                        s%tol_stall >= 0.0_wp .and. s%ds > 0.0_wp .and. s%ds_min > 0.0_wp &
+                        .and. s%ds_max >= s%ds_min .and. s%ds <= s%ds_max .and. &
+                        s%ds_max <= huge(1.0_wp) .and. s%tol_residual <= huge(1.0_wp) .and. &
+                        s%tol_update <= huge(1.0_wp) .and. s%tol_stall <= huge(1.0_wp))) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'settings.tol_residual, '// &
+                            'tol_update, ds, ds_min, ds_max: positive and finite, tol_stall '// &
+                            '>= 0, ds_min <= ds <= ds_max expected')
+        else if (.not. (s%formulation == RUN_CONDENSED .or. s%formulation == RUN_BANDED)) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'settings.formulation: expected '// &
+                            '1 (condensed) or 2 (banded)')
+        end if
+    end subroutine check_settings
+end submodule frirom_run_drive
