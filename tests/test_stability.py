@@ -285,7 +285,7 @@ def test_hill_refused_with_its_memory_when_it_cannot_fit(monkeypatch):
     tens of GiB for the banded Hill matrices; the run is refused up front naming
     options.stability and the figure, instead of being killed by the kernel. Here the
     machine's memory is made small so that the 12-DoF chain's Hill (a few MiB) is refused."""
-    import frirom._pack as pk
+    import frirom._routes as pk
     assert pk.hill_bytes(1900, 3, 1899) > 16 * 2**30
     assert pk.hill_bytes(6, 3, 2) < 2**20            # the dense path: small
     model, ex = duffing_plus_oscillators(n_extra=5)

@@ -27,7 +27,7 @@ from ..reduction.multistage import (cylindrical_frame, travelling_wave_pairs,
                                      travelling_wave_selection)
 from ..reduction.rom import (PairSpec, build_reduced_model, cache_file, rom_key,
                              same_reduction)
-from ..solver import SolverOptions
+from ..options import SolverOptions
 from .build_cyclic import check_sector_contacts, cyclic_modes, cyclic_sector_of
 from .fields import Context, DofRef
 from .schema import DeckSettings
