@@ -9,6 +9,7 @@ from Fortran at import (``int_constant``), so no number of the boundary is typed
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -391,9 +392,15 @@ def _pairs_on_nl(packed: _Packed, pairs) -> np.ndarray:
 def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed:
     H, n = opts.harmonics, model.n_dof
     nl = model.nonlinear_dofs()
+    note = ""
     if opts.formulation == "condensed" and nl.size == 0:
-        raise ParameterError("formulation 'condensed' needs contact DoFs; the model has "
-                             "no contact group (use 'banded')")
+        # nothing to condense to: the linear response, by the banded LU of all DoFs
+        if opts.selection is not None:
+            raise ParameterError("options.selection: the model has no contact DoFs to "
+                                 "select")
+        opts = dataclasses.replace(opts, formulation="banded", modes=None)
+        note = ("; no contact DoFs to condense to: the linear response, solved in the "
+                "banded formulation")
     groups = model.contacts
     c = _pack_contacts(groups, n)
     band = _Band(model, c.G)
@@ -424,7 +431,7 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
                    G=_csr(c.G), ginfo=c.ginfo, params=c.params, w0=c.w0, nw=c.nw,
                    group_names=c.names, group_sizes=c.sizes, outputs=out, out_f=out,
                    stability=bool(opts.stability), modes=modes, tcontact=tcontact, sparse=sparse,
-                   info=info)
+                   info=info + note)
 
 
 def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Packed:
