@@ -101,7 +101,9 @@ int frirom_frf(int n, int nk, const int *kr, const int *kc, const double *kv,
  *                        (nout, k+1) and y (ny, k+1) or NULL; status: 0 going, 1 done
  *                        (reached omega_end), 2 max_points made, 3 the curve turned back
  *                        and left the range, 4 a corrector failed (the return value is its
- *                        code, msg says why; the points made are kept)
+ *                        code, msg says why; the points made are kept), 5 stalled: no
+ *                        progress in frequency over 200 points (msg gives the diagnosis:
+ *                        a family of solutions, a singular direction, a tolerance floor)
  *   frirom_run_solve_at  one solve at omega from y0 (ny) or from the linear solution
  *                        (y0 NULL), the continuation state untouched
  *   frirom_run_checkpoint  after an advance, everything exact resume needs: nck doubles

@@ -265,7 +265,7 @@ end subroutine frun_start
 
 !> Up to k more points of a started run (frirom_run run_advance) into arrays of room
 !> maxpts >= k + 1: npts points; status (RUN_*: 0 going, 1 done, 2 max_points, 3 left the
-!> range, 4 failed), fail_info the failure's code and message its text (or why it
+!> range, 4 failed, 5 stalled), fail_info the failure's code and message its text (or why it
 !> stopped); advice (ADVISE_* bits) and stalled (|R|/rref, -1: none) of a failure at ds_min;
 !> fold(k) = 1 where the tangent turned; ds_next(k) > 0 at a checkpoint.
 subroutine frun_advance(handle, k, maxpts, ny, nout, nc, netot, nw, ys, lams, tans, iters, &
@@ -487,7 +487,7 @@ subroutine int_constant(name, value, info, msg)
     use frirom_status, only: FRIROM_ERR_PARAM, frirom_status_code, set_status
     use frirom_run, only: RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_LOAD, &
                           RUN_START_COLD, RUN_START_POINT, RUN_START_RESUME, RUN_GOING, &
-                          RUN_DONE, RUN_MAX_POINTS, RUN_LEFT_RANGE, RUN_FAILED, &
+                          RUN_DONE, RUN_MAX_POINTS, RUN_LEFT_RANGE, RUN_FAILED, RUN_STALLED, &
                           RUN_SOLVE_FIXED, RUN_SOLVE_STEP, ADVISE_TOL_STALL, ADVISE_MAX_ITER, &
                           ADVISE_DS_MIN, ADVISE_SAMPLES, N_ISET, N_RSET, COORD_AUTO, COORD_DOFS, &
                           COORD_CONTACT
@@ -526,6 +526,8 @@ subroutine int_constant(name, value, info, msg)
         value = RUN_LEFT_RANGE
     case ('RUN_FAILED')
         value = RUN_FAILED
+    case ('RUN_STALLED')
+        value = RUN_STALLED
     case ('RUN_SOLVE_FIXED')
         value = RUN_SOLVE_FIXED
     case ('RUN_SOLVE_STEP')

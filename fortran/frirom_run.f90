@@ -43,7 +43,8 @@ module frirom_run
               run_checkpoint, run_restore, run_contact_coords
     public :: RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_LOAD, &
               RUN_START_COLD, RUN_START_POINT, RUN_START_RESUME, &
-              RUN_GOING, RUN_DONE, RUN_MAX_POINTS, RUN_LEFT_RANGE, RUN_FAILED, &
+              RUN_GOING, RUN_DONE, RUN_MAX_POINTS, RUN_LEFT_RANGE, RUN_FAILED, RUN_STALLED, &
+              STALL_POINTS, STALL_PROGRESS, &
               RUN_SOLVE_FIXED, RUN_SOLVE_STEP, &
               ADVISE_TOL_STALL, ADVISE_MAX_ITER, ADVISE_DS_MIN, ADVISE_SAMPLES, &
               N_ISET, N_RSET, COORD_AUTO, COORD_DOFS, COORD_CONTACT
@@ -60,7 +61,11 @@ module frirom_run
     !> Why a run stopped (run_t%status): still going, reached the end of its range, made
     !> max_points points, turned back and left the range, a corrector failed.
     integer(ip), parameter :: RUN_GOING = 0, RUN_DONE = 1, RUN_MAX_POINTS = 2, &
-                              RUN_LEFT_RANGE = 3, RUN_FAILED = 4
+                              RUN_LEFT_RANGE = 3, RUN_FAILED = 4, RUN_STALLED = 5
+    !> A run stalls when its last STALL_POINTS points moved the parameter by less than
+    !> STALL_PROGRESS of its range: more points or a resume would only repeat them.
+    integer(ip), parameter :: STALL_POINTS = 200
+    real(wp), parameter :: STALL_PROGRESS = 1.0e-6_wp
     !> run_solve: at a fixed parameter, or a step of given length from a point.
     integer(ip), parameter :: RUN_SOLVE_FIXED = 1, RUN_SOLVE_STEP = 2
     !> run_advice bits: settings that would change the outcome of a run stopped at ds_min
@@ -165,6 +170,10 @@ module frirom_run
         logical :: have_prev = .false.
         integer(ip) :: n_before = 0, n_made = 0
         integer(ip) :: status = RUN_GOING
+        !> the last STALL_POINTS points' parameter, |unknowns| and |outputs| (a ring,
+        !> filled up to n_ring), for the stall test and its diagnosis
+        real(wp) :: ring(3, STALL_POINTS) = 0.0_wp
+        integer(ip) :: n_ring = 0
         !> status code and message of the failure that stopped the run
         integer(ip) :: fail_info = FRIROM_OK
         character(len=512) :: message = ''

@@ -293,6 +293,7 @@ contains
         run%pending = .false.
         run%have_prev = .false.
         run%prev_t = 0.0_wp
+        run%n_ring = 0
         run%n_before = 0
         run%n_made = 0
         run%ds = run%s%ds
@@ -496,6 +497,16 @@ contains
         end do
         run%n_made = run%n_made + (np - j0 + 1)
         if (np > 0 .and. info == 0) pts%ds_next(ne) = dsout
+        do i = 1, merge(ne, 0_ip, info == 0)
+            if (stalled(run, pts, i)) then
+                ! the points after the stall's are dropped: the run ends there
+                pts%npts = i
+                pts%ds_next(i) = 0.0_wp
+                run%n_made = run%n_made - (ne - i)
+                run%pending = .false.
+                return
+            end if
+        end do
         run%pending = .false.
         if (info /= 0) then
             run%status = RUN_FAILED
@@ -727,6 +738,64 @@ contains
         b%ds_next(j) = a%ds_next(i)
         b%fold(j) = a%fold(i)
     end subroutine copy_point
+
+    !> Note point i of pts in the run's ring; true (status RUN_STALLED, the diagnosis in
+    !> run%message) when the last STALL_POINTS points moved the parameter by less than
+    !> STALL_PROGRESS of the range. The diagnosis: the unknowns drift while the parameter
+    !> and the outputs stay fixed, a family of solutions at one parameter (a direction the
+    !> equations leave free, such as the mean position of a body held only by friction
+    !> contacts in gross slip); the outputs change too, the curve turns in place (a
+    !> singular direction); neither, steps at the tolerance floor.
+    logical function stalled(run, pts, i)
+        type(run_t), intent(inout) :: run
+        type(run_points), intent(in) :: pts
+        integer(ip), intent(in) :: i
+        integer(ip) :: at, n
+        real(wp) :: dl, dy, dx, ymax, xmax
+        character(len=16) :: b1, b2, b3
+        stalled = .false.
+        at = modulo(run%n_ring, STALL_POINTS) + 1
+        run%ring(:, at) = [pts%lam(i), norm2(pts%y(:, i)), norm2(pts%xo(:, :, i))]
+        run%n_ring = run%n_ring + 1
+        if (run%n_ring < STALL_POINTS) return
+        dl = maxval(run%ring(1, :)) - minval(run%ring(1, :))
+        if (dl >= STALL_PROGRESS*run%lscale) return
+        stalled = .true.
+        n = STALL_POINTS
+        ymax = max(maxval(run%ring(2, :)), tiny(1.0_wp))
+        xmax = max(maxval(run%ring(3, :)), tiny(1.0_wp))
+        dy = (maxval(run%ring(2, :)) - minval(run%ring(2, :)))/ymax
+        dx = (maxval(run%ring(3, :)) - minval(run%ring(3, :)))/xmax
+        write (b1, '(es9.2)') dl/run%lscale
+        write (b2, '(es9.2)') dy
+        write (b3, '(es9.2)') dx
+        run%status = RUN_STALLED
+        run%message = 'no progress in the parameter: its last '//trim(itoa(n))// &
+                      ' points moved it by '//trim(adjustl(b1))//' of the range'
+        if (dy > 1.0e3_wp*dx .and. dy > 1.0e-6_wp) then
+            run%message = trim(run%message)//'; the unknowns drift ('//trim(adjustl(b2))// &
+                ') while the outputs stay fixed ('//trim(adjustl(b3))//'): a family of '// &
+                'solutions at one parameter, a direction the equations leave free (e.g. '// &
+                'the mean position of a body held only by friction contacts in gross '// &
+                'slip). More points or a resume repeat it: hold that direction (a '// &
+                'grounded stiffness, or contacts that stick)'
+        else if (dx > 1.0e-6_wp) then
+            run%message = trim(run%message)//'; the unknowns ('//trim(adjustl(b2))// &
+                ') and the outputs ('//trim(adjustl(b3))//') change at a fixed parameter: '// &
+                'the curve turns in place (a singular direction). A smaller ds_max, or '// &
+                'more harmonics or samples where contact states switch, may pass it'
+        else
+            run%message = trim(run%message)//'; neither the unknowns nor the outputs '// &
+                'change: steps at the tolerance floor. A larger tol_stall or more samples '// &
+                'may pass it'
+        end if
+    end function stalled
+
+    pure function itoa(k) result(t)
+        integer(ip), intent(in) :: k
+        character(len=16) :: t
+        write (t, '(i0)') k
+    end function itoa
 
     subroutine stop_max(run)
         type(run_t), intent(inout) :: run

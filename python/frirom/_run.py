@@ -21,8 +21,9 @@ from ._errors import int_constant, raise_for_status
 #: run_start kinds, stop reasons, solve kinds and advice bits (frirom_run RUN_*, ADVISE_*)
 START_COLD, START_POINT, START_RESUME = (int_constant(f"RUN_START_{k}")
                                          for k in ("COLD", "POINT", "RESUME"))
-GOING, DONE, MAX_POINTS, LEFT_RANGE, FAILED = (
-    int_constant(f"RUN_{k}") for k in ("GOING", "DONE", "MAX_POINTS", "LEFT_RANGE", "FAILED"))
+GOING, DONE, MAX_POINTS, LEFT_RANGE, FAILED, STALLED = (
+    int_constant(f"RUN_{k}") for k in ("GOING", "DONE", "MAX_POINTS", "LEFT_RANGE", "FAILED",
+                                       "STALLED"))
 SOLVE_FIXED, SOLVE_STEP = int_constant("RUN_SOLVE_FIXED"), int_constant("RUN_SOLVE_STEP")
 ADVISE = {k.lower(): int_constant(f"ADVISE_{k}")
           for k in ("TOL_STALL", "MAX_ITER", "DS_MIN", "SAMPLES")}
@@ -62,7 +63,7 @@ class Points(NamedTuple):
     ds_next: np.ndarray     #: (m,) the step after a checkpoint (0: no checkpoint)
     fold: np.ndarray        #: (m,) 1 where the tangent turned in the parameter
     npts: int
-    status: int             #: GOING, DONE, MAX_POINTS, LEFT_RANGE, FAILED
+    status: int             #: GOING, DONE, MAX_POINTS, LEFT_RANGE, FAILED, STALLED
     fail_info: int          #: the failure's status code (FAILED)
     message: str            #: why the run stopped ('' while it goes on)
     advice: int             #: ADVISE bits of a failure at ds_min

@@ -156,6 +156,9 @@ class _Continuation:
                 return True, ""
             if res.status == _run.FAILED:
                 return False, self._stopped(res)
+            if res.status == _run.STALLED:
+                warnings.warn(f"frirom: continuation stalled, {len(self.points)} points kept: "
+                              f"{res.message}", RuntimeWarning, stacklevel=4)
             return False, res.message
 
     def _advice(self, res) -> str:
