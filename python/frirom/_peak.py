@@ -1,8 +1,8 @@
 """The peak of a continuation run solved on the curve: for each output, the largest
 max-over-the-period amplitude between the points around the largest one, found by a
 bounded Brent search along the curve whose every evaluation is one corrector solve (one
-search per resonance, for the first output that peaks there; the other outputs take the
-largest of its solves).
+search per resonance and output, for the first MAX_SOLVED outputs; the others take the
+largest of those solves).
 
 The curve near the largest point i is parameterised by the arc length s along the tangent
 of point i - 1 (pseudo-arc-length: the corrector solves R = 0 on the hyperplane at distance
@@ -23,6 +23,9 @@ from .results import FRFPoint, Peak
 #: (at most MAX_CANDIDATES of them, the largest first)
 NEAR = 2e-3
 MAX_CANDIDATES = 3
+#: outputs whose peaks are each searched for (a Brent search per output and candidate);
+#: the others take the largest of those solves (Peak.method 'shared')
+MAX_SOLVED = 16
 #: Brent's tolerance on the arc length, relative to the bracket (two steps): at a corner
 #: the amplitude error is this times the amplitude change over a step (~1e-5 relative)
 XTOL = 2e-3
@@ -40,8 +43,9 @@ def refine_peaks(packed: _Packed, points: list, lscale: float) -> tuple[list, li
 
     Returns (peaks, solved). peaks: a list of :class:`frirom.results.Peak` (n_out,), the
     largest of the solved local maxima (``method`` 'solve'; the interior local maxima of
-    the points within NEAR of the largest are solved for, at most MAX_CANDIDATES), or the
-    largest point itself when none is larger (an end of the curve, or a failed solve).
+    the points within NEAR of the largest are solved for, at most MAX_CANDIDATES, each
+    output's own for the first MAX_SOLVED outputs, 'shared' past them), or the largest
+    point itself when none is larger (an end of the curve, or a failed solve).
     solved: the FRFPoints the searches solved (their leak is checked like the run's).
     Every solve is one corrector on the run that made the points (frirom_run run_solve:
     a step of given length along a point's tangent, from the history that point left;
@@ -75,26 +79,25 @@ def refine_peaks(packed: _Packed, points: list, lscale: float) -> tuple[list, li
         inner = np.flatnonzero((a[1:-1] >= a[:-2]) & (a[1:-1] >= a[2:])) + 1
         inner = inner[a[inner] >= (1.0 - NEAR) * a[i]]
         cands.append((i, inner[np.argsort(-a[inner], kind="stable")][:MAX_CANDIDATES]))
-    # one Brent search per candidate point, for the first output (in the caller's order)
-    # that has it; the other outputs sharing the candidate take the largest of the same
-    # solves (the corrector gives every output at once: a structure with 300 outputs costs
-    # what one output does, and their peaks are found to the spacing of those solves)
-    first = {}
-    for j, (_, inner) in enumerate(cands):
+    # one Brent search per candidate point and output, for the first MAX_SOLVED outputs
+    # (in the caller's order): each output's peak is its own, even where the outputs peak
+    # at one resonance (at other arc lengths along it). Outputs past MAX_SOLVED take the
+    # largest of those solves (the corrector gives every output at once), to the spacing
+    # of the solves: their Peak.method says 'shared'.
+    for j, (_, inner) in enumerate(cands[:MAX_SOLVED]):
         for k in inner:
-            first.setdefault(int(k), j)
-    for k, j in first.items():
-        _search_peak(solve, points, k, j, lscale)
+            _search_peak(solve, points, int(k), j, lscale)
     solved = {}   # candidate k -> the points solved between its neighbours
     for (b, _), p in cache.items():
         solved.setdefault(b + 1, []).append(p)
     peaks = []
     for j, (i, inner) in enumerate(cands):
         best = Peak(points[i].omega, float(amp[i, j]), i)
+        how = "solve" if j < MAX_SOLVED else "shared"
         for k in inner:
             for p in solved.get(int(k), []):
                 if p.amp_max[j] > best.amplitude:
-                    best = Peak(p.omega, float(p.amp_max[j]), int(k), "solve")
+                    best = Peak(p.omega, float(p.amp_max[j]), int(k), how)
         peaks.append(best)
     return peaks, list(cache.values())
 
