@@ -275,10 +275,7 @@ contains
         type(run_t), pointer :: r
         integer(ip) :: st, n
         character(len=512) :: text
-        text = ''
-        call get_run(run, 'frirom_run_set_modes', r, st, text)
-        if (st == FRIROM_OK .and. nmodes < 1) call set_status(st, FRIROM_ERR_SIZE, text, &
-            'frirom_run_set_modes: nmodes: expected >= 1')
+        call get_run(run, 'frirom_run_set_modes', r, st, text, nmodes, 'nmodes')
         if (st == FRIROM_OK) then
             n = r%m%ndof
             call run_set_modes(r, reshape(phi(:n*nmodes), [n, int(nmodes, ip)]), &
@@ -300,10 +297,7 @@ contains
         integer(c_int), pointer :: pp(:)
         integer(ip) :: st, h1
         character(len=512) :: text
-        text = ''
-        call get_run(run, 'frirom_run_set_selection', r, st, text)
-        if (st == FRIROM_OK .and. nnl < 1) call set_status(st, FRIROM_ERR_SIZE, text, &
-            'frirom_run_set_selection: nnl: expected >= 1')
+        call get_run(run, 'frirom_run_set_selection', r, st, text, nnl, 'nnl')
         if (st == FRIROM_OK) then
             h1 = r%m%nh + 1
             if (c_associated(pair)) then
@@ -433,35 +427,48 @@ contains
     !>                           int msglen): nck = frirom_run_sizes' nck
     function frirom_run_checkpoint_c(run, nck, ck, msg, msglen) result(info) &
         bind(c, name='frirom_run_checkpoint')
-        type(c_ptr), value :: run, msg
+        type(c_ptr), value :: run, ck, msg
         integer(c_int), value :: nck, msglen
-        real(c_double), intent(out) :: ck(*)
         integer(c_int) :: info
-        type(run_t), pointer :: r
-        integer(ip) :: st
-        character(len=512) :: text
-        call run_and_ck(run, nck, 'frirom_run_checkpoint', r, st, text)
-        if (st == FRIROM_OK) call run_checkpoint(r, ck(:nck), st, text)
-        call to_c_string(text, msg, msglen)
-        info = int(st, c_int)
+        info = ck_transfer(run, nck, ck, .true., msg, msglen)
     end function frirom_run_checkpoint_c
 
     !> int frirom_run_restore(frirom_run *run, int nck, const double *ck, char *msg,
     !>                        int msglen): continue from a checkpoint (instead of start)
     function frirom_run_restore_c(run, nck, ck, msg, msglen) result(info) &
         bind(c, name='frirom_run_restore')
-        type(c_ptr), value :: run, msg
+        type(c_ptr), value :: run, ck, msg
         integer(c_int), value :: nck, msglen
-        real(c_double), intent(in) :: ck(*)
+        integer(c_int) :: info
+        info = ck_transfer(run, nck, ck, .false., msg, msglen)
+    end function frirom_run_restore_c
+
+    !> Write (save) or read a run's checkpoint of nck doubles at ck.
+    function ck_transfer(run, nck, ck, save, msg, msglen) result(info)
+        type(c_ptr), intent(in) :: run, ck, msg
+        integer(c_int), intent(in) :: nck, msglen
+        logical, intent(in) :: save
         integer(c_int) :: info
         type(run_t), pointer :: r
+        real(c_double), pointer :: v(:)
         integer(ip) :: st
         character(len=512) :: text
-        call run_and_ck(run, nck, 'frirom_run_restore', r, st, text)
-        if (st == FRIROM_OK) call run_restore(r, ck(:nck), st, text)
+        character(len=*), parameter :: names(2) = ['frirom_run_restore   ', &
+                                                   'frirom_run_checkpoint']
+        call run_and_ck(run, nck, trim(names(merge(2, 1, save))), r, st, text)
+        if (st == FRIROM_OK .and. .not. c_associated(ck)) call set_status(st, &
+            FRIROM_ERR_PARAM, text, trim(names(merge(2, 1, save)))//': ck: NULL')
+        if (st == FRIROM_OK) then
+            call c_f_pointer(ck, v, [nck])
+            if (save) then
+                call run_checkpoint(r, v, st, text)
+            else
+                call run_restore(r, v, st, text)
+            end if
+        end if
         call to_c_string(text, msg, msglen)
         info = int(st, c_int)
-    end function frirom_run_restore_c
+    end function ck_transfer
 
     !> The run behind a C pointer and a checkpoint length that fits it (FRIROM_ERR_SIZE
     !> naming nck otherwise).
@@ -498,14 +505,21 @@ contains
         info = int(st, c_int)
     end function frirom_run_close_c
 
-    !> The run behind a C pointer (FRIROM_ERR_PARAM naming `who` for NULL or a closed run).
-    subroutine get_run(run, who, r, st, text)
+    !> The run behind a C pointer (FRIROM_ERR_PARAM naming `who` for NULL or a closed run)
+    !> and, given, a count >= 1 (FRIROM_ERR_SIZE naming it otherwise).
+    subroutine get_run(run, who, r, st, text, count, name)
         type(c_ptr), intent(in) :: run
         character(len=*), intent(in) :: who
         type(run_t), pointer, intent(out) :: r
         integer(ip), intent(out) :: st
         character(len=*), intent(inout) :: text
+        integer(c_int), intent(in), optional :: count
+        character(len=*), intent(in), optional :: name
+        text = ''
         call run_from_handle(transfer(run, 0_c_intptr_t), r, who, st, text)
+        if (st /= FRIROM_OK .or. .not. present(count)) return
+        if (count < 1) call set_status(st, FRIROM_ERR_SIZE, text, who//': '//name// &
+                                        ': expected >= 1')
     end subroutine get_run
 
     !> FRIROM_ERR_SIZE naming the first negative count (names: blank-separated, in order).

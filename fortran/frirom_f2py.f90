@@ -213,17 +213,13 @@ subroutine frun_set_selection(handle, nnl, nh1, keep, pair, haspair, orbits, orb
     character(len=512), intent(out) :: msg
     type(run_t), pointer :: r
     integer(ip) :: linfo
+    integer(ip), allocatable :: pr(:, :)     ! unallocated: no pair (absent)
     msg = ''
     orbinfo = 0.0d0
+    if (haspair == 1) pr = int(pair, ip)
     call run_from_handle(handle, r, 'run_set_selection', linfo, msg)
-    if (linfo == 0) then
-        if (haspair == 1) then
-            call fr_select(r, int(keep, ip), linfo, msg, pair=int(pair, ip), &
-                           orbits=orbits == 1, orbtol=orbtol)
-        else
-            call fr_select(r, int(keep, ip), linfo, msg)
-        end if
-    end if
+    if (linfo == 0) call fr_select(r, int(keep, ip), linfo, msg, pair=pr, &
+                                   orbits=orbits == 1, orbtol=orbtol)
     if (linfo == 0) orbinfo = [real(r%orb_nrep, 8), r%orb_mis]
     info = linfo
 end subroutine frun_set_selection
@@ -247,18 +243,15 @@ subroutine frun_start(handle, kind, lam_start, lam_end, lam0, ny, y0, tan0, ysca
     character(len=512), intent(out) :: msg
     type(run_t), pointer :: r
     integer(ip) :: linfo
+    real(8), allocatable :: sl(:)            ! unallocated: the run's own history (absent)
     msg = ''
     timings = 0.0d0
+    if (hassliders == 1) sl = sliders
     call run_from_handle(handle, r, 'run_start', linfo, msg)
-    if (linfo == 0 .and. hassliders == 1) then
-        call fr_start(r, int(kind, ip), lam_start, lam_end, linfo, msg, lam0=lam0, y0=y0, &
-                      tan0=tan0, yscale=yscale, ds=ds, lscale_old=lscale_old, &
-                      n_before=int(n_before, ip), sliders=sliders)
-    else if (linfo == 0) then
-        call fr_start(r, int(kind, ip), lam_start, lam_end, linfo, msg, lam0=lam0, y0=y0, &
-                      tan0=tan0, yscale=yscale, ds=ds, lscale_old=lscale_old, &
-                      n_before=int(n_before, ip))
-    end if
+    if (linfo == 0) call fr_start(r, int(kind, ip), lam_start, lam_end, linfo, msg, &
+                                  lam0=lam0, y0=y0, tan0=tan0, yscale=yscale, ds=ds, &
+                                  lscale_old=lscale_old, n_before=int(n_before, ip), &
+                                  sliders=sl)
     if (associated(r)) timings(1:min(ntim, size(r%timers))) = r%timers(1:min(ntim, size(r%timers)))
     info = linfo
 end subroutine frun_start
@@ -357,6 +350,7 @@ subroutine frun_solve(handle, kind, lam0, ny, y0, tan0, yscale, ds, nw, sliders,
     type(run_t), pointer :: r
     type(run_points) :: p
     integer(ip) :: linfo
+    real(8), allocatable :: sl(:)            ! unallocated: the run's own history (absent)
     msg = ''
     y = 0.0d0
     lam = 0.0d0
@@ -376,14 +370,10 @@ subroutine frun_solve(handle, kind, lam0, ny, y0, tan0, yscale, ds, nw, sliders,
             call set_status(linfo, FRIROM_ERR_SIZE, msg, 'run_solve: array sizes do not '// &
                             'match the run')
     end if
-    if (linfo == 0 .and. hassliders == 1) then
-        call fr_solve(r, int(kind, ip), lam0, y0, p, linfo, msg, tan0=tan0, yscale=yscale, &
-                      ds=ds, sliders=sliders(1:r%nw), stability=stability == 1, &
-                      cold=cold == 1)
-    else if (linfo == 0) then
-        call fr_solve(r, int(kind, ip), lam0, y0, p, linfo, msg, tan0=tan0, yscale=yscale, &
-                      ds=ds, stability=stability == 1, cold=cold == 1)
-    end if
+    if (hassliders == 1 .and. associated(r)) sl = sliders(1:r%nw)
+    if (linfo == 0) call fr_solve(r, int(kind, ip), lam0, y0, p, linfo, msg, tan0=tan0, &
+                                  yscale=yscale, ds=ds, sliders=sl, &
+                                  stability=stability == 1, cold=cold == 1)
     if (linfo == 0 .and. p%npts /= 1) call set_status(linfo, FRIROM_ERR_SIZE, msg, &
                                                       'run_solve: no point')
     if (linfo == 0) then

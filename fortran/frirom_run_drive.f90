@@ -92,9 +92,7 @@ contains
     end procedure run_open
 
     module procedure run_build
-        integer(ip) :: nrep, g
-        integer(ip), allocatable :: omap(:)
-        real(wp) :: mis
+        integer(ip) :: g
         info = FRIROM_OK
         if (allocated(run%sys)) then
             call aft_plan_destroy(run%sys%plan)
@@ -119,27 +117,8 @@ contains
                                                               info, errmsg)
             if (info /= 0) return
             run%netot = sum(m%ginfo(2, :))
-            if (allocated(m%keep)) then
-                if (run%s%stability /= 0) then
-                    call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: Hill '// &
-                                    'stability would see only perturbations inside the '// &
-                                    'selection; not with stability')
-                    return
-                end if
-                if (allocated(m%pair)) then
-                    call hbm_set_selection(run%sys, m%keep, info, errmsg, pair=m%pair)
-                    if (info == 0 .and. m%orbits) then
-                        allocate (omap(max(run%netot, 1)))
-                        omap = 0
-                        call hbm_set_orbits(run%sys, m%orbtol, nrep, mis, info, errmsg, omap)
-                        run%orb_nrep = nrep
-                        run%orb_mis = mis
-                    end if
-                else
-                    call hbm_set_selection(run%sys, m%keep, info, errmsg)
-                end if
-                if (info /= 0) return
-            end if
+            if (allocated(m%keep)) call apply_selection(run, info, errmsg)
+            if (info /= 0) return
             run%nout = size(m%outdofs)
         end associate
         select type (sys => run%sys)
@@ -156,17 +135,12 @@ contains
     end procedure run_build
 
     module procedure run_set_modes
-        info = FRIROM_OK
-        if (.not. open_run(run, 'run_set_modes', info, errmsg)) return
-        if (size(phi, 1) /= run%m%ndof .or. size(wm) /= size(phi, 2) .or. &
-            size(zm) /= size(phi, 2) .or. size(phi, 2) < 1) then
-            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'modes: phi (ndof, nm), omega '// &
-                            'and zeta (nm) expected, nm >= 1')
-        else if (.not. (all(abs(phi) <= huge(1.0_wp)) .and. good_modes(wm, zm))) then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'modes: finite shapes, '// &
-                            'positive frequencies and damping ratios >= 0 expected')
-        end if
-        if (info /= 0) return
+        if (.not. modes_ok(run, size(phi, 1) /= run%m%ndof .or. size(phi, 2) < 1 .or. &
+                           any(shape(wm) /= [size(phi, 2)]) .or. &
+                           any(shape(zm) /= [size(phi, 2)]), &
+                           all(abs(phi) <= huge(1.0_wp)) .and. good_modes(wm, zm), &
+                           'run_set_modes: phi (ndof, nm), omega and zeta (nm)', info, &
+                           errmsg)) return
         run%m%phi = phi
         run%m%wm = wm
         run%m%zm = zm
@@ -175,25 +149,38 @@ contains
     end procedure run_set_modes
 
     module procedure run_set_modes_harmonic
-        info = FRIROM_OK
-        if (.not. open_run(run, 'run_set_modes_harmonic', info, errmsg)) return
-        if (size(psi, 1) /= run%m%ndof .or. size(psi, 3) /= run%m%nh + 1 .or. &
-            any(shape(wh) /= [size(psi, 2), size(psi, 3)]) .or. &
-            any(shape(zh) /= shape(wh))) then
-            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'harmonic modes: psi (ndof, '// &
-                            'nm, H+1), omega and zeta (nm, H+1) expected')
-        else if (.not. (all(abs(psi) <= huge(1.0_wp)) .and. &
-                        good_modes(reshape(wh, [size(wh)]), reshape(zh, [size(zh)])))) then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'harmonic modes: finite '// &
-                            'shapes, positive frequencies and damping ratios >= 0 expected')
-        end if
-        if (info /= 0) return
+        if (.not. modes_ok(run, size(psi, 1) /= run%m%ndof .or. size(psi, 3) /= &
+                           run%m%nh + 1 .or. any(shape(wh) /= [size(psi, 2), size(psi, 3)]) &
+                           .or. any(shape(zh) /= shape(wh)), all(abs(psi) <= huge(1.0_wp)) &
+                           .and. good_modes(reshape(wh, [size(wh)]), reshape(zh, &
+                           [size(zh)])), 'run_set_modes_harmonic: psi (ndof, nm, H+1), '// &
+                           'omega and zeta (nm, H+1)', info, errmsg)) return
         run%m%psi = psi
         run%m%wh = wh
         run%m%zh = zh
         call apply_modes(run, .true., info, errmsg)
         if (info /= 0) deallocate (run%m%psi, run%m%wh, run%m%zh)
     end procedure run_set_modes_harmonic
+
+    !> An open run and modes of the sizes (bad_size false) and values (good) expected;
+    !> else info (FRIROM_ERR_SIZE or _PARAM) with `what` in the message.
+    logical function modes_ok(run, bad_size, good, what, info, errmsg)
+        type(run_t), intent(in) :: run
+        logical, intent(in) :: bad_size, good
+        character(len=*), intent(in) :: what
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        info = FRIROM_OK
+        modes_ok = .false.
+        if (.not. open_run(run, what(1:index(what, ':') - 1), info, errmsg)) return
+        if (bad_size) then
+            call set_status(info, FRIROM_ERR_SIZE, errmsg, what//' expected (nm >= 1)')
+        else if (.not. good) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, what//': finite shapes, '// &
+                            'positive frequencies and damping ratios >= 0 expected')
+        end if
+        modes_ok = info == FRIROM_OK
+    end function modes_ok
 
     !> Finite positive natural frequencies and finite damping ratios >= 0.
     pure logical function good_modes(w, z)
@@ -219,41 +206,49 @@ contains
     end subroutine apply_modes
 
     module procedure run_set_selection
+        info = FRIROM_OK
+        if (.not. open_run(run, 'run_set_selection', info, errmsg)) return
+        if (allocated(run%m%keep)) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'run_set_selection: the run has '// &
+                            'a selection already (open a new run)')
+            return
+        end if
+        run%m%keep = keep
+        if (present(pair)) run%m%pair = pair
+        run%m%orbits = .false.
+        if (present(pair) .and. present(orbits)) run%m%orbits = orbits
+        if (present(orbtol)) run%m%orbtol = orbtol
+        call apply_selection(run, info, errmsg)
+        if (info /= 0) then
+            deallocate (run%m%keep)
+            if (allocated(run%m%pair)) deallocate (run%m%pair)
+        end if
+    end procedure run_set_selection
+
+    !> The model's selection (run%m keep, pair, orbits) on the system, after its modes;
+    !> refused with stability (Hill's method would see only perturbations inside it).
+    subroutine apply_selection(run, info, errmsg)
+        type(run_t), intent(inout) :: run
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
         integer(ip) :: nrep
         integer(ip), allocatable :: omap(:)
         real(wp) :: mis
         info = FRIROM_OK
-        if (.not. open_run(run, 'run_set_selection', info, errmsg)) return
         if (run%s%stability /= 0) then
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'selection: Hill stability '// &
                             'would see only perturbations inside the selection; not with '// &
                             'stability')
             return
         end if
-        if (allocated(run%m%keep)) then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'run_set_selection: the run has '// &
-                            'a selection already (open a new run)')
-            return
-        end if
-        if (present(pair)) then
-            call hbm_set_selection(run%sys, keep, info, errmsg, pair=pair)
-        else
-            call hbm_set_selection(run%sys, keep, info, errmsg)
-        end if
-        if (info /= 0) return
-        run%m%keep = keep
-        if (present(pair)) run%m%pair = pair
-        if (present(pair) .and. present(orbits)) run%m%orbits = orbits
-        if (present(orbtol)) run%m%orbtol = orbtol
-        if (run%m%orbits) then
-            allocate (omap(max(run%netot, 1)))
-            omap = 0
-            call hbm_set_orbits(run%sys, run%m%orbtol, nrep, mis, info, errmsg, omap)
-            if (info /= 0) return
-            run%orb_nrep = nrep
-            run%orb_mis = mis
-        end if
-    end procedure run_set_selection
+        call hbm_set_selection(run%sys, run%m%keep, info, errmsg, pair=run%m%pair)
+        if (info /= 0 .or. .not. (run%m%orbits .and. allocated(run%m%pair))) return
+        allocate (omap(max(run%netot, 1)))
+        omap = 0
+        call hbm_set_orbits(run%sys, run%m%orbtol, nrep, mis, info, errmsg, omap)
+        run%orb_nrep = nrep
+        run%orb_mis = mis
+    end subroutine apply_selection
 
     module procedure run_start
         real(wp) :: nt
