@@ -40,7 +40,7 @@ module frirom_run
               run_start, run_advance, run_solve, run_close, run_get_sliders, run_set_sliders, &
               run_advice, run_sizes, run_default_samples, settings_pack, settings_unpack, &
               run_settings_names, run_handle, run_from_handle, run_checkpoint_size, &
-              run_checkpoint, run_restore, run_contact_coords
+              run_checkpoint, run_restore, run_contact_coords, open_run
     public :: RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_LOAD, &
               RUN_START_COLD, RUN_START_POINT, RUN_START_RESUME, &
               RUN_GOING, RUN_DONE, RUN_MAX_POINTS, RUN_LEFT_RANGE, RUN_FAILED, RUN_STALLED, &
@@ -564,12 +564,23 @@ contains
                                                    'or never opened)')
     end subroutine run_from_handle
 
+    !> Whether the run is open and built; else info = FRIROM_ERR_PARAM naming the call.
+    !> (Public: gfortran leaves out a private module procedure that only submodules call.)
+    logical function open_run(run, who, info, errmsg)
+        type(run_t), intent(in) :: run
+        character(len=*), intent(in) :: who
+        integer(ip), intent(inout) :: info
+        character(len=*), intent(inout) :: errmsg
+        open_run = run%built .and. run%magic == RUN_MAGIC
+        if (.not. open_run) call set_status(info, FRIROM_ERR_PARAM, errmsg, who// &
+                                            ': the run is not open (run_open first)')
+    end function open_run
+
     !> Free everything the run holds; the run can be opened again.
     subroutine run_close(run)
         use frirom_aft, only: aft_plan_destroy
         type(run_t), intent(inout) :: run
-        type(run_t) :: fresh
         if (allocated(run%sys)) call aft_plan_destroy(run%sys%plan)
-        run = fresh
+        run = run_t()
     end subroutine run_close
 end module frirom_run
