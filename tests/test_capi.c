@@ -60,6 +60,52 @@ int main(void) {
             return 1;
         }
     }
+    {   /* the run object: bad calls return a code and a message naming the argument or
+         * the call, never stop the process (a NULL or closed run, a negative count, a NaN
+         * contact parameter, a checkpoint of another length, an advance before start) */
+        const int kr[] = {0}, md[] = {0}, ginfo[] = {FRIROM_LAW_JENKINS, 1, 1}, gr[] = {0};
+        const int out[] = {0};
+        const double kv[] = {1e4}, mv[] = {1.0}, gv[] = {1.0}, fe[3] = {0, 1, 0};
+        double p[3] = {1e5, 0.3, 100.0}, om[2], xo[6], amp[2], ck[64];
+        int npts, status, ny, nw, ne, nck;
+        struct frirom_settings s;
+        frirom_run *run = NULL;
+        frirom_settings_default(&s);
+        s.harmonics = 1;
+#define REFUSED(what, call, expect)                                                       \
+        if ((call) == 0 || strstr(msg, expect) == NULL) {                                   \
+            fprintf(stderr, "%s: accepted or unnamed: %s\n", what, msg);                    \
+            return 1;                                                                       \
+        }
+        REFUSED("NULL run", frirom_run_start(NULL, 50.0, 150.0, msg, 256), "not an open run")
+        REFUSED("negative nk", frirom_run_open(&run, 1, -1, kr, kr, kv, 1, md, md, mv, 0, NULL,
+                NULL, NULL, 0.0, 0.0, 0, NULL, 1, ginfo, 1, gr, gr, gv, 3, p, 0, NULL, fe, 1,
+                out, &s, 0, msg, 256), "nk")
+        p[1] = NAN;
+        REFUSED("NaN mu", frirom_run_open(&run, 1, 1, kr, kr, kv, 1, md, md, mv, 0, NULL, NULL,
+                NULL, 0.0, 0.0, 0, NULL, 1, ginfo, 1, gr, gr, gv, 3, p, 0, NULL, fe, 1, out, &s,
+                0, msg, 256), "params")
+        p[1] = 0.3;
+        if (run != NULL || frirom_run_open(&run, 1, 1, kr, kr, kv, 1, md, md, mv, 0, NULL,
+                                           NULL, NULL, 0.0, 0.0, 0, NULL, 1, ginfo, 1, gr, gr,
+                                           gv, 3, p, 0, NULL, fe, 1, out, &s, 0, msg, 256)) {
+            fprintf(stderr, "run_open: %s\n", msg);
+            return 1;
+        }
+        frirom_run_sizes(run, &ny, &nw, &ne, &nck);
+        REFUSED("advance before start", frirom_run_advance(run, 1, &npts, om, xo, amp, NULL,
+                &status, msg, 256), "run_start first")
+        REFUSED("negative start", frirom_run_start(run, -50.0, 150.0, msg, 256),
+                "positive frequencies")
+        REFUSED("restore of another length", frirom_run_restore(run, nck + 1, ck, msg, 256),
+                "nck")
+        REFUSED("no modes", frirom_run_set_modes(run, 0, NULL, NULL, NULL, msg, 256), "nmodes")
+        frirom_run_close(&run);
+        if (run != NULL || frirom_run_close(&run) != 0) {
+            fprintf(stderr, "close did not clear the run\n");
+            return 1;
+        }
+    }
     puts("test_capi: ok");
     return 0;
 }
