@@ -359,7 +359,6 @@ contains
         integer(ip) :: h, i, k, j, ndof, nnl, stat
         complex(wp), allocatable :: rhs(:, :)
         real(wp) :: hw
-        logical :: ok
         info = FRIROM_OK
         ndof = sys%ndof
         nnl = sys%nnl
@@ -378,31 +377,15 @@ contains
             call zband_init(sys%d, sys%ndof, sys%bw, sys%bw, info, errmsg)
             if (info /= 0) return
         end if
-        ok = .true.
+        if (.not. allocated(sys%dband)) then
+            call band_layout(sys, info, errmsg)
+            if (info /= 0) return
+        end if
         allocate (rhs(ndof, nnl + 2))
         do h = 0, sys%nh
             hw = h*w
-            call zband_zero(sys%d)
-            do i = 1, ndof
-                do k = sys%k%p(i), sys%k%p(i + 1) - 1
-                    call zband_add(sys%d, sys%iperm(i), sys%iperm(sys%k%i(k)), &
-                                   cmplx(sys%k%x(k), 0.0_wp, wp), ok)
-                end do
-                do k = sys%m%p(i), sys%m%p(i + 1) - 1
-                    call zband_add(sys%d, sys%iperm(i), sys%iperm(sys%m%i(k)), &
-                                   cmplx(-hw*hw*sys%m%x(k), 0.0_wp, wp), ok)
-                end do
-                if (h > 0) then
-                    do k = sys%c%p(i), sys%c%p(i + 1) - 1
-                        call zband_add(sys%d, sys%iperm(i), sys%iperm(sys%c%i(k)), &
-                                       cmplx(0.0_wp, hw*sys%c%x(k), wp), ok)
-                    end do
-                end if
-            end do
-            if (.not. ok) then
-                call set_status(info, FRIROM_ERR_MODEL, errmsg, 'receptance: entry outside band')
-                return
-            end if
+            sys%d%ab = cmplx(sys%dband(:, :, 1) - hw*hw*sys%dband(:, :, 2), &
+                             hw*sys%dband(:, :, 3), wp)
             call zband_factor(sys%d, info, errmsg)
             if (info /= 0) return
             rhs = (0.0_wp, 0.0_wp)
@@ -422,6 +405,43 @@ contains
             end do
         end do
     end subroutine receptance_banded
+
+    !> K, M and C (sys%dband(:, :, 1:3)) in the band layout of sys%d, in RCM order: the
+    !> dynamic stiffness of any harmonic is then their combination (receptance_banded).
+    subroutine band_layout(sys, info, errmsg)
+        type(hbm_condensed), intent(inout) :: sys
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        integer(ip) :: i, k, stat
+        logical :: ok
+        info = FRIROM_OK
+        allocate (sys%dband(size(sys%d%ab, 1), size(sys%d%ab, 2), 3), stat=stat)
+        if (stat /= 0) then
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'receptance: band of K, M, C')
+            return
+        end if
+        ok = .true.
+        call put(sys%k, 1_ip)
+        call put(sys%m, 2_ip)
+        call put(sys%c, 3_ip)
+        if (.not. ok) call set_status(info, FRIROM_ERR_MODEL, errmsg, 'receptance: entry '// &
+                                      'outside band')
+
+    contains
+
+        subroutine put(a, m)
+            type(csr_matrix), intent(in) :: a
+            integer(ip), intent(in) :: m
+            call zband_zero(sys%d)
+            do i = 1, sys%ndof
+                do k = a%p(i), a%p(i + 1) - 1
+                    call zband_add(sys%d, sys%iperm(i), sys%iperm(a%i(k)), &
+                                   cmplx(a%x(k), 0.0_wp, wp), ok)
+                end do
+            end do
+            sys%dband(:, :, m) = real(sys%d%ab, wp)
+        end subroutine put
+    end subroutine band_layout
 
     !> receptance_banded's columns (into the allocated ymat) by a sparse LU of D_h per
     !> harmonic (MUMPS, one triangle of K, M, C in coordinate form, natural DoF order:
