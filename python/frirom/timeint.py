@@ -7,8 +7,9 @@ Integrates
 
 over many forcing periods with a fixed step until the response is periodic, then returns
 the harmonics of the last period. It is written from the contact physics alone (each law's
-slider is tracked by its own return map here; nothing from :mod:`frirom.contact`, the AFT
-kernel or the solver is used), so that it is an independent check of the HBM results.
+slider is tracked by its own return map, :mod:`frirom._timeint_maps`; nothing from
+:mod:`frirom.contact`, the AFT kernel or the solver is used), so that it is an independent
+check of the HBM results.
 
 Scheme: central differences with the damping term centred (explicit Newmark, gamma = 1/2,
 beta = 0), ``x[n+1] = E1 (f_e - g) + E2 x[n] - E3 x[n-1]``. It is second order in the step
@@ -52,7 +53,9 @@ import numpy as np
 import scipy.linalg
 
 from ._errors import InputError
+from ._timeint_maps import _forces, period_change
 from .contact import LAWS
+from .timeint_implicit import integrate_implicit
 
 #: ``method="auto"`` integrates implicitly when the explicit scheme needs more than this
 #: times ``steps_per_period`` steps. An implicit step costs 4 to 7 times an explicit one
@@ -126,53 +129,6 @@ class TimeContact:
         k = np.abs(k).reshape(-1)
         assert k.size == self.G.shape[0] and ndir >= 1
         return self.G.T @ (k[:, None] * self.G)
-
-
-def _forces(law: str, p: list, u: np.ndarray, w: np.ndarray):
-    """Contact forces and updated sliders for a batch.
-
-    u: (nb, ne, ndir) local relative displacements; w: (nb, ne, nslider).
-    Returns f (nb, ne, ndir), w_new, state (nb, ne) int: 0 stick, 1 slip, 2 lift-off.
-    """
-    if law == "cubic":
-        k1, k3 = p
-        x = u[..., 0]
-        f = (k1 * x + k3 * x ** 3)[..., None]
-        return f, w, np.zeros(x.shape, dtype=np.int8)
-    if law == "jenkins":
-        kt, mu, fn0 = p
-        x = u[..., 0]
-        limit = mu * fn0
-        trial = kt * (x - w[..., 0])
-        slip = np.abs(trial) > limit
-        ft = np.where(slip, np.sign(trial) * limit, trial)
-        w_new = np.where(slip, x - ft / kt, w[..., 0])[..., None]
-        return ft[..., None], w_new, slip.astype(np.int8)
-    if law == "normal1d":
-        kt, kn, mu, n0 = p
-        x, v = u[..., 0], u[..., 1]
-        fn = np.maximum(n0 + kn * v, 0.0)
-        limit = mu * fn
-        trial = kt * (x - w[..., 0])
-        slip = np.abs(trial) > limit
-        ft = np.where(slip, np.sign(trial) * limit, trial)
-        w_new = np.where(slip, x - ft / kt, w[..., 0])[..., None]
-        state = np.where(fn <= 0.0, 2, slip.astype(np.int8)).astype(np.int8)
-        return np.stack([ft, fn], axis=-1), w_new, state
-    if law == "normal2d":
-        kt, kn, mu, n0 = p
-        x, v = u[..., :2], u[..., 2]
-        fn = np.maximum(n0 + kn * v, 0.0)
-        limit = mu * fn
-        trial = kt[..., None] * (x - w)
-        norm = np.sqrt(np.sum(trial ** 2, axis=-1))
-        slip = norm > limit
-        scale = np.where(slip, limit / np.where(norm > 0.0, norm, 1.0), 1.0)
-        ft = trial * scale[..., None]
-        w_new = np.where(slip[..., None], x - ft / kt[..., None], w)
-        state = np.where(fn <= 0.0, 2, slip.astype(np.int8)).astype(np.int8)
-        return np.concatenate([ft, fn[..., None]], axis=-1), w_new, state
-    raise InputError(f"timeint: unknown law {law!r}")
 
 
 @dataclass
@@ -369,17 +325,6 @@ def integrate(M, C, K, contacts, F, omega, *, H: int = 5, periods: int = 200,
                    [gr[5] for gr in groups])
 
 
-def period_change(last, prev, may_stop: bool, tol: float):
-    """(drift (nb,), stop): largest change of x between the periods ``prev`` and ``last``
-    (nb, N, n) relative to max |x| (inf without ``prev``), and whether every frequency is
-    below ``tol`` while ``may_stop``."""
-    if prev is None:
-        return np.full(last.shape[0], np.inf), False
-    scale = np.maximum(np.abs(last).max(axis=(1, 2)), 1e-300)
-    drift = np.abs(last - prev).max(axis=(1, 2)) / scale
-    return drift, bool(may_stop and np.all(drift < tol))
-
-
 def _external(F):
     """f_e at phases tau: tau (k,) -> (k, n), f_e = Re sum_h F[:, h] exp(i h tau)."""
     hF = np.arange(F.shape[1])
@@ -412,7 +357,6 @@ def _result(omega, H, last, drift, n_done, N, states, x, x_prev, v, w,
 def _run_implicit(M, C, K, contacts, F, omega, *, H, periods, min_periods,
                   steps_per_period, tol, x0, v0, w0, alpha) -> TimeResult:
     """integrate(..., method="implicit"): see :mod:`frirom.timeint_implicit`."""
-    from .timeint_implicit import integrate_implicit
     n, nb = M.shape[0], omega.size
     N = max(int(steps_per_period), 4 * H + 4)
     N += N % 2

@@ -33,10 +33,10 @@ are fewer) by Newton's method,
     z - z_lin + (1 + alpha) W f(B z) = 0,     W = T K_eff^-1 G^T,
 
 with the exact (generalised) Jacobian of the return maps. The return maps are those of
-:func:`frirom.timeint._forces` (this module's own, not the HB code's): the slider is updated
-from the step's start, exact for a monotone relative displacement within the step. Newton
-converges in a finite number of iterations for the piecewise-linear laws (jenkins,
-normal1d, normal2d in 1-D slip) once the stick/slip/lift-off states are right.
+:func:`frirom._timeint_maps._forces` (the time integrations' own, not the HB code's): the
+slider is updated from the step's start, exact for a monotone relative displacement within
+the step. Newton converges in a finite number of iterations for the piecewise-linear laws
+(jenkins, normal1d, normal2d in 1-D slip) once the stick/slip/lift-off states are right.
 """
 
 from __future__ import annotations
@@ -45,8 +45,8 @@ import numpy as np
 import scipy.linalg
 
 from ._errors import ConvergenceError, InputError
+from ._timeint_maps import _forces, period_change  # the same return maps
 from .contact import LAWS
-from .timeint import _forces, period_change  # the same return maps
 
 
 def hht_coefficients(alpha: float) -> tuple[float, float]:
@@ -82,7 +82,7 @@ def algorithmic_properties(alpha: float, omega_dt) -> tuple[np.ndarray, np.ndarr
 
 
 def _forces_and_tangent(law: str, p: list, u: np.ndarray, w: np.ndarray):
-    """Forces, updated sliders, states (as :func:`frirom.timeint._forces`) and the
+    """Forces, updated sliders, states (as :func:`frirom._timeint_maps._forces`) and the
     tangent D (nb, ne, ndir, ndir) = d f / d u of the return map from the sliders w."""
     f, w_new, state = _forces(law, p, u, w)
     nb, ne, nd = u.shape
