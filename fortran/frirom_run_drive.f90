@@ -582,7 +582,7 @@ contains
             sys%gm_spent = 0.0_wp
             sys%gm_next = .false.
             sys%refresh = .false.
-            sys%wb_ok = .false.
+            sys%held%wb%ok = .false.
         end select
     end subroutine forget_lu
 
