@@ -74,7 +74,7 @@ class Deck:
     omega_end: float
     frequency_unit: str
     continuation: dict        # the [continuation] keys given
-    solver: dict              # the [solver] tolerances given, and 'stability'
+    solver: dict              # the [solver] tolerances given, 'stability', 'history'
     outputs: list             # DoF indices (-1: an FE DoF recovered through output_map)
     output_names: list        # as the deck names them ("ACTIVE:z", "1234:UX", "tip:x")
     dof_labels: list | None = None
@@ -177,7 +177,8 @@ class Deck:
         kw = {"harmonics": self.harmonics, "samples": self.samples,
               "formulation": self.formulation}
         for key, name in (("tol_residual", "tol_residual"), ("tol_update", "tol_update"),
-                          ("max_iterations", "max_iter"), ("stability", "stability")):
+                          ("max_iterations", "max_iter"), ("stability", "stability"),
+                          ("tol_stall", "tol_stall"), ("history", "history")):
             if key in self.solver:
                 kw[name] = self.solver[key]
         for key, name in (("step", "ds"), ("min_step", "ds_min"), ("max_step", "ds_max"),
@@ -330,9 +331,11 @@ class _Builder:
         if s.cyclic is not None:
             cyclic = cyclic_modes(s.path, sector, rom, s.cyclic, damping, H, log.append)
         sol = s.solver
-        solver = {k: getattr(sol, k) for k in ("tol_residual", "tol_update", "max_iterations")
+        solver = {k: getattr(sol, k) for k in ("tol_residual", "tol_update", "max_iterations",
+                                               "tol_stall")
                   if getattr(sol, k) is not None}
         solver["stability"] = sol.stability
+        solver["history"] = sol.history
         cont = {k: v for k, v in vars(s.continuation).items() if v is not None}
         return Deck(path=s.path, title=s.title, M=M, K=K, damping=damping, F=F,
                     contacts=contacts, harmonics=H, samples=sol.samples,
