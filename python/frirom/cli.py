@@ -297,9 +297,18 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
             progress.update(point)
 
         t0 = time.perf_counter()
+        # interface modes "auto": the chosen rung's curve when it is this run's (frirom.auto)
+        reuse = None if args.resume else getattr(deck, "auto_response", None)
         try:
-            result = frf(model, excitation, deck.omega_start, deck.omega_end, options,
-                         outputs=deck.solver_outputs, sink=sink, start=start)
+            if reuse is not None:
+                result = reuse[0]
+                for point in reuse[1]:
+                    sink(point)
+                print("frirom: auto: the chosen rung's curve covers the range with these "
+                      "settings: written, not computed again")
+            else:
+                result = frf(model, excitation, deck.omega_start, deck.omega_end, options,
+                             outputs=deck.solver_outputs, sink=sink, start=start)
         except KeyboardInterrupt:
             progress.close()
             writer.close(complete=False, message="interrupted")
