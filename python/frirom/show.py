@@ -364,7 +364,7 @@ def write_point(state: PointState, out: Path, chosen=None, n_top: int = 4) -> li
         w = csv.writer(fh)
         w.writerow(["t_s", "phase_rad"] + list(state.labels))
         for i in range(n):
-            w.writerow([repr(tau[i] / state.omega), repr(tau[i])]
+            w.writerow([repr(float(tau[i] / state.omega)), repr(float(tau[i]))]
                        + [repr(float(v)) for v in xt[:, i]])
     written.append(out / "time.csv")
     pick = _chosen(state, chosen, n_top)
@@ -376,7 +376,7 @@ def write_point(state: PointState, out: Path, chosen=None, n_top: int = 4) -> li
             c = state.contacts[g]
             for d, dn in enumerate(c.directions):
                 for i in range(c.tau.size):
-                    w.writerow([c.name, e, repr(c.tau[i]), dn, repr(float(c.u[e, d, i])),
+                    w.writerow([c.name, e, repr(float(c.tau[i])), dn, repr(float(c.u[e, d, i])),
                                 repr(float(c.f[e, d, i]))])
     written.append(out / "hysteresis.csv")
     with open(out / "contacts.csv", "w", newline="") as fh:
