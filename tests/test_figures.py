@@ -100,3 +100,45 @@ def test_linear_figure_names_outputs_and_ignores_round_off():
         assert n in names, names
     lo, hi = fig.axes[0].get_ylim()
     assert lo >= 1e-4 * big.max() / 1.5 * 0.999 and hi <= 1.5 * big.max() * 1.001
+
+
+def test_paper_flange_markers_named_for_every_load(tmp_path, monkeypatch):
+    # fig9_stage1.png drew ROM_II markers for 10, 30 and 100 N in colours the legend never
+    # named: colours were named by ROM_I's lines only (here ROM_I ran the quick family 1,
+    # 30, 300 N), marker styles by the first F0's. Now every colour of a line or marker
+    # has an F0 entry and every marker style a model entry.
+    import json
+    import sys
+    from pathlib import Path
+
+    import matplotlib.colors as mcolors
+    from matplotlib.figure import Figure
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "paper_flange"))
+    import paper_flange as pf
+    (tmp_path / "case.json").write_text(json.dumps({"f_stuck": 100.0}))
+    f = np.linspace(90, 110, 50)
+
+    def curve(f0):
+        a = f0 / (1 + (f - 100) ** 2)
+        return {"f": f.tolist(), "amp": [a.tolist(), (0.5 * a).tolist()],
+                "peak_amp": [a.max(), 0.5 * a.max()], "f0": f0}
+    res = {"rom1": {f"{x:g}": curve(x) for x in pf.F0_QUICK},
+           "rom2": {f"{x:g}": curve(x) for x in (10.0, 30.0, 100.0)}}
+    figs = []
+    real = Figure.savefig
+    monkeypatch.setattr(Figure, "savefig", lambda self, *a, **k: (figs.append(self),
+                                                                    real(self, *a, **k)))
+    paths = pf.figures(tmp_path, False, res)
+    assert [p.name for p in paths] == ["fig9_stage1.png", "fig10_stage2.png"]
+    for fig in figs:
+        ax = fig.axes[0]
+        entries = dict(zip([t.get_text() for t in ax.get_legend().get_texts()],
+                           ax.get_legend().legend_handles))
+        for x in (10, 30, 100):
+            assert f"F0 = {x} N" in entries, entries.keys()
+        assert "ROM_II (h = 2)" in entries and "ROM_I (line)" in entries
+        named = {mcolors.to_hex(h.get_color()) for t, h in entries.items()
+                 if t.startswith("F0")}
+        for line in ax.get_lines():
+            if line.get_xdata().size and line.get_marker() not in ("None", "", None):
+                assert mcolors.to_hex(line.get_color()) in named
