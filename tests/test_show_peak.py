@@ -47,3 +47,25 @@ def test_show_peak_falls_back_to_the_highest_stored_point(tmp_path, monkeypatch,
     assert f"point {k} at {r.omega[k] / 2 / np.pi:.6g} Hz" in io.err
     assert f"point {k} solved at {r.omega[k] / 2 / np.pi:.6g} Hz" in io.out
     assert (tmp_path / "pt" / "hysteresis.csv").is_file()
+
+
+def test_cli_turns_python_warnings_into_frirom_lines(monkeypatch, capsys):
+    # A frirom warning and a numpy RuntimeWarning during a command reach the terminal as
+    # one "frirom: warning:" line each, frequencies also in Hz, no Python source line.
+    import warnings
+
+    import frirom.cli
+
+    def cmd(args):
+        warnings.warn("frirom: continuation stopped early: the range through omega = "
+                      "2950.3 rad/s", RuntimeWarning)
+        np.log(np.zeros(1))                    # numpy: divide by zero in log
+        return 0
+    monkeypatch.setattr(frirom.cli, "cmd_show", cmd)
+    assert main(["show", "somewhere"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert err[0] == ("frirom: warning: continuation stopped early: the range through "
+                      f"omega = 2950.3 rad/s ({2950.3 / 2 / np.pi:.6g} Hz)"), err
+    assert err[1].startswith("frirom: warning: numerical: divide by zero encountered in "
+                             "log (at test_show_peak.py:"), err
+    assert len(err) == 2

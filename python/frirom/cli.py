@@ -20,9 +20,11 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import shutil
 import sys
 import time
+import warnings
 from pathlib import Path
 
 from . import __version__
@@ -518,6 +520,30 @@ def _print_peaks(result, deck) -> None:
               f"({p.method})")
 
 
+_RAD_S = re.compile(r"([-+]?\d[\d.]*(?:[eE][-+]?\d+)?) ?rad/s(?! \()")
+
+
+def with_hz(text: str) -> str:
+    """A message's frequencies in rad/s followed by the same in Hz:
+    ``through omega = 2950.3 rad/s`` -> ``... 2950.3 rad/s (469.56 Hz)``."""
+    return _RAD_S.sub(lambda m: f"{m.group(0)} ({float(m.group(1)) / 2 / 3.141592653589793:.6g}"
+                      " Hz)", text)
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Python warnings as frirom messages: one line ``frirom: warning: ...`` with the
+    frequencies also in Hz; a RuntimeWarning that is not frirom's own (numpy or scipy
+    arithmetic: overflow, invalid value) says so and names where it arose, without the
+    source line."""
+    text = " ".join(str(message).split())
+    if text.startswith("frirom: "):             # frirom's own warnings say what they are
+        text = text[len("frirom: "):]
+    elif issubclass(category, RuntimeWarning):  # numpy / scipy arithmetic
+        text = (f"numerical: {text} (at {Path(filename).name}:{lineno}; --debug shows it "
+                "as Python does)")
+    print(f"frirom: warning: {with_hz(text)}", file=sys.stderr if file is None else file)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -530,7 +556,10 @@ def main(argv: list[str] | None = None) -> int:
         out = getattr(args, "out", None)
         if out is not None and out.exists() and not out.is_dir():
             raise InputError(f"--out {out}: expected a folder, got an existing file")
-        return args.func(args)
+        with warnings.catch_warnings():
+            if not debug:
+                warnings.showwarning = _show_warning
+            return args.func(args)
     except FriromError as exc:
         if debug:
             raise
