@@ -319,6 +319,8 @@ class _Builder:
         F = np.zeros((n, H + 1), complex)
         for ld in s.loads:
             self.add_load(F, ld.dof, ld.harmonic, ld.amplitude)
+        for pl in s.preloads:
+            log.append(self.add_preload(F, contacts, pl))
         if not np.any(F[:, 1:]):
             raise ctx.error("excitation", "at least one load on a harmonic >= 1 "
                             "([[excitation.load]] or [[excitation.engine_order]])")
@@ -433,6 +435,65 @@ class _Builder:
         ne = self.rom.pairs[c.name].n_elem
         return ContactSpec(name=c.name, law=c.law, G=G, params=np.tile(c.params, (ne, 1)),
                            w0=None if c.w0 is None else np.tile(c.w0, (ne, 1)))
+
+    def add_preload(self, F, contacts: list, pl) -> str:
+        """A ``[[preload]]``: the normal preload n0 of each pair of its contacts and the
+        balancing harmonic-0 loads, from the body's load; returns the log line.
+
+        The body (side ``pl.body`` of each contact) is in equilibrium at zero displacement
+        under its load P d and the pairs' preloads: on side a a pair pushes with -n0 n
+        (v = n . (x_a - x_b) closes the contact), so sum_c n0_c S_c = s P d with S_c the
+        sum of contact c's pair normals and s = 1 (body a) or -1 (body b); one n0 per
+        contact, the same on each of its pairs (a uniform pressure on each face). Least
+        squares over the contacts; refused when the normals cannot carry the load
+        (residual above 1e-6 P: friction would have to hold the body statically), when
+        it is not determined (parallel faces) and when an n0 comes out negative (that
+        face would be pulled: its normal points the wrong way, or the load's).
+        The balancing loads, +n0 n on side a and -n0 n on side b of each pair (as in
+        docs/deck.md), are G_n^T n0: the static state then has every face closed with
+        normal force n0, and those on the body add up to its load.
+        """
+        ctx = self.ctx
+        specs = {c.name: c for c in contacts}
+        settings = {c.name: c for c in self.s.contacts}
+        S, G_n, j_n0 = [], [], []
+        for name in pl.contacts:
+            c = specs[name]
+            frames = self.rom.pairs[name].frames
+            S.append(frames[:, -1, :].sum(axis=0))
+            nd = LAWS[c.law].n_dir
+            G_n.append(c.G[nd - 1::nd])
+            j_n0.append(LAWS[c.law].parameters.index("n0"))
+        A = np.array(S).T                                   # (3, n_contacts)
+        sign = 1.0 if pl.body == "a" else -1.0
+        target = sign * pl.load * np.asarray(pl.direction)
+        n0, _, rank, _ = np.linalg.lstsq(A, target, rcond=None)
+        if rank < len(pl.contacts):
+            raise ctx.error(f"{pl.key}.contacts", "contacts whose faces' normals determine "
+                            "how the load is shared (two of them are parallel: the share is "
+                            "indeterminate; give each contact's n0 instead)",
+                            list(pl.contacts))
+        miss = np.linalg.norm(A @ n0 - target)
+        if miss > 1e-6 * pl.load:
+            raise ctx.error(f"{pl.key}.direction", "a load the contacts' normals can carry "
+                            f"({miss:.4g} N of it is along no face normal: friction would "
+                            "have to hold the body statically)", list(pl.direction))
+        for name, v in zip(pl.contacts, n0):
+            if v <= 0:
+                c = settings[name]
+                raise ctx.error(f"{c.key}.normal", f"a normal along which {pl.key}'s load "
+                                f"presses the face closed (it would pull it open, n0 = "
+                                f"{v:.4g} N per pair): a normal points from side a towards "
+                                "side b (v = n . (x_a - x_b) closes the contact); flip it, "
+                                f"or {pl.key}.direction or .body", list(c.normal))
+        parts = []
+        for name, v, Gn, j in zip(pl.contacts, n0, G_n, j_n0):
+            c = specs[name]
+            c.params[:, j] = v
+            F[:, 0] += np.asarray(Gn.T @ np.full(Gn.shape[0], v)).ravel()
+            parts.append(f"{name} n0 = {v:.6g} N x {Gn.shape[0]} pairs")
+        return (f"{pl.key}: {pl.load:g} N on side {pl.body} carried by " + ", ".join(parts)
+                + " (and the balancing harmonic-0 loads)")
 
     def add_load(self, F, ref: DofRef, h: int, amp: complex):
         """Add a load to F (n, H+1); with [fe_model] a node set loads each of its nodes."""

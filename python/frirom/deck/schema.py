@@ -18,7 +18,7 @@ from ..io._common import read_text
 from ..reduction.rom import FESource, ReductionSpec
 from .fields import Context, DofRef, boolean, dof_ref, file, number, string, table, unknown
 from ..solver import SolverOptions
-from .schema_contacts import parse_contacts
+from .schema_contacts import parse_contacts, parse_preloads
 from .schema_model import (CyclicSettings, MatrixModel, check_travelling_wave, parse_fe_model,
                            parse_matrix_model, parse_reduction)
 
@@ -210,6 +210,8 @@ class DeckSettings:
         The TOML as read.
     modes_auto : ModesAuto or None
         Interface-mode counts ``"auto"`` (frirom.auto); ``reduction`` holds the first rung.
+    preloads : tuple of Preload
+        ``[[preload]]``: loads whose contacts' n0 and balancing loads are derived.
     """
 
     path: Path
@@ -227,6 +229,7 @@ class DeckSettings:
     outputs: OutputSettings
     raw: dict = field(default_factory=dict, repr=False)
     modes_auto: object = None
+    preloads: tuple = ()
 
     @property
     def fe(self) -> bool:
@@ -263,7 +266,7 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
     ctx = Context(path)
     unknown(ctx, raw, {"title", "model", "fe_model", "reduction", "damping", "excitation",
                        "contacts", "solver", "frequency", "continuation", "outputs",
-                       "study"}, "")
+                       "study", "preload"}, "")
     title = string(ctx, raw, "title", "title", default=path.stem)
 
     # structure: [model] (matrices as they are) or [fe_model] + [reduction]
@@ -283,7 +286,8 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
     H = solver.harmonics
     damping = _damping(ctx, table(ctx, raw, "damping"), fe)
     loads = _excitation(ctx, table(ctx, raw, "excitation"), H, fe, labels, cyc)
-    contacts = parse_contacts(ctx, raw, fe, labels, cyc)
+    preloads = parse_preloads(ctx, raw, fe)
+    contacts = parse_contacts(ctx, raw, fe, labels, cyc, preloads)
     frequency = _frequency(ctx, table(ctx, raw, "frequency"))
     continuation = _continuation(ctx, table(ctx, raw, "continuation", required=False))
     outputs = _outputs(ctx, table(ctx, raw, "outputs"), fe, labels)
@@ -293,7 +297,7 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
                         cyclic=cyc, solver=solver, damping=damping, loads=tuple(loads),
                         contacts=tuple(contacts), frequency=frequency,
                         continuation=continuation, outputs=outputs, raw=raw,
-                        modes_auto=modes_auto)
+                        modes_auto=modes_auto, preloads=tuple(preloads))
 
 
 def _aliased(ctx, d: dict, table_name: str) -> dict:
