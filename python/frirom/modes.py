@@ -7,6 +7,11 @@ stick stiffnesses kt, kn of the law, k1 of the cubic law). The nonlinear resonan
 between the two, so their natural frequencies bracket it and their FRFs are reference
 curves for every nonlinear one. Stuck: K_s = K + sum over groups G^T diag(k) G.
 
+A zero natural frequency is a motion the stiffness does not hold: stuck, a warning (no
+contact holds it: the static harmonic cannot be solved); free, a body held only by its
+contacts (a damper). Each such motion is named: the node sets it moves and its direction
+(FE decks), or its DoFs.
+
 With ``[reduction.cyclic]`` the frequencies are per harmonic index (nodal diameter) k_h of
 the harmonics 0..H; the stuck ones need contacts inside the sector (a contact with the
 next sector is left out with a note), and the linear FRFs are the modal sums of harmonic
@@ -22,6 +27,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from .contact import LAWS
+from .model import describe_motion, null_motions
 from .results import amplitude_max
 
 __all__ = ["LinearCheck", "linear_check", "linear_response", "stuck_stiffness"]
@@ -104,6 +110,61 @@ def stuck_stiffness(contacts, n_dof: int) -> sp.csr_matrix:
     return Ks.tocsr()
 
 
+def _free_body(deck, phi) -> str:
+    """What a motion of the model ``phi`` (n,) moves, in the deck's terms: with an FE deck
+    the node sets it moves and its mean direction there (from the reduction's rows of the
+    FE DoFs), with [model] the DoFs (:func:`frirom.model.describe_motion`)."""
+    rom = getattr(deck, "reduced", None)
+    if rom is None or not getattr(rom, "node_sets", None):
+        return describe_motion(phi, getattr(deck, "dof_labels", None))
+    sets = {}
+    for name, nodes in rom.node_sets.items():
+        try:
+            U = np.array([[rom.load_row(int(nd), d) @ phi for d in (1, 2, 3)]
+                          for nd in nodes])
+        except Exception:           # a set of nodes the reduction does not keep rows of
+            continue
+        if U.size:
+            sets[name] = U
+    if not sets:
+        return describe_motion(phi, getattr(deck, "dof_labels", None))
+    rms = {k: float(np.sqrt(np.mean(np.sum(U * U, axis=1)))) for k, U in sets.items()}
+    top = max(rms.values())
+    moving = [k for k, v in rms.items() if v >= 0.2 * top]
+    U = np.vstack([sets[k] for k in moving])
+    mean = U.mean(axis=0)
+    spread = float(np.sqrt(np.mean(np.sum((U - mean) ** 2, axis=1))))
+    if np.linalg.norm(mean) > 10 * spread:
+        how = "a translation along ({:.2f}, {:.2f}, {:.2f})".format(
+            *(mean / np.linalg.norm(mean)))
+    else:
+        how = "a rotation or a deformation (no one direction)"
+    others = sorted(set(sets) - set(moving))
+    return (f"node set{'s' if len(moving) > 1 else ''} {', '.join(sorted(moving))}: {how}"
+            + (f"; {', '.join(others)} still" if others else ""))
+
+
+def _zero_modes(deck, K, M, around, which: str) -> list:
+    """Notes naming each motion K does not hold (a zero natural frequency), for the
+    ``which`` limit ("stuck": a warning, nothing holds it; "free": the body the contacts
+    hold)."""
+    try:
+        lam, phi = null_motions(K, M, n_max=6)
+    except (np.linalg.LinAlgError, ValueError, RuntimeError):
+        return []
+    if phi.shape[1] == 0:
+        return []
+    head = (f"WARNING: {phi.shape[1]} stuck natural frequenc"
+            f"{'ies are' if phi.shape[1] > 1 else 'y is'} 0 Hz: a motion no contact holds "
+            "even stuck (the static harmonic cannot be solved; constrain the structure or "
+            "add a contact)" if which == "stuck" else
+            f"contacts free: {phi.shape[1]} natural frequenc"
+            f"{'ies are' if phi.shape[1] > 1 else 'y is'} 0 Hz: a body held only by its "
+            "contacts")
+    return [head] + [f"  free motion {j + 1}: {_free_body(deck, phi[:, j])}"
+                     for j in range(phi.shape[1])]
+
+
 def _frequencies(K, M, around: tuple, n_show: int) -> np.ndarray:
     """Natural frequencies [rad/s]: those in ``around`` and ``n_show`` each side."""
     n = K.shape[0]
@@ -167,6 +228,8 @@ def linear_check(deck, n_grid: int | None = None, n_show: int = 2) -> LinearChec
     if deck.cyclic is None:
         free, stuck = _frequencies(K, M, (w0, w1), n_show), _frequencies(Ks, M, (w0, w1),
                                                                           n_show)
+        notes += _zero_modes(deck, Ks, M, (w0, w1), "stuck")
+        notes += _zero_modes(deck, K, M, (w0, w1), "free")
         C = deck.damping_object().assemble(M, K)
         amp_f = _response(K, M, C, deck.F, deck.outputs, omega)
         amp_s = _response(Ks, M, C, deck.F, deck.outputs, omega)

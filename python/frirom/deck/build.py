@@ -296,7 +296,8 @@ class _Builder:
             contacts = [self.dof_contact(c) for c in s.contacts]
             try:
                 check_definite(K, M, f"model.stiffness ({s.model.stiffness.name})",
-                               f"model.mass ({s.model.mass.name})", [c.G for c in contacts])
+                               f"model.mass ({s.model.mass.name})", [c.G for c in contacts],
+                               labels=self.labels)
             except FriromError as exc:
                 raise InputError(f"{s.path}: {exc}") from None
         else:
