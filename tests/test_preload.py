@@ -108,3 +108,23 @@ def test_study_key_path_reaches_the_preload(lap):
     raw = tomllib.loads(_by_load(text, 2080.0))
     set_key(raw, "preload[0].load", 650.0)
     assert raw["preload"][0]["load"] == 650.0
+
+
+def test_parallel_faces_share_one_pressure(lap, tmp_path, monkeypatch):
+    # the overlap's pairs as two contacts with the same normal (as a flat strip damper
+    # under two platforms): the balance leaves the shares open; each pair gets the same
+    # n0, 2080 N / 130 pairs, and the loads are twice the one-contact bolt's
+    case, text = lap
+    monkeypatch.setenv("FRIROM_CACHE", str(tmp_path / "cache"))
+    two = _by_load(text, 2080.0).replace('contacts = ["lap"]', 'contacts = ["lap", "lap2"]')
+    block = two[two.index("[[contacts]]"):two.index("[damping]")]
+    two = two.replace(block, block + block.replace('name = "lap"', 'name = "lap2"'))
+    (case / "two.toml").write_text(two)
+    d = load_deck(case / "two.toml")
+    for c in d.contacts:
+        assert c.params[:, 3] == pytest.approx(16.0, rel=1e-12)
+    assert any("statically indeterminate" in s for s in d.log)
+    (case / "one.toml").write_text(_by_load(text, 2080.0))
+    one = load_deck(case / "one.toml")
+    np.testing.assert_allclose(d.F[:, 0], one.F[:, 0], rtol=0,
+                               atol=1e-12 * np.abs(one.F[:, 0]).max())

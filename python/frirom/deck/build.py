@@ -446,10 +446,12 @@ class _Builder:
         (v = n . (x_a - x_b) closes the contact), so sum_c n0_c S_c = s P d with S_c the
         sum of contact c's pair normals and s = 1 (body a) or -1 (body b); one n0 per
         contact, the same on each of its pairs (a uniform pressure on each face). Least
-        squares over the contacts; refused when the normals cannot carry the load
-        (residual above 1e-6 P: friction would have to hold the body statically), when
-        it is not determined (parallel faces) and when an n0 comes out negative (that
-        face would be pulled: its normal points the wrong way, or the load's).
+        squares over the contacts; where the balance does not fix the shares (parallel
+        faces: statically indeterminate) the one of least sum over pairs of n0^2, which
+        is the same n0 on every pair (one pressure). Refused when the normals cannot
+        carry the load (residual above 1e-6 P: friction would have to hold the body
+        statically) and when an n0 comes out negative (that face would be pulled: its
+        normal points the wrong way, or the load's).
         The balancing loads, +n0 n on side a and -n0 n on side b of each pair (as in
         docs/deck.md), are G_n^T n0: the static state then has every face closed with
         normal force n0, and those on the body add up to its load.
@@ -457,23 +459,23 @@ class _Builder:
         ctx = self.ctx
         specs = {c.name: c for c in contacts}
         settings = {c.name: c for c in self.s.contacts}
-        S, G_n, j_n0 = [], [], []
+        S, G_n, j_n0, npairs = [], [], [], []
         for name in pl.contacts:
             c = specs[name]
             frames = self.rom.pairs[name].frames
             S.append(frames[:, -1, :].sum(axis=0))
+            npairs.append(frames.shape[0])
             nd = LAWS[c.law].n_dir
             G_n.append(c.G[nd - 1::nd])
             j_n0.append(LAWS[c.law].parameters.index("n0"))
         A = np.array(S).T                                   # (3, n_contacts)
         sign = 1.0 if pl.body == "a" else -1.0
         target = sign * pl.load * np.asarray(pl.direction)
-        n0, _, rank, _ = np.linalg.lstsq(A, target, rcond=None)
-        if rank < len(pl.contacts):
-            raise ctx.error(f"{pl.key}.contacts", "contacts whose faces' normals determine "
-                            "how the load is shared (two of them are parallel: the share is "
-                            "indeterminate; give each contact's n0 instead)",
-                            list(pl.contacts))
+        # unknowns sqrt(pairs) n0: lstsq's least-norm answer is then the least sum over
+        # pairs of n0^2 (one pressure on parallel faces); the same answer when determined
+        root = np.sqrt(np.asarray(npairs, float))
+        y, _, rank, _ = np.linalg.lstsq(A / root, target, rcond=None)
+        n0 = y / root
         miss = np.linalg.norm(A @ n0 - target)
         if miss > 1e-6 * pl.load:
             raise ctx.error(f"{pl.key}.direction", "a load the contacts' normals can carry "
@@ -494,7 +496,9 @@ class _Builder:
             F[:, 0] += np.asarray(Gn.T @ np.full(Gn.shape[0], v)).ravel()
             parts.append(f"{name} n0 = {v:.6g} N x {Gn.shape[0]} pairs")
         return (f"{pl.key}: {pl.load:g} N on side {pl.body} carried by " + ", ".join(parts)
-                + " (and the balancing harmonic-0 loads)")
+                + " (and the balancing harmonic-0 loads)"
+                + ("; statically indeterminate (parallel faces): one pressure on every pair"
+                   if rank < len(pl.contacts) else ""))
 
     def add_load(self, F, ref: DofRef, h: int, amp: complex):
         """Add a load to F (n, H+1); with [fe_model] a node set loads each of its nodes."""
