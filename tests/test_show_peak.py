@@ -69,3 +69,15 @@ def test_cli_turns_python_warnings_into_frirom_lines(monkeypatch, capsys):
     assert err[1].startswith("frirom: warning: numerical: divide by zero encountered in "
                              "log (at test_show_peak.py:"), err
     assert len(err) == 2
+
+
+def test_cli_error_gives_frequencies_in_hz(monkeypatch, capsys):
+    import frirom.cli
+    from frirom._errors import ConvergenceError
+
+    def cmd(args):
+        raise ConvergenceError("hbm_continue: step below ds_min at omega = 2950.3 rad/s")
+    monkeypatch.setattr(frirom.cli, "cmd_show", cmd)
+    assert main(["show", "somewhere"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith(f"at omega = 2950.3 rad/s ({2950.3 / 2 / np.pi:.6g} Hz)"), err

@@ -425,7 +425,8 @@ def _print_stop(full, deck, h5) -> None:
     else:
         hint = ("the same deck resumed stops at the same place: change the deck and run "
                 "without --resume")
-    print(f"frirom: the run stopped before the end of its range{where}: {full.message}; "
+    print(f"frirom: the run stopped before the end of its range{where}: "
+          f"{with_hz(full.message)}; "
           f"the points are in {h5}; {hint} (exit code 3)", file=sys.stderr)
 
 
@@ -563,7 +564,7 @@ def main(argv: list[str] | None = None) -> int:
     except FriromError as exc:
         if debug:
             raise
-        print(f"frirom: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        print(f"frirom: error: {with_hz(' '.join(str(exc).split()))}", file=sys.stderr)
         return 2
     except Exception as exc:            # a bug or an unforeseen input: one line, no traceback
         if debug:
