@@ -110,59 +110,77 @@ def stuck_stiffness(contacts, n_dof: int) -> sp.csr_matrix:
     return Ks.tocsr()
 
 
-def _free_body(deck, phi) -> str:
-    """What a motion of the model ``phi`` (n,) moves, in the deck's terms: with an FE deck
-    the node sets it moves and its mean direction there (from the reduction's rows of the
-    FE DoFs), with [model] the DoFs (:func:`frirom.model.describe_motion`)."""
+def _set_motions(deck, phi):
+    """{node set: (k, n_nodes, 3) displacements} of the motions phi (n, k) at the reduced
+    model's FE node sets (None without them)."""
     rom = getattr(deck, "reduced", None)
     if rom is None or not getattr(rom, "node_sets", None):
-        return describe_motion(phi, getattr(deck, "dof_labels", None))
+        return None
     sets = {}
     for name, nodes in rom.node_sets.items():
         try:
-            U = np.array([[rom.load_row(int(nd), d) @ phi for d in (1, 2, 3)]
-                          for nd in nodes])
+            R = np.array([[rom.load_row(int(nd), d) for d in (1, 2, 3)] for nd in nodes])
         except Exception:           # a set of nodes the reduction does not keep rows of
             continue
-        if U.size:
-            sets[name] = U
-    if not sets:
-        return describe_motion(phi, getattr(deck, "dof_labels", None))
-    rms = {k: float(np.sqrt(np.mean(np.sum(U * U, axis=1)))) for k, U in sets.items()}
+        if R.size:
+            sets[name] = np.einsum("ndr,rk->knd", R, phi)
+    return sets or None
+
+
+def _free_body(deck, phi) -> str:
+    """What the motions ``phi`` (n,) or (n, k) of the model move, in the deck's terms: with
+    an FE deck the node sets they move (the others named as still) and, of the motions
+    together, the rigid translations among them (from the reduction's rows of the FE
+    DoFs); with [model] the DoFs (:func:`frirom.model.describe_motion`)."""
+    phi = np.asarray(phi, float)
+    phi = phi[:, None] if phi.ndim == 1 else phi
+    sets = _set_motions(deck, phi)
+    if sets is None:
+        return "; ".join(describe_motion(phi[:, j], getattr(deck, "dof_labels", None))
+                         for j in range(phi.shape[1]))
+    rms = {k: float(np.sqrt(np.mean(np.sum(U * U, axis=2)))) for k, U in sets.items()}
     top = max(rms.values())
-    moving = [k for k, v in rms.items() if v >= 0.2 * top]
-    U = np.vstack([sets[k] for k in moving])
-    mean = U.mean(axis=0)
-    spread = float(np.sqrt(np.mean(np.sum((U - mean) ** 2, axis=1))))
-    if np.linalg.norm(mean) > 10 * spread:
-        how = "a translation along ({:.2f}, {:.2f}, {:.2f})".format(
-            *(mean / np.linalg.norm(mean)))
+    moving = sorted(k for k, v in rms.items() if v >= 0.2 * top)
+    U = np.concatenate([sets[k] for k in moving], axis=1)      # (k, nodes, 3)
+    means = U.mean(axis=1)                                      # (k, 3) translations
+    size = float(np.sqrt(np.mean(np.sum(U * U, axis=2))))
+    _, sv, Vt = np.linalg.svd(means)
+    dirs = Vt[:int(np.sum(sv > 0.1 * size * np.sqrt(phi.shape[1])))]
+    k = phi.shape[1]
+    if len(dirs) == 3:
+        trans = "translations in every direction"
+    elif len(dirs):
+        trans = ("a translation along " if len(dirs) == 1 else "translations in the plane of ") \
+            + " and ".join("({:.2f}, {:.2f}, {:.2f})".format(*(v * np.sign(v[np.argmax(
+                np.abs(v))]) + 0.0)) for v in np.round(dirs, 2))
     else:
-        how = "a rotation or a deformation (no one direction)"
+        trans = ""
+    rest = k - len(dirs)
+    how = ", ".join(x for x in (trans, f"{rest} rotation{'s' if rest > 1 else ''} or "
+                                f"deformation{'s' if rest > 1 else ''}" if rest else "") if x)
     others = sorted(set(sets) - set(moving))
-    return (f"node set{'s' if len(moving) > 1 else ''} {', '.join(sorted(moving))}: {how}"
+    return (f"node set{'s' if len(moving) > 1 else ''} {', '.join(moving)}: {how}"
             + (f"; {', '.join(others)} still" if others else ""))
 
 
 def _zero_modes(deck, K, M, around, which: str) -> list:
-    """Notes naming each motion K does not hold (a zero natural frequency), for the
-    ``which`` limit ("stuck": a warning, nothing holds it; "free": the body the contacts
+    """Notes naming the motions K does not hold (zero natural frequencies), for the
+    ``which`` limit ("stuck": a warning, nothing holds them; "free": the body the contacts
     hold)."""
     try:
         lam, phi = null_motions(K, M, n_max=6)
     except (np.linalg.LinAlgError, ValueError, RuntimeError):
         return []
-    if phi.shape[1] == 0:
+    k = phi.shape[1]
+    if k == 0:
         return []
-    head = (f"WARNING: {phi.shape[1]} stuck natural frequenc"
-            f"{'ies are' if phi.shape[1] > 1 else 'y is'} 0 Hz: a motion no contact holds "
+    many = "ies are" if k > 1 else "y is"
+    head = (f"WARNING: {k} stuck natural frequenc{many} 0 Hz: a motion no contact holds "
             "even stuck (the static harmonic cannot be solved; constrain the structure or "
             "add a contact)" if which == "stuck" else
-            f"contacts free: {phi.shape[1]} natural frequenc"
-            f"{'ies are' if phi.shape[1] > 1 else 'y is'} 0 Hz: a body held only by its "
+            f"contacts free: {k} natural frequenc{many} 0 Hz: a body held only by its "
             "contacts")
-    return [head] + [f"  free motion {j + 1}: {_free_body(deck, phi[:, j])}"
-                     for j in range(phi.shape[1])]
+    return [head, f"  free motion{'s' if k > 1 else ''}: {_free_body(deck, phi)}"]
 
 
 def _frequencies(K, M, around: tuple, n_show: int) -> np.ndarray:
