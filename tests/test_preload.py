@@ -128,3 +128,18 @@ def test_parallel_faces_share_one_pressure(lap, tmp_path, monkeypatch):
     one = load_deck(case / "one.toml")
     np.testing.assert_allclose(d.F[:, 0], one.F[:, 0], rtol=0,
                                atol=1e-12 * np.abs(one.F[:, 0]).max())
+
+
+def test_hand_written_preload_with_flipped_normal_is_warned(lap, tmp_path, monkeypatch):
+    # no [[preload]]: n0 = 32 N and the +-32 N loads by hand, the normal flipped; the
+    # loads then push against the preload's balance (factor -1): a warning names the key
+    case, text = lap
+    monkeypatch.setenv("FRIROM_CACHE", str(tmp_path / "cache"))
+    (case / "ok.toml").write_text(text)
+    assert not any("WARNING" in s for s in load_deck(case / "ok.toml").log)
+    (case / "flip2.toml").write_text(text.replace("normal = [0.0, 0.0, 1.0]",
+                                                  "normal = [0.0, 0.0, -1.0]"))
+    log = load_deck(case / "flip2.toml").log
+    assert any("WARNING: contacts[0].normal = [0.0, 0.0, -1.0]: the deck's harmonic-0 "
+               "loads push against the balance of its preload n0" in s and "factor -1.00"
+               in s for s in log), log

@@ -322,6 +322,8 @@ class _Builder:
             self.add_load(F, ld.dof, ld.harmonic, ld.amplitude)
         for pl in s.preloads:
             log.append(self.add_preload(F, contacts, pl))
+        if s.fe:
+            log.extend(self.normal_warnings(F, contacts))
         if not np.any(F[:, 1:]):
             raise ctx.error("excitation", "at least one load on a harmonic >= 1 "
                             "([[excitation.load]] or [[excitation.engine_order]])")
@@ -499,6 +501,37 @@ class _Builder:
                 + " (and the balancing harmonic-0 loads)"
                 + ("; statically indeterminate (parallel faces): one pressure on every pair"
                    if rank < len(pl.contacts) else ""))
+
+    def normal_warnings(self, F, contacts: list) -> list:
+        """Warnings for node-set contacts whose preload n0 the deck's harmonic-0 loads
+        push the wrong way: the loads that balance a preload are G_n^T n0 (+n0 n on side
+        a, -n0 n on side b); static loads that project on it with a factor below -1/2
+        balance the preload of the opposite normal, i.e. the normal (or the loads) points
+        the wrong way. Contacts of a [[preload]] are balanced by construction."""
+        derived = {n for p in self.s.preloads for n in p.contacts}
+        out = []
+        F0 = np.real(F[:, 0])
+        for c, st in zip(contacts, self.s.contacts):
+            law = LAWS[c.law]
+            if c.name in derived or "n0" not in law.parameters or not np.any(F0):
+                continue
+            n0 = c.params[:, law.parameters.index("n0")]
+            if not np.any(n0 > 0):
+                continue
+            nd = law.n_dir
+            b = np.asarray(c.G[nd - 1::nd].T @ np.clip(n0, 0.0, None)).ravel()
+            bb = float(b @ b)
+            if bb == 0.0:
+                continue
+            ratio = float(F0 @ b) / bb
+            if ratio < -0.5:
+                out.append(f"WARNING: {st.key}.normal = {list(st.normal)}: the deck's "
+                           f"harmonic-0 loads push against the balance of its preload n0 "
+                           f"(they project on +n0 n / -n0 n of sides a / b with factor "
+                           f"{ratio:.2f}, -1 for a normal flipped): the normal points from "
+                           "side a towards side b (v = n . (x_a - x_b) closes the contact); "
+                           "check its sign, or the loads'")
+        return out
 
     def add_load(self, F, ref: DofRef, h: int, amp: complex):
         """Add a load to F (n, H+1); with [fe_model] a node set loads each of its nodes."""
