@@ -299,3 +299,102 @@ def test_ms_time_harmonics_auto_on_the_flange(tmp_path, monkeypatch):
                                                                 stability=False),
                             full, full)[0] for d in (deck, rom1)]
     assert np.allclose(got, ref, rtol=1e-6, atol=0), (got, ref)
+
+
+# ---- issue 29 item 4: automatic choices that stop in time ------------------------------
+
+@pytest.mark.parametrize("solver", [{"harmonics": "auto", "samples": "auto"},
+                                    {"samples": "auto"}])
+def test_no_probe_solve_stops_with_the_reason(monkeypatch, solver):
+    # Every probe solve failing left no estimate, and "auto" chose the maximum (H = 15,
+    # N = 4096: a run 30x slower); now it stops and says why, naming the probes and the
+    # first failure.
+    import frirom.solver
+    from frirom._errors import ConvergenceError
+
+    def fail(*args, **kw):
+        raise ConvergenceError("newton_correct: no convergence")
+    monkeypatch.setattr(frirom.solver, "solve_point", fail)
+    deck = _deck("joint.toml", solver, (455.0, 480.0))
+    with pytest.raises(ConvergenceError, match=r"no probe solve succeeded \(probes at "
+                       r"[0-9., ]+ Hz; \d+ solves failed, the first: H = \d+, N = \d+ at "
+                       r"[0-9.]+ Hz: newton_correct: no convergence\).*nothing was run"):
+        resolve_deck(deck, lambda s: None)
+
+
+class _FakeRung:
+    """A rung's deck as choose_modes uses it (n_dof, model, options, reduced)."""
+
+    def __init__(self, n, opts):
+        self.n_dof, self._opts, self.reduced = n, opts, None
+
+    def model(self):
+        return type("M", (), {"nonlinear_dofs": lambda self: [0]})()
+
+    def options(self):
+        return self._opts
+
+
+def _ladder(monkeypatch, amps):
+    """choose_modes on fake rungs (free = 5, 10, 20, 40 modes) whose single peak, at
+    1000 rad/s, has the amplitude ``amps[n]``; returns (deck, choice, log, calls)."""
+    import frirom.auto as auto
+    from frirom.solver import SolverOptions
+    opts = SolverOptions(harmonics=1)
+    calls = {"built": [], "run": []}
+
+    def rung_deck(deck, values):
+        calls["built"].append(values["free"])
+        return _FakeRung(values["free"], opts)
+
+    def rung_peaks(d, H, o, window, full):
+        calls["run"].append(d.n_dof)
+        whole = tuple(window) == (min(full), max(full))
+        return ([(1000.0, amps[d.n_dof])], (10, 0.1, window, "done"),
+                (type("R", (), {"complete": True})(), ["points"], whole))
+
+    monkeypatch.setattr(auto, "_rung_deck", rung_deck)
+    monkeypatch.setattr(auto, "_rung_peaks", rung_peaks)
+    ma = type("MA", (), {"tolerance": 1e-3,
+                         "rungs": lambda self: [{"free": n} for n in (5, 10, 20, 40)]})()
+    sol = type("S", (), {"auto_harmonics": False, "auto_samples": False,
+                         "tolerance_auto": 1e-3})()
+    first = _FakeRung(5, opts)
+    first.settings = type("St", (), {"modes_auto": ma, "solver": sol})()
+    first.harmonics, first.samples, first.F = 1, None, np.ones((1, 2))
+    first.omega_start, first.omega_end = 900.0, 1100.0
+    lines = []
+    d, ch = auto.choose_modes(first, lines.append)
+    return d, ch, "\n".join(lines), calls
+
+
+def test_ladder_prints_the_rule_that_rejects_a_rung(monkeypatch):
+    # The peak changes by e = 9.9e-3 (5 -> 10 modes), 9.49e-4 (10 -> 20), 1e-5 (20 -> 40).
+    # Rung 10's e is below the tolerance 1e-3 but the rule is the tail e / (1 - r), r =
+    # 9.49e-4 / 9.9e-3 = 0.096: 1.05e-3, rejected; before, the log gave the estimate alone
+    # next to "NOT within the tolerance". Now each rung's line gives the rule and its
+    # numbers. Each rung is built and run once; the chosen one's deck is the one built.
+    a20 = 1.01 * (1 + 9.5e-4)
+    d, ch, text, calls = _ladder(monkeypatch, {5: 1.0, 10: 1.01, 20: a20,
+                                               40: a20 * (1 + 1e-5)})
+    e10 = 9.5e-4 / (1 + 9.5e-4)
+    r = e10 / (0.01 / 1.01)
+    assert (f"modes free = 10 rejected (its change to free = 20): e = {e10:.2e}, "
+            f"r = {r:.2f}") in text, text
+    assert f"error e / (1 - r) = {e10 / (1 - r):.2e} > tolerance 0.001" in text, text
+    assert "modes free = 5 rejected (its change to free = 10): e = 9.90e-03, r = 1/2" \
+        in text, text
+    assert "modes free = 20 accepted (its change to free = 40)" in text, text
+    assert ch.modes == {"free": 20} and ch.met_modes
+    assert calls["built"] == [10, 20, 40] and calls["run"] == [5, 10, 20, 40]
+    assert d.n_dof == 20 and d.auto_response is None       # run over a window only
+    assert "error e / (1 - r) = 1.0" in ch.summary()
+
+
+def test_ladder_reuses_the_chosen_rungs_curve(monkeypatch):
+    # The first rung (run over the whole range with the run's options) is chosen: its
+    # curve is kept for frirom run (deck.auto_response), not computed a second time.
+    d, ch, text, calls = _ladder(monkeypatch, {5: 1.0, 10: 1.0 + 1e-5, 20: 1.0, 40: 1.0})
+    assert ch.modes == {"free": 5} and calls["run"] == [5, 10]
+    assert d.n_dof == 5 and d.auto_response is not None
+    assert d.auto_response[1] == ["points"] and d.auto_response[0].complete

@@ -56,7 +56,7 @@ def test_joint_deck_loads():
     assert np.isclose(d.omega_start, 2 * np.pi * 400) and np.isclose(d.omega_end,
                                                                      2 * np.pi * 520)
     assert d.continuation == {"step": 0.02, "max_step": 0.1, "max_points": 1000}
-    assert d.solver["stability"] is True
+    assert d.solver["stability"] is True        # the deck says so (default false)
 
 
 def test_normal1d_frame_and_solver_objects(deckdir):
@@ -146,7 +146,7 @@ BAD = [
      "non-empty"),
     ('max_step = 0.1 ', 'max_step = 0.1\nmin_step = 0.5 ', "continuation.min_step",
      "max_step"),
-    ('formulation = "condensed"', 'formulation = "condensed"\nstability = 1',
+    ('stability = true ', 'stability = 1 ',
      "solver.stability", "true or false"),
     ('[solver]', '[solvers]', "solvers", "unknown key"),
 ]
@@ -221,3 +221,74 @@ def test_per_element_frames_and_parameters(deckdir):
     # element 0 in the contact's frame, element 1 in its own (0, 2) made unit length
     assert np.allclose(G, [[COS30, 0.5, 0, 0, 0], [0, 1, 0, 0, 0]], rtol=0, atol=1e-15)
     assert np.array_equal(d.contacts[0].params, [[1e7, 0.5, 100.0], [1e7, 0.2, 100.0]])
+
+
+# --- issue 29 item 3: every hint names a deck key, deck and Python defaults agree -----
+
+def _with(text, table, lines):
+    """BASE with ``lines`` added at the top of its [table]."""
+    return text.replace(f"[{table}]\n", f"[{table}]\n" + "".join(f"{x}\n" for x in lines), 1)
+
+
+def test_solver_advice_names_deck_keys(deckdir):
+    """Each setting the corrector failure's advice names (frirom.solver._contact_advice: a
+    stalled residual below 1/N^2 and below tol_residual, a large ds_min, fewer samples than
+    the default) is a key a deck accepts, in [solver] or [continuation], and reaches the
+    solver's options with the advised value."""
+    import re
+
+    from frirom.solver import SolverOptions, _contact_advice
+    opts = SolverOptions(harmonics=5, samples=16, ds_min=1e-3)
+    advice = _contact_advice(opts, "no convergence, |R|/rref = 1.0e-9")
+    tips = re.findall(r"(?:try |; or )(\w+) = ([0-9.e+-]+)", advice)
+    assert {k for k, _ in tips} == {"tol_stall", "max_iter", "ds_min", "samples"}, advice
+    for key, value in tips:
+        table = "continuation" if key.startswith("ds") else "solver"
+        body = BASE.replace("samples = 64\n", "") if key == "samples" else BASE
+        d = load_deck(write(deckdir, _with(body, table, [f"{key} = {value}"])))
+        o = d.options()
+        name = {"samples": "samples"}.get(key, key)
+        assert float(getattr(o, name)) == float(value), (key, value)
+
+
+def test_history_key_and_aliases(deckdir):
+    d = load_deck(write(deckdir, _with(BASE, "solver", ["history = false",
+                                                         "tol_stall = 1e-10"])))
+    assert d.options().history is False and d.options().tol_stall == 1e-10
+    d = load_deck(write(deckdir, _with(BASE, "solver", ["max_iter = 40"])))
+    assert d.options().max_iter == 40
+    for table, a, b in (("solver", "max_iter = 40", "max_iterations = 30"),
+                        ("continuation", "ds_min = 1e-7", "min_step = 1e-6")):
+        with pytest.raises(InputError, match=rf"{table}\.{a.split()[0]}: expected either"):
+            load_deck(write(deckdir, _with(BASE, table, [a, b])))
+    with pytest.raises(InputError, match=r"solver\.tol_stall: expected a number >= 0"):
+        load_deck(write(deckdir, _with(BASE, "solver", ["tol_stall = -1.0"])))
+
+
+# deck key -> SolverOptions attribute, for the defaults docs/deck.md gives
+DEFAULTS_DOCUMENTED = {"tol_residual": "tol_residual", "tol_update": "tol_update",
+                       "max_iterations": "max_iter", "tol_stall": "tol_stall",
+                       "history": "history", "stability": "stability", "step": "ds",
+                       "min_step": "ds_min", "max_step": "ds_max",
+                       "max_points": "max_points"}
+
+
+def test_deck_defaults_are_the_solvers_and_documented(deckdir):
+    """A deck without the keys gives SolverOptions' own defaults (one place), and
+    docs/deck.md's row of each key says that default."""
+    import re
+
+    from frirom.solver import SolverOptions
+    text = re.sub(r"(?m)^(stability|step|max_step|max_points) = .*\n", "", BASE)
+    o, ref = load_deck(write(deckdir, text)).options(), SolverOptions()
+    doc = (ROOT / "docs" / "deck.md").read_text()
+    for key, name in DEFAULTS_DOCUMENTED.items():
+        assert getattr(o, name) == getattr(ref, name), key
+        row = re.search(rf"(?m)^\| `{key}`[^|]*\|[^|]*default ([^ |;,]+)", doc)
+        assert row, f"docs/deck.md gives no default for {key}"
+        want = getattr(ref, name)
+        got = row.group(1)
+        if isinstance(want, bool):
+            assert got == str(want).lower(), key
+        else:
+            assert float(got) == float(want), key

@@ -217,3 +217,20 @@ def test_power_balance_of_a_cyclic_sector(tmp_path_factory):
     assert np.abs(ref[1]).max() > 1e-3 * np.abs(ref).max()
     assert b["contacts"] > 1e-3 * b["excitation"] and b["viscous"] > 0, b
     assert abs(b["residual"]) <= 1e-6 * b["excitation"], b
+
+
+def test_point_csv_files_hold_plain_numbers(liftoff, tmp_path):
+    """Issue 29 item 5: every numeric cell of time.csv, hysteresis.csv and contacts.csv is
+    a plain number (hysteresis.csv wrote phase_rad as ``np.float64(...)`` on every row)."""
+    from frirom.show import write_point
+    d, r = liftoff
+    write_point(point_state(r, d, 2, float(r.omega[2])), tmp_path)
+    text = {"group", "direction"}
+    for name in ("time.csv", "hysteresis.csv", "contacts.csv"):
+        with open(tmp_path / name) as fh:
+            rows = list(csv.DictReader(fh))
+        assert rows, name
+        for row in rows:
+            for k, v in row.items():
+                if k not in text:
+                    float(v)        # raises on "np.float64(0.1)"

@@ -551,29 +551,39 @@ def figures(work: Path, quick: bool, res: dict) -> list:
     for k, name in ((0, "fig9_stage1.png"), (1, "fig10_stage2.png")):
         norm = ref["peak_amp"][k] / ref["f0"] if ref else 1.0
         fig, ax = plt.subplots(figsize=(6.4, 4.4))
+        names = {"rom1": "ROM_I (line)", "rom2": "ROM_II (h = 2)",
+                 "rom2_eo": "ROM_II (EO 2 family, j = 1)",
+                 "rom2_family": "ROM_II (family, j = 0..3)",
+                 "rom2_tw": "ROM_II (family, travelling wave)"}
+        styles = (("rom1", dict(ls="-", lw=1.4)),
+                  ("rom2", dict(ls="none", marker="o", ms=3.5, mfc="none")),
+                  ("rom2_eo", dict(ls="none", marker="s", ms=3, mfc="none")),
+                  ("rom2_family", dict(ls="none", marker="x", ms=3)),
+                  ("rom2_tw", dict(ls="none", marker="+", ms=5)))
+        drawn = set()
         for i, f0 in enumerate(fam):
             c = f"C{i}"
-            for rom, style in (("rom1", dict(ls="-", lw=1.4)),
-                               ("rom2", dict(ls="none", marker="o", ms=3.5, mfc="none")),
-                               ("rom2_eo", dict(ls="none", marker="s", ms=3, mfc="none")),
-                               ("rom2_family", dict(ls="none", marker="x", ms=3)),
-                               ("rom2_tw", dict(ls="none", marker="+", ms=5))):
+            for rom, style in styles:
                 r = res.get(rom, {}).get(f"{f0:g}")
                 if r is None:
                     continue
                 f = np.asarray(r["f"]) / info["f_stuck"]
                 a = np.asarray(r["amp"][k]) / f0 / norm
                 step = max(1, len(f) // 40) if rom != "rom1" else 1
-                lab = {"rom1": f"ROM_I F0 = {f0:g} N", "rom2": "ROM_II (h = 2)",
-                       "rom2_eo": "ROM_II (EO 2 family, j = 1)",
-                       "rom2_family": "ROM_II (family, j = 0..3)",
-                       "rom2_tw": "ROM_II (family, travelling wave)"}[rom]
-                lab = lab if rom == "rom1" or i == 0 else None
-                ax.plot(f[::step], a[::step], color=c, label=lab, **style)
+                ax.plot(f[::step], a[::step], color=c, **style)
+                drawn.add(rom)
+        # the legend names each colour (F0) and each line or marker style (the model), so
+        # every marker of every F0 is named
+        for i, f0 in enumerate(fam):
+            if any(f"{f0:g}" in res.get(rom, {}) for rom, _ in styles):
+                ax.plot([], [], color=f"C{i}", lw=4, label=f"F0 = {f0:g} N")
+        for rom, style in styles:
+            if rom in drawn:
+                ax.plot([], [], color="k", label=names[rom], **style)
         ax.set_xlabel("frequency / stuck EO 2 resonance")
         ax.set_ylabel("amplitude / F0, over the stuck peak")
         ax.set_title(f"Stage {k + 1}: ROM_I (lines) vs ROM_II (markers)")
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=7, loc="best", ncol=2)
         ax.grid(alpha=0.3)
         fig.tight_layout()
         p = work / name

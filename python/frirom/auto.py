@@ -23,7 +23,7 @@ The estimate costs a coarse run and a few point solves, not a ladder of FRFs:
    e(N) / (1 - e(N) / e(N/2)) within the budget.
 
 Where the estimate does not reach the tolerance within ``max_harmonics`` /
-``max_samples`` (it stalls, rises, or a solve fails) the choice is the maximum and the
+``max_samples`` (it stalls, rises, or a solve above a successful one fails) the choice is the maximum and the
 log and ``FRF.solver_info`` say so: never a silent pick.
 
 Interface modes (``[reduction.interface_modes]`` ``free`` / ``stick`` or
@@ -36,8 +36,13 @@ the others only over the **peak region**: the previous rung's peaks +- :data:`WI
 (the whole range again when a peak lands on the window's edge). The estimate e(k) is the
 largest relative change of the peak amplitude and the peak frequency from rung k to k+1
 over the outputs; the error of rung k is the tail e(k) / (1 - r), r = e(k) / e(k-1) the
-observed rate (as for H), and the smallest rung within the tolerance is chosen. The modes
-are chosen first, at the smallest H when H is auto too.
+observed rate (as for H), and the smallest rung within the tolerance is chosen; the log
+gives, per rung, that rule with its numbers. The modes are chosen first, at the smallest H
+when H is auto too. The chosen rung's reduced model is the run's (not built again), and
+so is its curve when it covered the whole range with the run's settings.
+
+When no probe solve succeeds (every estimate inf), the H or N choice stops with the
+reason (:class:`frirom.ConvergenceError`) instead of running the maximum.
 """
 
 from __future__ import annotations
@@ -60,16 +65,34 @@ RATE_MAX = 0.9
 WINDOW = 0.05
 
 
+def _rate(est: list, back: int) -> float:
+    """The rate r of :func:`_tail`: the last estimate over the one ``back`` rungs below,
+    clamped to [0, RATE_MAX]; 1/2 when there is none (nan or inf below)."""
+    e = est[-1][1]
+    below = est[-1 - back][1] if len(est) > back else float("nan")
+    return min(max(e / max(below, 1e-300), 0.0), RATE_MAX) if np.isfinite(below) else 0.5
+
+
+def _rule(est: list, back: int, tol: float) -> str:
+    """The rule that accepts or rejects the last rung, with its numbers: ``e = 9.0e-04,
+    r = 0.90: error e / (1 - r) = 9.0e-03 > tolerance 0.001``."""
+    e, r = est[-1][1], _rate(est, back)
+    if not np.isfinite(e):
+        return "no estimate (a solve or curve failed): not accepted"
+    t = e / (1.0 - r)
+    how = (f"r = {r:.2f} (the estimate below over this one, at most {RATE_MAX})"
+           if len(est) > back and np.isfinite(est[-1 - back][1]) else "r = 1/2 (no rate yet)")
+    return (f"e = {e:.2e}, {how}: error e / (1 - r) = {t:.2e} "
+            f"{'<=' if t <= tol else '>'} tolerance {tol:g}")
+
+
 def _tail(est: list, back: int) -> float:
     """The error of the last rung from its estimate e (its change to the next rung) and
     the rate r = e / (the estimate ``back`` rungs below, 2 for H: the same parity, 1 for
     N and modes): the geometric tail e / (1 - r), r clamped to [0, RATE_MAX]; r = 1/2 when
     there is no rate: for the first rungs, and after a rung whose estimate is not finite
     (a failed solve or curve gives no rate, not a rate of 0)."""
-    e = est[-1][1]
-    below = est[-1 - back][1] if len(est) > back else float("nan")
-    r = min(max(e / max(below, 1e-300), 0.0), RATE_MAX) if np.isfinite(below) else 0.5
-    return e / (1.0 - r)
+    return est[-1][1] / (1.0 - _rate(est, back))
 
 
 def _first_harmonic(F: np.ndarray) -> int:
@@ -127,16 +150,27 @@ class AutoChoice:
         """One line for ``FRF.solver_info``."""
         out = []
         if self.modes:
-            e = dict(self.mode_estimates).get(self.modes_text(), float("nan"))
-            out.append(f"interface modes {self.modes_text()} auto (estimate {e:.2e}"
-                       + ("" if self.met_modes else ", NOT within the tolerance: the "
-                          "largest") + f", tolerance {self.modes_tolerance:g})")
+            est = self.mode_estimates
+            keys = [k for k, _ in est]
+            if self.modes_text() in keys:
+                why = _rule(est[:keys.index(self.modes_text()) + 1], 1, self.modes_tolerance)
+            else:
+                why = "no estimate" + (f"; the last rung's {_rule(est, 1, self.modes_tolerance)}"
+                                       if est else "")
+            out.append(f"interface modes {self.modes_text()} auto ({why}"
+                       + ("" if self.met_modes else "; NOT within the tolerance: the "
+                          "largest") + ")")
         parts = []
-        for name, v, est, met in (("H", self.harmonics, self.h_estimates, self.met_h),
-                                  ("N", self.samples, self.n_estimates, self.met_n)):
+        for name, v, est, met, back in (
+                ("H", self.harmonics, self.h_estimates, self.met_h, 2),
+                ("N", self.samples, self.n_estimates, self.met_n, 1)):
             if est:
-                e = dict(est).get(v, est[-1][1])
+                keys = [k for k, _ in est]
+                upto = est[:keys.index(v) + 1] if v in keys else est
+                e = upto[-1][1]
                 parts.append(f"{name} = {v} auto (estimate {e:.2e}"
+                             + (f", error e / (1 - r) = {_tail(upto, back):.2e}"
+                                if np.isfinite(e) else "")
                              + ("" if met else ", NOT within the tolerance: the maximum")
                              + ")")
         if parts:
@@ -217,9 +251,10 @@ def _probes(model, F, omega_start, omega_end, opts, outputs, H0, notes) -> list:
     return out
 
 
-def _follow(model, F, opts, outputs, probe, H, N, prev):
+def _follow(model, F, opts, outputs, probe, H, N, prev, errors=None):
     """The solution at the probe's frequency with H harmonics and N samples, started from
-    ``prev`` (a point and its H) and the probe's contact history; None if it fails."""
+    ``prev`` (a point and its H) and the probe's contact history; None if it fails (the
+    reason appended to ``errors``)."""
     from .solver import solve_point
     o = dataclasses.replace(opts, harmonics=H, samples=N, stability=False)
     point, Hp = prev
@@ -227,8 +262,21 @@ def _follow(model, F, opts, outputs, probe, H, N, prev):
         return solve_point(model, _excitation(F, H), probe.omega, o, outputs=outputs,
                            start={"unknowns": point.unknowns, "slider": probe.slider},
                            start_harmonics=Hp)
-    except (FriromError, ArithmeticError, np.linalg.LinAlgError):
+    except (FriromError, ArithmeticError, np.linalg.LinAlgError) as exc:
+        if errors is not None:
+            errors.append(f"H = {H}, N = {N} at {probe.omega / 2 / np.pi:.6g} Hz: {exc}")
         return None                 # a failed solve: an estimate of inf, reported
+
+
+def _no_probe(key: str, ch: AutoChoice, errors: list) -> str:
+    """The message of a choice that stops: no probe solve gave an estimate."""
+    probes = ", ".join(f"{w / 2 / np.pi:.6g}" for w in ch.probes)
+    first = errors[0] if errors else "no solve"
+    return (f'solver.{key} = "auto": no probe solve succeeded (probes at {probes} Hz; '
+            f"{len(errors)} solves failed, the first: {first}), so there is no estimate "
+            f"to choose {'H' if key == 'harmonics' else 'N'} from; nothing was run at the "
+            "maximum. Give solver.harmonics and solver.samples as integers (a run that "
+            "fails then says where), or check the model")
 
 
 def choose(model, F, omega_start, omega_end, options, outputs=None, *, harmonics=True,
@@ -268,6 +316,7 @@ def choose(model, F, omega_start, omega_end, options, outputs=None, *, harmonics
     def n_for(H):
         return fixed_N if fixed_N is not None else default_samples(H)
 
+    errors = []                 # why each failed probe solve failed
     H = options.harmonics
     H0 = H_lo if harmonics else H
     probes = _probes(model, F, omega_start, omega_end,
@@ -288,7 +337,7 @@ def choose(model, F, omega_start, omega_end, options, outputs=None, *, harmonics
                 for k in (h + 1, h + 2):
                     if k not in s and s.get(k - 1) is not None:
                         s[k] = _follow(model, F, options, outputs, p, k, n_for(k),
-                                       (s[k - 1], k - 1))
+                                       (s[k - 1], k - 1), errors)
                 a, b = s.get(h), s.get(h + 2)
                 errs.append(float("inf") if a is None or b is None else
                             _rel(a.amp_max, b.amp_max))
@@ -296,6 +345,9 @@ def choose(model, F, omega_start, omega_end, options, outputs=None, *, harmonics
             if _tail(ch.h_estimates, 2) <= budget:
                 H, ch.met_h = h, True
                 break
+        if not ch.met_h and ch.h_estimates and not any(
+                np.isfinite(e) for _, e in ch.h_estimates):
+            raise ConvergenceError(_no_probe("harmonics", ch, errors))
         if not ch.met_h:
             last = ch.h_estimates[-1][1] if ch.h_estimates else float("nan")
             why = ("a solve failed" if not np.isfinite(last) else
@@ -312,10 +364,10 @@ def choose(model, F, omega_start, omega_end, options, outputs=None, *, harmonics
         for s in sols:
             k = H if s.get(H) is not None else max(k for k, v in s.items() if v is not None)
             starts.append((s[k], k))
-        cur = [_follow(model, F, options, outputs, p, H, N, st)
+        cur = [_follow(model, F, options, outputs, p, H, N, st, errors)
                for p, st in zip(probes, starts)]
         while 2 * N <= max_samples:
-            nxt = [_follow(model, F, options, outputs, p, H, 2 * N, (c, H))
+            nxt = [_follow(model, F, options, outputs, p, H, 2 * N, (c, H), errors)
                    if c is not None else None for p, c in zip(probes, cur)]
             errs = [float("inf") if a is None or b is None else _rel(a.amp_max, b.amp_max)
                     for a, b in zip(cur, nxt)]
@@ -324,6 +376,9 @@ def choose(model, F, omega_start, omega_end, options, outputs=None, *, harmonics
                 ch.met_n = True
                 break
             N, cur = 2 * N, nxt
+        if not ch.met_n and ch.n_estimates and not any(
+                np.isfinite(e) for _, e in ch.n_estimates):
+            raise ConvergenceError(_no_probe("samples", ch, errors))
         if not ch.met_n:
             last = ch.n_estimates[-1][1] if ch.n_estimates else float("nan")
             N = max_samples
@@ -352,25 +407,36 @@ def _rung_deck(deck, values: dict):
 
 def _rung_peaks(deck, H, opts, window, full):
     """The peaks [(omega rad/s, amplitude)] per output of the deck's FRF at H over
-    ``window`` (the whole range ``full`` again when a peak lies on its edge), and the
-    run's (points, seconds, (lo, hi) range run, message); peaks None when the curve
+    ``window`` (the whole range ``full`` again when a peak lies on its edge), the
+    run's (points, seconds, (lo, hi) range run, message), and the run itself (FRF, its
+    FRFPoints, whether it covered ``full``) for reuse; peaks None when the curve
     stopped. Frequencies in rad/s, swept in the direction of ``full``."""
     from .solver import frf
     model, exc = deck.model(), _excitation(deck.F, H)
     t0 = time.perf_counter()
     down = full[0] > full[1]
     for lo, hi in (window, (min(full), max(full))):
+        pts = []
         r = frf(model, exc, *((hi, lo) if down else (lo, hi)), opts,
-                outputs=deck.solver_outputs)
+                outputs=deck.solver_outputs, sink=pts.append)
         n = len(r)
         peaks = [r.peak(j) for j in range(r.amp_max.shape[1])] if n else []
         edge = any(p.index in (0, n - 1) for p in peaks)
         if not edge or (lo, hi) == (min(full), max(full)):
             break
     info = (n, time.perf_counter() - t0, (lo, hi), r.message)
+    run = (r, pts, (lo, hi) == (min(full), max(full)))
     if not r.complete or not peaks:
-        return None, info
-    return [(p.omega, p.amplitude) for p in peaks], info
+        return None, info, run
+    return [(p.omega, p.amplitude) for p in peaks], info, run
+
+
+def _same_options(a, b) -> bool:
+    """Two SolverOptions that compute the same curve (no travelling-wave selection: its
+    arrays are not compared)."""
+    if a.selection is not None or b.selection is not None:
+        return False
+    return all(getattr(a, f.name) == getattr(b, f.name) for f in dataclasses.fields(a))
 
 
 def _peak_change(a, b) -> float:
@@ -409,16 +475,24 @@ def choose_modes(deck, log=print):
     ch = AutoChoice(harmonics=deck.harmonics, samples=deck.samples,
                     tolerance=sol.tolerance_auto, modes_tolerance=ma.tolerance)
     prev, chosen, d, last, size = None, None, deck, None, None  # last: the rung run before
+    built, runs = {}, {}        # rung -> its deck, its run (reused, not built or run again)
 
     def step(i, line, peaks):
-        """Log a rung; True when the rung before it is within the tolerance."""
+        """Log a rung, and the rule that accepts or rejects the rung before it (its
+        change to this one); True when that rung is within the tolerance."""
         log(line)
         ch.mode_lines.append(line)
         if last is None:
             return False
         ch.mode_estimates.append((_rung_label(rungs[last]), _peak_change(prev, peaks)))
-        return bool(np.isfinite(ch.mode_estimates[-1][1])
-                    and _tail(ch.mode_estimates, 1) <= ma.tolerance)
+        ok = bool(np.isfinite(ch.mode_estimates[-1][1])
+                  and _tail(ch.mode_estimates, 1) <= ma.tolerance)
+        rule = (f"auto: modes {_rung_label(rungs[last])} "
+                f"{'accepted' if ok else 'rejected'} (its change to "
+                f"{_rung_label(rungs[i])}): {_rule(ch.mode_estimates, 1, ma.tolerance)}")
+        log(rule)
+        ch.mode_lines.append(rule)
+        return ok
 
     for i, values in enumerate(rungs):
         window = (min(full), max(full))
@@ -435,7 +509,8 @@ def choose_modes(deck, log=print):
                 ch.mode_lines.append(line)
                 continue
             size = d.n_dof
-            peaks, (n, sec, (lo, hi), msg) = _rung_peaks(d, H, opts, window, full)
+            built[i] = d
+            peaks, (n, sec, (lo, hi), msg), runs[i] = _rung_peaks(d, H, opts, window, full)
         except (FriromError, ArithmeticError, np.linalg.LinAlgError) as exc:
             d = None                # a rung that cannot be built or solved: inf
             ch.notes.append(f"modes {_rung_label(values)}: {exc}")
@@ -468,8 +543,14 @@ def choose_modes(deck, log=print):
     est = ", ".join(f"{k}: {e:.2e}" for k, e in ch.mode_estimates)
     ch.mode_lines.append(f"auto: interface-mode estimate (relative change of the peak "
                          f"amplitude and frequency to the next rung): {est}")
-    if chosen != i or d is None:
-        d = _rung_deck(deck, rungs[chosen])
+    d = built[chosen] if chosen in built else _rung_deck(deck, rungs[chosen])
+    # the chosen rung's curve is the run's when it covered the whole range with the run's
+    # own options (H and N not auto): frirom run writes it instead of computing it again
+    run = runs.get(chosen)
+    d.auto_response = None
+    if (run is not None and run[2] and run[0].complete and not sol.auto_harmonics
+            and not sol.auto_samples and _same_options(opts, d.options())):
+        d.auto_response = run[:2]
     ch.seconds = time.perf_counter() - t0
     return d, ch
 
@@ -511,5 +592,5 @@ def resolve_deck(deck, log=print):
     H = ch.harmonics
     F = _excitation(deck.F, H).F
     new = dataclasses.replace(deck, harmonics=H, samples=ch.samples, F=F)
-    new.auto = ch
+    new.auto, new.auto_response = ch, None
     return new

@@ -20,9 +20,11 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import shutil
 import sys
 import time
+import warnings
 from pathlib import Path
 
 from . import __version__
@@ -297,9 +299,18 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
             progress.update(point)
 
         t0 = time.perf_counter()
+        # interface modes "auto": the chosen rung's curve when it is this run's (frirom.auto)
+        reuse = None if args.resume else getattr(deck, "auto_response", None)
         try:
-            result = frf(model, excitation, deck.omega_start, deck.omega_end, options,
-                         outputs=deck.solver_outputs, sink=sink, start=start)
+            if reuse is not None:
+                result = reuse[0]
+                for point in reuse[1]:
+                    sink(point)
+                print("frirom: auto: the chosen rung's curve covers the range with these "
+                      "settings: written, not computed again")
+            else:
+                result = frf(model, excitation, deck.omega_start, deck.omega_end, options,
+                             outputs=deck.solver_outputs, sink=sink, start=start)
         except KeyboardInterrupt:
             progress.close()
             writer.close(complete=False, message="interrupted")
@@ -414,7 +425,8 @@ def _print_stop(full, deck, h5) -> None:
     else:
         hint = ("the same deck resumed stops at the same place: change the deck and run "
                 "without --resume")
-    print(f"frirom: the run stopped before the end of its range{where}: {full.message}; "
+    print(f"frirom: the run stopped before the end of its range{where}: "
+          f"{with_hz(full.message)}; "
           f"the points are in {h5}; {hint} (exit code 3)", file=sys.stderr)
 
 
@@ -509,6 +521,30 @@ def _print_peaks(result, deck) -> None:
               f"({p.method})")
 
 
+_RAD_S = re.compile(r"([-+]?\d[\d.]*(?:[eE][-+]?\d+)?) ?rad/s(?! \()")
+
+
+def with_hz(text: str) -> str:
+    """A message's frequencies in rad/s followed by the same in Hz:
+    ``through omega = 2950.3 rad/s`` -> ``... 2950.3 rad/s (469.56 Hz)``."""
+    return _RAD_S.sub(lambda m: f"{m.group(0)} ({float(m.group(1)) / 2 / 3.141592653589793:.6g}"
+                      " Hz)", text)
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Python warnings as frirom messages: one line ``frirom: warning: ...`` with the
+    frequencies also in Hz; a RuntimeWarning that is not frirom's own (numpy or scipy
+    arithmetic: overflow, invalid value) says so and names where it arose, without the
+    source line."""
+    text = " ".join(str(message).split())
+    if text.startswith("frirom: "):             # frirom's own warnings say what they are
+        text = text[len("frirom: "):]
+    elif issubclass(category, RuntimeWarning):  # numpy / scipy arithmetic
+        text = (f"numerical: {text} (at {Path(filename).name}:{lineno}; --debug shows it "
+                "as Python does)")
+    print(f"frirom: warning: {with_hz(text)}", file=sys.stderr if file is None else file)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -521,11 +557,14 @@ def main(argv: list[str] | None = None) -> int:
         out = getattr(args, "out", None)
         if out is not None and out.exists() and not out.is_dir():
             raise InputError(f"--out {out}: expected a folder, got an existing file")
-        return args.func(args)
+        with warnings.catch_warnings():
+            if not debug:
+                warnings.showwarning = _show_warning
+            return args.func(args)
     except FriromError as exc:
         if debug:
             raise
-        print(f"frirom: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        print(f"frirom: error: {with_hz(' '.join(str(exc).split()))}", file=sys.stderr)
         return 2
     except Exception as exc:            # a bug or an unforeseen input: one line, no traceback
         if debug:

@@ -73,14 +73,57 @@ def _positive_definite(A: sp.csr_matrix) -> bool:
     return bool(np.array_equal(lu.perm_r, lu.perm_c) and np.all(lu.U.diagonal() > 0))
 
 
+def null_motions(K, M, rtol: float = 1e-9, n_max: int = 6):
+    """(lam (m,), phi (n, m)): the motions K does not hold, K phi = lam M phi with lam <=
+    rtol max|K| / max|M| (at most ``n_max``, M-orthonormal); dense below
+    :data:`DENSE_CHECK` DoFs, else shift-invert Lanczos about a small negative shift."""
+    import scipy.linalg as sla
+    K, M = sp.csr_matrix(K), sp.csr_matrix(M)
+    n = K.shape[0]
+    scale = (abs(K).max() if K.nnz else 1.0) / (abs(M).max() if M.nnz else 1.0)
+    k = min(n_max, n)
+    if n <= DENSE_CHECK:
+        lam, phi = sla.eigh(K.toarray(), M.toarray(), subset_by_index=[0, k - 1])
+    else:
+        import scipy.sparse.linalg as spla
+        lam, phi = spla.eigsh(K.tocsc(), k=min(k, n - 2), M=M.tocsc(),
+                              sigma=-1e-6 * scale, which="LM")
+        order = np.argsort(lam)
+        lam, phi = lam[order], phi[:, order]
+    keep = lam <= rtol * scale
+    return lam[keep], phi[:, keep]
+
+
+def describe_motion(phi, labels=None, share: float = 0.2, n_names: int = 8) -> str:
+    """The DoFs a motion ``phi`` (n,) moves: those above ``share`` of its largest, by label
+    (``dof j`` without), and, with "NAME:DIR" labels, its share per direction."""
+    phi = np.asarray(phi, float)
+    a = np.abs(phi)
+    idx = np.flatnonzero(a >= share * a.max())
+    names = [labels[i] if labels else f"dof {i}" for i in idx]
+    text = ", ".join(names[:n_names]) + (f" and {len(names) - n_names} more"
+                                         if len(names) > n_names else "")
+    if labels and all(":" in str(lab) for lab in labels):
+        per = {}
+        for lab, v in zip(labels, phi):
+            d = str(lab).rsplit(":", 1)[1]
+            per[d] = per.get(d, 0.0) + v * v
+        tot = sum(per.values()) or 1.0
+        dirs = ", ".join(f"{d} {np.sqrt(v / tot):.2f}" for d, v in
+                         sorted(per.items(), key=lambda kv: -kv[1]) if v > 1e-6 * tot)
+        text += f" (directions: {dirs})"
+    return text
+
+
 def check_definite(K: sp.csr_matrix, M: sp.csr_matrix, k_name: str = "K",
-                   m_name: str = "M", contacts=()) -> None:
+                   m_name: str = "M", contacts=(), labels=None) -> None:
     """M positive definite and K positive semi-definite and, with the contacts tied
     (each row of their G a spring of K's largest stiffness), not singular.
 
     Checked by a Cholesky of M, of K + sigma M with sigma = 1e-6 max|K| / max|M| (an
     eigenvalue of K below about -1e-6 max|K| max|M|^-1 min eig(M) fails it) and of K with
-    the contacts tied. ParameterError (SingularMatrixError for the last) names the matrix.
+    the contacts tied. ParameterError (SingularMatrixError for the last) names the matrix,
+    and for the last the DoFs of each free motion (``labels``: one per DoF).
     """
     if not _positive_definite(M):
         raise ParameterError(f"{m_name}: expected a positive definite mass matrix "
@@ -97,10 +140,18 @@ def check_definite(K: sp.csr_matrix, M: sp.csr_matrix, k_name: str = "K",
     for G in contacts:
         tied = tied + kmax * (G.T @ G)
     if not _positive_definite(sp.csr_matrix(tied)):
+        try:
+            _, phi = null_motions(tied, M)
+        except (np.linalg.LinAlgError, ValueError, RuntimeError):
+            phi = np.zeros((K.shape[0], 0))
+        which = "; ".join(f"motion {j + 1} moves {describe_motion(phi[:, j], labels)}"
+                          for j in range(phi.shape[1]))
         raise SingularMatrixError(
             f"{k_name}: singular stiffness matrix: a rigid-body motion that no contact "
             "holds (its Cholesky factorisation fails with the contacts tied); the static "
-            "harmonic cannot be solved: constrain the structure")
+            "harmonic cannot be solved: constrain the structure"
+            + (f" ({phi.shape[1]} free motion{'s' if phi.shape[1] > 1 else ''}: {which})"
+               if phi.shape[1] else ""))
 
 
 @dataclass

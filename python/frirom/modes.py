@@ -7,6 +7,11 @@ stick stiffnesses kt, kn of the law, k1 of the cubic law). The nonlinear resonan
 between the two, so their natural frequencies bracket it and their FRFs are reference
 curves for every nonlinear one. Stuck: K_s = K + sum over groups G^T diag(k) G.
 
+A zero natural frequency is a motion the stiffness does not hold: stuck, a warning (no
+contact holds it: the static harmonic cannot be solved); free, a body held only by its
+contacts (a damper). Each such motion is named: the node sets it moves and its direction
+(FE decks), or its DoFs.
+
 With ``[reduction.cyclic]`` the frequencies are per harmonic index (nodal diameter) k_h of
 the harmonics 0..H; the stuck ones need contacts inside the sector (a contact with the
 next sector is left out with a note), and the linear FRFs are the modal sums of harmonic
@@ -22,6 +27,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from .contact import LAWS
+from .model import describe_motion, null_motions
 from .results import amplitude_max
 
 __all__ = ["LinearCheck", "linear_check", "linear_response", "stuck_stiffness"]
@@ -104,6 +110,79 @@ def stuck_stiffness(contacts, n_dof: int) -> sp.csr_matrix:
     return Ks.tocsr()
 
 
+def _set_motions(deck, phi):
+    """{node set: (k, n_nodes, 3) displacements} of the motions phi (n, k) at the reduced
+    model's FE node sets (None without them)."""
+    rom = getattr(deck, "reduced", None)
+    if rom is None or not getattr(rom, "node_sets", None):
+        return None
+    sets = {}
+    for name, nodes in rom.node_sets.items():
+        try:
+            R = np.array([[rom.load_row(int(nd), d) for d in (1, 2, 3)] for nd in nodes])
+        except Exception:           # a set of nodes the reduction does not keep rows of
+            continue
+        if R.size:
+            sets[name] = np.einsum("ndr,rk->knd", R, phi)
+    return sets or None
+
+
+def _free_body(deck, phi) -> str:
+    """What the motions ``phi`` (n,) or (n, k) of the model move, in the deck's terms: with
+    an FE deck the node sets they move (the others named as still) and, of the motions
+    together, the rigid translations among them (from the reduction's rows of the FE
+    DoFs); with [model] the DoFs (:func:`frirom.model.describe_motion`)."""
+    phi = np.asarray(phi, float)
+    phi = phi[:, None] if phi.ndim == 1 else phi
+    sets = _set_motions(deck, phi)
+    if sets is None:
+        return "; ".join(describe_motion(phi[:, j], getattr(deck, "dof_labels", None))
+                         for j in range(phi.shape[1]))
+    rms = {k: float(np.sqrt(np.mean(np.sum(U * U, axis=2)))) for k, U in sets.items()}
+    top = max(rms.values())
+    moving = sorted(k for k, v in rms.items() if v >= 0.2 * top)
+    U = np.concatenate([sets[k] for k in moving], axis=1)      # (k, nodes, 3)
+    means = U.mean(axis=1)                                      # (k, 3) translations
+    size = float(np.sqrt(np.mean(np.sum(U * U, axis=2))))
+    _, sv, Vt = np.linalg.svd(means)
+    dirs = Vt[:int(np.sum(sv > 0.1 * size * np.sqrt(phi.shape[1])))]
+    k = phi.shape[1]
+    if len(dirs) == 3:
+        trans = "translations in every direction"
+    elif len(dirs):
+        trans = ("a translation along " if len(dirs) == 1 else "translations in the plane of ") \
+            + " and ".join("({:.2f}, {:.2f}, {:.2f})".format(*(v * np.sign(v[np.argmax(
+                np.abs(v))]) + 0.0)) for v in np.round(dirs, 2))
+    else:
+        trans = ""
+    rest = k - len(dirs)
+    how = ", ".join(x for x in (trans, f"{rest} rotation{'s' if rest > 1 else ''} or "
+                                f"deformation{'s' if rest > 1 else ''}" if rest else "") if x)
+    others = sorted(set(sets) - set(moving))
+    return (f"node set{'s' if len(moving) > 1 else ''} {', '.join(moving)}: {how}"
+            + (f"; {', '.join(others)} still" if others else ""))
+
+
+def _zero_modes(deck, K, M, around, which: str) -> list:
+    """Notes naming the motions K does not hold (zero natural frequencies), for the
+    ``which`` limit ("stuck": a warning, nothing holds them; "free": the body the contacts
+    hold)."""
+    try:
+        lam, phi = null_motions(K, M, n_max=6)
+    except (np.linalg.LinAlgError, ValueError, RuntimeError):
+        return []
+    k = phi.shape[1]
+    if k == 0:
+        return []
+    many = "ies are" if k > 1 else "y is"
+    head = (f"WARNING: {k} stuck natural frequenc{many} 0 Hz: a motion no contact holds "
+            "even stuck (the static harmonic cannot be solved; constrain the structure or "
+            "add a contact)" if which == "stuck" else
+            f"contacts free: {k} natural frequenc{many} 0 Hz: a body held only by its "
+            "contacts")
+    return [head, f"  free motion{'s' if k > 1 else ''}: {_free_body(deck, phi)}"]
+
+
 def _frequencies(K, M, around: tuple, n_show: int) -> np.ndarray:
     """Natural frequencies [rad/s]: those in ``around`` and ``n_show`` each side."""
     n = K.shape[0]
@@ -167,6 +246,8 @@ def linear_check(deck, n_grid: int | None = None, n_show: int = 2) -> LinearChec
     if deck.cyclic is None:
         free, stuck = _frequencies(K, M, (w0, w1), n_show), _frequencies(Ks, M, (w0, w1),
                                                                           n_show)
+        notes += _zero_modes(deck, Ks, M, (w0, w1), "stuck")
+        notes += _zero_modes(deck, K, M, (w0, w1), "free")
         C = deck.damping_object().assemble(M, K)
         amp_f = _response(K, M, C, deck.F, deck.outputs, omega)
         amp_s = _response(Ks, M, C, deck.F, deck.outputs, omega)

@@ -130,11 +130,17 @@ def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = No
         else:
             ax = fig.add_subplot()
     fig = ax.figure
-    rel = relevant_outputs(amp) if amp.size else np.ones(amp.shape[1], bool)
+    refs = {k: (v[0], np.asarray(v[1], float).reshape(len(v[0]), -1))
+            for k, v in (linear or {}).items() if k in ("free", "stuck")}
+    # the amplitudes that set the axis: the curve's, else (no point) the linear curves'
+    scale = amp if amp.shape[0] or not refs else np.vstack([a for _, a in refs.values()])
+    rel = relevant_outputs(scale) if scale.size else np.ones(amp.shape[1], bool)
     colors = mpl.rcParams["axes.prop_cycle"].by_key()["color"]
     for j in range(amp.shape[1]):
         col = colors[j % len(colors)]
         label = names[j] if rel[j] else f"{names[j]} (< 1e-3 of the largest)"
+        if f.size == 0:                 # linear curves only: name each output's colour
+            ax.plot([], [], color=col, lw=1.6, label=label)
         for a, b, st in _runs(stable):
             # join each stretch to the next point so the curve has no gaps
             sl = slice(a, min(b + 1, f.size))
@@ -147,17 +153,17 @@ def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = No
             ax.plot(f[marks], amp[marks, top], "o", mfc="none", mec="k", ms=6, mew=1.0,
                     zorder=5, label="fold")
     for kind, ls in (("free", ":"), ("stuck", "-.")):
-        if linear and kind in linear:
-            wl, al = linear[kind]
-            al = np.asarray(al, float).reshape(len(wl), -1)
+        if kind in refs:
+            wl, al = refs[kind]
             for j in range(al.shape[1]):
                 ax.plot(frequency_axis(wl, unit)[0], al[:, j], color=colors[j % len(colors)],
-                        lw=0.8, ls=ls, alpha=0.7,
-                        label=f"linear, contacts {kind}" if j == 0 else None)
+                        lw=0.8 if f.size else 1.2, ls=ls, alpha=0.7 if f.size else 1.0)
+            # the line style's entry in a neutral colour: the colours are the outputs'
+            ax.plot([], [], color="0.3", lw=1.0, ls=ls, label=f"linear, contacts {kind}")
             if f.size > 1:              # the reference curves do not widen the axis
                 pad = 0.02 * (f.max() - f.min())
                 ax.set_xlim(f.min() - pad, f.max() + pad)
-    pos = amp[:, rel][amp[:, rel] > 0]
+    pos = scale[:, rel][scale[:, rel] > 0]
     if log is None:
         log = pos.size > 0 and pos.max() / pos.min() > 30.0
     if log:
@@ -168,7 +174,7 @@ def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = No
             # the bottom: where the relevant outputs spend all but 5 % of the curve (a
             # direction that passes through zero at a few points dips below it), four
             # decades below the largest amplitude at most
-            lows = [np.percentile(a[a > 0], 5) for a in amp[:, rel].T if np.any(a > 0)]
+            lows = [np.percentile(a[a > 0], 5) for a in scale[:, rel].T if np.any(a > 0)]
             ax.set_ylim(max(min(lows), 1e-4 * hi) / 1.5, hi * 1.5)
         else:
             ax.set_ylim(0.0, hi * 1.08)

@@ -21,13 +21,14 @@ from __future__ import annotations
 
 import csv
 import re
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
 
-from ._errors import InputError
+from ._errors import FriromError, InputError
 from .contact import LAWS, aft, time_histories
 from .model import CyclicModel
 from .results import FRF, _series
@@ -364,7 +365,7 @@ def write_point(state: PointState, out: Path, chosen=None, n_top: int = 4) -> li
         w = csv.writer(fh)
         w.writerow(["t_s", "phase_rad"] + list(state.labels))
         for i in range(n):
-            w.writerow([repr(tau[i] / state.omega), repr(tau[i])]
+            w.writerow([repr(float(tau[i] / state.omega)), repr(float(tau[i]))]
                        + [repr(float(v)) for v in xt[:, i]])
     written.append(out / "time.csv")
     pick = _chosen(state, chosen, n_top)
@@ -376,7 +377,7 @@ def write_point(state: PointState, out: Path, chosen=None, n_top: int = 4) -> li
             c = state.contacts[g]
             for d, dn in enumerate(c.directions):
                 for i in range(c.tau.size):
-                    w.writerow([c.name, e, repr(c.tau[i]), dn, repr(float(c.u[e, d, i])),
+                    w.writerow([c.name, e, repr(float(c.tau[i])), dn, repr(float(c.u[e, d, i])),
                                 repr(float(c.f[e, d, i]))])
     written.append(out / "hysteresis.csv")
     with open(out / "contacts.csv", "w", newline="") as fh:
@@ -406,9 +407,22 @@ def cmd_show(args) -> int:
     from .plots import plot_frf
     frf, deck = load_run(args.out, args.deck)
     at = parse_frequency(args.at, deck.frequency_unit) if args.at is not None else None
-    k, omega = pick_point(frf, at=at, point=args.point,
-                          peak=args.peak or (at is None and args.point is None))
-    state = point_state(frf, deck, k, omega)
+    peak = args.peak or (at is None and args.point is None)
+    k, omega = pick_point(frf, at=at, point=args.point, peak=peak)
+    try:
+        state = point_state(frf, deck, k, omega)
+    except FriromError as exc:
+        if not peak:
+            raise
+        # the peak lies between stored points: when its solve fails, the highest stored
+        # point (solved before, so its start is its own solution) is shown instead
+        name = (deck.output_names or ["output 0"])[0]
+        k = int(np.argmax(np.asarray(frf.amp_max, float)[:, 0]))
+        print(f"frirom: the peak of {name} at {omega / 2 / np.pi:.6g} Hz could not be "
+              f"solved again ({exc}); showing the highest stored point instead: point {k} "
+              f"at {float(frf.omega[k]) / 2 / np.pi:.6g} Hz", file=sys.stderr)
+        omega = float(frf.omega[k])
+        state = point_state(frf, deck, k, omega)
     base = args.out if args.out.is_dir() else args.out.parent
     folder = args.dir or base / f"show_{state.frequency_hz:.6g}Hz"
     written = write_point(state, folder, args.contact, args.top)

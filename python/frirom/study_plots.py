@@ -19,9 +19,17 @@ def _short(key: str) -> str:
     return ".".join(parts[-2:]) if len(parts) > 2 else key
 
 
-def _label(values: dict) -> str:
-    return ", ".join(f"{_short(k)} = {v:g}" if isinstance(v, (int, float)) else
+def _label(values: dict, width: int = 0) -> str:
+    """``load[0].amplitude = 2, contacts[0].n0 = 50`` (wrapped at ``width`` characters
+    on the commas when width > 0: a legend entry that stays inside the figure)."""
+    text = ", ".join(f"{_short(k)} = {v:g}" if isinstance(v, (int, float)) else
                      f"{_short(k)} = {v}" for k, v in values.items())
+    return "\n".join(textwrap.wrap(text, width)) if width else text
+
+
+#: Legend text width in characters (family.png: the legend sits beside the axes, inside
+#: the figure).
+LEGEND_WIDTH = 30
 
 
 def plot_family(study, frfs, summaries, *, unit: str = "hz", linear=None,
@@ -37,7 +45,7 @@ def plot_family(study, frfs, summaries, *, unit: str = "hz", linear=None,
     (amplitude per unit load: the linear limits are then one curve each).
     """
     j = study.settings.output
-    fig = Figure(figsize=(7.5, 4.8), dpi=130)
+    fig = Figure(figsize=(9.0, 4.8), dpi=130, layout="constrained")
     ax = fig.add_subplot()
     cmap = colormaps["viridis"]
     n = len(frfs)
@@ -49,7 +57,8 @@ def plot_family(study, frfs, summaries, *, unit: str = "hz", linear=None,
         scale = abs(float(m["values"][per_load])) or 1.0 if per_load else 1.0
         a = fr.amp_max[:, j] / scale
         st = np.asarray(fr.stable, bool)
-        ax.plot(f, np.where(st, a, np.nan), color=col, lw=1.4, label=_label(m["values"]))
+        ax.plot(f, np.where(st, a, np.nan), color=col, lw=1.4,
+                label=_label(m["values"], LEGEND_WIDTH))
         if not st.all():
             ax.plot(f, np.where(st, np.nan, a), color=col, lw=1.0, ls="--")
         w, pa = s["peaks"][j]
@@ -82,8 +91,15 @@ def plot_family(study, frfs, summaries, *, unit: str = "hz", linear=None,
     if pos.size and pos.max() / pos.min() > 30:
         ax.set_yscale("log")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7, loc="best")
-    fig.tight_layout()
+    # what the markers are, in black: their colours are the members'
+    ax.plot([], [], "o", color="k", ms=4, label="peak (solved)")
+    if not all(s["complete"] for s in summaries):
+        ax.plot([], [], "x", color="r", ms=8, mew=2, label="curve stopped here")
+    if any(not np.asarray(fr.stable, bool).all() for fr in frfs if len(fr)):
+        ax.plot([], [], color="k", lw=1.0, ls="--", label="unstable (Hill)")
+    # beside the axes, inside the figure (constrained layout makes room): never over the
+    # curves, never cut off
+    fig.legend(loc="outside right upper", fontsize=7)
     return fig
 
 
@@ -93,7 +109,7 @@ def plot_peaks(study, summaries, *, unit: str = "hz") -> Figure:
     j = study.settings.output
     keys = [k for k, _ in study.settings.parameters]
     k0 = keys[0]
-    fig = Figure(figsize=(7.5, 4.8), dpi=130)
+    fig = Figure(figsize=(7.5, 4.8), dpi=130, layout="constrained")
     axa, axf = fig.subplots(2, 1, sharex=True)
     groups = {}
     for m, s in zip(study.members, summaries):
@@ -117,15 +133,15 @@ def plot_peaks(study, summaries, *, unit: str = "hz") -> Figure:
         axf.set_xticklabels([str(v) for v, _ in next(iter(groups.values()))])
     axa.set_ylabel("peak amplitude")
     axf.set_ylabel("peak " + frequency_axis(1.0, unit)[1])
-    axf.set_xlabel(k0 + ("  (zipped with " + ", ".join(keys[1:]) + ")"
-                         if study.settings.combine == "zip" and keys[1:] else ""))
+    axf.set_xlabel("\n".join(textwrap.wrap(
+        k0 + ("  (zipped with " + ", ".join(keys[1:]) + ")"
+              if study.settings.combine == "zip" and keys[1:] else ""), 90)))
     for ax in (axa, axf):
         ax.grid(True, alpha=0.3)
     if any(r for r in groups):
         axa.legend(fontsize=7)
     axa.set_title(f"{study.raw.get('title', study.path.stem)}: peak against {_short(k0)}",
                   fontsize=10)
-    fig.tight_layout()
     return fig
 
 

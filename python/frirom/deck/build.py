@@ -74,7 +74,7 @@ class Deck:
     omega_end: float
     frequency_unit: str
     continuation: dict        # the [continuation] keys given
-    solver: dict              # the [solver] tolerances given, and 'stability'
+    solver: dict              # the [solver] tolerances given, 'stability', 'history'
     outputs: list             # DoF indices (-1: an FE DoF recovered through output_map)
     output_names: list        # as the deck names them ("ACTIVE:z", "1234:UX", "tip:x")
     dof_labels: list | None = None
@@ -177,7 +177,8 @@ class Deck:
         kw = {"harmonics": self.harmonics, "samples": self.samples,
               "formulation": self.formulation}
         for key, name in (("tol_residual", "tol_residual"), ("tol_update", "tol_update"),
-                          ("max_iterations", "max_iter"), ("stability", "stability")):
+                          ("max_iterations", "max_iter"), ("stability", "stability"),
+                          ("tol_stall", "tol_stall"), ("history", "history")):
             if key in self.solver:
                 kw[name] = self.solver[key]
         for key, name in (("step", "ds"), ("min_step", "ds_min"), ("max_step", "ds_max"),
@@ -295,7 +296,8 @@ class _Builder:
             contacts = [self.dof_contact(c) for c in s.contacts]
             try:
                 check_definite(K, M, f"model.stiffness ({s.model.stiffness.name})",
-                               f"model.mass ({s.model.mass.name})", [c.G for c in contacts])
+                               f"model.mass ({s.model.mass.name})", [c.G for c in contacts],
+                               labels=self.labels)
             except FriromError as exc:
                 raise InputError(f"{s.path}: {exc}") from None
         else:
@@ -318,6 +320,10 @@ class _Builder:
         F = np.zeros((n, H + 1), complex)
         for ld in s.loads:
             self.add_load(F, ld.dof, ld.harmonic, ld.amplitude)
+        for pl in s.preloads:
+            log.append(self.add_preload(F, contacts, pl))
+        if s.fe:
+            log.extend(self.normal_warnings(F, contacts))
         if not np.any(F[:, 1:]):
             raise ctx.error("excitation", "at least one load on a harmonic >= 1 "
                             "([[excitation.load]] or [[excitation.engine_order]])")
@@ -330,9 +336,11 @@ class _Builder:
         if s.cyclic is not None:
             cyclic = cyclic_modes(s.path, sector, rom, s.cyclic, damping, H, log.append)
         sol = s.solver
-        solver = {k: getattr(sol, k) for k in ("tol_residual", "tol_update", "max_iterations")
+        solver = {k: getattr(sol, k) for k in ("tol_residual", "tol_update", "max_iterations",
+                                               "tol_stall")
                   if getattr(sol, k) is not None}
         solver["stability"] = sol.stability
+        solver["history"] = sol.history
         cont = {k: v for k, v in vars(s.continuation).items() if v is not None}
         return Deck(path=s.path, title=s.title, M=M, K=K, damping=damping, F=F,
                     contacts=contacts, harmonics=H, samples=sol.samples,
@@ -430,6 +438,100 @@ class _Builder:
         ne = self.rom.pairs[c.name].n_elem
         return ContactSpec(name=c.name, law=c.law, G=G, params=np.tile(c.params, (ne, 1)),
                            w0=None if c.w0 is None else np.tile(c.w0, (ne, 1)))
+
+    def add_preload(self, F, contacts: list, pl) -> str:
+        """A ``[[preload]]``: the normal preload n0 of each pair of its contacts and the
+        balancing harmonic-0 loads, from the body's load; returns the log line.
+
+        The body (side ``pl.body`` of each contact) is in equilibrium at zero displacement
+        under its load P d and the pairs' preloads: on side a a pair pushes with -n0 n
+        (v = n . (x_a - x_b) closes the contact), so sum_c n0_c S_c = s P d with S_c the
+        sum of contact c's pair normals and s = 1 (body a) or -1 (body b); one n0 per
+        contact, the same on each of its pairs (a uniform pressure on each face). Least
+        squares over the contacts; where the balance does not fix the shares (parallel
+        faces: statically indeterminate) the one of least sum over pairs of n0^2, which
+        is the same n0 on every pair (one pressure). Refused when the normals cannot
+        carry the load (residual above 1e-6 P: friction would have to hold the body
+        statically) and when an n0 comes out negative (that face would be pulled: its
+        normal points the wrong way, or the load's).
+        The balancing loads, +n0 n on side a and -n0 n on side b of each pair (as in
+        docs/deck.md), are G_n^T n0: the static state then has every face closed with
+        normal force n0, and those on the body add up to its load.
+        """
+        ctx = self.ctx
+        specs = {c.name: c for c in contacts}
+        settings = {c.name: c for c in self.s.contacts}
+        S, G_n, j_n0, npairs = [], [], [], []
+        for name in pl.contacts:
+            c = specs[name]
+            frames = self.rom.pairs[name].frames
+            S.append(frames[:, -1, :].sum(axis=0))
+            npairs.append(frames.shape[0])
+            nd = LAWS[c.law].n_dir
+            G_n.append(c.G[nd - 1::nd])
+            j_n0.append(LAWS[c.law].parameters.index("n0"))
+        A = np.array(S).T                                   # (3, n_contacts)
+        sign = 1.0 if pl.body == "a" else -1.0
+        target = sign * pl.load * np.asarray(pl.direction)
+        # unknowns sqrt(pairs) n0: lstsq's least-norm answer is then the least sum over
+        # pairs of n0^2 (one pressure on parallel faces); the same answer when determined
+        root = np.sqrt(np.asarray(npairs, float))
+        y, _, rank, _ = np.linalg.lstsq(A / root, target, rcond=None)
+        n0 = y / root
+        miss = np.linalg.norm(A @ n0 - target)
+        if miss > 1e-6 * pl.load:
+            raise ctx.error(f"{pl.key}.direction", "a load the contacts' normals can carry "
+                            f"({miss:.4g} N of it is along no face normal: friction would "
+                            "have to hold the body statically)", list(pl.direction))
+        for name, v in zip(pl.contacts, n0):
+            if v <= 0:
+                c = settings[name]
+                raise ctx.error(f"{c.key}.normal", f"a normal along which {pl.key}'s load "
+                                f"presses the face closed (it would pull it open, n0 = "
+                                f"{v:.4g} N per pair): a normal points from side a towards "
+                                "side b (v = n . (x_a - x_b) closes the contact); flip it, "
+                                f"or {pl.key}.direction or .body", list(c.normal))
+        parts = []
+        for name, v, Gn, j in zip(pl.contacts, n0, G_n, j_n0):
+            c = specs[name]
+            c.params[:, j] = v
+            F[:, 0] += np.asarray(Gn.T @ np.full(Gn.shape[0], v)).ravel()
+            parts.append(f"{name} n0 = {v:.6g} N x {Gn.shape[0]} pairs")
+        return (f"{pl.key}: {pl.load:g} N on side {pl.body} carried by " + ", ".join(parts)
+                + " (and the balancing harmonic-0 loads)"
+                + ("; statically indeterminate (parallel faces): one pressure on every pair"
+                   if rank < len(pl.contacts) else ""))
+
+    def normal_warnings(self, F, contacts: list) -> list:
+        """Warnings for node-set contacts whose preload n0 the deck's harmonic-0 loads
+        push the wrong way: the loads that balance a preload are G_n^T n0 (+n0 n on side
+        a, -n0 n on side b); static loads that project on it with a factor below -1/2
+        balance the preload of the opposite normal, i.e. the normal (or the loads) points
+        the wrong way. Contacts of a [[preload]] are balanced by construction."""
+        derived = {n for p in self.s.preloads for n in p.contacts}
+        out = []
+        F0 = np.real(F[:, 0])
+        for c, st in zip(contacts, self.s.contacts):
+            law = LAWS[c.law]
+            if c.name in derived or "n0" not in law.parameters or not np.any(F0):
+                continue
+            n0 = c.params[:, law.parameters.index("n0")]
+            if not np.any(n0 > 0):
+                continue
+            nd = law.n_dir
+            b = np.asarray(c.G[nd - 1::nd].T @ np.clip(n0, 0.0, None)).ravel()
+            bb = float(b @ b)
+            if bb == 0.0:
+                continue
+            ratio = float(F0 @ b) / bb
+            if ratio < -0.5:
+                out.append(f"WARNING: {st.key}.normal = {list(st.normal)}: the deck's "
+                           f"harmonic-0 loads push against the balance of its preload n0 "
+                           f"(they project on +n0 n / -n0 n of sides a / b with factor "
+                           f"{ratio:.2f}, -1 for a normal flipped): the normal points from "
+                           "side a towards side b (v = n . (x_a - x_b) closes the contact); "
+                           "check its sign, or the loads'")
+        return out
 
     def add_load(self, F, ref: DofRef, h: int, amp: complex):
         """Add a load to F (n, H+1); with [fe_model] a node set loads each of its nodes."""

@@ -17,7 +17,8 @@ from .._errors import MAX_HARMONICS, MAX_OMEGA, InputError, samples_problem
 from ..io._common import read_text
 from ..reduction.rom import FESource, ReductionSpec
 from .fields import Context, DofRef, boolean, dof_ref, file, number, string, table, unknown
-from .schema_contacts import parse_contacts
+from ..solver import SolverOptions
+from .schema_contacts import parse_contacts, parse_preloads
 from .schema_model import (CyclicSettings, MatrixModel, check_travelling_wave, parse_fe_model,
                            parse_matrix_model, parse_reduction)
 
@@ -28,6 +29,15 @@ except ModuleNotFoundError:            # pragma: no cover - Python 3.10 with tom
         import tomli as tomllib
     except ModuleNotFoundError:
         tomllib = None
+
+#: The solver's defaults: the one place a deck's omitted [solver] / [continuation] key
+#: takes its value from (docs/deck.md gives each; tests/test_deck.py checks they agree).
+SOLVER_DEFAULTS = SolverOptions()
+
+#: Deck keys that also go by the solver's own name (SolverOptions, the solver's advice):
+#: table -> {alias: deck key}.
+ALIASES = {"solver": {"max_iter": "max_iterations"},
+           "continuation": {"ds": "step", "ds_min": "min_step", "ds_max": "max_step"}}
 
 #: frequency unit -> factor to rad/s
 FREQUENCY_UNITS = {"hz": 2.0 * math.pi, "rad/s": 1.0}
@@ -46,9 +56,15 @@ class SolverSettings:
     tol_residual, tol_update : float or None
         Newton tolerances (None: the solver's defaults).
     max_iterations : int or None
-        Newton iterations per point (None: the solver's default).
+        Newton iterations per point (None: the solver's default); the deck also accepts
+        the solver's name ``max_iter``.
     stability : bool
-        Hill stability of every point (false with [reduction.cyclic]).
+        Hill stability of every point (false with [reduction.cyclic]); default
+        ``SolverOptions.stability``.
+    tol_stall : float or None
+        A corrector stalling below this residual is accepted (None: the solver's default).
+    history : bool
+        Carry the contact history along the curve; default ``SolverOptions.history``.
     auto_harmonics, auto_samples : bool
         ``harmonics = "auto"`` / ``samples = "auto"``: :mod:`frirom.auto` chooses them
         before the run (``harmonics`` then holds ``max_harmonics``, the largest allowed;
@@ -66,6 +82,8 @@ class SolverSettings:
     tol_update: float | None
     max_iterations: int | None
     stability: bool
+    tol_stall: float | None = None
+    history: bool = SOLVER_DEFAULTS.history
     auto_harmonics: bool = False
     auto_samples: bool = False
     tolerance_auto: float = 1e-3
@@ -144,7 +162,8 @@ class ContinuationSettings:
     """``[continuation]`` (None: the solver's default).
 
     step, min_step, max_step : float or None
-        The solver's dimensionless arc-length steps (first, smallest, largest).
+        The solver's dimensionless arc-length steps (first, smallest, largest); the deck
+        also accepts the solver's names ``ds``, ``ds_min``, ``ds_max``.
     max_points : int or None
         Points of the curve at most.
     """
@@ -191,6 +210,8 @@ class DeckSettings:
         The TOML as read.
     modes_auto : ModesAuto or None
         Interface-mode counts ``"auto"`` (frirom.auto); ``reduction`` holds the first rung.
+    preloads : tuple of Preload
+        ``[[preload]]``: loads whose contacts' n0 and balancing loads are derived.
     """
 
     path: Path
@@ -208,6 +229,7 @@ class DeckSettings:
     outputs: OutputSettings
     raw: dict = field(default_factory=dict, repr=False)
     modes_auto: object = None
+    preloads: tuple = ()
 
     @property
     def fe(self) -> bool:
@@ -244,7 +266,7 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
     ctx = Context(path)
     unknown(ctx, raw, {"title", "model", "fe_model", "reduction", "damping", "excitation",
                        "contacts", "solver", "frequency", "continuation", "outputs",
-                       "study"}, "")
+                       "study", "preload"}, "")
     title = string(ctx, raw, "title", "title", default=path.stem)
 
     # structure: [model] (matrices as they are) or [fe_model] + [reduction]
@@ -264,7 +286,8 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
     H = solver.harmonics
     damping = _damping(ctx, table(ctx, raw, "damping"), fe)
     loads = _excitation(ctx, table(ctx, raw, "excitation"), H, fe, labels, cyc)
-    contacts = parse_contacts(ctx, raw, fe, labels, cyc)
+    preloads = parse_preloads(ctx, raw, fe)
+    contacts = parse_contacts(ctx, raw, fe, labels, cyc, preloads)
     frequency = _frequency(ctx, table(ctx, raw, "frequency"))
     continuation = _continuation(ctx, table(ctx, raw, "continuation", required=False))
     outputs = _outputs(ctx, table(ctx, raw, "outputs"), fe, labels)
@@ -274,13 +297,28 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
                         cyclic=cyc, solver=solver, damping=damping, loads=tuple(loads),
                         contacts=tuple(contacts), frequency=frequency,
                         continuation=continuation, outputs=outputs, raw=raw,
-                        modes_auto=modes_auto)
+                        modes_auto=modes_auto, preloads=tuple(preloads))
+
+
+def _aliased(ctx, d: dict, table_name: str) -> dict:
+    """``d`` with each alias of :data:`ALIASES` renamed to its deck key (both given: an
+    error naming the two)."""
+    out = dict(d)
+    for alias, key in ALIASES[table_name].items():
+        if alias in out:
+            if key in out:
+                raise ctx.error(f"{table_name}.{alias}", f"either {table_name}.{key} or its "
+                                f"alias {table_name}.{alias}, not both", out[alias])
+            out[key] = out.pop(alias)
+    return out
 
 
 def _solver(ctx, sol, cyc) -> SolverSettings:
     unknown(ctx, sol, {"harmonics", "samples", "formulation", "tol_residual",
                        "tol_update", "max_iterations", "stability", "tolerance_auto",
-                       "max_harmonics", "max_samples"}, "solver")
+                       "max_harmonics", "max_samples", "tol_stall", "history",
+                       *ALIASES["solver"]}, "solver")
+    sol = _aliased(ctx, sol, "solver")
     auto = _auto(ctx, sol, cyc)
     H = auto["max_harmonics"] if auto["auto_harmonics"] else number(
         ctx, sol, "harmonics", "solver.harmonics", required=True, integer=True, minimum=1,
@@ -300,7 +338,9 @@ def _solver(ctx, sol, cyc) -> SolverSettings:
         tols.append(None if v is None else float(v))
     max_it = number(ctx, sol, "max_iterations", "solver.max_iterations", integer=True,
                     minimum=1)
-    stability = boolean(ctx, sol, "stability", "solver.stability", True)
+    stability = boolean(ctx, sol, "stability", "solver.stability", SOLVER_DEFAULTS.stability)
+    stall = number(ctx, sol, "tol_stall", "solver.tol_stall", nonneg=True)
+    history = boolean(ctx, sol, "history", "solver.history", SOLVER_DEFAULTS.history)
     if cyc is not None:
         if form != "condensed":
             raise ctx.error("solver.formulation", "'condensed' with [reduction.cyclic] "
@@ -311,6 +351,7 @@ def _solver(ctx, sol, cyc) -> SolverSettings:
         stability = False
     return SolverSettings(harmonics=H, samples=N, formulation=form, tol_residual=tols[0],
                           tol_update=tols[1], max_iterations=max_it, stability=stability,
+                          tol_stall=None if stall is None else float(stall), history=history,
                           **auto)
 
 
@@ -463,7 +504,9 @@ MAX_STEP = 10.0
 
 
 def _continuation(ctx, con) -> ContinuationSettings:
-    unknown(ctx, con, {"step", "min_step", "max_step", "max_points"}, "continuation")
+    unknown(ctx, con, {"step", "min_step", "max_step", "max_points",
+                       *ALIASES["continuation"]}, "continuation")
+    con = _aliased(ctx, con, "continuation")
     steps = {}
     for k in ("step", "min_step", "max_step"):
         v = number(ctx, con, k, f"continuation.{k}", positive=True, maximum=MAX_STEP)

@@ -96,30 +96,104 @@ class NodeSetContact:
     b_sector: int = 0
 
 
+@dataclass(frozen=True)
+class Preload:
+    """A ``[[preload]]`` table: one body's load (a damper's centrifugal load, a bolt's
+    clamping force) carried by the normal preloads of some contacts, given once.
+
+    load : float
+        The load on the body [N], > 0.
+    direction : tuple of 3 float
+        Its unit direction (global axes).
+    contacts : tuple of str
+        The ``[[contacts]]`` tables (laws with ``n0``) that carry it: their ``n0`` per pair
+        and the balancing harmonic-0 loads are derived from the load
+        (:meth:`frirom.deck.build.Builder.add_preloads`).
+    body : str
+        ``"a"`` or ``"b"``: the side of those contacts the loaded body is on.
+    key : str
+        Key path (``preload[0]``).
+    """
+
+    load: float
+    direction: tuple
+    contacts: tuple
+    body: str
+    key: str
+
+
+def parse_preloads(ctx: Context, raw: dict, fe: bool) -> list:
+    """Every ``[[preload]]`` table, checked (the contacts it names: by
+    :func:`parse_contacts`)."""
+    pls = raw.get("preload", [])
+    if isinstance(pls, dict):
+        pls = [pls]
+    if not isinstance(pls, list):
+        raise ctx.error("preload", "an array of tables [[preload]]", pls)
+    out = []
+    for i, t in enumerate(pls):
+        key = f"preload[{i}]"
+        if not isinstance(t, dict):
+            raise ctx.error(key, "a table [[preload]]", t)
+        if not fe:
+            raise ctx.error(key, "[fe_model] (a preload is spread over node-set contacts; "
+                            "with [model] give each element's n0 or fn0)")
+        unknown(ctx, t, {"load", "direction", "contacts", "body"}, key)
+        load = number(ctx, t, "load", f"{key}.load", required=True, positive=True)
+        d = np.array(vector(ctx, t, "direction", f"{key}.direction"))
+        names = t.get("contacts")
+        if (not isinstance(names, list) or not names
+                or not all(isinstance(x, str) for x in names)):
+            raise ctx.error(f"{key}.contacts", "a non-empty list of [[contacts]] names", names)
+        body = string(ctx, t, "body", f"{key}.body", default="a", choices=("a", "b"))
+        out.append(Preload(load=float(load), direction=tuple(d / np.linalg.norm(d)),
+                           contacts=tuple(names), body=body, key=key))
+    return out
+
+
 def parse_contacts(ctx: Context, raw: dict, fe: bool, labels: bool,
-                   cyclic: CyclicSettings | None) -> list:
-    """Every ``[[contacts]]`` table, checked (``fe``, ``labels`` as :func:`dof_ref`)."""
+                   cyclic: CyclicSettings | None, preloads=()) -> list:
+    """Every ``[[contacts]]`` table, checked (``fe``, ``labels`` as :func:`dof_ref`);
+    ``preloads``: the [[preload]] tables, whose contacts get their ``n0`` from them."""
     cons = raw.get("contacts", [])
     if not isinstance(cons, list):
         raise ctx.error("contacts", "an array of tables [[contacts]]", cons)
     if cyclic is not None and not cons:
         raise ctx.error("contacts", "at least one [[contacts]] table with "
                         "[reduction.cyclic] (a cyclic sector is solved for its contacts)")
-    contacts = [_contact(ctx, c, f"contacts[{i}]", fe, labels, cyclic)
+    derived = {n for p in preloads for n in p.contacts}
+    contacts = [_contact(ctx, c, f"contacts[{i}]", fe, labels, cyclic, derived)
                 for i, c in enumerate(cons)]
     names = [c.name for c in contacts]
     for i, nm in enumerate(names):
         if nm in names[:i]:
             raise ctx.error(f"contacts[{i}].name", "a name not used by another contact", nm)
+    seen = {}
+    for p in preloads:
+        for j, nm in enumerate(p.contacts):
+            if nm not in names:
+                raise ctx.error(f"{p.key}.contacts[{j}]", "the name of a [[contacts]] table "
+                                f"({', '.join(names) or 'none'})", nm)
+            if nm in seen:
+                raise ctx.error(f"{p.key}.contacts[{j}]", f"a contact no other preload "
+                                f"carries ({seen[nm]} does)", nm)
+            seen[nm] = p.key
+            c = contacts[names.index(nm)]
+            if "n0" not in LAWS[c.law].parameters:
+                raise ctx.error(f"{p.key}.contacts[{j}]", "a contact whose law has a normal "
+                                f"preload n0 (normal1d, normal2d), not {c.law!r}", nm)
+            if not isinstance(c.normal, tuple):
+                raise ctx.error(f"{c.key}.normal", "a 3-vector normal with a [[preload]] "
+                                "(the load's balance needs the faces' directions)", c.normal)
     return contacts
 
 
-def _contact(ctx, c, key, fe, labels, cyclic):
+def _contact(ctx, c, key, fe, labels, cyclic, derived=frozenset()):
     if not isinstance(c, dict):
         raise ctx.error(key, "a table [[contacts]]", c)
     law = string(ctx, c, "law", f"{key}.law", required=True, choices=tuple(LAWS))
     if fe:
-        return _node_set_contact(ctx, c, key, law, cyclic)
+        return _node_set_contact(ctx, c, key, law, cyclic, derived)
     dirs, pnames = LAWS[law].directions, LAWS[law].parameters
     ndir = len(dirs)
     unknown(ctx, c, {"name", "law", "elements", "directions", "w0"} | set(pnames), key)
@@ -186,11 +260,18 @@ def _frame(ctx, frame, key, nd, dirs) -> np.ndarray:
     return D
 
 
-def _law_parameters(ctx, c, key, law, ne):
-    """(params (ne, n_par), w0 (ne, n_slider) or None) of a contact table."""
+def _law_parameters(ctx, c, key, law, ne, derived=()):
+    """(params (ne, n_par), w0 (ne, n_slider) or None) of a contact table; the parameters
+    in ``derived`` come from elsewhere (a [[preload]]: 0 here) and must not be given."""
     pnames, nsl = LAWS[law].parameters, LAWS[law].n_slider
     params = np.empty((ne, len(pnames)))
     for j, p in enumerate(pnames):
+        if p in derived:
+            if p in c:
+                raise ctx.error(f"{key}.{p}", "no value: a [[preload]] carried by this "
+                                "contact derives it", c[p])
+            params[:, j] = 0.0
+            continue
         params[:, j] = per_element(ctx, c, p, f"{key}.{p}", ne, required=True,
                                    nonneg=p in _NONNEGATIVE)
     if "kt" in pnames and np.any(params[:, 0] <= 0):
@@ -205,7 +286,7 @@ def _law_parameters(ctx, c, key, law, ne):
     return params, w0
 
 
-def _node_set_contact(ctx, c, key, law, cyclic):
+def _node_set_contact(ctx, c, key, law, cyclic, derived=frozenset()):
     """A [[contacts]] table of a reduced model: node sets a, b, a normal."""
     pnames = LAWS[law].parameters
     unknown(ctx, c, {"name", "law", "a", "b", "b_sector", "normal", "tangent", "tol",
@@ -236,7 +317,8 @@ def _node_set_contact(ctx, c, key, law, cyclic):
         if isinstance(c.get(p), list):
             raise ctx.error(f"{key}.{p}", "a number (the same for every pair of the "
                             "node sets)", c[p])
-    params, w0 = _law_parameters(ctx, c, key, law, 1)
+    params, w0 = _law_parameters(ctx, c, key, law, 1,
+                                 ("n0",) if name in derived and "n0" in pnames else ())
     stick = (params[0, 0], params[0, 1] if "kn" in pnames else 0.0)
     return NodeSetContact(name=name, law=law, a=a, b=b, normal=normal, tangent=tangent,
                           tol=tol, params=params[0], w0=None if w0 is None else w0[0],

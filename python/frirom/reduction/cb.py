@@ -20,7 +20,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .._errors import InputError
-from .eigen import default_ncv, eigsh_shift_invert
+from .eigen import canonical_modes, default_ncv, eigsh_shift_invert
 
 __all__ = ["CraigBampton", "craig_bampton"]
 
@@ -195,7 +195,7 @@ def _scipy_modes_and_statics(Kss, Mss, Ksm, n_modes, sigma, tol, ncv):
         lam, phi = spla.eigsh(Kss, k=n_modes, M=Mss, sigma=sigma, OPinv=op, tol=tol,
                               ncv=ncv or default_ncv(n_modes, n))
         order = np.argsort(lam)
-        lam, phi = lam[order], phi[:, order]
+        lam, phi = canonical_modes(lam[order], phi[:, order])
     else:
         lam, phi = np.zeros(0), np.zeros((n, 0))
     if sigma:

@@ -28,6 +28,7 @@ import scipy.sparse.linalg as spla
 
 from .._errors import InputError, NumericalError, SingularMatrixError, SizeError
 from ..model import ContactGroup
+from .eigen import canonical_modes
 
 #: reduced models up to this size are returned as dense matrices, larger ones as CSR
 DENSE_LIMIT = 3000
@@ -275,7 +276,8 @@ class _CCModes:
         n = min(n, self.kc.shape[0])
         if self.v is None or self.v.shape[1] < n:
             try:
-                self.w, self.v = sla.eigh(self.kc, self.mc, subset_by_index=[0, n - 1])
+                self.w, self.v = canonical_modes(
+                    *sla.eigh(self.kc, self.mc, subset_by_index=[0, n - 1]))
             except (np.linalg.LinAlgError, ValueError) as exc:
                 raise NumericalError(f"GSI: eigen-solve of the master partition failed "
                                      f"({exc}); is M_mm positive definite?") from exc

@@ -1,0 +1,38 @@
+"""Write the UPD case's CalculiX matrices and references next to upd.toml (gmsh-free
+structured hexahedra + ccx, not committed).
+
+    python cases/upd/make_upd.py                 # upd.inp/.sti/.mas/.dof, free.dat, stuck.dat
+    frirom modes cases/upd/upd.toml
+
+Two blades and a strip damper under both platforms (cases/models/upd.py): the matrices
+(``*FREQUENCY, SOLVER=MATRIXSTORAGE``), and CalculiX's own eigenfrequencies of the blades
+alone (free.dat) and of the assembly with the contact pairs joined by the deck's kt, kn
+springs (stuck.dat): the references of the linear limits.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "models"))
+from upd import write_upd  # noqa: E402
+
+
+def make(out=HERE, h: float = 0.002) -> Path:
+    """Mesh, run ccx three times; returns the job path (out/upd)."""
+    return write_upd(Path(out), h)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--h", type=float, default=0.002, help="lattice spacing [m]")
+    ap.add_argument("--out", type=Path, default=HERE, help="folder (default: this one)")
+    a = ap.parse_args(argv)
+    print(f"wrote {make(a.out, a.h)}.sti/.mas/.dof, free.dat, stuck.dat")
+
+
+if __name__ == "__main__":
+    main()
