@@ -203,6 +203,7 @@ contains
         real(wp) :: dsout, tl
         logical :: fin
         character(len=64) :: buf
+        character(len=8) :: unit
         info = FRIROM_OK
         call alloc_points(run, pts, 0_ip)
         if (.not. open_run(run, 'run_advance', info, errmsg)) return
@@ -294,15 +295,16 @@ contains
         run%yscale = pts%yscale(ne)
         run%ds = dsout
         run%start_mode = HBM_START_RESUME
+        unit = merge(' rad/s', '      ', run%m%mode == RUN_FREQUENCY)
         if (fin) then
             run%status = RUN_DONE
             if (run%lam /= run%lam_end) then
                 run%status = RUN_LEFT_RANGE
-                write (buf, '(es14.7)') run%lam
+                write (buf, '(g0.7)') run%lam
                 run%message = 'the solution curve turned back and left the range through '// &
-                              trim(adjustl(buf))
-                write (buf, '(es14.7)') run%lam_start
-                run%message = trim(run%message)//' (start '//trim(adjustl(buf))//')'
+                              trim(adjustl(buf))//trim(unit)
+                write (buf, '(g0.7)') run%lam_start
+                run%message = trim(run%message)//' (start '//trim(adjustl(buf))//trim(unit)//')'
             end if
         else if (run%n_before + run%n_made >= run%s%max_points) then
             call stop_max(run)
