@@ -39,7 +39,7 @@ def test_missing_package_names_its_extra(monkeypatch, module, extra):
         require(module, extra, "this feature")
 
 
-def test_study_without_distributed_names_the_extra(monkeypatch, tmp_path):
+def test_study_without_distributed_names_the_extra(monkeypatch):
     from frirom import study
     monkeypatch.setitem(sys.modules, "distributed", None)
     with pytest.raises(MissingExtraError, match=r"frirom\[study\]"):
