@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from ._errors import InputError
+from ._optional import require
 from ._resume import ResultsLock
 from .deck.schema import parse_deck, read_toml
 from .deck.schema_study import StudySettings, member_raw, parse_study
@@ -279,12 +280,10 @@ class _Runner:
         self.scheduler = scheduler
         if scheduler == "serial":
             return
-        try:
-            from distributed import Client, LocalCluster
-        except ModuleNotFoundError:
-            raise InputError("study.scheduler: running on Dask needs the 'distributed' "
-                             "package (pip install distributed), or scheduler = "
-                             "\"serial\"") from None
+        distributed = require("distributed", "study",
+                              "study.scheduler: running members as Dask tasks (or "
+                              "scheduler = \"serial\")")
+        Client, LocalCluster = distributed.Client, distributed.LocalCluster
         if scheduler == "local":
             n = workers or os.cpu_count() or 1
             env = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
@@ -315,7 +314,7 @@ class _Runner:
                 if on_done:
                     on_done(i, out[i])
             return out
-        from distributed import wait
+        wait = require("distributed", "study", "a Dask study").wait
         futures = {self.client.submit(fn, *args, pure=False): i
                    for i, args in enumerate(jobs)}
         pending = set(futures)
