@@ -150,8 +150,22 @@ def test_demo_writes_figures_and_harmonics(tmp_path, capsys):
 
 
 def test_version(capsys):
-    try:
+    """`frirom --version` prints exactly "frirom <version>" and exits 0, the version being
+    the installed distribution's (importlib.metadata: pyproject.toml's [project] version),
+    which frirom.__version__ and meson.build's project() version (the C and Fortran
+    library's, in frirom.pc) must equal: three places hold it, a release that bumps one
+    and not the others fails here."""
+    import importlib.metadata
+    import re
+
+    import frirom
+    version = importlib.metadata.version("frirom")
+    assert re.fullmatch(r"\d+\.\d+\.\d+\S*", version), version
+    assert frirom.__version__ == version
+    project = re.search(r"project\([^)]*?version\s*:\s*'([^']+)'",
+                        (ROOT / "meson.build").read_text())
+    assert project and project.group(1) == version
+    with pytest.raises(SystemExit) as exc:
         main(["--version"])
-    except SystemExit as exc:
-        assert exc.code == 0
-    assert "frirom" in capsys.readouterr().out
+    assert exc.value.code == 0
+    assert capsys.readouterr().out == f"frirom {version}\n"

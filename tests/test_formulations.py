@@ -171,7 +171,8 @@ def _curve_gap(a, b):
     return np.sqrt(((a[:, None] - p[None] - s[..., None] * d[None])**2).sum(2)).min(1).max()
 
 
-@pytest.mark.parametrize("deck", ["joint/joint.toml", "bladed_disk/bladed_disk.toml",
+@pytest.mark.parametrize("deck", [pytest.param("joint/joint.toml", marks=pytest.mark.slow),
+                                  "bladed_disk/bladed_disk.toml",
                                   pytest.param("joint/joint_liftoff.toml",
                                                marks=pytest.mark.slow)])
 def test_bundled_deck_same_curve_in_both_formulations(deck):

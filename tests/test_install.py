@@ -116,12 +116,8 @@ def test_legacy_fortran_program_links_installed_library(tmp_path):
         assert expect in out
     # no test program is installed or built by `meson install`
     assert not list(prefix.rglob("test_*")) and not list(build.rglob("test_aft"))
-    sys.path.insert(0, str(ROOT / "tests"))
-    try:
-        import capi_compare
-        import readme_program
-    finally:
-        sys.path.pop(0)
+    import capi_compare
+    import readme_program
     exe_f, exe_c = tmp_path / "frf_joint", tmp_path / "frf_joint_c"
     for exe, cmd in ((exe_f, ["gfortran"]), (exe_c, ["cc"])):
         src = tmp_path / f"{exe.name.removesuffix('_c')}.{'c' if cmd == ['cc'] else 'f90'}"

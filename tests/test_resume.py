@@ -65,6 +65,7 @@ def _same(a: FRF, b: FRF, what: str) -> None:
                                       err_msg=f"{what}: {name}")
 
 
+@pytest.mark.slow
 def test_killed_anywhere_then_resumed_equals_uninterrupted(joint, tmp_path):
     """Kill after k points (k = 5: before the first checkpoint; 21: on one; 37, 48: inside
     a call; 48 also with a torn record, rows written for point 49 in some datasets only),
@@ -331,7 +332,6 @@ def test_resume_exact_when_the_solver_carries_its_lu(tmp_path):
     840 unknowns, large enough that Fortran holds the LU (checked). Tolerance 0; without
     the drop the resumed calls would start from a fresh LU where the uninterrupted ones
     used the carried one, and differ at the GMRES tolerance."""
-    sys.path.insert(0, str(ROOT / "cases" / "bench"))
     from condensed import F_RES, reduced_model
 
     from frirom import _kernels
