@@ -152,6 +152,7 @@ def test_samples_only_meets_tolerance_against_many_samples():
     assert np.all(err <= tol), (ch.lines(), err)
 
 
+@pytest.mark.slow
 def test_study_member_uses_the_choice(tmp_path):
     # A study member (frirom.study.run_member) of an "auto" deck runs at the H and N that
     # the deck alone would choose.

@@ -92,6 +92,7 @@ def test_cb_bad_input(ccx_block):
         craig_bampton(model, 5)
 
 
+@pytest.mark.slow
 def test_cb_lap_joint_gmsh_tet10(tmp_path):
     """Lap joint of two plates meshed by gmsh (C3D10), both contact faces as masters: the
     first 10 CB frequencies converge to ccx's, below 0.1 % with 40 fixed-interface modes.

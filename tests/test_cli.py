@@ -97,11 +97,29 @@ def test_bad_deck_gives_clear_error(deck, tmp_path, capsys):
     assert "contacts[0].mu" in err and ">= 0" in err and str(deck) in err
 
 
+def test_resume_refuses_a_changed_deck_after_a_few_points(deck, tmp_path, capsys):
+    """The fast variant of tests/test_resume.py's test_resume_refuses_a_changed_deck: a run
+    stopped at max_points after 5 points (exit 3), then --resume with another friction
+    coefficient and harmonic count exits 2 naming both changes."""
+    out = tmp_path / "out"
+    text = deck.read_text().replace("max_points = 1000", "max_points = 5")
+    deck.write_text(text)
+    assert main(["run", str(deck), "--out", str(out), "--quiet"]) == 3
+    capsys.readouterr()
+    deck.write_text(text.replace("mu = 0.5", "mu = 0.4").replace("harmonics = 5",
+                                                                  "harmonics = 6"))
+    assert main(["run", str(deck), "--out", str(out), "--quiet", "--resume"]) == 2
+    err = capsys.readouterr().err
+    assert "the deck changed" in err and "contacts[0].mu: 0.5 then, 0.4 now" in err
+    assert "solver.harmonics: 5 then, 6 now" in err
+
+
 def test_resume_without_previous_run(deck, tmp_path, capsys):
     assert main(["run", str(deck), "--out", str(tmp_path / "none"), "--resume"]) == 2
     assert "nothing to resume" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_ctrl_c_keeps_points_and_resumes(deck, tmp_path, monkeypatch, capsys):
     """An interrupt (Ctrl-C) after some points: exit code 130, the points are in frf.h5,
     and --resume finishes the curve."""

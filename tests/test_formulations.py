@@ -127,7 +127,7 @@ def _every(points, k):
     return [points[i] for i in sorted(set(range(0, len(points), k)) | {ip, len(points) - 1})]
 
 
-@pytest.mark.parametrize("samples", [256, 1024])
+@pytest.mark.parametrize("samples", [256, pytest.param(1024, marks=pytest.mark.slow)])
 def test_nlvib_beam_both_formulations_trace_the_same_curve(samples):
     """Both runs reach 330 rad/s through the corner at 398.78 rad/s; every 6th point of
     each (and its peak) is a solution of the other formulation to SAME_POINT."""

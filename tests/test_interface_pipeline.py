@@ -119,6 +119,7 @@ def test_cb_then_gsi(fe, capsys):
     assert e[-2] < 2e-2 and e_cb < 1e-2  # 32 GSI modes for 3x25 DoFs: within 2 %
 
 
+@pytest.mark.slow
 def test_gsi_on_gmsh_lap_joint(tmp_path, capsys):
     """The paper's setting (Sec. 3.2.1): two components joined over an extended contact,
     reduced by CB (ROM_I, the benchmark), then GSI with free + full-stick modes per side

@@ -251,6 +251,7 @@ def test_second_run_on_a_folder_is_refused_until_the_first_dies(deck, tmp_path, 
     ResultsLock(out).release()      # free again
 
 
+@pytest.mark.slow
 def test_resume_refuses_a_changed_deck(deck, tmp_path, capsys):
     """--resume names each change (a key, a matrix file's content); frequency.end and
     continuation.max_points may change (they extend the run); a shorter range may not."""

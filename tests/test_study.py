@@ -187,6 +187,7 @@ def test_resume_member_by_member_and_point_by_point(tmp_path, monkeypatch):
         assert res["summaries"][i]["peaks"] == clean["summaries"][i]["peaks"]
 
 
+@pytest.mark.slow
 def test_convergence_ladder_and_choice(tmp_path):
     """A ladder over H (samples with it) on the joint: the errors against the richest rung
     fall; the chosen rung meets the tolerance and is the smallest that does. Checked
