@@ -36,6 +36,7 @@ def test_hht_spectral_properties_match_closed_forms():
         algorithmic_properties(0.1, 1.0)
 
 
+@pytest.mark.slow
 def test_linear_two_dof_second_order_against_closed_form():
     # The closed-form FRF of a 2-DoF system (1 % and 1.5 % damping) at 6 frequencies
     # including both resonances. Step error O(dt^2): the frequency shift (2 pi/N)^2/12 =
