@@ -8,7 +8,7 @@ import pytest
 from frirom.results import FRF, Peak, amplitude_max
 from frirom.solver import SolverOptions, frf
 
-from test_solver_core import duffing
+from _models import duffing
 
 
 def shifted(coeffs, phi):
