@@ -109,12 +109,8 @@ def test_readme_fortran_c_block_and_legacy_programs(tmp_path):
     tmp_path: it installs the library into $HOME/.local and builds examples/frf_joint.f90
     and examples/frf_joint.c, which must reproduce the Python FRF (capi_compare). Then
     legacy programs link the same install through pkg-config."""
-    sys.path.insert(0, str(ROOT / "tests"))
-    try:
-        import capi_compare
-        import readme_program
-    finally:
-        sys.path.pop(0)
+    import capi_compare
+    import readme_program
     block = next(b for b in readme_program.blocks(ROOT / "README.md")
                  if b.lang == "sh" and "examples/frf_joint.f90" in b.code)
     src, home = tmp_path / "src", tmp_path / "home"

@@ -19,8 +19,7 @@ import scipy.linalg as sl
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
-sys.path.insert(0, str(ROOT / "tests"))
-import readme_program  # noqa: E402
+import readme_program
 
 BLOCKS = readme_program.blocks(README)
 
