@@ -136,7 +136,19 @@ def _add_study(sub) -> None:
                    help="output folder (default: results/<deck name>)")
     p.add_argument("--scheduler", default=None,
                    help='"local" (a LocalCluster, the default), "serial", or a Dask '
-                   "scheduler address (tcp://host:8786); overrides study.scheduler")
+                   "scheduler address (tcp://host:8786, tls://host:8786); overrides "
+                   "FRIROM_SCHEDULER and study.scheduler. A scheduler can run any code in "
+                   "this process: name only one you trust (docs/security.md)")
+    p.add_argument("--trust-deck-scheduler", action="store_true",
+                   help="connect to the scheduler address the deck's study.scheduler names "
+                   "(refused without this flag, --scheduler or FRIROM_SCHEDULER)")
+    p.add_argument("--tls-ca", default=None, metavar="FILE",
+                   help="CA certificate of a tls:// scheduler (default: Dask's "
+                   "configuration, distributed.comm.tls.ca-file)")
+    p.add_argument("--tls-cert", default=None, metavar="FILE",
+                   help="this client's certificate for a tls:// scheduler")
+    p.add_argument("--tls-key", default=None, metavar="FILE",
+                   help="this client's private key for a tls:// scheduler")
     p.add_argument("--workers", type=int, default=None,
                    help="LocalCluster workers (default: study.workers, or one per core)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -145,8 +157,10 @@ def _add_study(sub) -> None:
 
 def _study(args) -> int:
     from .study import run_study
+    tls = {"ca": args.tls_ca, "cert": args.tls_cert, "key": args.tls_key}
     res = run_study(args.deck, args.out, scheduler=args.scheduler, workers=args.workers,
-                    quiet=args.quiet, log=lambda s: print(f"frirom: {s}"))
+                    quiet=args.quiet, log=lambda s: print(f"frirom: {s}"),
+                    trust_deck_scheduler=args.trust_deck_scheduler, tls=tls)
     return 0 if all(s["complete"] for s in res["summaries"]) else 1
 
 
@@ -362,11 +376,12 @@ def _resume_start(h5: Path, deck, fingerprint: str):
     if not h5.is_file():
         raise InputError(f"{h5}: nothing to resume (run without --resume first)")
     try:
-        f = h5py.File(h5, "r")
+        h5py.File(h5, "r").close()
     except OSError as exc:
         raise InputError(f"{h5}: cannot be read as HDF5 ({exc}); it cannot be resumed: run "
                          "without --resume (the folder's results are replaced)") from None
-    with f:
+    previous = FRF.load(h5)         # refuses a damaged, edited or inconsistent file
+    with h5py.File(h5, "r") as f:
         old = f.attrs.get("deck_fingerprint")
         rng = f.attrs.get("omega_range")
     redo = "run without --resume (the results in that folder are replaced) or choose " \
@@ -380,7 +395,6 @@ def _resume_start(h5: Path, deck, fingerprint: str):
             raise InputError(f"{h5}: the deck changed since these results were made (only "
                              f"{' and '.join(EXTENDABLE)} may change on --resume):\n  "
                              + "\n  ".join(changes) + f"\n{redo}")
-    previous = FRF.load(h5)         # refuses an inconsistent file
     extended = rng is not None and float(rng[1]) != deck.omega_end
     if extended and (deck.omega_end - rng[1]) * np.sign(rng[1] - rng[0]) < 0:
         raise InputError(f"{deck.path}: frequency.end: --resume may extend the range, not "

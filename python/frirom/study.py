@@ -36,9 +36,10 @@ from pathlib import Path
 import numpy as np
 
 from ._errors import InputError
+from ._h5check import DIGEST, seal
 from ._resume import ResultsLock
 from .deck.schema import parse_deck, read_toml
-from .deck.schema_study import StudySettings, member_raw, parse_study
+from .deck.schema_study import StudySettings, check_address, member_raw, parse_study
 
 __all__ = ["Study", "load_study", "run_member", "run_study", "convergence_table",
            "smallest_within", "curve_distance"]
@@ -264,6 +265,7 @@ def _write_peaks(h5, peaks) -> None:
         f.create_dataset("peak_amplitude", data=[p.amplitude for p in peaks])
         f.create_dataset("peak_index", data=[p.index for p in peaks])
         f.attrs["peak_method"] = np.array([p.method for p in peaks], dtype="S")
+        seal(f)
 
 
 def _label(values: dict) -> str:
@@ -271,14 +273,92 @@ def _label(values: dict) -> str:
 
 
 # ---- running ---------------------------------------------------------------------------
+#: Environment variable naming the Dask scheduler a study connects to (as --scheduler).
+SCHEDULER_ENV = "FRIROM_SCHEDULER"
+#: Seconds to reach a Dask scheduler (the TCP connection, its first message, the client's
+#: handshake) before the study is refused.
+CONNECT_TIMEOUT = 10.0
+#: Largest first message [bytes] a scheduler may send: a Dask handshake is a few hundred
+#: bytes; anything else answering on that port is refused before the client reads it (an
+#: HTTP or SSH server's first bytes read as a length would ask for exbibytes).
+PROBE_MAX_BYTES = 1 << 26
+#: Most LocalCluster workers a study may ask for.
+MAX_WORKERS = 1024
+def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
+    """Check that a Dask scheduler answers at a tcp:// ``address`` before a Client is
+    made: it must accept the connection and send the length of a handshake-sized first
+    message within ``timeout`` s. InputError naming the address otherwise (nothing
+    listens, nothing is said, or a length no handshake has)."""
+    import socket
+    import struct
+    proto, host, port = check_address(address)
+    if proto != "tcp":
+        return              # TLS: the handshake itself checks the certificates
+    try:
+        with socket.create_connection((host, port), timeout=timeout) as sock:
+            sock.settimeout(timeout)
+            head = b""
+            while len(head) < 8:
+                part = sock.recv(8 - len(head))
+                if not part:
+                    raise InputError(f"scheduler {address}: closed the connection without "
+                                     "a Dask handshake: not a Dask scheduler")
+                head += part
+    except socket.timeout:
+        raise InputError(f"scheduler {address}: no Dask handshake within {timeout:g} s "
+                         "(not a Dask scheduler, or unreachable)") from None
+    except OSError as exc:
+        raise InputError(f"scheduler {address}: cannot connect ({exc})") from None
+    (n,) = struct.unpack("<Q", head)
+    if n > PROBE_MAX_BYTES:
+        raise InputError(f"scheduler {address}: its first message announces {n} bytes, "
+                         "no Dask handshake does: not a Dask scheduler (refused before "
+                         "reading it)")
+
+
+def check_workers(workers) -> int | None:
+    """The LocalCluster worker count (None: one per core), checked."""
+    if workers is None:
+        return None
+    from ._errors import check_integer
+    return check_integer("--workers (study.workers)", workers, minimum=1,
+                         maximum=MAX_WORKERS, cls=InputError)
+
+
+def _security(proto: str, tls: dict | None):
+    """distributed.Security of a connection: the certificate files given (``tls``: ca,
+    cert, key) or, without them, Dask's own configuration (distributed.comm.tls.*);
+    None for tcp:// without certificates."""
+    from distributed.security import Security
+    tls = {k: v for k, v in (tls or {}).items() if v is not None}
+    for k, v in tls.items():
+        if not Path(v).is_file():
+            raise InputError(f"--tls-{k} {v}: no such file")
+    if tls and proto != "tls":
+        raise InputError("TLS certificates are given but the scheduler address is not "
+                         "tls://HOST:PORT: a tcp:// connection would not use them")
+    if tls:
+        return Security(tls_ca_file=tls.get("ca"), tls_client_cert=tls.get("cert"),
+                        tls_client_key=tls.get("key"), require_encryption=True)
+    sec = Security()            # from Dask's configuration, if any
+    if proto == "tls" and not sec.tls_ca_file:
+        raise InputError("a tls:// scheduler needs certificates: give --tls-ca (and "
+                         "--tls-cert, --tls-key) or set distributed.comm.tls.ca-file "
+                         "(and .client.cert, .client.key) in Dask's configuration")
+    return sec if proto == "tls" or sec.require_encryption else None
+
+
 class _Runner:
     """Where tasks run: this process, a LocalCluster made here, or a named scheduler."""
 
-    def __init__(self, scheduler: str, workers: int | None):
+    def __init__(self, scheduler: str, workers: int | None, tls: dict | None = None):
         self.client = self.cluster = None
         self.scheduler = scheduler
         if scheduler == "serial":
             return
+        workers = check_workers(workers)
+        if scheduler != "local":
+            proto = check_address(scheduler)[0]
         try:
             from distributed import Client, LocalCluster
         except ModuleNotFoundError:
@@ -293,11 +373,13 @@ class _Runner:
                                         dashboard_address=None, env=env)
             self.client = Client(self.cluster)
         else:
+            sec = _security(proto, tls)
+            probe_scheduler(scheduler)
             try:
-                self.client = Client(scheduler, timeout=30)
-            except OSError as exc:
-                raise InputError(f"study.scheduler: cannot reach the Dask scheduler "
-                                 f"{scheduler!r} ({exc})") from None
+                self.client = Client(scheduler, timeout=CONNECT_TIMEOUT, security=sec)
+            except (OSError, TimeoutError) as exc:
+                raise InputError(f"scheduler {scheduler}: cannot reach the Dask scheduler "
+                                 f"({type(exc).__name__}: {exc})") from None
 
     @property
     def n_workers(self) -> int:
@@ -340,18 +422,43 @@ class _Runner:
             self.cluster.close()
 
 
+def choose_scheduler(settings: StudySettings, given: str | None, trust_deck: bool = False,
+                     path="the deck") -> str:
+    """The scheduler a study runs on: ``given`` (the command line or the caller), else the
+    environment's FRIROM_SCHEDULER, else the deck's ``study.scheduler`` when it is
+    ``"local"`` or ``"serial"``. A deck's own address is used only with ``trust_deck``
+    (``--trust-deck-scheduler``): a Dask scheduler can run any code in the process that
+    connects to it (docs/security.md), so which one is the user's choice, not a deck's."""
+    sched = given or os.environ.get(SCHEDULER_ENV) or None
+    if sched is None:
+        sched = settings.scheduler
+        if sched not in ("local", "serial") and not trust_deck:
+            raise InputError(f"{path}: study.scheduler = {sched!r}: frirom connects only to a "
+                             "Dask scheduler you name (a scheduler can run any code in the "
+                             "process that connects to it, see docs/security.md): give "
+                             f"--scheduler {sched} or set {SCHEDULER_ENV}, or "
+                             "--trust-deck-scheduler to use the deck's")
+    if sched not in ("local", "serial"):
+        check_address(sched)
+    return sched
+
+
 def run_study(deck_path, out=None, scheduler: str | None = None, workers: int | None = None,
-              quiet: bool = False, log=print) -> dict:
+              quiet: bool = False, log=print, trust_deck_scheduler: bool = False,
+              tls: dict | None = None) -> dict:
     """Run (or continue) the study of a deck into ``out`` and write its file and plots.
 
     Parameters
     ----------
     deck_path : path of a deck with a ``[study]`` table.
     out : folder, default ``results/<deck name>``.
-    scheduler : ``"local"``, ``"serial"`` or a Dask scheduler address; default the
-        deck's ``study.scheduler``.
+    scheduler : ``"local"``, ``"serial"`` or a Dask scheduler address; default
+        FRIROM_SCHEDULER, else the deck's ``study.scheduler`` (an address from the deck
+        only with ``trust_deck_scheduler``: :func:`choose_scheduler`).
     workers : LocalCluster workers; default the deck's ``study.workers`` or one per core.
     quiet : no progress bar. log : callable(str) for the lines printed.
+    tls : {'ca', 'cert', 'key'} certificate files of a tls:// scheduler (default: Dask's
+        configuration, distributed.comm.tls.*).
 
     Returns
     -------
@@ -362,17 +469,18 @@ def run_study(deck_path, out=None, scheduler: str | None = None, workers: int | 
     """
     deck_path = Path(deck_path)
     out = Path(out) if out is not None else Path("results") / deck_path.stem
-    out.mkdir(parents=True, exist_ok=True)
     study = load_study(deck_path)
     st = study.settings
-    sched = scheduler or st.scheduler
+    sched = choose_scheduler(st, scheduler, trust_deck_scheduler, deck_path)
+    check_workers(workers)
+    out.mkdir(parents=True, exist_ok=True)
     n_done = sum((out / "members" / m["name"] / "member.json").is_file()
                  for m in study.members)
     log(f"{st.kind} study of {len(study.members)} members over "
         + ", ".join(f"{k} ({len(v)} values)" for k, v in st.parameters)
         + f" ({st.combine}); {n_done} already finished in {out}")
     t0 = time.perf_counter()
-    runner = _Runner(sched, workers or st.workers)
+    runner = _Runner(sched, workers or st.workers, tls)
     try:
         log(f"running on {sched}" + (f" ({runner.n_workers} workers)"
                                      if runner.client is not None else ""))
@@ -453,7 +561,8 @@ def write_study_file(study: Study, out: Path, summaries: list) -> Path:
                 for k in src:
                     src.copy(src[k], dst, name=k)
                 for k, v in src.attrs.items():
-                    dst.attrs[k] = v
+                    if k != DIGEST:         # the member file's own checksum
+                        dst.attrs[k] = v
             dst.attrs["values"] = json.dumps(m["values"])
             for k, v in m["values"].items():
                 if isinstance(v, (int, float, str, bool)):
