@@ -350,7 +350,8 @@ def _hostile(h5, how):
         if how == "X*1.01":
             f["X"][0] = 1.01 * f["X"][0]
             return
-        del f.attrs["content_sha256"]       # as a file whose run never closed it
+        if "content_sha256" in f.attrs:       # as a file whose run never closed it
+            del f.attrs["content_sha256"]
         if how == "bad JSON":
             f.attrs["deck_fingerprint"] = "{not json"
         elif how == "NaN omega":
@@ -440,3 +441,134 @@ def test_error_does_not_echo_a_file_outside_the_deck_folder(tmp_path, capsys):
     deck.write_text(deck.read_text().replace(str(secret), "secret.txt"))
     assert main(["run", str(deck), "--out", str(tmp_path / "o"), "--quiet"]) == 2
     assert "s3cr3t" in capsys.readouterr().err
+
+
+# ---- 3. operating-system errors: the path, what to do, a documented exit code ------------
+def test_out_below_a_file_and_h5_a_folder(tmp_path, capsys):
+    """--out below a file, and frf.h5 being a folder: exit code 4, the path and what to
+    do named, not the catch-all."""
+    deck = study_deck(tmp_path / "case", "")
+    (tmp_path / "afile").write_text("x")
+    assert main(["run", str(deck), "--out", str(tmp_path / "afile" / "sub"),
+                 "--quiet"]) == 4
+    err = capsys.readouterr().err
+    assert "afile" in err and "not a folder" in err and "frirom bug" not in err, err
+    out = tmp_path / "o"
+    (out / "frf.h5").mkdir(parents=True)
+    assert main(["run", str(deck), "--out", str(out), "--quiet"]) == 4
+    err = capsys.readouterr().err
+    assert "frf.h5" in err and "remove or rename" in err and "frirom bug" not in err, err
+
+
+def test_read_only_out(tmp_path, capsys, monkeypatch):
+    """A read-only --out (the file system refuses the folder: EROFS, simulated, since the
+    tests may run as root, whom permissions do not stop): exit code 4 naming the path."""
+    import errno
+    import pathlib
+    deck = study_deck(tmp_path / "case", "")
+    real = pathlib.Path.mkdir
+
+    def mkdir(self, *a, **k):
+        if "ro" in self.parts:
+            raise OSError(errno.EROFS, "Read-only file system", str(self))
+        return real(self, *a, **k)
+    monkeypatch.setattr(pathlib.Path, "mkdir", mkdir)
+    assert main(["run", str(deck), "--out", str(tmp_path / "ro" / "o"), "--quiet"]) == 4
+    err = capsys.readouterr().err
+    assert str(tmp_path / "ro") in err and "read-only" in err, err
+
+
+def test_full_disk_keeps_every_committed_point(tmp_path, capsys, monkeypatch):
+    """The disk fills up at the 6th point (ENOSPC from the writer, simulated): exit code 4
+    naming frf.h5 and --resume, no crash; the 5 committed points are in the file, and
+    --resume once space is back ends on the uninterrupted run's points exactly."""
+    import errno
+    import numpy as np
+    from frirom.results import FRF, FRFWriter
+    deck = study_deck(tmp_path / "case", "")
+    ref = tmp_path / "ref"
+    assert main(["run", str(deck), "--out", str(ref), "--quiet"]) == 0
+    full = FRF.load(ref / "frf.h5")
+    real = FRFWriter._append
+    count = [0]
+
+    def append(self, p):
+        count[0] += 1
+        if count[0] == 6:
+            raise OSError(errno.ENOSPC, "No space left on device", str(self.path))
+        return real(self, p)
+    monkeypatch.setattr(FRFWriter, "_append", append)
+    out = tmp_path / "o"
+    assert main(["run", str(deck), "--out", str(out), "--quiet"]) == 4
+    err = capsys.readouterr().err
+    assert "frf.h5" in err and "no space" in err and "--resume" in err, err
+    assert "frirom bug" not in err
+    kept = FRF.load(out / "frf.h5")
+    assert len(kept) == 5 and np.array_equal(kept.omega, full.omega[:5])
+    monkeypatch.setattr(FRFWriter, "_append", real)
+    assert main(["run", str(deck), "--out", str(out), "--resume", "--quiet"]) == 0
+    again = FRF.load(out / "frf.h5")
+    assert np.array_equal(again.omega, full.omega) and np.array_equal(again.X, full.X)
+
+
+def test_two_studies_on_one_folder(tmp_path, capsys):
+    """A second study on a folder another study is writing is refused at once (exit 2,
+    naming the folder); main waited two minutes per member, then failed."""
+    from frirom._resume import ResultsLock
+    deck = study_deck(tmp_path, '[study]\nscheduler = "serial"\n[study.parameters]\n'
+                      '"contacts[0].mu" = [0.3, 0.5]\n')
+    out = tmp_path / "o"
+    out.mkdir()
+    lock = ResultsLock(out)
+    try:
+        t0 = time.monotonic()
+        assert main(["study", str(deck), "--out", str(out), "--quiet"]) == 2
+        err = capsys.readouterr().err
+        assert str(out) in err and "another frirom run" in err, err
+        assert time.monotonic() - t0 < 30
+        assert not (out / "members").exists()
+    finally:
+        lock.release()
+
+
+# ---- 4. studies that survive a bad member ------------------------------------------------
+def test_a_failing_member_does_not_stop_the_study(tmp_path, capsys):
+    """Member m001's deck cannot be built (a DoF label the model lacks, found only when
+    that member runs): the other members run and are kept, each equal to its deck run
+    alone; m001 is recorded with its message (failed.json, study.h5) and named in the
+    summary; exit code 5."""
+    import h5py
+    import numpy as np
+    from frirom.results import FRF
+    deck = study_deck(tmp_path, '[study]\nscheduler = "serial"\n[study.parameters]\n'
+                      '"excitation.load[0].dof" = ["tip:x", "nosuch:x", "platform:x"]\n')
+    out = tmp_path / "o"
+    assert main(["study", str(deck), "--out", str(out), "--quiet"]) == 5
+    captured = capsys.readouterr()
+    text = captured.out + captured.err
+    assert "1 of 3 members failed" in text and "m001" in text and "nosuch:x" in text, text
+    for name, dof in (("m000", "tip:x"), ("m002", "platform:x")):
+        assert (out / "members" / name / "member.json").is_file()
+        alone = tmp_path / f"alone_{name}.toml"
+        alone.write_text(BASE.replace('dof = "tip:x"', f'dof = "{dof}"'))
+        assert main(["run", str(alone), "--out", str(tmp_path / name), "--quiet"]) == 0
+        a = FRF.load(tmp_path / name / "frf.h5")
+        b = FRF.load(out / "members" / name / "frf.h5")
+        assert np.array_equal(a.omega, b.omega) and np.array_equal(a.X, b.X)
+    assert "nosuch:x" in (out / "members" / "m001" / "failed.json").read_text()
+    with h5py.File(out / "study.h5", "r") as f:
+        assert "nosuch:x" in f["members/m001"].attrs["failed"]
+        assert "omega" in f["members/m002"]
+
+
+def test_study_size_shown_and_limited(tmp_path, capsys):
+    """A study of 1 000 000 members (1000 x 1000 values) is refused at once, naming the
+    count and --force; a small study shows its size before it starts."""
+    vals = ", ".join(f"{0.1 + i * 1e-4:.4f}" for i in range(1000))
+    deck = study_deck(tmp_path, '[study]\nscheduler = "serial"\n[study.parameters]\n'
+                      f'"contacts[0].mu" = [{vals}]\n"contacts[0].kt" = [{vals}]\n')
+    t0 = time.monotonic()
+    assert main(["study", str(deck), "--out", str(tmp_path / "o"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "1000000 members" in err and "--force" in err, err
+    assert time.monotonic() - t0 < 20

@@ -12,13 +12,19 @@
 
 Exit codes of `frirom run` on several decks: 0 every run reached the end of its frequency
 range; 2 a deck is wrong (the message names the field); 3 a run stopped before the end of
-its range (its points are kept: see --resume); 130 interrupted (Ctrl-C stops the batch at
-once); the code of the first deck that did not end with 0, after all of them have run.
+its range (its points are kept: see --resume); 4 the operating system refused a file
+(disk full, read-only or missing folder, a file where a folder belongs: the message names
+the path and what to do; committed points are kept); 130 interrupted (Ctrl-C stops the
+batch at once); the code of the first deck that did not end with 0, after all of them
+have run. `frirom study`: 0 every member complete, 1 a member stopped before the end of
+its range, 5 a member failed (named in the summary; the others ran and are kept), 2 and 4
+as above.
 """
 
 from __future__ import annotations
 
 import argparse
+import errno
 import os
 import shutil
 import sys
@@ -40,8 +46,16 @@ exit codes:
   2    bad input, refused --resume, or the folder is in use: nothing computed
   3    the run stopped before the end of its range (continuation failure, max_points,
        the curve turned back); where and why are printed, the points are in OUT/frf.h5
+  4    the operating system refused a file (disk full, read-only folder, a file where a
+       folder belongs, a folder where a file belongs): the path and what to do are
+       printed; every committed point is kept (continue with --resume)
   130  interrupted (Ctrl-C); the points are kept, continue with --resume
 """
+
+#: Exit code of an operating-system error on a file (the message names the path).
+EXIT_SYSTEM = 4
+#: Exit code of `frirom study` when a member failed (the others ran).
+EXIT_MEMBER_FAILED = 5
 
 
 def _add_run(sub) -> None:
@@ -128,9 +142,22 @@ def cmd_show(args) -> int:
 def _add_study(sub) -> None:
     p = sub.add_parser(
         "study", help="run the [study] of a deck: a family of FRFs or a model-size ladder",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
         description="Run every member of the deck's [study] table (docs/deck.md) as a Dask "
         "task, into OUT/members/<name>/; finished members are kept, so running again "
-        "continues an interrupted study. Writes OUT/study.h5 and the plots.")
+        "continues an interrupted study. Writes OUT/study.h5 and the plots.",
+        epilog="""\
+A member that fails (an error in its deck or its solve, a lost worker) is recorded in
+OUT/members/<name>/failed.json and named in the summary; the others run and are kept;
+running the study again retries it. Connecting to a scheduler: docs/security.md.
+
+exit codes:
+  0    every member reached the end of its frequency range
+  1    a member stopped before the end of its range (its points are kept)
+  2    bad input (the message names the field), or the folder is in use
+  4    the operating system refused a file (the message names the path)
+  5    a member failed (named in the summary); the others ran
+""")
     p.add_argument("deck", type=Path, help="a TOML deck with a [study] table")
     p.add_argument("--out", type=Path, default=None,
                    help="output folder (default: results/<deck name>)")
@@ -150,7 +177,10 @@ def _add_study(sub) -> None:
     p.add_argument("--tls-key", default=None, metavar="FILE",
                    help="this client's private key for a tls:// scheduler")
     p.add_argument("--workers", type=int, default=None,
-                   help="LocalCluster workers (default: study.workers, or one per core)")
+                   help="LocalCluster workers, 1..1024 (default: study.workers, or one per "
+                   "core)")
+    p.add_argument("--force", action="store_true",
+                   help="run a study of more than 10 000 members (frirom.study.MAX_MEMBERS)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_study)
 
@@ -160,7 +190,10 @@ def _study(args) -> int:
     tls = {"ca": args.tls_ca, "cert": args.tls_cert, "key": args.tls_key}
     res = run_study(args.deck, args.out, scheduler=args.scheduler, workers=args.workers,
                     quiet=args.quiet, log=lambda s: print(f"frirom: {s}"),
-                    trust_deck_scheduler=args.trust_deck_scheduler, tls=tls)
+                    trust_deck_scheduler=args.trust_deck_scheduler, tls=tls,
+                    force=args.force)
+    if any(s.get("failed") for s in res["summaries"]):
+        return EXIT_MEMBER_FAILED
     return 0 if all(s["complete"] for s in res["summaries"]) else 1
 
 
@@ -322,7 +355,10 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
             return EXIT_INTERRUPTED
         except BaseException as exc:
             progress.close()
-            writer.close(complete=False, message=f"{type(exc).__name__}: {exc}")
+            try:
+                writer.close(complete=False, message=f"{type(exc).__name__}: {exc}")
+            except OSError:
+                pass            # the disk that failed the point may fail this too
             raise
         progress.close()
         writer.close(complete=result.complete, message=result.message)
@@ -466,6 +502,9 @@ def _run_one(args, deck: Path, out: Path | None) -> int:
     except FriromError as exc:
         print(f"frirom: error: {exc}", file=sys.stderr)
         return EXIT_INPUT
+    except OSError as exc:
+        print(f"frirom: error: {system_error(exc)}", file=sys.stderr)
+        return EXIT_SYSTEM
     return code
 
 
@@ -486,7 +525,8 @@ def cmd_run_decks(args) -> int:
             print(f"frirom: interrupted; {len(decks) - i - 1} decks not run", file=sys.stderr)
             break
     what = {0: "complete", EXIT_INPUT: "error in the deck", EXIT_STOPPED:
-            "stopped before the end of its range", EXIT_INTERRUPTED: "interrupted"}
+            "stopped before the end of its range", EXIT_INTERRUPTED: "interrupted",
+            EXIT_SYSTEM: "a file could not be written or read (see above)"}
     for deck, code in zip(decks, codes):
         print(f"frirom: {deck}: {what.get(code, f'exit code {code}')}")
     bad = [c for c in codes if c != 0]
@@ -523,6 +563,42 @@ def _print_peaks(result, deck) -> None:
               f"({p.method})")
 
 
+#: What to do about an operating-system error, by errno.
+_OS_HINTS = {
+    errno.ENOSPC: "no space left on the device: free some, then continue with --resume "
+                  "(every committed point is kept)",
+    errno.EDQUOT: "disk quota exceeded: free some space, then continue with --resume "
+                  "(every committed point is kept)",
+    errno.EROFS: "the file system is read-only: choose another --out",
+    errno.EACCES: "permission denied: choose another --out or change its permissions",
+    errno.EPERM: "permission denied: choose another --out or change its permissions",
+    errno.ENOTDIR: "a part of the path is a file, not a folder: choose another --out",
+    errno.EISDIR: "a folder is where frirom writes a file: remove or rename it, or choose "
+                  "another --out",
+    errno.EEXIST: "a file is where frirom makes a folder: choose another --out",
+    errno.ENOENT: "no such file or folder",
+    errno.ENAMETOOLONG: "the path is too long: choose a shorter --out",
+}
+
+
+def system_error(exc: OSError) -> str:
+    """One line for an operating-system error: the path, what happened and what to do.
+    h5py's errors carry errno and the file name in their text, read from there."""
+    import re
+    text = str(exc)
+    code = exc.errno
+    if code is None:
+        m = re.search(r"errno = (\d+)", text)
+        code = int(m.group(1)) if m else None
+    path = exc.filename
+    if path is None:
+        m = re.search(r"name = '([^']*)'", text)
+        path = m.group(1) if m else None
+    what = _OS_HINTS.get(code, exc.strerror or " ".join(text.split()))
+    where = f"{os.fspath(path)}: " if path is not None else ""
+    return f"{where}{what} ({type(exc).__name__}" + (f", errno {code}" if code else "") + ")"
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -541,6 +617,11 @@ def main(argv: list[str] | None = None) -> int:
             raise
         print(f"frirom: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2
+    except OSError as exc:
+        if debug:
+            raise
+        print(f"frirom: error: {system_error(exc)}", file=sys.stderr)
+        return EXIT_SYSTEM
     except Exception as exc:            # a bug or an unforeseen input: one line, no traceback
         if debug:
             raise

@@ -634,11 +634,13 @@ class FRFWriter:
 
     def close(self, complete: bool = True, message: str = "") -> None:
         if self.f:
-            self.f.attrs["complete"] = complete
-            self.f.attrs["message"] = message
-            _h5check.seal(self.f)
-            self.f.close()
-            self.f = None
+            f, self.f = self.f, None
+            try:
+                f.attrs["complete"] = complete
+                f.attrs["message"] = message
+                _h5check.seal(f)
+            finally:
+                f.close()       # even when the disk refused the attributes
 
     def __enter__(self):
         return self

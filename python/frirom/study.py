@@ -72,14 +72,27 @@ class Study:
         return self.settings.kind
 
 
-def load_study(path) -> Study:
+#: Most members a study may have without ``force`` (``--force``): each member is a
+#: folder, a results file and a task; a study above it is most likely a typo (a product
+#: of long lists) and would spend minutes checking members before anything runs.
+MAX_MEMBERS = 10_000
+
+
+def load_study(path, force: bool = False) -> Study:
     """Read a deck's ``[study]`` and check every member's deck (parse only, no matrices);
-    an error names the member and its values."""
+    an error names the member and its values. A study of more than MAX_MEMBERS members is
+    refused unless ``force``."""
     path = Path(path)
     raw = read_toml(path)
     st = parse_study(path, raw, read_toml)
     if st is None:
         raise InputError(f"{path}: no [study] table (see docs/deck.md, 'Studies')")
+    n = st.size()
+    if n > MAX_MEMBERS and not force:
+        raise InputError(f"{path}: study.parameters: {n} members ("
+                         + " x ".join(str(len(v)) for _, v in st.parameters)
+                         + f"), more than the {MAX_MEMBERS} a study may have without "
+                         "--force (frirom.study.MAX_MEMBERS)")
     deck = path
     if st.base is not None:
         deck, raw = st.base, read_toml(st.base)
@@ -348,6 +361,13 @@ def _security(proto: str, tls: dict | None):
     return sec if proto == "tls" or sec.require_encryption else None
 
 
+class Failed:
+    """A task that raised: ``message`` is its exception's class and text."""
+
+    def __init__(self, exc: BaseException):
+        self.message = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+
+
 class _Runner:
     """Where tasks run: this process, a LocalCluster made here, or a named scheduler."""
 
@@ -387,13 +407,20 @@ class _Runner:
             return 1
         return max(len(self.client.scheduler_info().get("workers", {})), 1)
 
-    def map(self, fn, jobs: list, on_done=None, poll=None) -> list:
+    def map(self, fn, jobs: list, on_done=None, poll=None, keep_going: bool = False) -> list:
         """fn(*args) for each args tuple of ``jobs``, results in order; ``on_done(i, r)``
-        as each finishes, ``poll()`` about twice a second while waiting."""
+        as each finishes, ``poll()`` about twice a second while waiting. With
+        ``keep_going`` a task that raises gives a :class:`Failed` in its place and the
+        others run on; without, its exception is raised."""
         out = [None] * len(jobs)
         if self.client is None:
             for i, args in enumerate(jobs):
-                out[i] = fn(*args)
+                try:
+                    out[i] = fn(*args)
+                except Exception as exc:
+                    if not keep_going:
+                        raise
+                    out[i] = Failed(exc)
                 if on_done:
                     on_done(i, out[i])
             return out
@@ -408,7 +435,12 @@ class _Runner:
                 done = set()
             for f in done:
                 i = futures[f]
-                out[i] = f.result()         # a task's exception is raised here
+                try:
+                    out[i] = f.result()         # a task's exception is raised here
+                except Exception as exc:        # the member's error, or its lost worker
+                    if not keep_going:
+                        raise
+                    out[i] = Failed(exc)
                 if on_done:
                     on_done(i, out[i])
             if poll:
@@ -445,7 +477,7 @@ def choose_scheduler(settings: StudySettings, given: str | None, trust_deck: boo
 
 def run_study(deck_path, out=None, scheduler: str | None = None, workers: int | None = None,
               quiet: bool = False, log=print, trust_deck_scheduler: bool = False,
-              tls: dict | None = None) -> dict:
+              tls: dict | None = None, force: bool = False) -> dict:
     """Run (or continue) the study of a deck into ``out`` and write its file and plots.
 
     Parameters
@@ -459,6 +491,11 @@ def run_study(deck_path, out=None, scheduler: str | None = None, workers: int | 
     quiet : no progress bar. log : callable(str) for the lines printed.
     tls : {'ca', 'cert', 'key'} certificate files of a tls:// scheduler (default: Dask's
         configuration, distributed.comm.tls.*).
+    force : run a study of more than MAX_MEMBERS members.
+
+    A member that fails (its deck, its solve, its worker lost) is recorded with its
+    message (:func:`failed_summary`, ``summary['failed']``) and named in the log; the
+    other members run and are kept. One study at a time writes a folder.
 
     Returns
     -------
@@ -469,11 +506,25 @@ def run_study(deck_path, out=None, scheduler: str | None = None, workers: int | 
     """
     deck_path = Path(deck_path)
     out = Path(out) if out is not None else Path("results") / deck_path.stem
-    study = load_study(deck_path)
+    study = load_study(deck_path, force=force)
     st = study.settings
     sched = choose_scheduler(st, scheduler, trust_deck_scheduler, deck_path)
     check_workers(workers)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out}: is a file; expected a folder for the study")
     out.mkdir(parents=True, exist_ok=True)
+    lock = ResultsLock(out)         # one study per folder: a second is refused at once
+    try:
+        return _run_study_locked(study, out, sched, workers, quiet, log, tls)
+    finally:
+        lock.release()
+
+
+def _run_study_locked(study: Study, out: Path, sched: str, workers, quiet, log, tls) -> dict:
+    """run_study once the study's folder is locked."""
+    st = study.settings
+    log(f"size: {len(study.members)} members, at most {_max_points(study.raw)} points each "
+        f"(continuation.max_points); the limit without --force is {MAX_MEMBERS} members")
     n_done = sum((out / "members" / m["name"] / "member.json").is_file()
                  for m in study.members)
     log(f"{st.kind} study of {len(study.members)} members over "
@@ -498,6 +549,14 @@ def run_study(deck_path, out=None, scheduler: str | None = None, workers: int | 
     return res
 
 
+def _max_points(raw: dict) -> int:
+    """The deck's continuation.max_points (the solver's default without one)."""
+    from .solver import SolverOptions
+    c = raw.get("continuation", {})
+    v = c.get("max_points") if isinstance(c, dict) else None
+    return int(v) if isinstance(v, int) else int(SolverOptions.max_points)
+
+
 def _prepare(study: Study, out: Path, runner: _Runner, log) -> dict:
     """Build each distinct reduced model once (tasks) before the members read them."""
     if "fe_model" not in study.raw and "reduction" not in study.raw:
@@ -509,10 +568,14 @@ def _prepare(study: Study, out: Path, runner: _Runner, log) -> dict:
             todo.append((m, m["rom"]))
     if not todo:
         return {}
-    res = runner.map(prepare_member, [(str(study.deck), m["values"]) for m, _ in todo])
-    built = sum(not r["reused"] for r in res)
-    log(f"{len(todo)} reduced model(s): {built} built, {len(todo) - built} reused")
-    return {c: r["seconds"] for (_, c), r in zip(todo, res)}
+    res = runner.map(prepare_member, [(str(study.deck), m["values"]) for m, _ in todo],
+                     keep_going=True)
+    ok = [(c, r) for (_, c), r in zip(todo, res) if not isinstance(r, Failed)]
+    built = sum(not r["reused"] for _, r in ok)
+    log(f"{len(todo)} reduced model(s): {built} built, {len(ok) - built} reused"
+        + (f", {len(todo) - len(ok)} failed (their members fail)" if len(ok) < len(todo)
+           else ""))
+    return {c: r["seconds"] for c, r in ok}
 
 
 def _run_members(study: Study, out: Path, runner: _Runner, quiet: bool) -> list:
@@ -537,9 +600,42 @@ def _run_members(study: Study, out: Path, runner: _Runner, quiet: bool) -> list:
     jobs = [(str(study.deck), m["values"], str(f), runner.client is not None)
             for m, f in zip(study.members, folders)]
     try:
-        return runner.map(run_member, jobs, on_done, poll)
+        res = runner.map(run_member, jobs, on_done, poll, keep_going=True)
     finally:
         bar.close()
+    n_out = _n_outputs(study)
+    return [failed_summary(m, f, r.message, n_out) if isinstance(r, Failed) else r
+            for m, f, r in zip(study.members, folders, res)]
+
+
+def _n_outputs(study: Study) -> int:
+    out = study.raw.get("outputs", {})
+    dofs = out.get("dofs", []) if isinstance(out, dict) else []
+    return max(len(dofs) if isinstance(dofs, list) else 1, study.settings.output + 1)
+
+
+def failed_summary(member: dict, folder: Path, message: str, n_out: int) -> dict:
+    """The summary of a member whose task raised (see :func:`run_member` for the keys):
+    ``failed`` True, ``message`` the error, the points its file kept; also written to
+    ``folder/failed.json`` (a study run again retries the member)."""
+    points = 0
+    try:
+        from .results import FRF
+        points = len(FRF.load(folder / "frf.h5"))
+    except (InputError, OSError):
+        pass
+    nan = float("nan")
+    s = {"failed": True, "message": message, "complete": False, "points": points,
+         "seconds": 0.0, "cpu_seconds": 0.0, "pid": 0, "started": nan, "ended": nan,
+         "resumed": False, "peaks": [[nan, nan] for _ in range(n_out)], "fold": False,
+         "n_dof": 0, "n_nl": 0, "harmonics": 0, "unknowns": 0, "rom_seconds": 0.0,
+         "memory_mb": 0.0, "rss_mb": 0.0, "values": dict(member["values"])}
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "failed.json").write_text(json.dumps(s, indent=1, default=float))
+    except OSError:
+        pass
+    return s
 
 
 def write_study_file(study: Study, out: Path, summaries: list) -> Path:
@@ -556,13 +652,17 @@ def write_study_file(study: Study, out: Path, summaries: list) -> Path:
                                             study.settings.parameters])
         g = f.create_group("members")
         for m, s in zip(study.members, summaries):
-            with h5py.File(out / "members" / m["name"] / "frf.h5", "r") as src:
-                dst = g.create_group(m["name"])
-                for k in src:
-                    src.copy(src[k], dst, name=k)
-                for k, v in src.attrs.items():
-                    if k != DIGEST:         # the member file's own checksum
-                        dst.attrs[k] = v
+            dst = g.create_group(m["name"])
+            src_path = out / "members" / m["name"] / "frf.h5"
+            if s.get("failed"):
+                dst.attrs["failed"] = s["message"]
+            else:
+                with h5py.File(src_path, "r") as src:
+                    for k in src:
+                        src.copy(src[k], dst, name=k)
+                    for k, v in src.attrs.items():
+                        if k != DIGEST:         # the member file's own checksum
+                            dst.attrs[k] = v
             dst.attrs["values"] = json.dumps(m["values"])
             for k, v in m["values"].items():
                 if isinstance(v, (int, float, str, bool)):
@@ -578,15 +678,25 @@ def _report(study: Study, out: Path, summaries: list, log) -> dict:
     deck = study.raw
     unit = str(deck.get("frequency", {}).get("unit", "hz")).lower()
     j = study.settings.output
-    frfs = [FRF.load(out / "members" / m["name"] / "frf.h5") for m in study.members]
+    frfs = [_member_frf(out / "members" / m["name"] / "frf.h5", s)
+            for m, s in zip(study.members, summaries)]
     res, figs = {}, {}
     for m, s in zip(study.members, summaries):
+        if s.get("failed"):
+            log(f"{m['name']}: {_label(m['values'])}: FAILED: {s['message']}")
+            continue
         w, a = s["peaks"][j]
         f = w / (2 * np.pi) if unit == "hz" else w
         flag = "" if s["complete"] else f"  (stopped: {s['message']})"
         log(f"{m['name']}: {_label(m['values'])}: peak {a:.6g} at {f:.6g} "
             f"{'Hz' if unit == 'hz' else 'rad/s'}, {s['points']} points, "
             f"{s['seconds']:.1f} s{flag}")
+    bad = [(m, s) for m, s in zip(study.members, summaries) if s.get("failed")]
+    if bad:
+        log(f"{len(bad)} of {len(summaries)} members failed (the others ran and are kept; "
+            "running the study again retries them): "
+            + "; ".join(f"{m['name']} ({_label(m['values'])}): {s['message']}"
+                        for m, s in bad))
     if study.kind == "family":
         figs["family.png"] = study_plots.plot_family(study, frfs, summaries, unit=unit,
                                                      linear=_linear(study),
@@ -609,6 +719,23 @@ def _report(study: Study, out: Path, summaries: list, log) -> dict:
     log(f"wrote {out / 'study.h5'}, " + ", ".join(str(p) for p in paths))
     res["figures"] = paths
     return res
+
+
+def _member_frf(h5: Path, summary: dict):
+    """A member's FRF for the report: its file, or no point for a failed member whose
+    file is missing or unreadable."""
+    from .results import FRF
+    try:
+        return FRF.load(h5)
+    except (InputError, OSError):
+        if not summary.get("failed"):
+            raise
+    n = len(summary["peaks"])
+    z = np.zeros(0)
+    return FRF(omega=z, X=np.zeros((0, n, 1)), amp_max=np.zeros((0, n)),
+               state_fractions=np.zeros((0, 0, 3)), stable=z.astype(bool),
+               fold=z.astype(bool), iterations=z.astype(int), time_s=z, complete=False,
+               message=summary["message"])
 
 
 def _load_key(study: Study):
@@ -685,13 +812,15 @@ def convergence_table(study: Study, frfs: list, summaries: list) -> list:
                "n_nl": s["n_nl"], "unknowns": s["unknowns"], "points": s["points"],
                "err_amp": abs(a - ar) / ar, "err_freq": abs(w - wr) / wr,
                "distance": (curve_distance(np.c_[fr.omega, fr.amp_max[:, j]], cref)
-                            if len(fr) else float("inf")),
+                            if len(fr) and len(cref) else float("inf")),
                "rom_s": s["rom_seconds"], "frf_s": s["seconds"],
                "memory_mb": s["memory_mb"], "reference": i == len(summaries) - 1,
                "complete": s["complete"], "notes": []}
         row["cost_s"] = row["rom_s"] + row["frf_s"]
         row["error"] = max(row["err_amp"], row["err_freq"], row["distance"])
-        if not s["complete"]:
+        if s.get("failed"):
+            row["notes"].append(f"failed: {s['message']}")
+        elif not s["complete"]:
             row["notes"].append(f"curve stopped: {s['message']}")
         if s["fold"] and not ref["fold"]:
             row["notes"].append("fold not in the reference")

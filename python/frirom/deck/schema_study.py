@@ -73,6 +73,12 @@ class StudySettings:
     tolerance: float = 0.01
     base: Path | None = None
 
+    def size(self) -> int:
+        """How many members, without making them."""
+        import math
+        lens = [len(v) for _, v in self.parameters]
+        return math.prod(lens) if self.combine == "product" else min(lens, default=0)
+
     def members(self) -> list:
         """One dict {key path: value} per member, in run order."""
         keys = [k for k, _ in self.parameters]
@@ -272,6 +278,6 @@ def parse_study(path, raw: dict, read=None) -> StudySettings | None:
     tol = number(ctx, st, "tolerance", "study.tolerance", default=0.01, positive=True)
     s = StudySettings(kind=kind, parameters=tuple(params), combine=combine, scheduler=sched,
                       workers=workers, output=output, tolerance=float(tol), base=base)
-    if kind == "convergence" and len(s.members()) < 2:
+    if kind == "convergence" and s.size() < 2:
         raise ctx.error("study.parameters", "at least two rungs for a convergence study")
     return s
