@@ -194,7 +194,9 @@ def mutate_results(src: Path, dst: Path, rnd) -> str:
     done = []
     with h5py.File(dst, "a") as f:
         for _ in range(rnd.randint(1, 3)):
-            names, attrs = sorted(f), sorted(f.attrs)
+            names = sorted(k for k in f if isinstance(f.get(k, getlink=True), h5py.HardLink)
+                           and isinstance(f[k], h5py.Dataset))
+            attrs = sorted(f.attrs)
             op = rnd.randrange(9)
             if op == 0 and names:
                 n = rnd.choice(names)
@@ -211,11 +213,11 @@ def mutate_results(src: Path, dst: Path, rnd) -> str:
                 f.attrs[a] = rnd.choice([np.nan, "{bad json", 3, np.arange(4), b"\xff\xfe",
                                          "", np.array([1.5, np.inf])])
                 done.append(f"attribute {a} retyped")
-            elif op == 3:
-                f[f"ext{rnd.randrange(9)}"] = h5py.ExternalLink("/etc/hostname", "/")
+            elif op == 3 and f.get(f"ext{len(done)}", getlink=True) is None:
+                f[f"ext{len(done)}"] = h5py.ExternalLink("/etc/hostname", "/")
                 done.append("external link")
-            elif op == 4 and names:
-                f[f"soft{rnd.randrange(9)}"] = h5py.SoftLink("/" + rnd.choice(names))
+            elif op == 4 and names and f.get(f"soft{len(done)}", getlink=True) is None:
+                f[f"soft{len(done)}"] = h5py.SoftLink("/" + rnd.choice(names))
                 done.append("soft link")
             elif op == 5:
                 g = f
