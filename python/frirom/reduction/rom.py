@@ -397,7 +397,7 @@ class ReducedModel:
             with h5py.File(path, "r") as h:
                 if (h.attrs.get("fingerprint") != fingerprint
                         or h.attrs.get("version") != CACHE_VERSION):
-                    return no("built from other inputs or by another frirom version")
+                    return None         # other inputs: rebuilt as usual, no warning
                 if not verify(h, path):
                     return no("it has no content checksum")
                 pairs, rot = {}, {}
