@@ -267,6 +267,13 @@ def check_results(f, path) -> None:
         if a.dtype.kind not in "iu" or a.shape != (3,) or a[0] < 0:
             raise InputError(f"{path}: attribute 'committed': expected 3 integers "
                              f"(points, checkpoint, slot), got {_shown(c)}")
+        if a[2] >= 0:           # a checkpoint in slot a[2] of the ck_* datasets
+            for k, tail in (("ck_unknowns", None), ("ck_tangent", None), ("ck_scalars", 4)):
+                d = f.get(k)
+                if d is None or d.ndim != 2 or d.shape[0] != 2 or a[2] > 1 \
+                        or (tail is not None and d.shape[1] != tail):
+                    raise InputError(f"{path}: dataset {k!r}: the checkpoint's state is "
+                                     "missing or mis-shaped; the file cannot be resumed")
     fp = attr_json(f, path, "deck_fingerprint")
     if fp is not None and not (isinstance(fp, dict) and isinstance(fp.get("keys", {}), dict)
                                and isinstance(fp.get("files", {}), dict)):
@@ -287,7 +294,13 @@ def check_results(f, path) -> None:
 
 def check_finite(arrays: dict, path) -> None:
     """Refuse (InputError naming the file and dataset) a non-finite value in a committed
-    row of a dataset that always holds finite ones (``arrays``: {name: array})."""
+    row of a dataset that always holds finite ones (``arrays``: {name: array}), or a
+    per-point dataset with fewer rows than the file has points."""
+    n = len(arrays["omega"]) if arrays.get("omega") is not None else None
+    for name, a in arrays.items():
+        if n is not None and name in _ROWS and a is not None and a.shape[:1] != (n,):
+            raise InputError(f"{path}: dataset {name!r}: {a.shape[0] if a.ndim else 0} rows "
+                             f"for {n} points; the file was damaged or edited")
     for name, a in arrays.items():
         if a is not None and _ROWS.get(name, (0, False))[1] and a.dtype.kind == "f" \
                 and not np.all(np.isfinite(a)):
