@@ -274,6 +274,9 @@ def check_results(f, path) -> None:
                         or (tail is not None and d.shape[1] != tail):
                     raise InputError(f"{path}: dataset {k!r}: the checkpoint's state is "
                                      "missing or mis-shaped; the file cannot be resumed")
+                if d.dtype.kind not in "iuf" or not np.all(np.isfinite(d[()])):
+                    raise InputError(f"{path}: dataset {k!r}: the checkpoint's state holds "
+                                     "a non-finite number; the file cannot be resumed")
     fp = attr_json(f, path, "deck_fingerprint")
     if fp is not None and not (isinstance(fp, dict) and isinstance(fp.get("keys", {}), dict)
                                and isinstance(fp.get("files", {}), dict)):
