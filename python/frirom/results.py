@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import functools
 import os
 import signal
 import threading
@@ -13,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _kernels
+from . import _h5check, _kernels
 from ._errors import CODES, InputError, SizeError, raise_for_status
 
 _NONFINITE = CODES["FRIROM_ERR_NONFINITE"]
@@ -330,6 +331,7 @@ class FRF:
             f.attrs["message"] = self.message
             f.attrs["stability_computed"] = self.stability_computed
             f.attrs["solver_info"] = self.solver_info
+            _h5check.seal(f)
 
     def save_csv(self, path) -> None:
         """One row per point: frequency (Hz, rad/s), the load parameter of a load curve,
@@ -371,8 +373,10 @@ class FRF:
             missing = [n for n in cls._ARRAYS if n not in f]
             if missing:
                 raise InputError(f"{path}: not a frirom FRF file (missing {missing})")
+            _h5check.check_results(f, path)     # checksum, types, shapes, attributes
             n = _committed_rows(f, path)[0]    # rows beyond: a torn record
             kw = {k: f[k][...] if k == "output_dofs" else f[k][:n] for k in cls._ARRAYS}
+            _h5check.check_finite(kw, path)
             kw["stable"] = kw["stable"].astype(bool)
             kw["fold"] = kw["fold"].astype(bool)
             # files written before the contact history was kept have no slider
@@ -391,15 +395,18 @@ class FRF:
                                    f.attrs["peak_method"])]
             if "unknowns" in f and f["unknowns"].shape[0] == kw["omega"].shape[0]:
                 kw["unknowns"] = f["unknowns"][...]
-            kw["output_labels"] = [s.decode() for s in f.attrs.get("output_labels", [])]
-            kw["meta"] = {k: str(f.attrs[k]) for k in META_KEYS if k in f.attrs}
+            kw["output_labels"] = _h5check.attr_texts(f, path, "output_labels")
+            kw["meta"] = {k: _h5check.attr_text(f, path, k) for k in META_KEYS
+                          if k in f.attrs}
+            txt = functools.partial(_h5check.attr_text, f, path)
             return cls(**kw,
-                       group_names=[s.decode() for s in f.attrs.get("group_names", [])],
-                       parameter_name=str(f.attrs.get("parameter_name", "omega")),
-                       complete=bool(f.attrs.get("complete", True)),
-                       message=str(f.attrs.get("message", "")),
-                       stability_computed=bool(f.attrs.get("stability_computed", False)),
-                       solver_info=str(f.attrs.get("solver_info", "")))
+                       group_names=_h5check.attr_texts(f, path, "group_names"),
+                       parameter_name=txt("parameter_name", "omega"),
+                       complete=_h5check.attr_bool(f, path, "complete", True),
+                       message=txt("message", ""),
+                       stability_computed=_h5check.attr_bool(f, path, "stability_computed",
+                                                             False),
+                       solver_info=txt("solver_info", ""))
 
 
 #: File attribute of an FRFWriter file: [points committed, points up to the last
@@ -517,6 +524,7 @@ class FRFWriter:
             self.f.attrs[k] = v
         self.f.attrs["complete"] = False
         self.f.attrs["message"] = "running"
+        _h5check.unseal(self.f)         # sealed again by close()
         self._set_commit(*self._commit)
 
     def _rewind(self) -> None:
@@ -579,10 +587,13 @@ class FRFWriter:
 
     def close(self, complete: bool = True, message: str = "") -> None:
         if self.f:
-            self.f.attrs["complete"] = complete
-            self.f.attrs["message"] = message
-            self.f.close()
-            self.f = None
+            f, self.f = self.f, None
+            try:
+                f.attrs["complete"] = complete
+                f.attrs["message"] = message
+                _h5check.seal(f)
+            finally:
+                f.close()       # even when the disk refused the attributes
 
     def __enter__(self):
         return self
@@ -606,6 +617,7 @@ class FRFWriter:
         except OSError as exc:
             raise InputError(f"{path}: cannot open as HDF5 ({exc})") from None
         with f:
+            _h5check.check_results(f, path)
             n, nck, slot = _committed_rows(f, path)
             if slot < 0 and "last_unknowns" in f:       # a file from before checkpoints
                 state = {"parameter": float(f.attrs["last_parameter"]),
