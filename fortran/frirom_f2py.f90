@@ -678,3 +678,59 @@ subroutine law_info(law, ndir, npar, nslider, name, nlaw)
     nslider = int(ns, 4)
     nlaw = int(size(LAW_CODES), 4)
 end subroutine law_info
+
+! ---- peak amplitude and modal damping --------------------------------------------------
+
+!> max over one period of |x(t)| of each of n real trigonometric polynomials, exactly
+!> (frirom_peak): x (nc, n), one [a0, a1, b1, ..., aH, bH] per column (a C-ordered
+!> (n, nc) array); amp, t (n), t in rad. A non-finite column gives NaN and info
+!> FRIROM_ERR_NONFINITE, the others are still computed.
+subroutine peak_amplitudes(n, nc, x, amp, t, info, msg)
+    use frirom_kinds, only: ip
+    use frirom_peak, only: frirom_peak_amplitudes => peak_amplitudes
+    implicit none
+    integer(4), intent(in) :: n, nc
+    real(8), intent(in) :: x(nc, n)
+    real(8), intent(out) :: amp(n), t(n)
+    integer(4), intent(out) :: info
+    character(len=512), intent(out) :: msg
+    integer(ip) :: st
+    msg = ''
+    call frirom_peak_amplitudes(x, amp, t, st, msg)
+    info = int(st, 4)
+end subroutine peak_amplitudes
+
+!> Modal damping C = M Phi diag(2 zeta omega) Phi^T M of the lowest nm modes of dense
+!> real symmetric K, M (n, n) (frirom_damping; lower triangles read); omega (nm) rad/s.
+subroutine modal_damping(n, nm, k, m, zeta, c, omega, info, msg)
+    use frirom_kinds, only: ip
+    use frirom_damping, only: frirom_modal_damping => modal_damping
+    implicit none
+    integer(4), intent(in) :: n, nm
+    real(8), intent(in) :: k(n, n), m(n, n), zeta(nm)
+    real(8), intent(out) :: c(n, n), omega(nm)
+    integer(4), intent(out) :: info
+    character(len=512), intent(out) :: msg
+    integer(ip) :: st
+    msg = ''
+    call frirom_modal_damping(k, m, zeta, c, omega, st, msg)
+    info = int(st, 4)
+end subroutine modal_damping
+
+!> modal_damping of dense complex Hermitian K, M (n, n): C = M Phi diag(2 zeta omega) Phi^H M.
+subroutine modal_damping_hermitian(n, nm, k, m, zeta, c, omega, info, msg)
+    use frirom_kinds, only: ip
+    use frirom_damping, only: frirom_modal_damping => modal_damping
+    implicit none
+    integer(4), intent(in) :: n, nm
+    complex(8), intent(in) :: k(n, n), m(n, n)
+    real(8), intent(in) :: zeta(nm)
+    complex(8), intent(out) :: c(n, n)
+    real(8), intent(out) :: omega(nm)
+    integer(4), intent(out) :: info
+    character(len=512), intent(out) :: msg
+    integer(ip) :: st
+    msg = ''
+    call frirom_modal_damping(k, m, zeta, c, omega, st, msg)
+    info = int(st, 4)
+end subroutine modal_damping_hermitian

@@ -16,9 +16,10 @@
 !> run_set_modes on an opened run.
 module frirom_solve
     use frirom_kinds, only: wp, ip
-    use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, FRIROM_ERR_LAPACK, &
-                             FRIROM_ERR_ALLOC, set_status
-    use frirom_lapack, only: dsygv
+    use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, FRIROM_ERR_ALLOC, &
+                             set_status
+    use frirom_peak, only: peak_exact => peak_amplitude
+    use frirom_damping, only: modal_damping
     use frirom_banded, only: rcm_order
     use frirom_run, only: run_t, run_points, frf_settings => run_settings, run_open, &
                           run_start, run_advance, run_close, run_default_samples, &
@@ -58,57 +59,15 @@ contains
         ns = run_default_samples(nh)
     end function frf_default_samples
 
-    !> max over one period of |x(t)|, x(t) = a0 + sum_h a_h cos(h t) + b_h sin(h t): the
-    !> largest of 16(2H+1) samples and of the sampled local maxima polished by Newton on
-    !> x'(t) = 0 (every candidate a real time: never above the true maximum).
+    !> max over one period of |x(t)|, x(t) = a0 + sum_h a_h cos(h t) + b_h sin(h t), for
+    !> callers that want it as a function (frirom_peak peak_amplitude, the one algorithm:
+    !> exact, from the roots of x'(t)); NaN for non-finite coefficients.
     pure function peak_amplitude(x) result(amax)
         real(wp), intent(in) :: x(:)          !! (2H+1) [a0, a1, b1, ..., aH, bH]
         real(wp) :: amax
-        real(wp), parameter :: twopi = 2.0_wp*acos(-1.0_wp)
-        real(wp) :: v(16*size(x)), t, d1, d2, step
-        integer(ip) :: ns, k, it
-        ns = size(v)
-        do k = 1, ns
-            v(k) = abs(trig(twopi*(k - 1)/ns, 0_ip))
-        end do
-        amax = maxval(v)
-        do k = 1, ns
-            if (v(k) < v(modulo(k - 2, ns) + 1) .or. v(k) < v(modulo(k, ns) + 1)) cycle
-            t = twopi*(k - 1)/ns
-            do it = 1, 20
-                d1 = trig(t, 1_ip)
-                d2 = trig(t, 2_ip)
-                if (d2*sign(1.0_wp, trig(t, 0_ip)) >= 0.0_wp) exit   ! not a maximum of |x|
-                step = d1/d2
-                if (abs(step) > twopi/ns) exit
-                t = t - step
-                if (abs(step) <= 1.0e-15_wp*twopi) exit
-            end do
-            amax = max(amax, abs(trig(t, 0_ip)))
-        end do
-
-    contains
-
-        !> The m-th time derivative of x at t (m = 0, 1, 2).
-        pure function trig(tt, m) result(s)
-            real(wp), intent(in) :: tt
-            integer(ip), intent(in) :: m
-            real(wp) :: s, c, sn
-            integer(ip) :: h
-            s = merge(x(1), 0.0_wp, m == 0)
-            do h = 1, (size(x) - 1)/2
-                c = cos(h*tt)
-                sn = sin(h*tt)
-                select case (m)
-                case (0)
-                    s = s + x(2*h)*c + x(2*h + 1)*sn
-                case (1)
-                    s = s + h*(x(2*h + 1)*c - x(2*h)*sn)
-                case default
-                    s = s - h*h*(x(2*h)*c + x(2*h + 1)*sn)
-                end select
-            end do
-        end function trig
+        real(wp) :: t
+        integer(ip) :: st
+        call peak_exact(x, amax, t, st)
     end function peak_amplitude
 
     !> Coordinate triplets (1-based, duplicates summed) of an nrow x ncol matrix to CSR with
@@ -195,36 +154,17 @@ contains
     end subroutine coo_csr
 
     !> Dense modal damping C = M Phi diag(2 zeta_r w_r) Phi^T M of the lowest size(zeta)
-    !> modes (Phi M-normalised, K Phi = M Phi w^2; frirom.reduction.damping.modal_damping).
+    !> modes (frirom_damping modal_damping, the kernel frirom.reduction.damping calls too).
     subroutine modal_c(n, kp, ki, kx, mp, mi, mx, zeta, cd, info, errmsg)
         integer(ip), intent(in) :: n, kp(:), ki(:), mp(:), mi(:)
         real(wp), intent(in) :: kx(:), mx(:), zeta(:)
         real(wp), intent(out) :: cd(n, n)
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
-        real(wp), allocatable :: a(:, :), b(:, :), md(:, :), w(:), work(:), mphi(:, :)
-        real(wp) :: q(1)
-        integer(ip) :: nm, r
-        info = FRIROM_OK
-        nm = size(zeta)
-        allocate (a(n, n), b(n, n), w(n))
-        call dense(kp, ki, kx, a)
-        call dense(mp, mi, mx, b)
-        md = b
-        call dsygv(1, 'V', 'U', n, a, n, b, n, w, q, -1, info)
-        allocate (work(max(1, int(q(1)))))
-        call dsygv(1, 'V', 'U', n, a, n, b, n, w, work, size(work), info)
-        if (info /= 0) then
-            call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'damping: eigen-solve of (K, M) '// &
-                            'failed for the modal ratios; is M positive definite?')
-            return
-        end if
-        mphi = matmul(md, a(:, 1:nm))
-        do r = 1, nm
-            mphi(:, r) = mphi(:, r)*sqrt(2.0_wp*zeta(r)*sqrt(max(w(r), 0.0_wp)))
-        end do
-        cd = matmul(mphi, transpose(mphi))
-        cd = 0.5_wp*(cd + transpose(cd))
+        real(wp) :: kd(n, n), md(n, n), omega(size(zeta))
+        call dense(kp, ki, kx, kd)
+        call dense(mp, mi, mx, md)
+        call modal_damping(kd, md, zeta, cd, omega, info, errmsg)
 
     contains
 

@@ -2,10 +2,16 @@
 # Run the whole test suite: meson test (one Fortran test program per module, and the C
 # interface) and pytest (Python layer, against independent references), the tests marked
 # slow included; pytest lists the ten slowest. Needs scripts/setup.sh first.
-# Extra arguments go to pytest (e.g. `bash scripts/test.sh -m "not slow"`).
+# Extra arguments go to pytest (e.g. `bash scripts/test.sh -m "not slow"`, the fast loop:
+# under two minutes on two cores, every feature still covered; the whole suite stays
+# under ten).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export OPENBLAS_NUM_THREADS=${OPENBLAS_NUM_THREADS:-1}
 .venv/bin/python -c "import frirom._kernels"   # rebuilds build/py if sources changed
 .venv/bin/meson test -C build/py --print-errorlogs
+if [ $# -eq 0 ]; then
+    echo 'scripts/test.sh: the whole suite, slow tests included (several minutes); the fast' \
+         'loop while you work: bash scripts/test.sh -m "not slow"' >&2
+fi
 .venv/bin/python -m pytest -q --durations=10 tests "$@"

@@ -132,3 +132,140 @@ def load_and_check(path):
     d.excitation()
     d.options().check()
     return d
+
+
+# ---- issue 25: study decks and results files ---------------------------------------------
+#: A [study] table appended to a bundled deck before it is mutated (its scheduler, counts
+#: and key paths are what the mutations hit).
+STUDY_TABLE = """
+[study]
+kind = "family"
+combine = "product"
+scheduler = "serial"
+workers = 2
+output = 0
+[study.parameters]
+"contacts[0].mu" = [0.3, 0.5]
+"excitation.load[0].amplitude" = [1.0, 2.0]
+"""
+
+
+def study_check(path):
+    """What ``frirom study`` does before any member runs: read the study and its members'
+    decks, choose the scheduler (a deck's address is refused, never connected to)."""
+    import os
+    from frirom.study import check_workers, choose_scheduler, load_study
+    os.environ.pop("FRIROM_SCHEDULER", None)
+    s = load_study(path)
+    choose_scheduler(s.settings, None, path=path)
+    check_workers(s.settings.workers)
+    return s
+
+
+def _junk(rnd, shape):
+    import numpy as np
+    kind = rnd.randrange(8)
+    if kind == 0:
+        return np.full(shape, np.nan)
+    if kind == 1:
+        return np.array([b"text"] * max(int(np.prod(shape)), 1))
+    if kind == 2:
+        return np.zeros(shape[:1] + tuple(s + 1 for s in shape[1:]))
+    if kind == 3:
+        return np.full(shape, np.inf)
+    if kind == 4:
+        return np.zeros(())
+    if kind == 5:
+        return np.zeros(shape, dtype=np.int8) - 1
+    if kind == 6:
+        return np.zeros((0,) + tuple(shape[1:]))
+    return np.ones(shape)
+
+
+def mutate_results(src: Path, dst: Path, rnd) -> str:
+    """Copy the results file ``src`` to ``dst`` and make 1-3 hostile edits with h5py: a
+    dataset replaced by junk (NaN, text, other shapes, overflow, empty) or deleted, an
+    attribute given another type or bad JSON, an external or soft link, deep nesting, a
+    value changed (the checksum kept or removed). Returns what was done."""
+    import shutil
+    import h5py
+    import numpy as np
+    shutil.copyfile(src, dst)
+    done = []
+    with h5py.File(dst, "a") as f:
+        for _ in range(rnd.randint(1, 3)):
+            names = sorted(k for k in f if isinstance(f.get(k, getlink=True), h5py.HardLink)
+                           and isinstance(f[k], h5py.Dataset))
+            attrs = sorted(f.attrs)
+            op = rnd.randrange(9)
+            if op == 0 and names:
+                n = rnd.choice(names)
+                shape = f[n].shape
+                del f[n]
+                f[n] = _junk(rnd, shape)
+                done.append(f"dataset {n} junk")
+            elif op == 1 and names:
+                n = rnd.choice(names)
+                del f[n]
+                done.append(f"dataset {n} deleted")
+            elif op == 2 and attrs:
+                a = rnd.choice(attrs)
+                f.attrs[a] = rnd.choice([np.nan, "{bad json", 3, np.arange(4), b"\xff\xfe",
+                                         "", np.array([1.5, np.inf])])
+                done.append(f"attribute {a} retyped")
+            elif op == 3 and f.get(f"ext{len(done)}", getlink=True) is None:
+                f[f"ext{len(done)}"] = h5py.ExternalLink("/etc/hostname", "/")
+                done.append("external link")
+            elif op == 4 and names and f.get(f"soft{len(done)}", getlink=True) is None:
+                f[f"soft{len(done)}"] = h5py.SoftLink("/" + rnd.choice(names))
+                done.append("soft link")
+            elif op == 5:
+                g = f
+                for i in range(rnd.randint(2, 60)):
+                    g = g.require_group(f"n{i}")
+                done.append("nesting")
+            elif op == 6 and names:
+                n = rnd.choice(names)
+                d = f[n]
+                if d.dtype.kind == "f" and d.size:
+                    a = d[()]
+                    a.flat[rnd.randrange(a.size)] = rnd.choice([np.nan, -1.0, 1e300, 0.0])
+                    d[...] = a
+                    done.append(f"value of {n} changed")
+            elif op == 7 and "content_sha256" in f.attrs:
+                del f.attrs["content_sha256"]
+                done.append("checksum removed")
+            elif op == 8 and attrs:
+                a = rnd.choice(attrs)
+                del f.attrs[a]
+                done.append(f"attribute {a} deleted")
+    return "; ".join(done) or "unchanged"
+
+
+def results_check(path):
+    """What ``frirom show`` and ``--resume`` read of a results file."""
+    from frirom.results import FRF, FRFWriter
+    frf = FRF.load(path)
+    if len(frf):
+        frf.peak(0)
+    try:
+        FRFWriter.resume_point(path)
+    except Warning:
+        pass
+    return frf
+
+
+def make_results(folder: Path) -> Path:
+    """A small finished run of the joint case (H = 1, coarse steps): its frf.h5."""
+    import shutil
+    from frirom.cli import main
+    folder.mkdir(parents=True, exist_ok=True)
+    for f in ("M.mtx", "K.mtx", "dofs.txt"):
+        shutil.copy(ROOT / "cases" / "joint" / f, folder / f)
+    text = (ROOT / "cases" / "joint" / "joint.toml").read_text()
+    text = (text.replace("harmonics = 5", "harmonics = 1").replace("samples = 64", "samples = 16")
+            .replace("step = 0.02", "step = 0.1"))
+    (folder / "joint.toml").write_text(text)
+    if main(["run", str(folder / "joint.toml"), "--out", str(folder / "out"), "--quiet"]) != 0:
+        raise RuntimeError("the results file for the fuzzer could not be made")
+    return folder / "out" / "frf.h5"

@@ -1,4 +1,4 @@
-"""meson test and tests/test_install.py: the README's whole-solve programs (frf_joint.f90
+"""meson test and tests/test_install.py: the whole-solve programs of examples/ (frf_joint.f90
 through frirom_solve, frf_joint.c through frirom_frf) reproduce frirom.solver.frf on the
 joint deck.
 

@@ -1,26 +1,52 @@
-"""Write the program the README shows after the marker `<!-- program NAME -->` (the next
-fenced code block) to a file, so that the README's legacy Fortran and C programs are the
-ones meson test and tests/test_install.py compile and check.
+"""The fenced code blocks of README.md (or any Markdown page), so that tests run exactly
+what a reader copies: tests/test_readme.py runs the commands and the Python example, and
+tests/test_install.py the block that builds and links the Fortran and C examples.
 
-Usage: python readme_program.py README.md NAME OUTPUT
+Usage: python readme_program.py README.md   (lists the blocks: index, language, lines)
 """
 
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 
-def extract(readme: Path, name: str) -> str:
-    """The code of the fenced block after `<!-- program name -->` in readme."""
-    lines = readme.read_text().splitlines()
-    try:
-        at = lines.index(f"<!-- program {name} -->")
-    except ValueError:
-        raise SystemExit(f"{readme}: no '<!-- program {name} -->' marker") from None
-    start = next(i for i in range(at + 1, len(lines)) if lines[i].startswith("```")) + 1
-    end = next(i for i in range(start, len(lines)) if lines[i].startswith("```"))
-    return "\n".join(lines[start:end]) + "\n"
+@dataclass
+class Block:
+    """One fenced block: its info string (``sh``, ``python``, ...), its text and the line
+    of the file it starts on (1-based, the opening fence)."""
+
+    lang: str
+    code: str
+    line: int
+
+
+def blocks(page: Path) -> list[Block]:
+    """Every fenced (```) block of page, in order; an unclosed fence is an error."""
+    lines = Path(page).read_text().splitlines()
+    out, i = [], 0
+    while i < len(lines):
+        if lines[i].startswith("```"):
+            lang, start = lines[i][3:].strip(), i
+            try:
+                end = next(j for j in range(i + 1, len(lines)) if lines[j].startswith("```"))
+            except StopIteration:
+                raise SystemExit(f"{page}:{start + 1}: fenced block never closed") from None
+            out.append(Block(lang, "\n".join(lines[i + 1:end]) + "\n", start + 1))
+            i = end
+        i += 1
+    return out
+
+
+def commands(block: Block) -> list[str]:
+    """The shell commands of a block: its lines without comments and blank lines."""
+    out = []
+    for line in block.code.splitlines():
+        cmd = line.split("#", 1)[0].strip() if not line.lstrip().startswith("#!") else ""
+        if cmd:
+            out.append(cmd)
+    return out
 
 
 if __name__ == "__main__":
-    readme, name, output = sys.argv[1:4]
-    Path(output).write_text(extract(Path(readme), name))
+    for k, b in enumerate(blocks(Path(sys.argv[1]))):
+        print(k, b.lang, f"line {b.line}", len(b.code.splitlines()), "lines")

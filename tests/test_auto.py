@@ -50,7 +50,9 @@ def _peaks(deck, H, N):
 
 
 @pytest.mark.parametrize("name, tol, hz", [("joint.toml", 1e-3, (455.0, 480.0)),
-                                           ("joint_liftoff.toml", 1e-2, (420.0, 470.0))])
+                                           pytest.param("joint_liftoff.toml", 1e-2,
+                                                        (420.0, 470.0),
+                                                        marks=pytest.mark.slow)])
 def test_auto_meets_tolerance_against_richer_run(name, tol, hz):
     # Every output's peak amplitude with the chosen H, N is within the tolerance of an FRF
     # at H = 19, N = 2048 (the tolerance itself: that is the promise of "auto").
@@ -150,6 +152,7 @@ def test_samples_only_meets_tolerance_against_many_samples():
     assert np.all(err <= tol), (ch.lines(), err)
 
 
+@pytest.mark.slow
 def test_study_member_uses_the_choice(tmp_path):
     # A study member (frirom.study.run_member) of an "auto" deck runs at the H and N that
     # the deck alone would choose.
@@ -162,24 +165,17 @@ def test_study_member_uses_the_choice(tmp_path):
 
 
 # ---- interface modes "auto" (frirom.auto.choose_modes) on the lap joint ----------------
-ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture(scope="module")
-def lap(tmp_path_factory):
+def lap(lap_joint_mesh, tmp_path_factory):
     """The lap joint, coarse (element 12 mm: 65 node pairs), as test_lap_joint_case: H = 1,
     825-880 Hz; ``text(n or None, **auto keys)`` its deck with n GSI modes or "auto"."""
     import re
-    import shutil
-    import sys
-    if shutil.which("ccx") is None:
-        pytest.skip("ccx not installed")
-    pytest.importorskip("gmsh")
-    sys.path.insert(0, str(ROOT / "cases" / "lap_joint"))
-    import make_lap_joint
-    from test_lap_joint_case import small
-    out = tmp_path_factory.mktemp("lap_auto")
-    make_lap_joint.make(out, size=0.012)
+
+    from _models import copy_job
+    from _models import small_lap_joint_deck as small
+    out = copy_job(lap_joint_mesh, tmp_path_factory.mktemp("lap_auto"))
 
     def text(n=None, **keys):
         if n is not None:
@@ -190,6 +186,7 @@ def lap(tmp_path_factory):
     return out, text
 
 
+@pytest.mark.slow
 def test_interface_modes_auto_meets_tolerance_on_lap_joint(lap, tmp_path, monkeypatch,
                                                            capsys):
     # `frirom run` with free = stick = "auto" for 1 %: each rung is its own reduced model
@@ -275,10 +272,8 @@ def test_ms_time_harmonics_auto_on_the_flange(tmp_path, monkeypatch):
     # and it equals the unreduced-flange ROM_I (CB only, built separately) to 1e-6 in peak
     # amplitude and frequency (measured 1e-9: the family spans every interface motion).
     import shutil
-    import sys
     if shutil.which("ccx") is None:
         pytest.skip("ccx not installed")
-    sys.path.insert(0, str(ROOT / "cases" / "paper_flange"))
     import paper_flange as pf
     monkeypatch.setenv("FRIROM_CACHE", str(tmp_path / "cache"))
     pf.make(tmp_path, quick=True, log=lambda *a: None)

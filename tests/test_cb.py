@@ -7,8 +7,6 @@ independent reference.
 
 import os
 import shutil
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,8 +18,7 @@ from frirom.io import read_calculix, read_ccx_eigenvalues
 from frirom.reduction.cb import craig_bampton
 from frirom.reduction.eigen import eigsh_shift_invert
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "models"))
-import block  # noqa: E402
+import block  # cases/models/block.py
 
 pytestmark = pytest.mark.skipif(shutil.which("ccx") is None, reason="ccx not installed")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -95,6 +92,7 @@ def test_cb_bad_input(ccx_block):
         craig_bampton(model, 5)
 
 
+@pytest.mark.slow
 def test_cb_lap_joint_gmsh_tet10(tmp_path):
     """Lap joint of two plates meshed by gmsh (C3D10), both contact faces as masters: the
     first 10 CB frequencies converge to ccx's, below 0.1 % with 40 fixed-interface modes.

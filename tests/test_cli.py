@@ -97,11 +97,29 @@ def test_bad_deck_gives_clear_error(deck, tmp_path, capsys):
     assert "contacts[0].mu" in err and ">= 0" in err and str(deck) in err
 
 
+def test_resume_refuses_a_changed_deck_after_a_few_points(deck, tmp_path, capsys):
+    """The fast variant of tests/test_resume.py's test_resume_refuses_a_changed_deck: a run
+    stopped at max_points after 5 points (exit 3), then --resume with another friction
+    coefficient and harmonic count exits 2 naming both changes."""
+    out = tmp_path / "out"
+    text = deck.read_text().replace("max_points = 1000", "max_points = 5")
+    deck.write_text(text)
+    assert main(["run", str(deck), "--out", str(out), "--quiet"]) == 3
+    capsys.readouterr()
+    deck.write_text(text.replace("mu = 0.5", "mu = 0.4").replace("harmonics = 5",
+                                                                  "harmonics = 6"))
+    assert main(["run", str(deck), "--out", str(out), "--quiet", "--resume"]) == 2
+    err = capsys.readouterr().err
+    assert "the deck changed" in err and "contacts[0].mu: 0.5 then, 0.4 now" in err
+    assert "solver.harmonics: 5 then, 6 now" in err
+
+
 def test_resume_without_previous_run(deck, tmp_path, capsys):
     assert main(["run", str(deck), "--out", str(tmp_path / "none"), "--resume"]) == 2
     assert "nothing to resume" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_ctrl_c_keeps_points_and_resumes(deck, tmp_path, monkeypatch, capsys):
     """An interrupt (Ctrl-C) after some points: exit code 130, the points are in frf.h5,
     and --resume finishes the curve."""
@@ -150,8 +168,22 @@ def test_demo_writes_figures_and_harmonics(tmp_path, capsys):
 
 
 def test_version(capsys):
-    try:
+    """`frirom --version` prints exactly "frirom <version>" and exits 0, the version being
+    the installed distribution's (importlib.metadata: pyproject.toml's [project] version),
+    which frirom.__version__ and meson.build's project() version (the C and Fortran
+    library's, in frirom.pc) must equal: three places hold it, a release that bumps one
+    and not the others fails here."""
+    import importlib.metadata
+    import re
+
+    import frirom
+    version = importlib.metadata.version("frirom")
+    assert re.fullmatch(r"\d+\.\d+\.\d+\S*", version), version
+    assert frirom.__version__ == version
+    project = re.search(r"project\([^)]*?version\s*:\s*'([^']+)'",
+                        (ROOT / "meson.build").read_text())
+    assert project and project.group(1) == version
+    with pytest.raises(SystemExit) as exc:
         main(["--version"])
-    except SystemExit as exc:
-        assert exc.code == 0
-    assert "frirom" in capsys.readouterr().out
+    assert exc.value.code == 0
+    assert capsys.readouterr().out == f"frirom {version}\n"

@@ -44,6 +44,7 @@ def test_batch_runs_each_deck_as_alone(decks, tmp_path, capsys):
     assert "[2/2]" in text and "2 of 2 runs complete" in text
 
 
+@pytest.mark.slow
 def test_batch_exit_code_and_resume(decks, tmp_path, capsys):
     """A deck whose run stops at max_points makes the batch exit EXIT_STOPPED while
     the other deck still runs to the end; --resume with more points completes it and

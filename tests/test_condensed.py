@@ -218,9 +218,6 @@ def test_large_system_solves_by_gmres_on_the_held_lu():
     through slip: GMRES is used and most points need no LU; each point re-solved from its
     own unknowns and contact history by a fresh LU (the direct path) agrees to TOL (the
     GMRES solves reach 1e-8 of the right-hand side; Newton then converges to 1e-10)."""
-    import sys
-    from pathlib import Path
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "bench"))
     from condensed import reduced_model      # ROM_I's kind: random modes, 6 DoFs/contact
     model, ex = reduced_model(n=600, nc=80, seed=3)   # 160 coordinates: 1 120 unknowns
     out = np.arange(6)
@@ -241,6 +238,7 @@ def test_large_system_solves_by_gmres_on_the_held_lu():
         assert np.abs(kept[k].X - ref.X).max() / np.abs(ref.X).max() < TOL
 
 
+@pytest.mark.slow
 def test_ill_conditioned_j_falls_back_to_a_double_lu():
     """The held LU is single precision: it only preconditions GMRES, and when GMRES on it
     does not converge (J too ill-conditioned for single precision) J is factorised in
@@ -256,10 +254,7 @@ def test_ill_conditioned_j_falls_back_to_a_double_lu():
     pairwise to 0.5-6e-8, the round-off floor of this conditioning (Newton stops at 1e-10
     of the residual; the well-damped model agrees to ~1e-11); with zeta >= 1e-9 the
     single LU suffices and no fall-back fires."""
-    import sys
-    from pathlib import Path
     import scipy.linalg as sla
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "bench"))
     from condensed import F_RES, reduced_model
     model, ex = reduced_model(n=600, nc=80, seed=3)   # 160 coordinates: 1 120 unknowns
     w = np.sqrt(sla.eigh(model.K.toarray(), model.M.toarray(), eigvals_only=True))
@@ -281,6 +276,7 @@ def test_ill_conditioned_j_falls_back_to_a_double_lu():
         assert np.abs(p.X - ref.X).max() / np.abs(ref.X).max() < 1e-7, kw
 
 
+@pytest.mark.slow
 def test_held_lu_carried_from_solve_to_solve():
     """The LU a large system holds stays in the Fortran run from one corrector solve to
     the next (run_solve: the FRF's peak solves, solve_point's): a solve after the first
@@ -290,11 +286,8 @@ def test_held_lu_carried_from_solve_to_solve():
     fresh run (its own LU) to TOL, and of the dense path (unknowns on the contact DoFs,
     receptances by banded LU) to TOL. Tolerance as above: Newton converges to 1e-10 of
     the residual, GMRES solves to 1e-8."""
-    import sys
-    from pathlib import Path
     from frirom import _kernels, _run
     from frirom._pack import add_timings, pack
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "bench"))
     from condensed import reduced_model
     model, ex = reduced_model(n=600, nc=80, seed=3)   # 160 coordinates: 1 120 unknowns
     out = np.arange(6)

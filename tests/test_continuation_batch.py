@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import dataclasses
 import shutil
-import sys
 import warnings
 from pathlib import Path
 
@@ -24,7 +23,6 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "cases" / "paper_hooks"))
 
 pytestmark = pytest.mark.skipif(shutil.which("ccx") is None, reason="needs ccx")
 

@@ -4,7 +4,6 @@ against CalculiX's own *CYCLIC SYMMETRY MODEL frequencies."""
 
 import os
 import shutil
-import sys
 from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -14,80 +13,15 @@ import pytest
 import scipy.linalg as sla
 import scipy.sparse as sp
 
+import bladed_sector  # cases/models/bladed_sector.py
+import make_bladed_sector  # cases/bladed_sector/make_bladed_sector.py
+from _models import N_SEC, write_cyclic_deck as write
 from frirom._errors import InputError
 from frirom.deck import load_deck
 from frirom.model import CyclicModel
 from frirom.reduction.cyclic import axis_rotation
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
-sys.path.insert(0, str(CASES / "models"))
-sys.path.insert(0, str(CASES / "bladed_sector"))
-import bladed_sector  # noqa: E402
-import make_bladed_sector  # noqa: E402
-
-N_SEC = 12
-
-DECK = """
-[fe_model]
-format = "calculix"
-job = "{job}"
-
-[reduction]
-interface = {interface}
-active = "TIP"
-{cb}
-cache = "{cache}"
-{reduction_extra}
-
-[reduction.cyclic]
-sectors = {sectors}
-left = "LEFT"
-right = "RIGHT"
-engine_order = 2
-{cyclic_extra}
-
-[[contacts]]
-name = "flange"
-law = "normal2d"
-a = "{contact_set}"
-normal = [0.0, 0.0, -1.0]
-kt = {kp}
-kn = {kp}
-mu = 1.0e3
-n0 = 1.0e6
-{contact_extra}
-
-[damping]
-type = "modal"
-zeta = 0.005
-
-[[excitation.load]]
-dof = "TIP:z"
-amplitude = 1.0
-{excitation_extra}
-
-[solver]
-harmonics = {h}
-{solver_extra}
-
-[frequency]
-start = 600.0
-end = 720.0
-
-[outputs]
-dofs = ["TIP:z"]
-"""
-
-BASE = dict(job="inner/sector", interface='"FLANGE_C"', cb="fixed_interface_modes = 30",
-            cache="inner.rom.h5", reduction_extra="", sectors=N_SEC, cyclic_extra="",
-            contact_set="FLANGE_C", kp="1.0e13", contact_extra="", excitation_extra="",
-            h=3, solver_extra="")
-
-
-def write(folder, name="deck.toml", **kw):
-    p = Path(folder) / name
-    p.write_text(DECK.format(**{**BASE, **kw}))
-    return p
 
 
 @pytest.fixture(scope="module")

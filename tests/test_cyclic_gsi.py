@@ -4,7 +4,7 @@ coefficient) or the columns of G (5). Both must give the same answer; the contac
 coordinates once read past the end of the nonlinear DoF list in hbm_setup (a segfault on
 the paper_hooks ROM_II with coordinates = "contact").
 
-Model: the lattice rotor sector of tests/test_cyclic_solver.py (N = 7, EO = 2, H = 3), its
+Model: the lattice rotor sector of tests/_rotor.py (N = 7, EO = 2, H = 3), its
 three ground contacts (normal1d, 6 rows on 9 DoFs) reduced by 3 free GSI modes where they
 are off the cyclic boundary (G: 6 rows on 3 dense GSI columns + 2 boundary DoFs), the tip
 forced by the travelling wave. Tolerance 1e-8 on the output harmonics relative to their largest: both solves converge to a residual of 1e-11 of the
@@ -20,16 +20,16 @@ from frirom.model import ContactGroup, Damping, Excitation
 from frirom.reduction.cyclic import CyclicSector, cyclic_model
 from frirom.reduction.interface import gsi_basis, reduce_interface
 from frirom.solver import SolverOptions, frf, solve_point
-from test_cyclic_solver import (ALPHA, BETA, EO, FORCE, H, N, OPTS, P_GROUND, _rotor,
-                                _sector_contacts)
+from _rotor import (ALPHA, BETA, EO, FORCE, H, N, OPTS, P_GROUND, rotor,
+                    sector_contacts)
 
 
 @pytest.fixture(scope="module")
 def gsi_sector():
-    r, _, Ks, glob = _rotor()
+    r, _, Ks, glob = rotor()
     s = r["sector"]
     n_s = Ks.shape[0]
-    G1 = _sector_contacts(r, glob, n_s)[0].G
+    G1 = sector_contacts(r, glob, n_s)[0].G
     nd = s["node_dofs"]
     bnd = np.concatenate([nd[s["left"]].ravel(), nd[s["right"]].ravel()])
     iface = np.setdiff1d(G1.indices, bnd)      # the boundary stays physical

@@ -1,9 +1,10 @@
 """Nonlinear forced response of a cyclic sector against the whole tuned rotor.
 
 The reference is independent of the cyclic machinery: the full N-sector lattice rotor
-(tests/_lattices.py), every sector carrying its own friction contacts (to ground and
-between neighbouring blade tips), excited by an engine-order travelling wave and solved by
-the ordinary condensed harmonic balance on all its DoFs. The sector model only sees sector
+(tests/_lattices.py; its supports and contacts in tests/_rotor.py), every sector carrying
+its own friction contacts (to ground and between neighbouring blade tips), excited by an
+engine-order travelling wave and solved by the ordinary condensed harmonic balance on all
+its DoFs. The sector model only sees sector
 0 and the modes of the nodal diameters k_h = -h EO mod N of each time harmonic h.
 
 With N = 7 and EO = 2 the harmonics 0..3 live on nodal diameters 0, 5, 3 and 1: four
@@ -20,105 +21,24 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from _lattices import tuned_rotor
+from _rotor import (ALPHA, BETA, EO, FORCE, H, N, OPTS, full_model, rotor,
+                    sector_contacts)
 from frirom import ParameterError, SizeError
-from frirom.model import ContactGroup, CyclicModel, Damping, Excitation, Model
+from frirom.model import ContactGroup, CyclicModel, Damping, Excitation
 from frirom.reduction.cyclic import CyclicSector, axis_rotation, cyclic_model
 from frirom.solver import SolverOptions, frf, load_curve, solve_point
 
-N, EO, H = 7, 2, 3
-ALPHA, BETA = 2.0, 2e-6           # Rayleigh damping (1/s, s)
-K_SUPPORT = 3e5                   # N/m, linear springs tying the interface nodes to ground
-FORCE = 20.0                      # N, tangential tip load amplitude of sector 0
-# normal1d ground contacts: kt, kn, mu, n0 (preload); jenkins tip dampers: kt, mu, fn0
-P_GROUND = (4e5, 8e5, 0.3, 8.0)
-P_TIP = (2e5, 0.3, 3.0)
-OPTS = dict(harmonics=H, samples=16 * N, tol_residual=1e-11, tol_update=1e-11, max_iter=40)
-
-
-def _rotor():
-    r = tuned_rotor(n_sectors=N, per_sector=3, blade=2)
-    s = r["sector"]
-    n_full = r["K"].shape[0]
-    owner = r["node_owner"]
-    # linear supports on every interface node (removes the rigid-body motion)
-    sup_nodes = r["iface_nodes"]
-    sup = np.zeros(n_full)
-    sup[(3 * sup_nodes[:, None] + np.arange(3)).ravel()] = K_SUPPORT
-    K = (r["K"] + sp.diags(sup)).tocsr()
-    glob = r["dofs"][s["nodes"]].ravel()          # sector DoF -> global DoF
-    own0 = np.repeat(owner[s["nodes"]] == 0, 3)
-    Ks = (s["K"] + sp.diags(np.where(own0, sup[glob], 0.0))).tocsr()
-    return r, K, Ks, glob
-
-
-def _contacts(r, per_sector_rows):
-    """Ground contacts (normal1d, tangential + axial) on the middle-radius interface nodes
-    and tip-to-tip Jenkins dampers (tangential at mid-angle) of the sectors listed."""
-    Q = axis_rotation(2 * np.pi / N)
-    nz = r["nz"]
-    iface = r["iface_nodes"].reshape(nz, 3)          # (station, radius)
-    tips = r["tips"]
-    theta_tip = np.arctan2(r["coords"][tips[0], 1], r["coords"][tips[0], 0])
-    th = theta_tip + np.pi / N
-    e_tip = np.array([-np.sin(th), np.cos(th), 0.0])
-    ground, tip = [], []
-    for s in per_sector_rows:
-        for st in range(3 * s, 3 * s + 3):
-            node = iface[st, 1]
-            fr = r["frames"][np.nonzero(r["iface_nodes"] == node)[0][0]]
-            ground.append((node, fr[0], fr[2]))
-        Qs = np.linalg.matrix_power(Q, s)
-        tip.append((tips[s], tips[(s + 1) % N], Qs @ e_tip))
-    return ground, tip, e_tip
-
-
-def _full_model(r, K):
-    n = K.shape[0]
-    ground, tip, _ = _contacts(r, range(N))
-    G1 = sp.lil_matrix((2 * len(ground), n))
-    for e, (node, et, ea) in enumerate(ground):
-        G1[2 * e, 3 * node:3 * node + 3] = et
-        G1[2 * e + 1, 3 * node:3 * node + 3] = ea
-    G2 = sp.lil_matrix((len(tip), n))
-    for e, (a, b, d) in enumerate(tip):
-        G2[e, 3 * a:3 * a + 3] = d
-        G2[e, 3 * b:3 * b + 3] = -d
-    groups = [ContactGroup("normal1d", G1, P_GROUND, name="ground"),
-              ContactGroup("jenkins", G2, P_TIP, name="tips")]
-    return Model(r["M"], K, Damping.rayleigh(ALPHA, BETA), groups)
-
-
-def _sector_contacts(r, glob, n_s):
-    """The same contacts on sector 0 only, in sector DoFs; the tip damper reaches the next
-    sector's tip (columns n_s.., that sector's own frame: its global vector is Q x)."""
-    Q = axis_rotation(2 * np.pi / N)
-    ground, tip, e_tip = _contacts(r, [0])
-    loc = -np.ones(glob.max() + 1, dtype=np.int64)
-    loc[glob] = np.arange(glob.size)
-    G1 = sp.lil_matrix((2 * len(ground), n_s))
-    for e, (node, et, ea) in enumerate(ground):
-        d = loc[3 * node + np.arange(3)]
-        G1[2 * e, d] = et
-        G1[2 * e + 1, d] = ea
-    G2 = sp.lil_matrix((1, 2 * n_s))
-    tip0 = loc[3 * r["tips"][0] + np.arange(3)]
-    G2[0, tip0] = e_tip
-    G2[0, n_s + tip0] = -(e_tip @ Q)
-    return [ContactGroup("normal1d", G1, P_GROUND, name="ground"),
-            ContactGroup("jenkins", G2, P_TIP, name="tips")]
-
 
 def _models(single_index=None):
-    r, K, Ks, glob = _rotor()
+    r, K, Ks, glob = rotor()
     s = r["sector"]
     n_s = Ks.shape[0]
     sector = CyclicSector(n_dof=n_s, n_sectors=N, left=s["node_dofs"][s["left"]],
                           right=s["node_dofs"][s["right"]], axis=np.array([0.0, 0.0, 1.0]),
                           origin=np.zeros(3))
-    cm = cyclic_model(sector, Ks, s["M"], _sector_contacts(r, glob, n_s), EO, H,
+    cm = cyclic_model(sector, Ks, s["M"], sector_contacts(r, glob, n_s), EO, H,
                       damping=Damping.rayleigh(ALPHA, BETA), single_index=single_index)
-    full = _full_model(r, K)
+    full = full_model(r, K)
     # travelling wave on the blade tips: FORCE tangential (+ 0.3 FORCE axial) on sector 0
     Q = axis_rotation(2 * np.pi / N)
     tip = r["tips"]
@@ -234,10 +154,10 @@ def test_craig_bampton_sector_converges_to_the_unreduced_sector():
     resonance as fixed-interface modes are added: tip-harmonic errors measured 3.2e-2 /
     1.7e-2 / 5.4e-3 / 4.4e-4 / 3.8e-5 with 4 / 8 / 16 / 32 / 49 of the 51 slave modes."""
     from frirom.reduction.cb import craig_bampton
-    r, K, Ks, glob = _rotor()
+    r, K, Ks, glob = rotor()
     s = r["sector"]
     n_s = Ks.shape[0]
-    contacts = _sector_contacts(r, glob, n_s)
+    contacts = sector_contacts(r, glob, n_s)
     loc = -np.ones(glob.max() + 1, dtype=np.int64)
     loc[glob] = np.arange(glob.size)
     tip = loc[3 * r["tips"][0] + np.arange(3)]

@@ -231,15 +231,17 @@ def _with(text, table, lines):
 
 
 def test_solver_advice_names_deck_keys(deckdir):
-    """Each setting the corrector failure's advice names (frirom.solver._contact_advice: a
-    stalled residual below 1/N^2 and below tol_residual, a large ds_min, fewer samples than
-    the default) is a key a deck accepts, in [solver] or [continuation], and reaches the
-    solver's options with the advised value."""
+    """Each setting the corrector failure's advice names (frirom.solver._contact_advice of
+    the driver's advice bits: a stalled residual below 1/N^2 and below tol_residual, a
+    large ds_min, fewer samples than the default) is a key a deck accepts, in [solver] or
+    [continuation], and reaches the solver's options with the advised value."""
     import re
 
+    from frirom import _run
     from frirom.solver import SolverOptions, _contact_advice
     opts = SolverOptions(harmonics=5, samples=16, ds_min=1e-3)
-    advice = _contact_advice(opts, "no convergence, |R|/rref = 1.0e-9")
+    # every advice the driver can give (frirom_run run_advice's bits), stalled at 1e-9
+    advice = _contact_advice(opts, sum(_run.ADVISE.values()), 1.0e-9)
     tips = re.findall(r"(?:try |; or )(\w+) = ([0-9.e+-]+)", advice)
     assert {k for k, _ in tips} == {"tol_stall", "max_iter", "ds_min", "samples"}, advice
     for key, value in tips:

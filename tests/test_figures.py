@@ -108,12 +108,9 @@ def test_paper_flange_markers_named_for_every_load(tmp_path, monkeypatch):
     # 30, 300 N), marker styles by the first F0's. Now every colour of a line or marker
     # has an F0 entry and every marker style a model entry.
     import json
-    import sys
-    from pathlib import Path
 
     import matplotlib.colors as mcolors
     from matplotlib.figure import Figure
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "paper_flange"))
     import paper_flange as pf
     (tmp_path / "case.json").write_text(json.dumps({"f_stuck": 100.0}))
     f = np.linspace(90, 110, 50)

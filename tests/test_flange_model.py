@@ -6,7 +6,6 @@ other formulation.
 
 import os
 import shutil
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -15,8 +14,7 @@ import scipy.sparse as sp
 
 from frirom.solver import SolverOptions, solve_point
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "models"))
-import flange  # noqa: E402
+import flange  # cases/models/flange.py
 
 pytestmark = pytest.mark.skipif(shutil.which("ccx") is None, reason="ccx not installed")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")

@@ -127,7 +127,7 @@ def _every(points, k):
     return [points[i] for i in sorted(set(range(0, len(points), k)) | {ip, len(points) - 1})]
 
 
-@pytest.mark.parametrize("samples", [256, 1024])
+@pytest.mark.parametrize("samples", [256, pytest.param(1024, marks=pytest.mark.slow)])
 def test_nlvib_beam_both_formulations_trace_the_same_curve(samples):
     """Both runs reach 330 rad/s through the corner at 398.78 rad/s; every 6th point of
     each (and its peak) is a solution of the other formulation to SAME_POINT."""
@@ -171,7 +171,8 @@ def _curve_gap(a, b):
     return np.sqrt(((a[:, None] - p[None] - s[..., None] * d[None])**2).sum(2)).min(1).max()
 
 
-@pytest.mark.parametrize("deck", ["joint/joint.toml", "bladed_disk/bladed_disk.toml",
+@pytest.mark.parametrize("deck", [pytest.param("joint/joint.toml", marks=pytest.mark.slow),
+                                  "bladed_disk/bladed_disk.toml",
                                   pytest.param("joint/joint_liftoff.toml",
                                                marks=pytest.mark.slow)])
 def test_bundled_deck_same_curve_in_both_formulations(deck):

@@ -18,8 +18,9 @@ import pytest
 hypothesis = pytest.importorskip("hypothesis")
 from hypothesis import HealthCheck, given, settings, strategies as st  # noqa: E402
 
-from _mutate import (ROOT, load_and_check, mutate_bytes, mutate_deck,  # noqa: E402
-                     reader_cases, try_input)
+from _mutate import (ROOT, STUDY_TABLE, load_and_check, make_results,  # noqa: E402
+                     mutate_bytes, mutate_deck, mutate_results, reader_cases, results_check,
+                     study_check, try_input)
 
 DECKS = {"joint": ROOT / "cases" / "joint" / "joint.toml",
          "bladed_disk": ROOT / "cases" / "bladed_disk" / "bladed_disk.toml"}
@@ -86,3 +87,40 @@ def _write(files):
     for f, content in files.items():
         (d / f).write_bytes(content)
     return d
+
+
+@settings(max_examples=100, **FUZZ)
+@given(name=st.sampled_from(sorted(DECKS)), rnd=st.randoms(use_true_random=False))
+def test_mutated_study_decks_load_or_raise_frirom_errors(decks, name, rnd):
+    """Study decks (a bundled deck with a [study] table) mutated: read, members checked
+    and the scheduler chosen (never connected to), or a frirom error."""
+    d = decks[name]
+    data = mutate_deck(DECKS[name].read_text() + STUDY_TABLE, rnd)
+    path = d / "fuzzed_study.toml"
+    path.write_bytes(data)
+    t0 = time.perf_counter()
+    outcome, exc = try_input(lambda: study_check(path))
+    _check(outcome, exc, data[:2000])
+    assert time.perf_counter() - t0 < HANG_SECONDS
+
+
+@pytest.fixture(scope="module")
+def results_file(tmp_path_factory):
+    return make_results(tmp_path_factory.mktemp("results"))
+
+
+@settings(max_examples=100, **FUZZ)
+@given(rnd=st.randoms(use_true_random=False))
+def test_mutated_results_files_load_or_raise_frirom_errors(results_file, tmp_path, rnd):
+    """Results files edited with h5py (junk datasets, retyped attributes, links, nesting,
+    changed values): read as `frirom show` and --resume do, or refused by a frirom error;
+    an accepted file holds finite frequencies and amplitudes."""
+    import numpy as np
+    dst = Path(tempfile.mkdtemp(dir=tmp_path)) / "frf.h5"
+    what = mutate_results(results_file, dst, rnd)
+    outcome, exc = try_input(lambda: results_check(dst))
+    _check(outcome, exc, what)
+    if outcome == "ok":
+        from frirom.results import FRF
+        f = FRF.load(dst)
+        assert np.all(np.isfinite(f.omega)) and np.all(np.isfinite(f.amp_max)), what

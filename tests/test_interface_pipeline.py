@@ -9,8 +9,6 @@ modes are added, the CB model itself being within a small error of the full FE m
 
 import os
 import shutil
-import sys
-from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
@@ -24,8 +22,7 @@ from frirom.reduction.cb import craig_bampton
 from frirom.reduction.interface import (ContactPairs, contact_matrix, gsi_basis, local_frames,
                                         reduce_interface, stick_stiffness)
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "models"))
-import block  # noqa: E402
+import block  # cases/models/block.py
 
 pytestmark = pytest.mark.skipif(shutil.which("ccx") is None, reason="ccx not installed")
 ETA = 0.01
@@ -122,6 +119,7 @@ def test_cb_then_gsi(fe, capsys):
     assert e[-2] < 2e-2 and e_cb < 1e-2  # 32 GSI modes for 3x25 DoFs: within 2 %
 
 
+@pytest.mark.slow
 def test_gsi_on_gmsh_lap_joint(tmp_path, capsys):
     """The paper's setting (Sec. 3.2.1): two components joined over an extended contact,
     reduced by CB (ROM_I, the benchmark), then GSI with free + full-stick modes per side

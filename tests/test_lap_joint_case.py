@@ -19,44 +19,22 @@ Slow (~25 s: the CB reference alone has 413 coordinates, 260 in contact).
 """
 
 import os
-import shutil
-import sys
-from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
 import pytest
 
+from _models import copy_job, small_lap_joint_deck
 from frirom.cli import main
 from frirom.deck import load_deck
 from frirom.results import FRF
 
-ROOT = Path(__file__).resolve().parents[1]
-CASE = ROOT / "cases" / "lap_joint"
-sys.path.insert(0, str(CASE))
-
-
-def small(n_modes: int | None, mu: str = "0.3") -> str:
-    """The case's deck, small; n_modes None: CB only (no interface reduction)."""
-    from convergence import deck_text
-    return deck_text(n_modes, 1, [
-        ('dof = "ACTIVE:z"\namplitude = 20.0', 'dof = "ACTIVE:z"\namplitude = 12.0'),
-        ("amplitude = 20.0", "amplitude = 32.0"), ("amplitude = -20.0", "amplitude = -32.0"),
-        ("n0 = 20.0", "n0 = 32.0"), ("samples = 32", "samples = 16"),
-        ("start = 700.0", "start = 825.0"), ("end = 1000.0", "end = 880.0"),
-        ("mu = 0.3", f"mu = {mu}")])
-
 
 @pytest.fixture(scope="module")
-def case(tmp_path_factory):
-    if shutil.which("ccx") is None:
-        pytest.skip("ccx not installed")
-    pytest.importorskip("gmsh")
-    import make_lap_joint
-    out = tmp_path_factory.mktemp("lap_case")
-    make_lap_joint.make(out, size=0.012)
-    return out
+def case(lap_joint_mesh, tmp_path_factory):
+    """The coarse mesh in a folder of this module's own (its decks and reduced models)."""
+    return copy_job(lap_joint_mesh, tmp_path_factory.mktemp("lap_case"))
 
 
 def run(case, name, text, capsys, complete=True):
@@ -75,21 +53,45 @@ def run(case, name, text, capsys, complete=True):
         capsys.readouterr().out
 
 
+def test_gsi_lap_joint_reuses_its_reduction_and_cb_agrees_at_its_peak(tmp_path, lap_joint_mesh,
+                                                                      capsys):
+    """The fast variant of the next test: the GSI-40 deck's reduction is built, `frirom
+    run` after a change of friction coefficient reuses it, and the CB-only model (every
+    contact pair on physical DoFs) solved at the GSI curve's peak frequency alone (one
+    point, not its 133-point FRF) has the GSI peak amplitude within the next test's 2e-2
+    (measured 2.3e-3) and the joint slipping there too."""
+    from frirom.solver import solve_point
+    case = copy_job(lap_joint_mesh, tmp_path)
+    (case / "gsi.toml").write_text(small_lap_joint_deck(40))
+    built = load_deck(case / "gsi.toml")
+    assert not built.reduced.from_cache and "built" in built.log[0]
+    no_plot = small_lap_joint_deck(40, mu="0.30000001").replace("[outputs]\n",
+                                                                  "[outputs]\nplot = false\n")
+    f_g, a_g, st, log = run(case, "gsi", no_plot, capsys)
+    assert "not recomputed" in log, log
+    (case / "cb.toml").write_text(small_lap_joint_deck(None))
+    cb = load_deck(case / "cb.toml")
+    p = solve_point(cb.model(), cb.excitation(), 2 * np.pi * f_g, cb.options(),
+                    outputs=cb.outputs)
+    assert abs(p.amp_max[0] / a_g - 1) < 2e-2, (p.amp_max[0], a_g)
+    assert st[1] > 0.3 and p.state_fractions[0, 1] > 0.3          # slipping at the peak
+
+
 @pytest.mark.slow
 def test_gsi_lap_joint_matches_cb_and_reuses_its_reduction(case, capsys):
-    (case / "gsi.toml").write_text(small(40))
+    (case / "gsi.toml").write_text(small_lap_joint_deck(40))
     built = load_deck(case / "gsi.toml")
     assert not built.reduced.from_cache and "built" in built.log[0]
     # `frirom run` after a change of friction coefficient: the reduction is reused
-    f_g, a_g, st, log = run(case, "gsi", small(40, mu="0.30000001"), capsys)
+    f_g, a_g, st, log = run(case, "gsi", small_lap_joint_deck(40, mu="0.30000001"), capsys)
     assert "not recomputed" in log, log
     again = load_deck(case / "gsi.toml")
     assert again.reduced.from_cache
     assert np.array_equal(again.K, built.K) and np.array_equal(again.M, built.M)
 
-    f_c, a_c, st_c, log_cb = run(case, "cb", small(None), capsys)
+    f_c, a_c, st_c, log_cb = run(case, "cb", small_lap_joint_deck(None), capsys)
     m_g, m_c = built.model(), load_deck(case / "cb.toml").model()
-    rows = [(n, *run(case, f"gsi{n}", small(n), capsys, complete=n > 20)[:3])
+    rows = [(n, *run(case, f"gsi{n}", small_lap_joint_deck(n), capsys, complete=n > 20)[:3])
             for n in (10, 20, 60)]
     rows.insert(2, (40, f_g, a_g, st))
     with capsys.disabled():

@@ -94,18 +94,19 @@ def test_cyclic_stuck_frequency_is_ccx_clamped(tmp_path_factory):
     own cyclic eigen-solve (5e-6: the penalty and CB 30, as test_cyclic_deck measures)."""
     if shutil.which("ccx") is None:
         pytest.skip("ccx (calculix-ccx) not installed")
-    import test_cyclic_deck as tc
+    import bladed_sector
+    from _models import N_SEC, write_cyclic_deck
     out = tmp_path_factory.mktemp("modes_cyclic")
     for sub, clamp in (("inner", "inner"), ("clamped", "flange")):
-        cyc, sec = tc.bladed_sector.write_sector_decks(out / sub, tc.N_SEC, n_modes=4,
-                                                       sector_clamp=clamp)
+        cyc, sec = bladed_sector.write_sector_decks(out / sub, N_SEC, n_modes=4,
+                                                    sector_clamp=clamp)
         if sub == "inner":
-            tc.bladed_sector.run_ccx(sec, expect=(".sti", ".mas", ".dof"))
+            bladed_sector.run_ccx(sec, expect=(".sti", ".mas", ".dof"))
         else:
-            tc.bladed_sector.run_ccx(cyc, expect=(".dat",))
-    ref = tc.bladed_sector.read_cyclic_eigenvalues(out / "clamped" / "cyclic.dat")
+            bladed_sector.run_ccx(cyc, expect=(".dat",))
+    ref = bladed_sector.read_cyclic_eigenvalues(out / "clamped" / "cyclic.dat")
     f_ccx = np.sqrt(ref[2][0])
-    deck = load_deck(tc.write(out))
+    deck = load_deck(write_cyclic_deck(out))
     check = linear_check(deck)
     free, stuck = check.per_index[10]
     assert stuck is not None and np.min(np.abs(stuck / f_ccx - 1)) < 5e-6

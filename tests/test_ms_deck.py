@@ -3,8 +3,6 @@ basis per interface node set (stage face), harmonic indices named explicitly, an
 circumferential default tangent of `normal = "axial"` contacts."""
 
 import os
-import sys
-from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
@@ -12,12 +10,11 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _lattices import tuned_rotor  # noqa: E402
-from frirom._errors import InputError  # noqa: E402
-from frirom.deck import load_deck  # noqa: E402
-from frirom.io import write_calculix_matrices  # noqa: E402
-from frirom.reduction.multistage import harmonic_indices  # noqa: E402
+from _lattices import tuned_rotor
+from frirom._errors import InputError
+from frirom.deck import load_deck
+from frirom.io import write_calculix_matrices
+from frirom.reduction.multistage import harmonic_indices
 
 N, Z = 7, 3                 # sectors, radial line segments per sector
 K_FLANGE = 3e5              # isotropic springs tying the coincident flange nodes [N/m]

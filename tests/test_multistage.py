@@ -270,11 +270,8 @@ def fe_stage(tmp_path_factory):
     assembled by ccx; its flange face tied to ground by stick springs in cylindrical
     frames (axial normal)."""
     import shutil
-    import sys
-    from pathlib import Path
     if shutil.which("ccx") is None:
         pytest.skip("ccx not installed")
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "models"))
     import bladed_sector
     from frirom.io import read_calculix
     from frirom.reduction.rom import pairs_from_node_sets
@@ -285,7 +282,7 @@ def fe_stage(tmp_path_factory):
     return m, pairs
 
 
-@pytest.mark.parametrize("eo", [0, 3, 5, 8])
+@pytest.mark.parametrize("eo", [0] + [pytest.param(eo, marks=pytest.mark.slow) for eo in (3, 5, 8)])
 def test_ms_exact_on_fe_stage_from_ccx(fe_stage, eo):
     """MS on ccx's matrices of a whole tuned stage (72 radial line segments of 2 nodes):
     exact under an EO travelling wave on the blade tips when the family of EO is kept."""

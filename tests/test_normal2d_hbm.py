@@ -11,9 +11,9 @@ the march with Newton steps on the slider (frirom_aft_march) runs through in a f
 hundred points.
 
 Tolerances: those of tests/test_verification.py (the issue 3 criteria), whose peak
-comparison (_compare_peak) this reuses: peak amplitude within 1 % and resonance frequency
-within 0.2 % of time integration (central differences, N = 512, its own contact return
-maps); the H = 5 truncation dominates.
+comparison (compare_peak, now in tests/_models.py) this reuses: peak amplitude within 1 %
+and resonance frequency within 0.2 % of time integration (central differences, N = 512,
+its own contact return maps); the H = 5 truncation dominates.
 """
 
 import numpy as np
@@ -24,7 +24,7 @@ from frirom.model import ContactGroup, Damping, Excitation, Model
 from frirom.solver import SolverOptions
 from frirom.timeint import TimeContact
 
-from test_verification import _compare_peak, _run
+from _models import compare_peak, run_frf
 
 NE = 8                                   # parallel contact elements
 M2 = np.diag([1.0, 1.0, 1.0, 0.5])      # platform x, y, z; tip
@@ -46,7 +46,7 @@ def normal2d_run():
     group = ContactGroup(law="normal2d", G=G2, params=PAR2, name="platform")
     m = Model(M2, K2, Damping.matrix(C2), [group])
     opts = SolverOptions(harmonics=5, samples=64, ds=0.02, ds_max=0.02, max_points=1500)
-    return _run(m, Excitation(F2), 0.5, 1.5, opts)
+    return run_frf(m, Excitation(F2), 0.5, 1.5, opts)
 
 
 def test_normal2d_frf_runs_through_the_onset_of_partial_slip(normal2d_run):
@@ -70,7 +70,7 @@ def test_normal2d_frf_runs_through_the_onset_of_partial_slip(normal2d_run):
 @pytest.mark.slow
 def test_normal2d_peak_against_time_integration(normal2d_run):
     con = TimeContact("normal2d", G2, PAR2)
-    (w_h, a_h), (w_t, a_t), ti = _compare_peak(normal2d_run, 3, M2, C2, K2, [con], F2)
+    (w_h, a_h), (w_t, a_t), ti = compare_peak(normal2d_run, 3, M2, C2, K2, [con], F2)
     i = np.argmin(np.abs(ti.omega - w_t))
     assert ti.state_fractions[i, :, 1].max() > 0.2        # the contacts slip at the peak
     print(f"normal2d peak: HBM {w_h:.6f} rad/s {a_h:.6f}, time integration {w_t:.6f} rad/s "

@@ -4,9 +4,6 @@ was made."""
 
 import csv
 import os
-import shutil
-import sys
-from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
@@ -14,6 +11,7 @@ import h5py
 import numpy as np
 import pytest
 
+from _models import OUTPUTS_DECK
 from frirom import __version__
 from frirom._errors import InputError
 from frirom.cli import main
@@ -22,34 +20,19 @@ from frirom.io import read_calculix
 from frirom.results import FRF, harmonic_table
 from frirom.solver import frf, solve_point
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "models"))
-import block  # noqa: E402
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_reduction_deck import GSI_DECK  # noqa: E402
-
-#: the block of tests/test_reduction_deck.py (CB + GSI: the interface DoFs are not
-#: coordinates), two harmonics, few samples, 140..160 Hz: a few seconds per run
-DECK = (GSI_DECK.format(kt="2.0e8", h=2, mu=0.5)
-        .replace("harmonics = 2", "harmonics = 2\nsamples = 64")
-        .replace("start = 100.0\nend = 200.0", "start = 140.0\nend = 160.0")
-        .replace('dofs = ["ACTIVE:z", "ACTIVE:x"]', "plot = false\ndofs = {outputs}"))
-
 
 @pytest.fixture(scope="module")
-def block_case(tmp_path_factory):
-    """(deck path, FE model, interface node, interior node) of the block."""
-    if shutil.which("ccx") is None:
-        pytest.skip("ccx not installed")
-    out = tmp_path_factory.mktemp("outputs")
-    block.run_ccx(block.write_block_deck(out / "block.inp", 10, 3, 3, n_ref_modes=0))
+def block_case(block_dir):
+    """(deck path, FE model, interface node, interior node) of the block (OUTPUTS_DECK:
+    the block of tests/test_reduction_deck.py, two harmonics, 140..160 Hz)."""
+    out = block_dir
     fe = read_calculix(out / "block")
     iface, act = fe.node_sets["IFACE"], fe.node_sets["ACTIVE"]
     inner = [n for n in np.unique(fe.dofs[:, 0]) if n not in iface and n not in act]
     node_i, node_f = int(iface[0]), int(inner[len(inner) // 2])
     outs = f'["ACTIVE:z", "{node_i}:UX", "{node_f}:z"]'
     path = out / "block.toml"
-    path.write_text(DECK.format(outputs=outs))
+    path.write_text(OUTPUTS_DECK.format(outputs=outs))
     return path, fe, node_i, node_f
 
 
@@ -120,7 +103,7 @@ def test_files_label_outputs_and_say_how_they_were_made(block_case, tmp_path):
 def test_output_of_a_missing_dof_names_the_key(block_case):
     path, *_ = block_case
     bad = path.with_name("bad.toml")
-    bad.write_text(DECK.format(outputs='["999999:z"]'))
+    bad.write_text(OUTPUTS_DECK.format(outputs='["999999:z"]'))
     with pytest.raises(InputError) as exc:
         load_deck(bad)
     assert "outputs.dofs[0]" in str(exc.value) and "999999" in str(exc.value)

@@ -8,9 +8,7 @@ stuck and slipping, where index 2 alone and the set without index 0 are flagged.
 import math
 import os
 import shutil
-import sys
 import types
-from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
@@ -19,11 +17,10 @@ import pytest
 import scipy.sparse as sp
 from scipy.optimize import minimize_scalar
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "paper_flange"))
-import paper_flange as pf  # noqa: E402
-import paper_flange_mixed as pm  # noqa: E402
+import paper_flange as pf  # cases/paper_flange/paper_flange.py
+import paper_flange_mixed as pm  # cases/paper_flange/paper_flange_mixed.py
 
-from frirom.reduction.multistage import harmonic_indices, shared_indices  # noqa: E402
+from frirom.reduction.multistage import harmonic_indices, shared_indices
 
 needs_ccx = pytest.mark.skipif(shutil.which("ccx") is None, reason="ccx not installed")
 

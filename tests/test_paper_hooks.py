@@ -4,37 +4,20 @@ ROM_I (Craig-Bampton, every contact DoF nonlinear) is the reference; ROM_II redu
 hook and lug faces by GSI modes (half free, half full-stick). Both run on the same cyclic
 sector (Tran modes on the boundary), so their difference is the interface reduction alone.
 The interlocking lug is a preloaded contact; the same mesh with the lug tied is its
-reference. Needs gmsh-free structured meshing and ccx (calculix-ccx); about 40 s, hence
-slow.
+reference. Needs gmsh-free structured meshing and ccx (calculix-ccx). The FRFs take about
+40 s, hence slow; the first-point check (one ROM_I, three points) runs in the fast loop.
 """
 
 from __future__ import annotations
 
 import shutil
-import sys
-import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "cases" / "paper_hooks"))
+from _models import HOOKS_F0, hooks_peak
 
-pytestmark = [pytest.mark.slow,
-              pytest.mark.skipif(shutil.which("ccx") is None, reason="needs ccx")]
-
-#: the preload with the most slip in the coarse family (40 % of the hooks' cycle at the
-#: peak): where the interface modes and the lug are tested hardest
-F0 = 1000.0
-
-
-@pytest.fixture(scope="module")
-def case(tmp_path_factory):
-    import make_paper_hooks as mk
-    work = tmp_path_factory.mktemp("hooks")
-    mk.make(work, "coarse")
-    return work
+pytestmark = pytest.mark.skipif(shutil.which("ccx") is None, reason="needs ccx")
 
 
 @pytest.fixture(scope="module")
@@ -45,18 +28,9 @@ def tied(tmp_path_factory):
     return work
 
 
-def _peak(rom, f0):
-    import paper_hooks as ph
-    rom.set_preload(f0)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")          # an early stop is a failure here
-        res, _ = rom.frf()
-    assert res.complete
-    return ph._peak(res), res
-
-
+@pytest.mark.slow
 @pytest.mark.parametrize("law", ["normal1d", "normal2d"])
-def test_rom1_stuck_peak_is_the_stick_eigenfrequency(case, law):
+def test_rom1_stuck_peak_is_the_stick_eigenfrequency(hooks_case, law):
     """With a preload that keeps every hook stuck, ROM_I is linear: its peak lies at the
     first nodal-diameter-2 frequency of the sector with the hooks tied by their stick
     springs (an eigen-solve of the projected pair, independent of the HBM; normal2d
@@ -65,8 +39,8 @@ def test_rom1_stuck_peak_is_the_stick_eigenfrequency(case, law):
     refinement stay below 1e-5."""
     import paper_hooks as ph
     import scipy.linalg as sla
-    r1 = ph.Rom(case, "rom1", "coarse", law=law)
-    (f, a), res = _peak(r1, 1e5)
+    r1 = ph.Rom(hooks_case, "rom1", "coarse", law=law)
+    (f, a), res = hooks_peak(r1, 1e5)
     assert np.all(res.state_fractions[res.peak(0).index, :, 0] == pytest.approx(1.0))
     red, cs = r1.deck.reduced, r1.deck.cyclic["sector"]
     Ks = red.K.copy()
@@ -80,7 +54,8 @@ def test_rom1_stuck_peak_is_the_stick_eigenfrequency(case, law):
     assert f == pytest.approx(np.sqrt(lam[0]) / (2 * np.pi), rel=1e-4)
 
 
-def test_contact_lug_stays_stuck_and_equals_the_tied_lug(case, tied):
+@pytest.mark.slow
+def test_contact_lug_stays_stuck_and_equals_the_tied_lug(hooks_case, tied):
     """The interlocking lug as a preloaded contact (F_LUG = 300 kN, mu 0.3) against the
     same mesh with the lug's face tied to the platform, ROM_I at the preload where the
     hooks slip most: the lug's groups stick at every time sample of every point of the
@@ -91,11 +66,11 @@ def test_contact_lug_stays_stuck_and_equals_the_tied_lug(case, tied):
     which amplifies it, the peak moves by 1e-4 in amplitude and 1e-6 in frequency
     (measured), and the soft mount is in both models."""
     import paper_hooks as ph
-    rc, rt = ph.Rom(case, "rom1", "coarse"), ph.Rom(tied, "rom1", "coarse")
+    rc, rt = ph.Rom(hooks_case, "rom1", "coarse"), ph.Rom(tied, "rom1", "coarse")
     assert [g for g in rc.groups if g.startswith("lug")] == ["lug_t", "lug_z"]
     assert rt.groups == ["hooks"]
-    (fc, ac), res_c = _peak(rc, F0)
-    (ft, at), res_t = _peak(rt, F0)
+    (fc, ac), res_c = hooks_peak(rc, HOOKS_F0)
+    (ft, at), res_t = hooks_peak(rt, HOOKS_F0)
     assert ph.lug_stick(rc, res_c) == 1.0
     slip = res_c.state_fractions[:, rc._hooks, 1].max()
     assert slip > 0.3                   # the hooks do slip: the lug is loaded by it
@@ -103,7 +78,8 @@ def test_contact_lug_stays_stuck_and_equals_the_tied_lug(case, tied):
     assert fc == pytest.approx(ft, rel=1e-4)
 
 
-def test_gsi_error_decreases_with_modes_and_rom2_matches(case):
+@pytest.mark.slow
+def test_gsi_error_decreases_with_modes_and_rom2_matches(hooks_case):
     """ROM_II against ROM_I at the preload with the most slip: the peak-frequency error
     falls with every step 10 -> 20 -> 40 -> 80 GSI modes, the peak-amplitude error of 80
     modes is below those of 10, 20 and 40, and 80 modes (40 free + 40 stick) are within
@@ -112,10 +88,11 @@ def test_gsi_error_decreases_with_modes_and_rom2_matches(case):
     basis with the hooks'; with the lug tied, 40 modes are within 0.1 %); the case's table
     shows that row flagged."""
     import paper_hooks as ph
-    (f1, a1), _ = _peak(ph.Rom(case, "rom1", "coarse"), F0)
+    (f1, a1), _ = hooks_peak(ph.Rom(hooks_case, "rom1", "coarse"), HOOKS_F0)
     errs = {}
     for n in (10, 20, 40, 80):
-        (f2, a2), _ = _peak(ph.Rom(case, "rom2", "coarse", n, lug_reduction="shared"), F0)
+        r2 = ph.Rom(hooks_case, "rom2", "coarse", n, lug_reduction="shared")
+        (f2, a2), _ = hooks_peak(r2, HOOKS_F0)
         errs[n] = (abs(a2 / a1 - 1), abs(f2 / f1 - 1))
     df = [errs[n][1] for n in (10, 20, 40, 80)]
     assert all(b < a for a, b in zip(df, df[1:])), errs
@@ -123,6 +100,7 @@ def test_gsi_error_decreases_with_modes_and_rom2_matches(case):
     assert errs[80][0] < 0.01 and errs[80][1] < 0.001, errs
 
 
+@pytest.mark.slow
 def test_normal2d_hooks_rom2_matches_rom1_with_the_lug_tied(tied):
     """The paper's 2-D friction on the hooks (normal2d), lug tied, at the preload with the
     most slip: ROM_I runs through the range (the 2-D cycle closes at the onset of partial
@@ -133,15 +111,15 @@ def test_normal2d_hooks_rom2_matches_rom1_with_the_lug_tied(tied):
     (frirom_aft_march settle_step2d, tests/test_aft.f90)."""
     import paper_hooks as ph
     r1 = ph.Rom(tied, "rom1", "coarse", law="normal2d")
-    (f1, a1), res = _peak(r1, F0)
+    (f1, a1), res = hooks_peak(r1, HOOKS_F0)
     assert res.state_fractions[:, r1._hooks, 1].max() > 0.3
     assert res.state_fractions[:, r1._hooks, 2].max() > 0.1
-    (f2, a2), _ = _peak(ph.Rom(tied, "rom2", "coarse", 40, law="normal2d"), F0)
+    (f2, a2), _ = hooks_peak(ph.Rom(tied, "rom2", "coarse", 40, law="normal2d"), HOOKS_F0)
     assert a2 == pytest.approx(a1, rel=0.01)
     assert f2 == pytest.approx(f1, rel=0.001)
 
 
-def test_rom1_first_point_does_not_depend_on_the_stuck_lug_preload(case):
+def test_rom1_first_point_does_not_depend_on_the_stuck_lug_preload(hooks_case):
     """The lug stays stuck, so its preload P only adds a constant force that its static
     load balances: ROM_I's first point (f0 = 300 N, hooks slipping) is the same for
     P = 100 kN, 300 kN and 1 MN. The static load over the vane's 12 N/m soft mount used to
@@ -154,9 +132,9 @@ def test_rom1_first_point_does_not_depend_on_the_stuck_lug_preload(case):
     import paper_hooks as ph
     from frirom.contact import LAWS
     from frirom.solver import solve_point
-    rom = ph.Rom(case, "rom1", "coarse")
+    rom = ph.Rom(hooks_case, "rom1", "coarse")
     rom.set_preload(300.0)
-    lug = mk.lug_geometry(case / "hooks")
+    lug = mk.lug_geometry(hooks_case / "hooks")
     unit = ph.static_loads(rom.deck.reduced, lug, 1.0)       # per N of n0 on every pair
     other = rom.excitation.F[:, 0] - unit * (mk.F_LUG / len(lug[0]))
     groups = [i for i, g in enumerate(rom.groups) if g.startswith("lug")]

@@ -4,35 +4,26 @@ of its own: the hooks reduced by their GSI modes, the lug by its own full-stick 
 deck's checks of those keys.
 
 The case's tests need ccx (coarse mesh, about 15 s: slow); the deck checks use the small
-block model of tests/test_reduction_deck.py.
+block model of tests/test_reduction_deck.py (conftest.py's block_dir, _models.GSI_DECK).
 """
 
 from __future__ import annotations
 
 import shutil
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from _models import GSI_DECK, HOOKS_F0, hooks_peak
 from frirom._errors import InputError
 from frirom.deck import load_deck
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "cases" / "paper_hooks"))
-sys.path.insert(0, str(ROOT / "tests"))
-
 needs_ccx = pytest.mark.skipif(shutil.which("ccx") is None, reason="needs ccx")
-
-# the coarse case (fixture) and a complete FRF's peak, as in test_paper_hooks (F0 = 1 000 N:
-# the preload with the most slip, where the shared basis missed)
-from test_paper_hooks import F0, _peak, case  # noqa: E402,F401
 
 
 @pytest.mark.slow
 @needs_ccx
-def test_hooks_gsi_error_decreases_and_40_modes_match_with_the_lug_apart(case):
+def test_hooks_gsi_error_decreases_and_40_modes_match_with_the_lug_apart(hooks_case):
     """The lug apart from the hooks' basis (its own 12 full-stick GSI modes), ROM_II
     against ROM_I at the preload with the most slip: the errors in peak amplitude and in
     peak frequency both fall with every step 10 -> 20 -> 40 -> 80 hook GSI modes (the
@@ -43,12 +34,12 @@ def test_hooks_gsi_error_decreases_and_40_modes_match_with_the_lug_apart(case):
     1e-3 in peak amplitude and 1e-5 in frequency (measured 2e-5, 8e-7): 12 modes carry the
     stuck lug (six rigid motions per face)."""
     import paper_hooks as ph
-    (f1, a1), _ = _peak(ph.Rom(case, "rom1", "coarse"), F0)
+    (f1, a1), _ = hooks_peak(ph.Rom(hooks_case, "rom1", "coarse"), HOOKS_F0)
     errs, lugs, peaks = {}, {}, {}
     for n in (10, 20, 40, 80):
-        r2 = ph.Rom(case, "rom2", "coarse", n)
+        r2 = ph.Rom(hooks_case, "rom2", "coarse", n)
         assert r2.sizes["contact_dofs"] == n + 12
-        peaks[n], res = _peak(r2, F0)
+        peaks[n], res = hooks_peak(r2, HOOKS_F0)
         f2, a2 = peaks[n]
         errs[n] = (abs(a2 / a1 - 1), abs(f2 / f1 - 1))
         lugs[n] = ph.lug_stick(r2, res)
@@ -57,16 +48,16 @@ def test_hooks_gsi_error_decreases_and_40_modes_match_with_the_lug_apart(case):
         assert all(b < a for a, b in zip(e, e[1:])), errs
     assert errs[40][0] < 0.01 and errs[40][1] < 0.001, errs
     assert all(v == 1.0 for v in lugs.values()), lugs
-    rp = ph.Rom(case, "rom2", "coarse", 40, lug_reduction="physical")
+    rp = ph.Rom(hooks_case, "rom2", "coarse", 40, lug_reduction="physical")
     assert rp.sizes["contact_dofs"] == 40 + 48
-    (fp, ap), _ = _peak(rp, F0)
+    (fp, ap), _ = hooks_peak(rp, HOOKS_F0)
     fo, ao = peaks[40]                  # the lug's own modes, from the loop
     assert ao == pytest.approx(ap, rel=1e-3)
     assert fo == pytest.approx(fp, rel=1e-5)
 
 
 @needs_ccx
-def test_lug_kept_physical_points_are_converged_not_accepted_at_the_preloads_round_off(case):
+def test_lug_kept_physical_points_are_converged_not_accepted_at_the_preloads_round_off(hooks_case):
     """The lug kept physical (48 DoFs), everything stuck (10 000 N): its 300 kN preload's
     static image through the 12 N/m soft mount (|R_0 G^T f_rest| ~ 1.7e5 m) dominates
     the residual's reference, 1e9 x the vibration. A round-off rule on that reference
@@ -80,7 +71,7 @@ def test_lug_kept_physical_points_are_converged_not_accepted_at_the_preloads_rou
 
     import paper_hooks as ph
     from frirom.solver import solve_point
-    rom = ph.Rom(case, "rom2", "coarse", 40, lug_reduction="physical")
+    rom = ph.Rom(hooks_case, "rom2", "coarse", 40, lug_reduction="physical")
     rom.set_preload(1e4)
     res, _ = rom.frf()
     assert res.complete and np.all(res.state_fractions[:, :, 0] == 1.0)
@@ -92,17 +83,6 @@ def test_lug_kept_physical_points_are_converged_not_accepted_at_the_preloads_rou
                         outputs=rom.deck.outputs, start={"slider": res.slider[i]})
         errs.append(np.abs(p.X[:, 1:] - res.X[i][:, 1:]).max() / np.abs(p.X[:, 1:]).max())
     assert max(errs) < 1e-6, errs
-
-
-@pytest.fixture(scope="module")
-def block_dir(tmp_path_factory):
-    if shutil.which("ccx") is None:
-        pytest.skip("ccx not installed")
-    sys.path.insert(0, str(ROOT / "cases" / "models"))
-    import block
-    out = tmp_path_factory.mktemp("sepblock")
-    block.run_ccx(block.write_block_deck(out / "block.inp", 10, 3, 3, n_ref_modes=0))
-    return out
 
 
 BAD_SEPARATE = [
@@ -121,7 +101,6 @@ BAD_SEPARATE = [
 def test_separate_keys_are_checked(block_dir, old, new, expected):
     """A joint of its own must be interface sets, not all of them, and its stick-mode
     count needs the sets: each bad deck names the key."""
-    from test_reduction_deck import GSI_DECK
     good = GSI_DECK.format(kt="2.0e8", h=3, mu=0.5)
     assert old in good
     deck = block_dir / "bad.toml"

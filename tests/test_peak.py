@@ -8,7 +8,7 @@ import pytest
 from frirom.results import FRF, Peak, amplitude_max
 from frirom.solver import SolverOptions, frf
 
-from test_solver_core import duffing
+from _models import duffing
 
 
 def shifted(coeffs, phi):
@@ -109,7 +109,7 @@ def test_frf_peak_between_points_and_in_files(tmp_path):
     solved peaks (FRF.peaks) survive an HDF5 round trip."""
     w = np.linspace(1.0, 2.0, 11)
     a = 3.0 - 40.0 * (w - 1.437) ** 2
-    r = FRF(omega=w, X=np.zeros((11, 1, 3)), amp_max=np.c_[a, w],
+    r = FRF(omega=w, X=np.zeros((11, 2, 3)), amp_max=np.c_[a, w],
             state_fractions=np.zeros((11, 0, 3)), stable=np.ones(11, bool),
             fold=np.zeros(11, bool), iterations=np.zeros(11, int), time_s=np.zeros(11),
             output_dofs=np.array([0, 1]))

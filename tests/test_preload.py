@@ -9,7 +9,6 @@ round-off."""
 
 import re
 import shutil
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -19,8 +18,6 @@ from frirom import InputError
 from frirom.deck import load_deck
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "cases" / "lap_joint"))
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
 @pytest.fixture(scope="module")

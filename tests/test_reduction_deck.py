@@ -3,8 +3,6 @@ contacts on node sets, loads and outputs by node."""
 
 import os
 import shutil
-import sys
-from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
@@ -14,69 +12,13 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from _lattices import tuned_rotor
+from _models import GSI_DECK
 from frirom._errors import InputError
 from frirom.io import read_calculix, write_calculix_matrices
 from frirom.deck import load_deck
 from frirom.reduction.interface import contact_matrix, stick_stiffness
 from frirom.reduction import rom as rom_module
 from frirom.reduction.multistage import harmonic_indices
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "models"))
-import block  # noqa: E402
-
-GSI_DECK = """
-[fe_model]
-format = "calculix"
-job = "block"
-
-[reduction]
-interface = "IFACE"
-active = ["ACTIVE"]
-fixed_interface_modes = 30
-
-[reduction.interface_modes]
-method = "gsi"
-free = 6
-stick = 6
-
-[[contacts]]
-name = "end"
-law = "normal2d"
-a = "IFACE"
-b = "ground"
-normal = [1.0, 0.0, 0.0]
-kt = {kt}
-kn = 8.0e8
-mu = {mu}
-n0 = 100.0
-
-[damping]
-type = "modal"
-zeta = 0.01
-
-[[excitation.load]]
-dof = "ACTIVE:z"
-amplitude = 1.0
-
-[solver]
-harmonics = {h}
-
-[frequency]
-start = 100.0
-end = 200.0
-
-[outputs]
-dofs = ["ACTIVE:z", "ACTIVE:x"]
-"""
-
-
-@pytest.fixture(scope="module")
-def block_dir(tmp_path_factory):
-    if shutil.which("ccx") is None:
-        pytest.skip("ccx not installed")
-    out = tmp_path_factory.mktemp("deckblock")
-    block.run_ccx(block.write_block_deck(out / "block.inp", 10, 3, 3, n_ref_modes=0))
-    return out
 
 
 def _write(path, text):

@@ -6,7 +6,6 @@ import csv
 import dataclasses
 import os
 import shutil
-import sys
 from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -24,8 +23,6 @@ from frirom.solver import frf
 
 ROOT = Path(__file__).resolve().parents[1]
 JOINT = ROOT / "cases" / "joint"
-sys.path.insert(0, str(ROOT / "cases" / "models"))
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 
 @pytest.fixture(scope="module")
@@ -103,10 +100,11 @@ def test_show_cli_writes_point_maps_and_vtk(tmp_path, capsys):
     if shutil.which("ccx") is None:
         pytest.skip("ccx not installed")
     import block
-    from test_outputs import DECK
+    from _models import OUTPUTS_DECK
     block.run_ccx(block.write_block_deck(tmp_path / "block.inp", 10, 3, 3, n_ref_modes=0))
     deck = tmp_path / "block.toml"
-    deck.write_text(DECK.format(outputs='["ACTIVE:z"]').replace("start = 140.0", "start = 148.0")
+    deck.write_text(OUTPUTS_DECK.format(outputs='["ACTIVE:z"]')
+                    .replace("start = 140.0", "start = 148.0")
                     .replace("end = 160.0", "end = 152.0"))
     out = tmp_path / "out"
     assert main(["run", str(deck), "--out", str(out), "--quiet"]) == 0
@@ -186,12 +184,13 @@ def test_power_balance_of_a_cyclic_sector(tmp_path_factory):
     recovered through the sector's basis."""
     if shutil.which("ccx") is None:
         pytest.skip("ccx (calculix-ccx) not installed")
-    import test_cyclic_deck as tc
+    import bladed_sector
+    from _models import N_SEC, write_cyclic_deck
     out = tmp_path_factory.mktemp("cyclic_show")
-    _, sec = tc.bladed_sector.write_sector_decks(out / "inner", tc.N_SEC, n_modes=4,
-                                                 sector_clamp="inner")
-    tc.bladed_sector.run_ccx(sec, expect=(".sti", ".mas", ".dof"))
-    deck = tc.write(out, kp="1.0e9", h=3, solver_extra="samples = 64")
+    _, sec = bladed_sector.write_sector_decks(out / "inner", N_SEC, n_modes=4,
+                                              sector_clamp="inner")
+    bladed_sector.run_ccx(sec, expect=(".sti", ".mas", ".dof"))
+    deck = write_cyclic_deck(out, kp="1.0e9", h=3, solver_extra="samples = 64")
     from frirom.io import read_calculix
     fe = read_calculix(out / "inner" / "sector")
     kept = np.unique(np.concatenate([fe.node_sets[k] for k in ("FLANGE_C", "TIP", "LEFT",

@@ -242,12 +242,9 @@ def cantilever(tmp_path_factory):
     """cases/models/cantilever_pad.py at element size 10 mm (3 612 FE DoFs, 57 pad nodes)
     reduced to 15 coordinates (4 CB modes, 4 + 4 GSI modes, the tip node), H = 3."""
     import shutil
-    import sys
-    from pathlib import Path
     if shutil.which("ccx") is None:
         pytest.skip("ccx not installed")
     pytest.importorskip("gmsh")
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cases" / "models"))
     import cantilever_pad
     from frirom.deck import load_deck
     out = tmp_path_factory.mktemp("cantilever_pad")

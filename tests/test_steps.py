@@ -11,7 +11,7 @@ import scipy.sparse as sp
 from frirom.model import ContactGroup, Damping, Excitation, Model
 from frirom.solver import SolverOptions, frf
 
-from test_verification import J_C, J_F, J_K, J_M, J_PAR, model_of
+from _models import J_C, J_F, J_K, J_M, J_PAR, model_of
 
 
 def oscillator(k3):

@@ -21,6 +21,7 @@ import h5py
 import numpy as np
 import pytest
 
+from _models import copy_job, small_lap_joint_deck
 from frirom import InputError
 from frirom.cli import main
 from frirom.deck import load_deck
@@ -138,6 +139,7 @@ def test_member_equals_deck_run_alone(tmp_path):
     assert all((tmp_path / "out" / p).is_file() for p in ("family.png", "peaks.png"))
 
 
+@pytest.mark.slow
 def test_resume_member_by_member_and_point_by_point(tmp_path, monkeypatch):
     """A study interrupted in member m001 after 15 points: run again, m000 (finished) is
     not recomputed (its member.json untouched), m001 continues from its last checkpoint
@@ -185,6 +187,7 @@ def test_resume_member_by_member_and_point_by_point(tmp_path, monkeypatch):
         assert res["summaries"][i]["peaks"] == clean["summaries"][i]["peaks"]
 
 
+@pytest.mark.slow
 def test_convergence_ladder_and_choice(tmp_path):
     """A ladder over H (samples with it) on the joint: the errors against the richest rung
     fall; the chosen rung meets the tolerance and is the smallest that does. Checked
@@ -315,21 +318,15 @@ def test_study_of_a_base_deck(tmp_path):
 
 
 @pytest.mark.slow
-def test_reduction_ladder_gets_one_cache_per_rung(tmp_path, monkeypatch):
+def test_reduction_ladder_gets_one_cache_per_rung(lap_joint_mesh, tmp_path, monkeypatch):
     """A ladder over GSI counts on the lap joint (coarse mesh, H = 1, a narrow range): each
     rung's reduced model is built once, before the members run, into the content-keyed
     cache shared with the decks (one entry per rung; the deck run alone after the study
     reads the top rung's back), and a rung equals the deck edited by hand and run alone
     (1e-10)."""
-    if shutil.which("ccx") is None:
-        pytest.skip("ccx not installed")
-    pytest.importorskip("gmsh")
-    sys.path.insert(0, str(ROOT / "cases" / "lap_joint"))
-    import make_lap_joint
-    from test_lap_joint_case import small
     monkeypatch.setenv("FRIROM_CACHE", str(tmp_path / "cache"))
-    make_lap_joint.make(tmp_path, size=0.012)
-    (tmp_path / "lap.toml").write_text(small(16).replace("825.0", "835.0")
+    copy_job(lap_joint_mesh, tmp_path)
+    (tmp_path / "lap.toml").write_text(small_lap_joint_deck(16).replace("825.0", "835.0")
                                        .replace("880.0", "860.0"))
     (tmp_path / "ladder.toml").write_text(
         '[study]\nbase = "lap.toml"\nkind = "convergence"\nscheduler = "serial"\n'
@@ -353,20 +350,15 @@ def test_reduction_ladder_gets_one_cache_per_rung(tmp_path, monkeypatch):
     assert np.allclose(got["amp_max"], ref.amp_max, rtol=1e-10, atol=0)
 
 
-def test_reduction_ladder_beside_a_named_cache_file(tmp_path, monkeypatch):
+@pytest.mark.slow
+def test_reduction_ladder_beside_a_named_cache_file(lap_joint_mesh, tmp_path, monkeypatch):
     """A deck that names its cache file (reduction.cache = "*.h5") keeps its own reduced
     model there; a ladder member with another reduction gets its content-keyed entry in
     that file's folder instead of overwriting it (one file per reduction: the deck's
     fingerprint stays in the named file, the other rung's in its own)."""
-    if shutil.which("ccx") is None:
-        pytest.skip("ccx not installed")
-    pytest.importorskip("gmsh")
-    sys.path.insert(0, str(ROOT / "cases" / "lap_joint"))
-    import make_lap_joint
-    from test_lap_joint_case import small
     monkeypatch.delenv("FRIROM_CACHE", raising=False)
-    make_lap_joint.make(tmp_path, size=0.012)
-    deck = small(16).replace("825.0", "835.0").replace("880.0", "860.0")
+    copy_job(lap_joint_mesh, tmp_path)
+    deck = small_lap_joint_deck(16).replace("825.0", "835.0").replace("880.0", "860.0")
     assert deck.count("[reduction]\n") == 1
     (tmp_path / "lap.toml").write_text(deck.replace(
         "[reduction]\n", '[reduction]\ncache = "lap.rom.h5"\n'))

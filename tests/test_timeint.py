@@ -15,6 +15,7 @@ def _two_dof():
     return M, C, K
 
 
+@pytest.mark.slow
 def test_linear_two_dof_matches_closed_form():
     # Central differences shift a frequency by (omega dt)^2/24 = (2 pi/N)^2/24 = 1.6e-5
     # relatively at N = 1024; with a half-power bandwidth of ~1.5 % around the peaks the

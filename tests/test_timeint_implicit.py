@@ -36,6 +36,7 @@ def test_hht_spectral_properties_match_closed_forms():
         algorithmic_properties(0.1, 1.0)
 
 
+@pytest.mark.slow
 def test_linear_two_dof_second_order_against_closed_form():
     # The closed-form FRF of a 2-DoF system (1 % and 1.5 % damping) at 6 frequencies
     # including both resonances. Step error O(dt^2): the frequency shift (2 pi/N)^2/12 =
@@ -106,6 +107,7 @@ def test_friction_against_explicit(case):
         assert r.state_fractions[1, 0, 2] > 0.1                  # and lifts off at 1.05
 
 
+@pytest.mark.slow
 def test_normal2d_in_one_plane_equals_normal1d_implicit():
     # normal2d with the motion in one tangential plane equals normal1d to round-off in the
     # Newton solve (1e-10 of the amplitude: Newton stops at 1e-12 relative updates). The
@@ -129,6 +131,7 @@ def test_normal2d_in_one_plane_equals_normal1d_implicit():
     np.testing.assert_allclose(r1.state_fractions, r2.state_fractions)
 
 
+@pytest.mark.slow
 def test_duffing_against_explicit():
     # cubic law (Newton iterated to the update tolerance), Duffing oscillator with 5 %
     # damping on the resonance's flanks against the explicit scheme at N = 1024 (error
@@ -189,23 +192,21 @@ LAP_HZ = 877.65       # on the first bending resonance's flank (peak 859.8 Hz)
 
 
 @pytest.fixture(scope="module")
-def lap_gsi(tmp_path_factory):
-    import shutil
-    if shutil.which("ccx") is None:
-        pytest.skip("ccx not installed")
-    pytest.importorskip("gmsh")
-    return lap_deck(tmp_path_factory.mktemp("lap_ti"))
+def lap_gsi(lap_joint_mesh, tmp_path_factory):
+    from _models import copy_job
+    return lap_deck(copy_job(lap_joint_mesh, tmp_path_factory.mktemp("lap_ti")))
 
 
 def lap_deck(out):
     """The coarse lap joint of tests/test_lap_joint_case.py (element size 12 mm, CB 20 +
-    GSI 40 modes) made in ``out``: its loaded deck."""
-    from test_lap_joint_case import small
-
+    GSI 40 modes) in ``out`` (meshed here unless its ccx files are there): its loaded
+    deck."""
     import make_lap_joint
+    from _models import small_lap_joint_deck
     from frirom.deck import load_deck
-    make_lap_joint.make(out, size=0.012)
-    (out / "gsi.toml").write_text(small(40))
+    if not (out / "lap.sti").exists():
+        make_lap_joint.make(out, size=0.012)
+    (out / "gsi.toml").write_text(small_lap_joint_deck(40))
     return load_deck(out / "gsi.toml")
 
 

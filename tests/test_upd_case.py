@@ -7,7 +7,6 @@ springs (contacts stuck). Tolerance 1e-4 relative: the Craig-Bampton model keeps
 fixed-interface modes (its truncation error, measured 7e-5 at the second pair)."""
 
 import shutil
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -17,8 +16,6 @@ from frirom.deck import load_deck
 from frirom.modes import linear_check
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "cases" / "upd"))
-sys.path.insert(0, str(ROOT / "cases" / "models"))
 
 
 @pytest.mark.slow

@@ -37,33 +37,13 @@ import pytest
 import scipy.interpolate
 import scipy.optimize
 
-from frirom.model import ContactGroup, Damping, Excitation, Model
+from _models import (J_C, J_F, J_K, J_M, J_PAR, compare_peak, first_harmonic, model_of,
+                     peak_of, run_frf, vertex)
+from frirom.model import Excitation
 from frirom.solver import SolverOptions, frf, solve_point
 from frirom.timeint import TimeContact, integrate, state_from_harmonics
 
 # ---- helpers -----------------------------------------------------------------------------
-
-
-def model_of(M, C, K, law, G, params):
-    group = ContactGroup(law=law, G=np.asarray(G, float), params=np.atleast_2d(params),
-                         name=law)
-    return Model(M, K, Damping.matrix(C), [group])
-
-
-def vertex(x, y):
-    """Vertex (x*, y*) of the parabola through three points."""
-    a, b, c = np.polyfit(x, y, 2)
-    xs = -b / (2 * a)
-    return xs, np.polyval([a, b, c], xs)
-
-
-def peak_of(omega, amp):
-    """Resonance frequency and amplitude: parabola through the highest point and its
-    neighbours (points sorted by frequency)."""
-    o = np.argsort(omega)
-    omega, amp = np.asarray(omega)[o], np.asarray(amp)[o]
-    i = int(np.clip(np.argmax(amp), 1, omega.size - 2))
-    return vertex(omega[i - 1:i + 2], amp[i - 1:i + 2])
 
 
 def turns_of(omega, margin=0.02):
@@ -79,11 +59,6 @@ def turns_of(omega, margin=0.02):
 def linear_frf(M, C, K, F, omegas):
     """Closed-form first-harmonic response (n_pts, n) of the linear system."""
     return np.array([np.linalg.solve(K - w * w * M + 1j * w * C, F) for w in omegas])
-
-
-def first_harmonic(X):
-    """Complex first harmonic a1 - i b1 from real coefficients (..., 2H+1)."""
-    return X[..., 1] - 1j * X[..., 2]
 
 
 # ---- Duffing -----------------------------------------------------------------------------
@@ -252,58 +227,20 @@ def test_hill_stability_against_time_integration(duffing_h5):
     assert np.all(np.abs(rel[2:]) < 2e-3), rel       # back (to the HBM-vs-TI accuracy)
 
 
-# ---- SDOF with a Jenkins element -----------------------------------------------------------
-J_M, J_K, J_C = np.eye(1), np.eye(1), 0.02 * np.eye(1)
-J_PAR = [2.0, 0.2, 1.0]          # kt, mu, fn0: slip force 0.2, stuck frequency sqrt(3)
-J_F = np.array([[0.0, 0.3]], complex)   # 90 % slip at the peak, 5x below the free one
-
-
-def _run(model, excitation, w0, w1, opts):
-    """frf plus the converged points (with their unknowns, to restart from)."""
-    points = []
-    r = frf(model, excitation, w0, w1, opts, sink=points.append)
-    return {"model": model, "excitation": excitation, "opts": opts, "frf": r,
-            "points": points}
-
+# ---- SDOF with a Jenkins element (J_*: tests/_models.py) --------------------------------
 
 @pytest.fixture(scope="module")
 def jenkins_h5():
     m = model_of(J_M, J_C, J_K, "jenkins", [[1.0]], J_PAR)
     opts = SolverOptions(harmonics=5, samples=64, ds=0.02, ds_max=0.02, max_points=5000)
-    return _run(m, Excitation(J_F), 0.8, 1.3, opts)
-
-
-def _compare_peak(run, out, M, C, K, contacts, F):
-    """Resonance (omega, max amplitude) of the HBM and of time integration, both on the
-    same 0.05 %-spaced grid around the continuation's peak (HBM by solve_point restarted
-    from the nearest continuation point). The frequency is the vertex of the first-harmonic
-    magnitude (exact on both sides), the amplitude the vertex of max |x(t)|."""
-    r, pts = run["frf"], run["points"]
-    w_c, _ = peak_of(r.omega, np.abs(first_harmonic(r.X[:, out])))
-    grid = w_c * (1 + 5e-4 * np.arange(-12, 13))
-    hb = []
-    for w in grid:
-        near = pts[int(np.argmin(np.abs(r.omega - w)))]
-        hb.append(solve_point(run["model"], run["excitation"], w, run["opts"],
-                              start={"unknowns": near.unknowns}))
-    hX = np.array([p.X[out] for p in hb])
-    w_h, _ = peak_of(grid, np.abs(first_harmonic(hX)))
-    _, a_h = peak_of(grid, np.array([p.amp_max[out] for p in hb]))
-    ti = integrate(M, C, K, contacts, F, grid, H=5, periods=800, tol=2e-6,
-                   steps_per_period=512)
-    assert ti.drift.max() < 1e-5, ti.drift.max()
-    w_t, _ = peak_of(grid, np.abs(first_harmonic(ti.harmonics[:, out])))
-    _, a_t = peak_of(grid, ti.amp_max[:, out])
-    assert grid[1] < w_t < grid[-2], "time-integration peak not inside the grid"
-    assert grid[1] < w_h < grid[-2], "refined HBM peak not inside the grid"
-    return (w_h, a_h), (w_t, a_t), ti
+    return run_frf(m, Excitation(J_F), 0.8, 1.3, opts)
 
 
 def test_jenkins_sdof_peak_against_time_integration(jenkins_h5):
     r = jenkins_h5["frf"]
     assert r.complete, r.message
     jen = TimeContact("jenkins", np.array([[1.0]]), [J_PAR])
-    (w_h, a_h), (w_t, a_t), ti = _compare_peak(jenkins_h5, 0, J_M, J_C, J_K, [jen], J_F)
+    (w_h, a_h), (w_t, a_t), ti = compare_peak(jenkins_h5, 0, J_M, J_C, J_K, [jen], J_F)
     # partial slip at the peak: the friction element matters
     i = np.argmin(np.abs(ti.omega - w_t))
     assert 0.1 < ti.state_fractions[i, 0, 1] < 0.9
@@ -328,7 +265,7 @@ def normal_h5():
     m = model_of(N_M, N_C, N_K, "normal1d", N_G, N_PAR)
     opts = SolverOptions(harmonics=5, samples=64, ds=0.02, ds_max=0.02, max_points=3000,
                          tol_residual=1e-9, tol_update=1e-9)
-    return _run(m, Excitation(N_F), 0.8, 1.3, opts)
+    return run_frf(m, Excitation(N_F), 0.8, 1.3, opts)
 
 
 @pytest.mark.slow
@@ -336,7 +273,7 @@ def test_normal1d_liftoff_peak_against_time_integration(normal_h5):
     r = normal_h5["frf"]
     assert r.complete, r.message
     con = TimeContact("normal1d", N_G, [N_PAR])
-    (w_h, a_h), (w_t, a_t), ti = _compare_peak(normal_h5, 2, N_M, N_C, N_K, [con], N_F)
+    (w_h, a_h), (w_t, a_t), ti = compare_peak(normal_h5, 2, N_M, N_C, N_K, [con], N_F)
     i = np.argmin(np.abs(ti.omega - w_t))
     assert ti.state_fractions[i, 0, 2] > 0.05          # it really lifts off
     j = np.argmin(np.abs(r.omega - w_h))
@@ -461,11 +398,11 @@ def test_bundled_joint_case_against_time_integration():
     from frirom.deck import load_deck
     d = load_deck(Path(__file__).resolve().parents[1] / "cases" / "joint" / "joint.toml")
     m = d.model()
-    run = _run(m, d.excitation(), d.omega_start, d.omega_end, d.options())
+    run = run_frf(m, d.excitation(), d.omega_start, d.omega_end, d.options())
     assert run["frf"].complete, run["frf"].message
     c = d.contacts[0]
     tip = d.dof_labels.index("tip:x")
-    (w_h, a_h), (w_t, a_t), ti = _compare_peak(
+    (w_h, a_h), (w_t, a_t), ti = compare_peak(
         run, tip, m.M.toarray(), m.C.toarray(), m.K.toarray(),
         [TimeContact(c.law, c.G.toarray(), c.params)], d.F)
     i = np.argmin(np.abs(ti.omega - w_t))

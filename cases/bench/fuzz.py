@@ -10,7 +10,12 @@ built as `frirom run` does before the sweep (tests/_mutate.py: load_and_check); 
 mutated file is read by its reader. Mutations come from a seeded random.Random: a run is reproducible.
 
     OPENBLAS_NUM_THREADS=1 python cases/bench/fuzz.py [--decks 10000] [--files 2000]
-        [--seed 13] [--lap 100] [--work results/fuzz]
+        [--studies 2000] [--results 2000] [--seed 13] [--lap 100] [--work results/fuzz]
+
+--studies: bundled decks with a [study] table, mutated, read as `frirom study` does
+before any member runs (no scheduler is contacted). --results: a small run's frf.h5
+edited with h5py (junk datasets, retyped attributes, links, nesting, changed values),
+read as `frirom show` and --resume do (tests/_mutate.py: mutate_results).
 
 Prints a table per input kind, then each crash (the first 10) with its input.
 """
@@ -31,8 +36,9 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tests"))
 
-from _mutate import (load_and_check, mutate_bytes, mutate_deck, reader_cases,  # noqa: E402
-                     try_input)
+from _mutate import (STUDY_TABLE, load_and_check, make_results,  # noqa: E402
+                     mutate_bytes, mutate_deck, mutate_results, reader_cases, results_check,
+                     study_check, try_input)
 
 
 OUTCOMES = ("ok", "error", "crash", "hang")
@@ -90,12 +96,16 @@ def main(argv=None):
     ap.add_argument("--lap", type=int, default=0,
                     help="mutated lap-joint [fe_model] decks to try (a changed reduction is "
                     "rebuilt: seconds to a minute each)")
+    ap.add_argument("--studies", type=int, default=2000, help="mutated study decks to try")
+    ap.add_argument("--results", type=int, default=2000,
+                    help="hostile results files to try")
     ap.add_argument("--work", type=Path, default=ROOT / "results" / "fuzz")
     a = ap.parse_args(argv)
     rnd = random.Random(a.seed)
     sources = deck_sources(a.work, a.lap > 0)
     texts = {k: p.read_text() for k, p in sources.items()}
-    counts = {k: Counter() for k in list(sources) + [c[0] for c in reader_cases()]}
+    counts = {k: Counter() for k in list(sources) + [c[0] for c in reader_cases()]
+              + ["study", "results"]}
     crashes, slowest = [], (0.0, "")
     t_start = time.perf_counter()
     names = ["bladed_disk", "joint"]
@@ -129,9 +139,30 @@ def main(argv=None):
         counts[name]["named"] += outcome == "error" and str(folder) in str(exc)
         if outcome in ("crash", "hang"):
             crashes.append((f"{name}/{victim}", outcome, exc, data))
+    for i in range(a.studies):
+        name = ("bladed_disk", "joint")[i % 2]
+        data = mutate_deck(texts[name] + STUDY_TABLE, rnd)
+        path = sources[name].with_name("fuzzed_study.toml")
+        path.write_bytes(data)
+        outcome, exc = timed(lambda: study_check(path), a.hang)
+        counts["study"][outcome] += 1
+        counts["study"]["named"] += outcome == "error" and path.name in str(exc)
+        if outcome in ("crash", "hang"):
+            crashes.append((f"study of {name}", outcome, exc, data))
+    if a.results:
+        src = make_results(a.work / "results_src")
+        dst = a.work / "results_src" / "fuzzed.h5"
+        for i in range(a.results):
+            what = mutate_results(src, dst, rnd)
+            outcome, exc = timed(lambda: results_check(dst), a.hang)
+            counts["results"][outcome] += 1
+            counts["results"]["named"] += outcome == "error" and str(dst) in str(exc)
+            if outcome in ("crash", "hang"):
+                crashes.append(("results", outcome, exc, what.encode()))
     total = time.perf_counter() - t_start
 
-    print(f"fuzz: seed {a.seed}, {a.decks + a.lap} decks, {a.files} files, {total:.0f} s")
+    print(f"fuzz: seed {a.seed}, {a.decks + a.lap} decks, {a.files} files, {a.studies} "
+          f"study decks, {a.results} results files, {total:.0f} s")
     print(f"{'input':<16}{'tried':>8}{'accepted':>10}{'refused':>10}{'named':>8}"
           f"{'crashed':>9}{'hung':>6}")
     tot = Counter()

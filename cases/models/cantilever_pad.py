@@ -32,7 +32,8 @@ GEOMETRY = dict(L=0.2, W=0.02, T=0.02, x0=0.08, x1=0.12)   # m
 
 def cantilever_pad_mesh(size=0.006, L=0.2, W=0.02, T=0.02, x0=0.08, x1=0.12):
     """Nodes (ids, xyz), C3D10 connectivity and node sets of the beam (gmsh)."""
-    import gmsh
+    from frirom._optional import require
+    gmsh = require("gmsh", "mesh", "meshing the cantilever (gmsh)")
 
     gmsh.initialize(readConfigFiles=False)
     try:

@@ -45,7 +45,8 @@ def generate_tet10(gmsh, size):
 
 def lap_joint_mesh(L=0.1, W=0.03, t=0.005, a=0.03, size=0.006):
     """Nodes (ids, xyz), C3D10 connectivity and node sets of the two plates (gmsh)."""
-    import gmsh
+    from frirom._optional import require
+    gmsh = require("gmsh", "mesh", "meshing the lap joint (gmsh)")
 
     gmsh.initialize(readConfigFiles=False)
     try:

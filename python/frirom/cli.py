@@ -12,13 +12,19 @@
 
 Exit codes of `frirom run` on several decks: 0 every run reached the end of its frequency
 range; 2 a deck is wrong (the message names the field); 3 a run stopped before the end of
-its range (its points are kept: see --resume); 130 interrupted (Ctrl-C stops the batch at
-once); the code of the first deck that did not end with 0, after all of them have run.
+its range (its points are kept: see --resume); 4 the operating system refused a file
+(disk full, read-only or missing folder, a file where a folder belongs: the message names
+the path and what to do; committed points are kept); 130 interrupted (Ctrl-C stops the
+batch at once); the code of the first deck that did not end with 0, after all of them
+have run. `frirom study`: 0 every member complete, 1 a member stopped before the end of
+its range, 5 a member failed (named in the summary; the others ran and are kept), 2 and 4
+as above.
 """
 
 from __future__ import annotations
 
 import argparse
+import errno
 import os
 import re
 import shutil
@@ -42,8 +48,16 @@ exit codes:
   2    bad input, refused --resume, or the folder is in use: nothing computed
   3    the run stopped before the end of its range (continuation failure, max_points,
        the curve turned back); where and why are printed, the points are in OUT/frf.h5
+  4    the operating system refused a file (disk full, read-only folder, a file where a
+       folder belongs, a folder where a file belongs): the path and what to do are
+       printed; every committed point is kept (continue with --resume)
   130  interrupted (Ctrl-C); the points are kept, continue with --resume
 """
+
+#: Exit code of an operating-system error on a file (the message names the path).
+EXIT_SYSTEM = 4
+#: Exit code of `frirom study` when a member failed (the others ran).
+EXIT_MEMBER_FAILED = 5
 
 
 def _add_run(sub) -> None:
@@ -130,25 +144,58 @@ def cmd_show(args) -> int:
 def _add_study(sub) -> None:
     p = sub.add_parser(
         "study", help="run the [study] of a deck: a family of FRFs or a model-size ladder",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
         description="Run every member of the deck's [study] table (docs/deck.md) as a Dask "
         "task, into OUT/members/<name>/; finished members are kept, so running again "
-        "continues an interrupted study. Writes OUT/study.h5 and the plots.")
+        "continues an interrupted study. Writes OUT/study.h5 and the plots.",
+        epilog="""\
+A member that fails (an error in its deck or its solve, a lost worker) is recorded in
+OUT/members/<name>/failed.json and named in the summary; the others run and are kept;
+running the study again retries it. Connecting to a scheduler: docs/security.md.
+
+exit codes:
+  0    every member reached the end of its frequency range
+  1    a member stopped before the end of its range (its points are kept)
+  2    bad input (the message names the field), or the folder is in use
+  4    the operating system refused a file (the message names the path)
+  5    a member failed (named in the summary); the others ran
+""")
     p.add_argument("deck", type=Path, help="a TOML deck with a [study] table")
     p.add_argument("--out", type=Path, default=None,
                    help="output folder (default: results/<deck name>)")
     p.add_argument("--scheduler", default=None,
                    help='"local" (a LocalCluster, the default), "serial", or a Dask '
-                   "scheduler address (tcp://host:8786); overrides study.scheduler")
+                   "scheduler address (tcp://host:8786, tls://host:8786); overrides "
+                   "FRIROM_SCHEDULER and study.scheduler. A scheduler can run any code in "
+                   "this process: name only one you trust (docs/security.md)")
+    p.add_argument("--trust-deck-scheduler", action="store_true",
+                   help="connect to the scheduler address the deck's study.scheduler names "
+                   "(refused without this flag, --scheduler or FRIROM_SCHEDULER)")
+    p.add_argument("--tls-ca", default=None, metavar="FILE",
+                   help="CA certificate of a tls:// scheduler (default: Dask's "
+                   "configuration, distributed.comm.tls.ca-file)")
+    p.add_argument("--tls-cert", default=None, metavar="FILE",
+                   help="this client's certificate for a tls:// scheduler")
+    p.add_argument("--tls-key", default=None, metavar="FILE",
+                   help="this client's private key for a tls:// scheduler")
     p.add_argument("--workers", type=int, default=None,
-                   help="LocalCluster workers (default: study.workers, or one per core)")
+                   help="LocalCluster workers, 1..1024 (default: study.workers, or one per "
+                   "core)")
+    p.add_argument("--force", action="store_true",
+                   help="run a study of more than 10 000 members (frirom.study.MAX_MEMBERS)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_study)
 
 
 def _study(args) -> int:
     from .study import run_study
+    tls = {"ca": args.tls_ca, "cert": args.tls_cert, "key": args.tls_key}
     res = run_study(args.deck, args.out, scheduler=args.scheduler, workers=args.workers,
-                    quiet=args.quiet, log=lambda s: print(f"frirom: {s}"))
+                    quiet=args.quiet, log=lambda s: print(f"frirom: {s}"),
+                    trust_deck_scheduler=args.trust_deck_scheduler, tls=tls,
+                    force=args.force)
+    if any(s.get("failed") for s in res["summaries"]):
+        return EXIT_MEMBER_FAILED
     return 0 if all(s["complete"] for s in res["summaries"]) else 1
 
 
@@ -319,7 +366,10 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
             return EXIT_INTERRUPTED
         except BaseException as exc:
             progress.close()
-            writer.close(complete=False, message=f"{type(exc).__name__}: {exc}")
+            try:
+                writer.close(complete=False, message=f"{type(exc).__name__}: {exc}")
+            except OSError:
+                pass            # the disk that failed the point may fail this too
             raise
         progress.close()
         writer.close(complete=result.complete, message=result.message)
@@ -373,11 +423,12 @@ def _resume_start(h5: Path, deck, fingerprint: str):
     if not h5.is_file():
         raise InputError(f"{h5}: nothing to resume (run without --resume first)")
     try:
-        f = h5py.File(h5, "r")
+        h5py.File(h5, "r").close()
     except OSError as exc:
         raise InputError(f"{h5}: cannot be read as HDF5 ({exc}); it cannot be resumed: run "
                          "without --resume (the folder's results are replaced)") from None
-    with f:
+    previous = FRF.load(h5)         # refuses a damaged, edited or inconsistent file
+    with h5py.File(h5, "r") as f:
         old = f.attrs.get("deck_fingerprint")
         rng = f.attrs.get("omega_range")
     redo = "run without --resume (the results in that folder are replaced) or choose " \
@@ -391,7 +442,6 @@ def _resume_start(h5: Path, deck, fingerprint: str):
             raise InputError(f"{h5}: the deck changed since these results were made (only "
                              f"{' and '.join(EXTENDABLE)} may change on --resume):\n  "
                              + "\n  ".join(changes) + f"\n{redo}")
-    previous = FRF.load(h5)         # refuses an inconsistent file
     extended = rng is not None and float(rng[1]) != deck.omega_end
     if extended and (deck.omega_end - rng[1]) * np.sign(rng[1] - rng[0]) < 0:
         raise InputError(f"{deck.path}: frequency.end: --resume may extend the range, not "
@@ -464,6 +514,9 @@ def _run_one(args, deck: Path, out: Path | None) -> int:
     except FriromError as exc:
         print(f"frirom: error: {exc}", file=sys.stderr)
         return EXIT_INPUT
+    except OSError as exc:
+        print(f"frirom: error: {system_error(exc)}", file=sys.stderr)
+        return EXIT_SYSTEM
     return code
 
 
@@ -484,7 +537,8 @@ def cmd_run_decks(args) -> int:
             print(f"frirom: interrupted; {len(decks) - i - 1} decks not run", file=sys.stderr)
             break
     what = {0: "complete", EXIT_INPUT: "error in the deck", EXIT_STOPPED:
-            "stopped before the end of its range", EXIT_INTERRUPTED: "interrupted"}
+            "stopped before the end of its range", EXIT_INTERRUPTED: "interrupted",
+            EXIT_SYSTEM: "a file could not be written or read (see above)"}
     for deck, code in zip(decks, codes):
         print(f"frirom: {deck}: {what.get(code, f'exit code {code}')}")
     bad = [c for c in codes if c != 0]
@@ -545,6 +599,42 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
     print(f"frirom: warning: {with_hz(text)}", file=sys.stderr if file is None else file)
 
 
+#: What to do about an operating-system error, by errno.
+_OS_HINTS = {
+    errno.ENOSPC: "no space left on the device: free some, then continue with --resume "
+                  "(every committed point is kept)",
+    errno.EDQUOT: "disk quota exceeded: free some space, then continue with --resume "
+                  "(every committed point is kept)",
+    errno.EROFS: "the file system is read-only: choose another --out",
+    errno.EACCES: "permission denied: choose another --out or change its permissions",
+    errno.EPERM: "permission denied: choose another --out or change its permissions",
+    errno.ENOTDIR: "a part of the path is a file, not a folder: choose another --out",
+    errno.EISDIR: "a folder is where frirom writes a file: remove or rename it, or choose "
+                  "another --out",
+    errno.EEXIST: "a file is where frirom makes a folder: choose another --out",
+    errno.ENOENT: "no such file or folder",
+    errno.ENAMETOOLONG: "the path is too long: choose a shorter --out",
+}
+
+
+def system_error(exc: OSError) -> str:
+    """One line for an operating-system error: the path, what happened and what to do.
+    h5py's errors carry errno and the file name in their text, read from there."""
+    import re
+    text = str(exc)
+    code = exc.errno
+    if code is None:
+        m = re.search(r"errno = (\d+)", text)
+        code = int(m.group(1)) if m else None
+    path = exc.filename
+    if path is None:
+        m = re.search(r"name = '([^']*)'", text)
+        path = m.group(1) if m else None
+    what = _OS_HINTS.get(code, exc.strerror or " ".join(text.split()))
+    where = f"{os.fspath(path)}: " if path is not None else ""
+    return f"{where}{what} ({type(exc).__name__}" + (f", errno {code}" if code else "") + ")"
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -566,6 +656,11 @@ def main(argv: list[str] | None = None) -> int:
             raise
         print(f"frirom: error: {with_hz(' '.join(str(exc).split()))}", file=sys.stderr)
         return 2
+    except OSError as exc:
+        if debug:
+            raise
+        print(f"frirom: error: {system_error(exc)}", file=sys.stderr)
+        return EXIT_SYSTEM
     except Exception as exc:            # a bug or an unforeseen input: one line, no traceback
         if debug:
             raise

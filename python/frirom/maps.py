@@ -198,9 +198,9 @@ def write_vtk(state, deck, path, n_frames: int = 0) -> list:
     n_frames > 0 also writes that many frames of the period (``path`` with ``_kNNN``).
     Returns the paths written.
     """
-    import meshio
-
+    from ._optional import require
     from .results import amplitude_max
+    meshio = require("meshio", "vtk", "frirom show --vtk (ParaView output)")
     rom = deck.reduced
     if rom is None or rom.node_ids.size == 0:
         raise InputError("VTK export needs an FE deck ([fe_model]) with node coordinates "

@@ -14,7 +14,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._errors import InputError
+from . import _h5check, _kernels
+from ._errors import CODES, InputError, SizeError, raise_for_status
+
+_NONFINITE = CODES["FRIROM_ERR_NONFINITE"]
 
 
 def _series(X: np.ndarray, t: np.ndarray) -> tuple:
@@ -29,61 +32,18 @@ def _series(X: np.ndarray, t: np.ndarray) -> tuple:
             -(h * h * even).sum(axis=-1))
 
 
-@functools.lru_cache(maxsize=None)
-def _tan_half_basis(d: int) -> np.ndarray:
-    """(2d+1, 2d+1) complex B with B[k, j] the coefficient of u^j in
-    (1 + i u)^k (1 - i u)^(2d - k): z^k (1 - i u)^(2d) for z = exp(i t), u = tan(t / 2)."""
-    up, dn = np.polynomial.polynomial.polypow, np.polynomial.polynomial.polymul
-    return np.array([dn(up([1, 1j], k), up([1, -1j], 2 * d - k)) for k in range(2 * d + 1)])
-
-
-def _derivative_roots(Xf: np.ndarray, H: int) -> np.ndarray:
-    """Times t of the real roots of x'(t) per row of Xf (rows, 2H+1), with more candidate
-    times from the complex roots: (rows, 2H) rad.
-
-    z^d x'(t) is a polynomial P(z) of degree 2d in z = exp(i t) (d: the row's effective
-    degree, its highest harmonic above round-off); with u = tan(t / 2),
-    P(z) (1 - i u)^(2d) = (1 + u^2)^d x'(t) is a real polynomial in u whose real roots are
-    the critical times t = 2 atan(u): a real companion matrix per row, batched by degree.
-    Rows of degree d < H are padded with their first candidate, constant rows get 0."""
-    mag = np.hypot(Xf[:, 1::2], Xf[:, 2::2])                        # (rows, H)
-    big = mag > 1e-12 * mag.max(axis=1, keepdims=True)
-    deg = np.where(big.any(axis=1), H - np.argmax(big[:, ::-1], axis=1), 0)
-    t_r = np.zeros((Xf.shape[0], 2 * H))
-    full = deg.min() == H                     # the usual case: one batch, no row picking
-    for d in ([H] if full else np.unique(deg[deg > 0])):
-        rows = slice(None) if full else np.flatnonzero(deg == d)
-        a, b = Xf[rows, 1:2 * d:2], Xf[rows, 2:2 * d + 1:2]
-        hh = np.arange(1, d + 1)
-        n = a.shape[0]
-        # z^d x'(t) = sum_h h/2 [(b_h + i a_h) z^(d+h) + (b_h - i a_h) z^(d-h)]
-        p = np.zeros((n, 2 * d + 1), complex)                        # p[k]: coeff of z^k
-        p[:, d + hh] = hh * (b + 1j * a) / 2
-        p[:, d - hh] = hh * (b - 1j * a) / 2
-        q = (p @ _tan_half_basis(d)).real                            # q[j]: coeff of u^j
-        # a vanishing u^(2d) coefficient is a root at t = pi (u infinite), which the
-        # equally spaced candidates hold: keep it from dividing by zero
-        top = np.abs(q).max(axis=1)
-        lead = np.where(np.abs(q[:, -1]) > 1e-13 * top, q[:, -1], 1e-13 * top + 1e-300)
-        comp = np.zeros((n, 2 * d, 2 * d))
-        comp[:, 0, :] = -q[:, 2 * d - 1::-1] / lead[:, None]
-        comp[:, np.arange(1, 2 * d), np.arange(2 * d - 1)] = 1.0
-        t = 2 * np.arctan(np.linalg.eigvals(comp).real)
-        t_r[rows] = np.concatenate([t, np.repeat(t[:, :1], 2 * (H - d), axis=1)], axis=1)
-    return t_r
-
-
 def amplitude_max(X: np.ndarray, return_time: bool = False):
     """max over one period of |x(t)| for real harmonic coefficients X (..., 2H+1).
 
     x(t) = a0 + sum_h a_h cos(h t) + b_h sin(h t) is a trigonometric polynomial of degree H:
-    its extrema are roots of x'(t), which times (1 + u^2)^H is a real polynomial of degree
-    2H in u = tan(t / 2). Its roots (companion-matrix eigenvalues, batched over every row
-    of X with the same effective degree) give candidate times t = 2 atan(u), also polished
-    by a Newton step on x'; |x| is evaluated there and at 2(2H+1) equally spaced times
-    (t = pi among them), and the largest value is kept. Every candidate is a real time, so
-    the result never exceeds the true maximum, and it equals it to round-off once a root is
-    found (complex roots only add harmless candidates).
+    its extrema are roots of x'(t), which times (1 + u^2)^d is a real polynomial of degree
+    2d in u = tan(t / 2) (d: the effective degree, the highest harmonic above round-off).
+    Its roots (companion-matrix eigenvalues) give candidate times t = 2 atan(u), also
+    polished by a Newton step on x'; |x| is evaluated there and at 2(2H+1) equally spaced
+    times (t = pi among them), and the largest value is kept. Every candidate is a real
+    time, so the result never exceeds the true maximum, and it equals it to round-off
+    (complex roots only add harmless candidates). The algorithm is the Fortran library's
+    (fortran/frirom_peak.f90), the one the C API and frirom_solve report.
 
     Parameters
     ----------
@@ -95,30 +55,24 @@ def amplitude_max(X: np.ndarray, return_time: bool = False):
     Returns
     -------
     amp : ndarray (...)
-        max_t |x(t)|, the unit of X.
+        max_t |x(t)|, the unit of X; NaN where X has a NaN or Inf.
     t : ndarray (...), only with return_time
         A time of the maximum, rad in [0, 2 pi) (phase of the fundamental).
     """
     X = np.asarray(X, dtype=float)
+    if X.ndim == 0 or X.shape[-1] % 2 != 1:
+        raise SizeError(f"amplitude_max: X must be (..., 2H+1) harmonics, got shape {X.shape}")
     lead, nc = X.shape[:-1], X.shape[-1]
-    H = (nc - 1) // 2
-    Xf = X.reshape(-1, nc)
-    ns = 2 * (2 * H + 1)
-    t = np.broadcast_to(2 * np.pi * np.arange(ns) / ns, (Xf.shape[0], ns))
-    if H > 0 and Xf.shape[0]:
-        t_r = _derivative_roots(Xf, H)
-        # a Newton step on x' polishes the roots (quadratic: from eigenvalue accuracy to
-        # round-off); the roots as found stay candidates too
-        _, d1, d2 = _series(Xf, t_r)
-        step = np.divide(d1, d2, out=np.zeros_like(d1), where=d2 != 0)
-        t = np.concatenate([t, t_r, t_r - np.clip(step, -0.5, 0.5)], axis=1)
-    v = np.abs(_series(Xf, t)[0])
-    k = np.argmax(v, axis=1)
-    r = np.arange(Xf.shape[0])
-    amp = v[r, k].reshape(lead)
-    if return_time:
-        return amp, np.mod(t[r, k], 2 * np.pi).reshape(lead)
-    return amp
+    Xf = np.ascontiguousarray(X.reshape(-1, nc))
+    if Xf.shape[0] == 0:
+        amp = t = np.zeros(lead)
+    else:
+        # a C-ordered (rows, 2H+1) array is the Fortran (2H+1, rows) one: no copy
+        amp, t, info, msg = _kernels.peak_amplitudes(Xf.T)
+        if info not in (0, _NONFINITE):            # a non-finite row: NaN, not an error
+            raise_for_status(info, msg.decode(errors="replace"))
+        amp, t = amp.reshape(lead), t.reshape(lead)
+    return (amp, t) if return_time else amp
 
 
 def harmonic_table(X: np.ndarray) -> tuple:
@@ -377,6 +331,7 @@ class FRF:
             f.attrs["message"] = self.message
             f.attrs["stability_computed"] = self.stability_computed
             f.attrs["solver_info"] = self.solver_info
+            _h5check.seal(f)
 
     def save_csv(self, path) -> None:
         """One row per point: frequency (Hz, rad/s), the load parameter of a load curve,
@@ -418,8 +373,10 @@ class FRF:
             missing = [n for n in cls._ARRAYS if n not in f]
             if missing:
                 raise InputError(f"{path}: not a frirom FRF file (missing {missing})")
+            _h5check.check_results(f, path)     # checksum, types, shapes, attributes
             n = _committed_rows(f, path)[0]    # rows beyond: a torn record
             kw = {k: f[k][...] if k == "output_dofs" else f[k][:n] for k in cls._ARRAYS}
+            _h5check.check_finite(kw, path)
             kw["stable"] = kw["stable"].astype(bool)
             kw["fold"] = kw["fold"].astype(bool)
             # files written before the contact history was kept have no slider
@@ -438,15 +395,18 @@ class FRF:
                                    f.attrs["peak_method"])]
             if "unknowns" in f and f["unknowns"].shape[0] == kw["omega"].shape[0]:
                 kw["unknowns"] = f["unknowns"][...]
-            kw["output_labels"] = [s.decode() for s in f.attrs.get("output_labels", [])]
-            kw["meta"] = {k: str(f.attrs[k]) for k in META_KEYS if k in f.attrs}
+            kw["output_labels"] = _h5check.attr_texts(f, path, "output_labels")
+            kw["meta"] = {k: _h5check.attr_text(f, path, k) for k in META_KEYS
+                          if k in f.attrs}
+            txt = functools.partial(_h5check.attr_text, f, path)
             return cls(**kw,
-                       group_names=[s.decode() for s in f.attrs.get("group_names", [])],
-                       parameter_name=str(f.attrs.get("parameter_name", "omega")),
-                       complete=bool(f.attrs.get("complete", True)),
-                       message=str(f.attrs.get("message", "")),
-                       stability_computed=bool(f.attrs.get("stability_computed", False)),
-                       solver_info=str(f.attrs.get("solver_info", "")))
+                       group_names=_h5check.attr_texts(f, path, "group_names"),
+                       parameter_name=txt("parameter_name", "omega"),
+                       complete=_h5check.attr_bool(f, path, "complete", True),
+                       message=txt("message", ""),
+                       stability_computed=_h5check.attr_bool(f, path, "stability_computed",
+                                                             False),
+                       solver_info=txt("solver_info", ""))
 
 
 #: File attribute of an FRFWriter file: [points committed, points up to the last
@@ -564,6 +524,7 @@ class FRFWriter:
             self.f.attrs[k] = v
         self.f.attrs["complete"] = False
         self.f.attrs["message"] = "running"
+        _h5check.unseal(self.f)         # sealed again by close()
         self._set_commit(*self._commit)
 
     def _rewind(self) -> None:
@@ -626,10 +587,13 @@ class FRFWriter:
 
     def close(self, complete: bool = True, message: str = "") -> None:
         if self.f:
-            self.f.attrs["complete"] = complete
-            self.f.attrs["message"] = message
-            self.f.close()
-            self.f = None
+            f, self.f = self.f, None
+            try:
+                f.attrs["complete"] = complete
+                f.attrs["message"] = message
+                _h5check.seal(f)
+            finally:
+                f.close()       # even when the disk refused the attributes
 
     def __enter__(self):
         return self
@@ -653,6 +617,7 @@ class FRFWriter:
         except OSError as exc:
             raise InputError(f"{path}: cannot open as HDF5 ({exc})") from None
         with f:
+            _h5check.check_results(f, path)
             n, nck, slot = _committed_rows(f, path)
             if slot < 0 and "last_unknowns" in f:       # a file from before checkpoints
                 state = {"parameter": float(f.attrs["last_parameter"]),

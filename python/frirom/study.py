@@ -36,9 +36,11 @@ from pathlib import Path
 import numpy as np
 
 from ._errors import InputError
+from ._h5check import DIGEST, seal
+from ._optional import require
 from ._resume import ResultsLock
 from .deck.schema import parse_deck, read_toml
-from .deck.schema_study import StudySettings, member_raw, parse_study
+from .deck.schema_study import StudySettings, check_address, member_raw, parse_study
 
 __all__ = ["Study", "load_study", "run_member", "run_study", "convergence_table",
            "smallest_within", "curve_distance"]
@@ -71,14 +73,27 @@ class Study:
         return self.settings.kind
 
 
-def load_study(path) -> Study:
+#: Most members a study may have without ``force`` (``--force``): each member is a
+#: folder, a results file and a task; a study above it is most likely a typo (a product
+#: of long lists) and would spend minutes checking members before anything runs.
+MAX_MEMBERS = 10_000
+
+
+def load_study(path, force: bool = False) -> Study:
     """Read a deck's ``[study]`` and check every member's deck (parse only, no matrices);
-    an error names the member and its values."""
+    an error names the member and its values. A study of more than MAX_MEMBERS members is
+    refused unless ``force``."""
     path = Path(path)
     raw = read_toml(path)
     st = parse_study(path, raw, read_toml)
     if st is None:
         raise InputError(f"{path}: no [study] table (see docs/deck.md, 'Studies')")
+    n = st.size()
+    if n > MAX_MEMBERS and not force:
+        raise InputError(f"{path}: study.parameters: {n} members ("
+                         + " x ".join(str(len(v)) for _, v in st.parameters)
+                         + f"), more than the {MAX_MEMBERS} a study may have without "
+                         "--force (frirom.study.MAX_MEMBERS)")
     deck = path
     if st.base is not None:
         deck, raw = st.base, read_toml(st.base)
@@ -264,6 +279,7 @@ def _write_peaks(h5, peaks) -> None:
         f.create_dataset("peak_amplitude", data=[p.amplitude for p in peaks])
         f.create_dataset("peak_index", data=[p.index for p in peaks])
         f.attrs["peak_method"] = np.array([p.method for p in peaks], dtype="S")
+        seal(f)
 
 
 def _label(values: dict) -> str:
@@ -271,20 +287,103 @@ def _label(values: dict) -> str:
 
 
 # ---- running ---------------------------------------------------------------------------
+#: Environment variable naming the Dask scheduler a study connects to (as --scheduler).
+SCHEDULER_ENV = "FRIROM_SCHEDULER"
+#: Seconds to reach a Dask scheduler (the TCP connection, its first message, the client's
+#: handshake) before the study is refused.
+CONNECT_TIMEOUT = 10.0
+#: Largest first message [bytes] a scheduler may send: a Dask handshake is a few hundred
+#: bytes; anything else answering on that port is refused before the client reads it (an
+#: HTTP or SSH server's first bytes read as a length would ask for exbibytes).
+PROBE_MAX_BYTES = 1 << 26
+#: Most LocalCluster workers a study may ask for.
+MAX_WORKERS = 1024
+def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
+    """Check that a Dask scheduler answers at a tcp:// ``address`` before a Client is
+    made: it must accept the connection and send the length of a handshake-sized first
+    message within ``timeout`` s. InputError naming the address otherwise (nothing
+    listens, nothing is said, or a length no handshake has)."""
+    import socket
+    import struct
+    proto, host, port = check_address(address)
+    if proto != "tcp":
+        return              # TLS: the handshake itself checks the certificates
+    try:
+        with socket.create_connection((host, port), timeout=timeout) as sock:
+            sock.settimeout(timeout)
+            head = b""
+            while len(head) < 8:
+                part = sock.recv(8 - len(head))
+                if not part:
+                    raise InputError(f"scheduler {address}: closed the connection without "
+                                     "a Dask handshake: not a Dask scheduler")
+                head += part
+    except socket.timeout:
+        raise InputError(f"scheduler {address}: no Dask handshake within {timeout:g} s "
+                         "(not a Dask scheduler, or unreachable)") from None
+    except OSError as exc:
+        raise InputError(f"scheduler {address}: cannot connect ({exc})") from None
+    (n,) = struct.unpack("<Q", head)
+    if n > PROBE_MAX_BYTES:
+        raise InputError(f"scheduler {address}: its first message announces {n} bytes, "
+                         "no Dask handshake does: not a Dask scheduler (refused before "
+                         "reading it)")
+
+
+def check_workers(workers) -> int | None:
+    """The LocalCluster worker count (None: one per core), checked."""
+    if workers is None:
+        return None
+    from ._errors import check_integer
+    return check_integer("--workers (study.workers)", workers, minimum=1,
+                         maximum=MAX_WORKERS, cls=InputError)
+
+
+def _security(proto: str, tls: dict | None):
+    """distributed.Security of a connection: the certificate files given (``tls``: ca,
+    cert, key) or, without them, Dask's own configuration (distributed.comm.tls.*);
+    None for tcp:// without certificates."""
+    from distributed.security import Security
+    tls = {k: v for k, v in (tls or {}).items() if v is not None}
+    for k, v in tls.items():
+        if not Path(v).is_file():
+            raise InputError(f"--tls-{k} {v}: no such file")
+    if tls and proto != "tls":
+        raise InputError("TLS certificates are given but the scheduler address is not "
+                         "tls://HOST:PORT: a tcp:// connection would not use them")
+    if tls:
+        return Security(tls_ca_file=tls.get("ca"), tls_client_cert=tls.get("cert"),
+                        tls_client_key=tls.get("key"), require_encryption=True)
+    sec = Security()            # from Dask's configuration, if any
+    if proto == "tls" and not sec.tls_ca_file:
+        raise InputError("a tls:// scheduler needs certificates: give --tls-ca (and "
+                         "--tls-cert, --tls-key) or set distributed.comm.tls.ca-file "
+                         "(and .client.cert, .client.key) in Dask's configuration")
+    return sec if proto == "tls" or sec.require_encryption else None
+
+
+class Failed:
+    """A task that raised: ``message`` is its exception's class and text."""
+
+    def __init__(self, exc: BaseException):
+        self.message = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+
+
 class _Runner:
     """Where tasks run: this process, a LocalCluster made here, or a named scheduler."""
 
-    def __init__(self, scheduler: str, workers: int | None):
+    def __init__(self, scheduler: str, workers: int | None, tls: dict | None = None):
         self.client = self.cluster = None
         self.scheduler = scheduler
         if scheduler == "serial":
             return
-        try:
-            from distributed import Client, LocalCluster
-        except ModuleNotFoundError:
-            raise InputError("study.scheduler: running on Dask needs the 'distributed' "
-                             "package (pip install distributed), or scheduler = "
-                             "\"serial\"") from None
+        workers = check_workers(workers)
+        if scheduler != "local":
+            proto = check_address(scheduler)[0]
+        distributed = require("distributed", "study",
+                              "study.scheduler: running members as Dask tasks (or "
+                              "scheduler = \"serial\")")
+        Client, LocalCluster = distributed.Client, distributed.LocalCluster
         if scheduler == "local":
             n = workers or os.cpu_count() or 1
             env = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
@@ -293,11 +392,13 @@ class _Runner:
                                         dashboard_address=None, env=env)
             self.client = Client(self.cluster)
         else:
+            sec = _security(proto, tls)
+            probe_scheduler(scheduler)
             try:
-                self.client = Client(scheduler, timeout=30)
-            except OSError as exc:
-                raise InputError(f"study.scheduler: cannot reach the Dask scheduler "
-                                 f"{scheduler!r} ({exc})") from None
+                self.client = Client(scheduler, timeout=CONNECT_TIMEOUT, security=sec)
+            except (OSError, TimeoutError) as exc:
+                raise InputError(f"scheduler {scheduler}: cannot reach the Dask scheduler "
+                                 f"({type(exc).__name__}: {exc})") from None
 
     @property
     def n_workers(self) -> int:
@@ -305,17 +406,24 @@ class _Runner:
             return 1
         return max(len(self.client.scheduler_info().get("workers", {})), 1)
 
-    def map(self, fn, jobs: list, on_done=None, poll=None) -> list:
+    def map(self, fn, jobs: list, on_done=None, poll=None, keep_going: bool = False) -> list:
         """fn(*args) for each args tuple of ``jobs``, results in order; ``on_done(i, r)``
-        as each finishes, ``poll()`` about twice a second while waiting."""
+        as each finishes, ``poll()`` about twice a second while waiting. With
+        ``keep_going`` a task that raises gives a :class:`Failed` in its place and the
+        others run on; without, its exception is raised."""
         out = [None] * len(jobs)
         if self.client is None:
             for i, args in enumerate(jobs):
-                out[i] = fn(*args)
+                try:
+                    out[i] = fn(*args)
+                except Exception as exc:
+                    if not keep_going:
+                        raise
+                    out[i] = Failed(exc)
                 if on_done:
                     on_done(i, out[i])
             return out
-        from distributed import wait
+        wait = require("distributed", "study", "a Dask study").wait
         futures = {self.client.submit(fn, *args, pure=False): i
                    for i, args in enumerate(jobs)}
         pending = set(futures)
@@ -326,7 +434,12 @@ class _Runner:
                 done = set()
             for f in done:
                 i = futures[f]
-                out[i] = f.result()         # a task's exception is raised here
+                try:
+                    out[i] = f.result()         # a task's exception is raised here
+                except Exception as exc:        # the member's error, or its lost worker
+                    if not keep_going:
+                        raise
+                    out[i] = Failed(exc)
                 if on_done:
                     on_done(i, out[i])
             if poll:
@@ -340,18 +453,48 @@ class _Runner:
             self.cluster.close()
 
 
+def choose_scheduler(settings: StudySettings, given: str | None, trust_deck: bool = False,
+                     path="the deck") -> str:
+    """The scheduler a study runs on: ``given`` (the command line or the caller), else the
+    environment's FRIROM_SCHEDULER, else the deck's ``study.scheduler`` when it is
+    ``"local"`` or ``"serial"``. A deck's own address is used only with ``trust_deck``
+    (``--trust-deck-scheduler``): a Dask scheduler can run any code in the process that
+    connects to it (docs/security.md), so which one is the user's choice, not a deck's."""
+    sched = given or os.environ.get(SCHEDULER_ENV) or None
+    if sched is None:
+        sched = settings.scheduler
+        if sched not in ("local", "serial") and not trust_deck:
+            raise InputError(f"{path}: study.scheduler = {sched!r}: frirom connects only to a "
+                             "Dask scheduler you name (a scheduler can run any code in the "
+                             "process that connects to it, see docs/security.md): give "
+                             f"--scheduler {sched} or set {SCHEDULER_ENV}, or "
+                             "--trust-deck-scheduler to use the deck's")
+    if sched not in ("local", "serial"):
+        check_address(sched)
+    return sched
+
+
 def run_study(deck_path, out=None, scheduler: str | None = None, workers: int | None = None,
-              quiet: bool = False, log=print) -> dict:
+              quiet: bool = False, log=print, trust_deck_scheduler: bool = False,
+              tls: dict | None = None, force: bool = False) -> dict:
     """Run (or continue) the study of a deck into ``out`` and write its file and plots.
 
     Parameters
     ----------
     deck_path : path of a deck with a ``[study]`` table.
     out : folder, default ``results/<deck name>``.
-    scheduler : ``"local"``, ``"serial"`` or a Dask scheduler address; default the
-        deck's ``study.scheduler``.
+    scheduler : ``"local"``, ``"serial"`` or a Dask scheduler address; default
+        FRIROM_SCHEDULER, else the deck's ``study.scheduler`` (an address from the deck
+        only with ``trust_deck_scheduler``: :func:`choose_scheduler`).
     workers : LocalCluster workers; default the deck's ``study.workers`` or one per core.
     quiet : no progress bar. log : callable(str) for the lines printed.
+    tls : {'ca', 'cert', 'key'} certificate files of a tls:// scheduler (default: Dask's
+        configuration, distributed.comm.tls.*).
+    force : run a study of more than MAX_MEMBERS members.
+
+    A member that fails (its deck, its solve, its worker lost) is recorded with its
+    message (:func:`failed_summary`, ``summary['failed']``) and named in the log; the
+    other members run and are kept. One study at a time writes a folder.
 
     Returns
     -------
@@ -362,17 +505,32 @@ def run_study(deck_path, out=None, scheduler: str | None = None, workers: int | 
     """
     deck_path = Path(deck_path)
     out = Path(out) if out is not None else Path("results") / deck_path.stem
-    out.mkdir(parents=True, exist_ok=True)
-    study = load_study(deck_path)
+    study = load_study(deck_path, force=force)
     st = study.settings
-    sched = scheduler or st.scheduler
+    sched = choose_scheduler(st, scheduler, trust_deck_scheduler, deck_path)
+    check_workers(workers)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out}: is a file; expected a folder for the study")
+    out.mkdir(parents=True, exist_ok=True)
+    lock = ResultsLock(out)         # one study per folder: a second is refused at once
+    try:
+        return _run_study_locked(study, out, sched, workers, quiet, log, tls)
+    finally:
+        lock.release()
+
+
+def _run_study_locked(study: Study, out: Path, sched: str, workers, quiet, log, tls) -> dict:
+    """run_study once the study's folder is locked."""
+    st = study.settings
+    log(f"size: {len(study.members)} members, at most {_max_points(study.raw)} points each "
+        f"(continuation.max_points); the limit without --force is {MAX_MEMBERS} members")
     n_done = sum((out / "members" / m["name"] / "member.json").is_file()
                  for m in study.members)
     log(f"{st.kind} study of {len(study.members)} members over "
         + ", ".join(f"{k} ({len(v)} values)" for k, v in st.parameters)
         + f" ({st.combine}); {n_done} already finished in {out}")
     t0 = time.perf_counter()
-    runner = _Runner(sched, workers or st.workers)
+    runner = _Runner(sched, workers or st.workers, tls)
     try:
         log(f"running on {sched}" + (f" ({runner.n_workers} workers)"
                                      if runner.client is not None else ""))
@@ -390,6 +548,14 @@ def run_study(deck_path, out=None, scheduler: str | None = None, workers: int | 
     return res
 
 
+def _max_points(raw: dict) -> int:
+    """The deck's continuation.max_points (the solver's default without one)."""
+    from .solver import SolverOptions
+    c = raw.get("continuation", {})
+    v = c.get("max_points") if isinstance(c, dict) else None
+    return int(v) if isinstance(v, int) else int(SolverOptions.max_points)
+
+
 def _prepare(study: Study, out: Path, runner: _Runner, log) -> dict:
     """Build each distinct reduced model once (tasks) before the members read them."""
     if "fe_model" not in study.raw and "reduction" not in study.raw:
@@ -401,10 +567,14 @@ def _prepare(study: Study, out: Path, runner: _Runner, log) -> dict:
             todo.append((m, m["rom"]))
     if not todo:
         return {}
-    res = runner.map(prepare_member, [(str(study.deck), m["values"]) for m, _ in todo])
-    built = sum(not r["reused"] for r in res)
-    log(f"{len(todo)} reduced model(s): {built} built, {len(todo) - built} reused")
-    return {c: r["seconds"] for (_, c), r in zip(todo, res)}
+    res = runner.map(prepare_member, [(str(study.deck), m["values"]) for m, _ in todo],
+                     keep_going=True)
+    ok = [(c, r) for (_, c), r in zip(todo, res) if not isinstance(r, Failed)]
+    built = sum(not r["reused"] for _, r in ok)
+    log(f"{len(todo)} reduced model(s): {built} built, {len(ok) - built} reused"
+        + (f", {len(todo) - len(ok)} failed (their members fail)" if len(ok) < len(todo)
+           else ""))
+    return {c: r["seconds"] for c, r in ok}
 
 
 def _run_members(study: Study, out: Path, runner: _Runner, quiet: bool) -> list:
@@ -429,9 +599,42 @@ def _run_members(study: Study, out: Path, runner: _Runner, quiet: bool) -> list:
     jobs = [(str(study.deck), m["values"], str(f), runner.client is not None)
             for m, f in zip(study.members, folders)]
     try:
-        return runner.map(run_member, jobs, on_done, poll)
+        res = runner.map(run_member, jobs, on_done, poll, keep_going=True)
     finally:
         bar.close()
+    n_out = _n_outputs(study)
+    return [failed_summary(m, f, r.message, n_out) if isinstance(r, Failed) else r
+            for m, f, r in zip(study.members, folders, res)]
+
+
+def _n_outputs(study: Study) -> int:
+    out = study.raw.get("outputs", {})
+    dofs = out.get("dofs", []) if isinstance(out, dict) else []
+    return max(len(dofs) if isinstance(dofs, list) else 1, study.settings.output + 1)
+
+
+def failed_summary(member: dict, folder: Path, message: str, n_out: int) -> dict:
+    """The summary of a member whose task raised (see :func:`run_member` for the keys):
+    ``failed`` True, ``message`` the error, the points its file kept; also written to
+    ``folder/failed.json`` (a study run again retries the member)."""
+    points = 0
+    try:
+        from .results import FRF
+        points = len(FRF.load(folder / "frf.h5"))
+    except (InputError, OSError):
+        pass
+    nan = float("nan")
+    s = {"failed": True, "message": message, "complete": False, "points": points,
+         "seconds": 0.0, "cpu_seconds": 0.0, "pid": 0, "started": nan, "ended": nan,
+         "resumed": False, "peaks": [[nan, nan] for _ in range(n_out)], "fold": False,
+         "n_dof": 0, "n_nl": 0, "harmonics": 0, "unknowns": 0, "rom_seconds": 0.0,
+         "memory_mb": 0.0, "rss_mb": 0.0, "values": dict(member["values"])}
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "failed.json").write_text(json.dumps(s, indent=1, default=float))
+    except OSError:
+        pass
+    return s
 
 
 def write_study_file(study: Study, out: Path, summaries: list) -> Path:
@@ -448,12 +651,17 @@ def write_study_file(study: Study, out: Path, summaries: list) -> Path:
                                             study.settings.parameters])
         g = f.create_group("members")
         for m, s in zip(study.members, summaries):
-            with h5py.File(out / "members" / m["name"] / "frf.h5", "r") as src:
-                dst = g.create_group(m["name"])
-                for k in src:
-                    src.copy(src[k], dst, name=k)
-                for k, v in src.attrs.items():
-                    dst.attrs[k] = v
+            dst = g.create_group(m["name"])
+            src_path = out / "members" / m["name"] / "frf.h5"
+            if s.get("failed"):
+                dst.attrs["failed"] = s["message"]
+            else:
+                with h5py.File(src_path, "r") as src:
+                    for k in src:
+                        src.copy(src[k], dst, name=k)
+                    for k, v in src.attrs.items():
+                        if k != DIGEST:         # the member file's own checksum
+                            dst.attrs[k] = v
             dst.attrs["values"] = json.dumps(m["values"])
             for k, v in m["values"].items():
                 if isinstance(v, (int, float, str, bool)):
@@ -469,15 +677,25 @@ def _report(study: Study, out: Path, summaries: list, log) -> dict:
     deck = study.raw
     unit = str(deck.get("frequency", {}).get("unit", "hz")).lower()
     j = study.settings.output
-    frfs = [FRF.load(out / "members" / m["name"] / "frf.h5") for m in study.members]
+    frfs = [_member_frf(out / "members" / m["name"] / "frf.h5", s)
+            for m, s in zip(study.members, summaries)]
     res, figs = {}, {}
     for m, s in zip(study.members, summaries):
+        if s.get("failed"):
+            log(f"{m['name']}: {_label(m['values'])}: FAILED: {s['message']}")
+            continue
         w, a = s["peaks"][j]
         f = w / (2 * np.pi) if unit == "hz" else w
         flag = "" if s["complete"] else f"  (stopped: {s['message']})"
         log(f"{m['name']}: {_label(m['values'])}: peak {a:.6g} at {f:.6g} "
             f"{'Hz' if unit == 'hz' else 'rad/s'}, {s['points']} points, "
             f"{s['seconds']:.1f} s{flag}")
+    bad = [(m, s) for m, s in zip(study.members, summaries) if s.get("failed")]
+    if bad:
+        log(f"{len(bad)} of {len(summaries)} members failed (the others ran and are kept; "
+            "running the study again retries them): "
+            + "; ".join(f"{m['name']} ({_label(m['values'])}): {s['message']}"
+                        for m, s in bad))
     if study.kind == "family":
         figs["family.png"] = study_plots.plot_family(study, frfs, summaries, unit=unit,
                                                      linear=_linear(study),
@@ -500,6 +718,23 @@ def _report(study: Study, out: Path, summaries: list, log) -> dict:
     log(f"wrote {out / 'study.h5'}, " + ", ".join(str(p) for p in paths))
     res["figures"] = paths
     return res
+
+
+def _member_frf(h5: Path, summary: dict):
+    """A member's FRF for the report: its file, or no point for a failed member whose
+    file is missing or unreadable."""
+    from .results import FRF
+    try:
+        return FRF.load(h5)
+    except (InputError, OSError):
+        if not summary.get("failed"):
+            raise
+    n = len(summary["peaks"])
+    z = np.zeros(0)
+    return FRF(omega=z, X=np.zeros((0, n, 1)), amp_max=np.zeros((0, n)),
+               state_fractions=np.zeros((0, 0, 3)), stable=z.astype(bool),
+               fold=z.astype(bool), iterations=z.astype(int), time_s=z, complete=False,
+               message=summary["message"])
 
 
 def _load_key(study: Study):
@@ -576,13 +811,15 @@ def convergence_table(study: Study, frfs: list, summaries: list) -> list:
                "n_nl": s["n_nl"], "unknowns": s["unknowns"], "points": s["points"],
                "err_amp": abs(a - ar) / ar, "err_freq": abs(w - wr) / wr,
                "distance": (curve_distance(np.c_[fr.omega, fr.amp_max[:, j]], cref)
-                            if len(fr) else float("inf")),
+                            if len(fr) and len(cref) else float("inf")),
                "rom_s": s["rom_seconds"], "frf_s": s["seconds"],
                "memory_mb": s["memory_mb"], "reference": i == len(summaries) - 1,
                "complete": s["complete"], "notes": []}
         row["cost_s"] = row["rom_s"] + row["frf_s"]
         row["error"] = max(row["err_amp"], row["err_freq"], row["distance"])
-        if not s["complete"]:
+        if s.get("failed"):
+            row["notes"].append(f"failed: {s['message']}")
+        elif not s["complete"]:
             row["notes"].append(f"curve stopped: {s['message']}")
         if s["fold"] and not ref["fold"]:
             row["notes"].append("fold not in the reference")

@@ -621,4 +621,9 @@ def beside_named_cache(settings: DeckSettings, base: DeckSettings) -> DeckSettin
 
 def build_deck(settings: DeckSettings) -> Deck:
     """The matrices, contacts, loads and outputs of checked settings, as a :class:`Deck`."""
-    return _Builder(settings).run()
+    from ..io._common import QUOTE_UNDER
+    token = QUOTE_UNDER.set(Path(settings.path).parent)     # no quotes of other files
+    try:
+        return _Builder(settings).run()
+    finally:
+        QUOTE_UNDER.reset(token)

@@ -22,6 +22,19 @@ KINDS = ("family", "convergence")
 #: GSI counts climbed by ``free``/``stick = "auto"`` (those up to max_modes, then max_modes)
 GSI_LADDER = (5, 10, 20, 30, 40, 60, 80, 120, 160, 240, 320)
 _PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)$")
+_ADDRESS = re.compile(r"(tcp|tls)://(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9](?:[A-Za-z0-9.-]*"
+                      r"[A-Za-z0-9])?):(\d{1,5})/?")
+
+
+def check_address(address) -> tuple:
+    """(protocol, host, port) of a Dask scheduler address ``tcp://HOST:PORT`` or
+    ``tls://HOST:PORT``; InputError for anything else."""
+    m = _ADDRESS.fullmatch(str(address)) if isinstance(address, str) else None
+    if m is None or not 0 < int(m.group(3)) < 65536:
+        raise InputError(f"scheduler {address!r}: expected \"local\", \"serial\" or a Dask "
+                         "scheduler address tcp://HOST:PORT or tls://HOST:PORT (port "
+                         "1..65535)")
+    return m.group(1), m.group(2).strip("[]"), int(m.group(3))
 
 
 @dataclass(frozen=True)
@@ -59,6 +72,12 @@ class StudySettings:
     output: int = 0
     tolerance: float = 0.01
     base: Path | None = None
+
+    def size(self) -> int:
+        """How many members, without making them."""
+        import math
+        lens = [len(v) for _, v in self.parameters]
+        return math.prod(lens) if self.combine == "product" else min(lens, default=0)
 
     def members(self) -> list:
         """One dict {key path: value} per member, in run order."""
@@ -242,7 +261,14 @@ def parse_study(path, raw: dict, read=None) -> StudySettings | None:
         raise ctx.error("study.parameters", "lists of one length with combine = \"zip\"",
                         {k: len(v) for k, v in params})
     sched = string(ctx, st, "scheduler", "study.scheduler", default="local")
-    workers = number(ctx, st, "workers", "study.workers", integer=True, minimum=1)
+    if sched not in ("local", "serial"):
+        try:
+            check_address(sched)
+        except InputError as exc:
+            raise ctx.error("study.scheduler", str(exc).split(": expected ", 1)[1],
+                            sched) from None
+    workers = number(ctx, st, "workers", "study.workers", integer=True, minimum=1,
+                     maximum=1024)
     outputs = raw.get("outputs", {}).get("dofs", []) if isinstance(raw.get("outputs"),
                                                                    dict) else []
     output = number(ctx, st, "output", "study.output", default=0, integer=True, minimum=0)
@@ -252,6 +278,6 @@ def parse_study(path, raw: dict, read=None) -> StudySettings | None:
     tol = number(ctx, st, "tolerance", "study.tolerance", default=0.01, positive=True)
     s = StudySettings(kind=kind, parameters=tuple(params), combine=combine, scheduler=sched,
                       workers=workers, output=output, tolerance=float(tol), base=base)
-    if kind == "convergence" and len(s.members()) < 2:
+    if kind == "convergence" and s.size() < 2:
         raise ctx.error("study.parameters", "at least two rungs for a convergence study")
     return s

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import contextvars
 import os
+from pathlib import Path
 import warnings
 from dataclasses import dataclass, field
 
@@ -145,14 +147,31 @@ def check_matrices(K, M, where) -> None:
                          f"{K.shape}, got {M.shape}")
 
 
+#: The folder whose files' content an error may quote (a deck's folder while the deck
+#: is built: deck.build.build_deck); None: any file. A deck may name any readable file,
+#: and an error must not print a line of one outside its folder (docs/security.md).
+QUOTE_UNDER: contextvars.ContextVar = contextvars.ContextVar("quote_under", default=None)
+
+
 def fail(path, line, expected: str, got: str | None = None):
-    """Raise InputError naming the file, the 1-based line and what was expected."""
+    """Raise InputError naming the file, the 1-based line and what was expected, quoting
+    what was found when the file lies under QUOTE_UNDER (or that is unset)."""
     where = f"{os.fspath(path)}" + (f", line {line}" if line else "")
     msg = f"{where}: expected {expected}"
-    if got is not None:
+    root = QUOTE_UNDER.get()
+    if got is not None and root is not None and not _under(path, root):
+        msg += " (its content is not shown: the file is outside the deck's folder)"
+    elif got is not None:
         got = got.strip()
         msg += f", got {got[:80]!r}"
     raise InputError(msg)
+
+
+def _under(path, root) -> bool:
+    try:
+        return Path(os.path.realpath(path)).is_relative_to(os.path.realpath(root))
+    except (OSError, ValueError):
+        return False
 
 
 def read_text(path) -> str:

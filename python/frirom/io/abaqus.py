@@ -54,10 +54,17 @@ def _read_entries(path, fmt):
 def read_abaqus(stiffness, mass=None, fmt: str = "auto", dofs=None, inp=None) -> FEModel:
     """FEModel from Abaqus ``*MATRIX OUTPUT`` files.
 
-    fmt : "auto", "matrix input" or "coordinate".
-    dofs : (n_dof, 2) map for COORDINATE files (ignored for MATRIX INPUT, which labels
-        every entry itself).
-    inp : Abaqus deck for node coordinates and node sets.
+    Parameters
+    ----------
+    stiffness, mass : path
+        The stiffness and (optional) mass matrix files.
+    fmt : {"auto", "matrix input", "coordinate"}
+        The files' format.
+    dofs : (n_dof, 2) array_like of int, optional
+        DoF map for COORDINATE files (ignored for MATRIX INPUT, which labels every entry
+        itself).
+    inp : path, optional
+        Abaqus deck for node coordinates and node sets.
     """
     files = [stiffness] + ([mass] if mass is not None else [])
     parsed = [_read_entries(f, fmt) for f in files]

@@ -102,16 +102,29 @@ def craig_bampton(model, n_modes: int, interface=None, active=None, directions=(
                   ncv: int = 0, solver: str = "frirom") -> CraigBampton:
     """Craig-Bampton reduction of an FEModel (frirom.io) or of (K, M).
 
-    model : frirom.io.FEModel (K, M, dofs, node_sets), or a tuple (K, M).
-    n_modes : fixed-interface normal modes kept (0 = Guyan reduction).
-    interface, active : node-set name(s) whose DoFs in ``directions`` become masters.
-    masters : extra master rows (indices into the full matrices).
-    sigma : shift of the fixed-interface eigen-solve [rad^2/s^2]; 0 unless K_ss is
-        singular (then the constraint modes do not exist either: add masters).
-    tol, ncv : ARPACK tolerance and Lanczos basis size (0 = defaults).
-    solver : "frirom" (Fortran: ARPACK + MUMPS, the default) or "scipy" (eigsh on one
-        SuperLU factor of K_ss, reused for the constraint modes, same Lanczos basis size;
+    Parameters
+    ----------
+    model : frirom.io.FEModel or tuple
+        An FEModel (K, M, dofs, node_sets), or a tuple (K, M).
+    n_modes : int
+        Fixed-interface normal modes kept (0 = Guyan reduction).
+    interface, active : str or list of str, optional
+        Node-set name(s) whose DoFs in ``directions`` become masters.
+    masters : array_like of int, optional
+        Extra master rows (indices into the full matrices).
+    sigma : float
+        Shift of the fixed-interface eigen-solve [rad^2/s^2]; 0 unless K_ss is singular
+        (then the constraint modes do not exist either: add masters).
+    tol, ncv : float, int
+        ARPACK tolerance and Lanczos basis size (0 = defaults).
+    solver : {"frirom", "scipy"}
+        "frirom" (Fortran: ARPACK + MUMPS, the default) or "scipy" (eigsh on one SuperLU
+        factor of K_ss, reused for the constraint modes, same Lanczos basis size;
         reference and fallback).
+
+    Returns
+    -------
+    CraigBampton
     """
     if isinstance(model, tuple):
         K, M = model

@@ -3,17 +3,18 @@
 Modal: with the mass-normalised modes Phi of (K, M) and their circular frequencies omega,
 C = M Phi diag(2 zeta omega) Phi^H M, so that mode j has damping ratio zeta_j exactly and
 the modes stay uncoupled (the paper's choice for the assembled ROM, after Eq. 16). Modes
-beyond the ratios given get none. Rayleigh: C = alpha M + beta K, with
+beyond the ratios given get none. The kernel is the Fortran library's
+(fortran/frirom_damping.fypp), the one frirom_solve uses for C and legacy callers. Rayleigh: C = alpha M + beta K, with
 :func:`rayleigh_coefficients` fitting two (frequency, ratio) pairs.
 """
 
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 
-from .._errors import InputError, NumericalError, SizeError
+from .. import _kernels
+from .._errors import CODES, InputError, NumericalError, SizeError, raise_for_status
 
 __all__ = ["modal_damping", "rayleigh_coefficients", "rayleigh_damping"]
 
@@ -45,17 +46,20 @@ def modal_damping(K, M, zeta, n_modes: int | None = None):
         z = np.full(n_modes, z[0])
     elif z.size != n_modes:
         raise SizeError(f"modal_damping: {z.size} ratios for {n_modes} modes")
-    try:
-        lam, phi = sla.eigh(Kd, Md, subset_by_index=[0, n_modes - 1])
-    except (np.linalg.LinAlgError, ValueError) as exc:
-        raise NumericalError(f"modal_damping: eigen-solve of (K, M) failed ({exc}); is M "
-                             "positive definite?") from exc
-    if lam.min() < -1e-8 * max(abs(lam).max(), 1.0):
-        raise NumericalError(f"modal_damping: K has a negative eigenvalue {lam.min():.3e}")
-    omega = np.sqrt(np.maximum(lam, 0.0))
-    mp = Md @ phi
-    C = (mp * (2.0 * z * omega)) @ mp.conj().T
-    return 0.5 * (C + C.conj().T), omega
+    # the kernel reads the lower triangles (as scipy's eigh does by default)
+    herm = np.iscomplexobj(Kd) or np.iscomplexobj(Md)
+    dtype = complex if herm else float
+    kernel = _kernels.modal_damping_hermitian if herm else _kernels.modal_damping
+    C, omega, info, msg = kernel(np.asfortranarray(Kd, dtype=dtype),
+                                 np.asfortranarray(Md, dtype=dtype), z)
+    if info != 0:
+        text = msg.decode(errors="replace").strip()
+        if info in (CODES["FRIROM_ERR_SIZE"], CODES["FRIROM_ERR_NONFINITE"],
+                    CODES["FRIROM_ERR_PARAM"]):
+            raise_for_status(info, text)
+        # M not positive definite, K with a negative eigenvalue, a failed eigen-solve
+        raise NumericalError(text, code=int(info))
+    return C, omega
 
 
 def rayleigh_coefficients(f1: float, zeta1: float, f2: float, zeta2: float):

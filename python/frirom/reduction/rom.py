@@ -27,6 +27,7 @@ import hashlib
 import json
 import os
 import time
+import warnings
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -38,6 +39,7 @@ from scipy.spatial import cKDTree
 
 from .. import io as fio
 from .._errors import InputError
+from .._h5check import seal, verify
 from ..io import DIRECTION_NAMES
 from .cb import craig_bampton
 from .cyclic import axis_rotation
@@ -377,15 +379,27 @@ class ReducedModel:
                     g.create_dataset(k, data=getattr(p, k))
                 if name in self.b_rotation:
                     g.create_dataset("b_rotation", data=self.b_rotation[name])
+            seal(h)         # the content checksum, checked by load
 
     @classmethod
-    def load(cls, path, fingerprint: str):
-        """The cached model, or None if absent, unreadable or built from other inputs."""
+    def load(cls, path, fingerprint: str, why: list | None = None):
+        """The cached model, or None if absent, unreadable, built from other inputs, or
+        not as it was written: its content checksum (frirom._h5check) differs or is
+        missing, or it holds a non-finite number. ``why`` (a list) gets the reason an
+        existing entry is not used."""
+        def no(reason):
+            if why is not None:
+                why.append(reason)
+            return None
+        if not Path(path).is_file():
+            return None
         try:
             with h5py.File(path, "r") as h:
                 if (h.attrs.get("fingerprint") != fingerprint
                         or h.attrs.get("version") != CACHE_VERSION):
-                    return None
+                    return None         # other inputs: rebuilt as usual, no warning
+                if not verify(h, path):
+                    return no("it has no content checksum")
                 pairs, rot = {}, {}
                 for name in h.get("pairs", {}):
                     g = h[f"pairs/{name}"]
@@ -395,14 +409,19 @@ class ReducedModel:
                         rot[name] = g["b_rotation"][()]
                 sets = {k: v[()] for k, v in h.get("node_sets", {}).items()}
                 K, M, T = (_read_matrix(h[k]) for k in ("K", "M", "T"))
+                for k, a in (("K", K), ("M", M), ("T", T)):
+                    if not np.all(np.isfinite(a.data if sp.issparse(a) else a)):
+                        return no(f"its {k} holds a non-finite number")
                 return cls(K=K, M=M, T=T,
                            labels=[s.decode() for s in h["labels"][()]], pairs=pairs,
                            fe_dofs=h["fe_dofs"][()], node_sets=sets, from_cache=True,
                            build_seconds=float(h.attrs.get("build_seconds", 0.0)),
                            node_ids=h["node_ids"][()], node_xyz=h["node_xyz"][()],
                            b_rotation=rot, fingerprint=fingerprint)
-        except (OSError, KeyError):
-            return None
+        except InputError as exc:
+            return no(str(exc).split(": ", 1)[-1])
+        except (OSError, KeyError, ValueError, TypeError, AttributeError) as exc:
+            return no(f"unreadable ({type(exc).__name__}: {exc})")
 
 
 def _label(model, i):
@@ -488,12 +507,19 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
     where = f"{deck_path}: "
     fp = rom_key(source, spec, list(pairs))
     cache = cache_file(source, spec, fp)
-    cached = ReducedModel.load(cache, fp)
+    why = []
+    cached = ReducedModel.load(cache, fp, why)
     if cached is not None:
         if log:
             log(f"reduced model reused from {cache} ({cached.K.shape[0]} coordinates; "
                 f"built in {cached.build_seconds:.1f} s, not recomputed)")
         return cached
+    if why:
+        msg = f"reduced model cache {cache} not used ({why[0]}): building it again"
+        if log:
+            log(msg)
+        else:
+            warnings.warn(msg, RuntimeWarning, stacklevel=2)
 
     t0 = time.perf_counter()
     model = read_fe_model(source)
