@@ -268,3 +268,47 @@ def hooks_peak(rom, f0):
         res, _ = rom.frf()
     assert res.complete
     return ph._peak(res), res
+
+
+# ---- the bundled joint (cases/joint), coarse: the study and trust tests' deck ---------
+
+_COARSE_JOINT = """title = "joint, coarse"
+[model]
+format = "mtx"
+mass = "M.mtx"
+stiffness = "K.mtx"
+dof_labels = "dofs.txt"
+[damping]
+type = "modal"
+zeta = 0.003
+[[excitation.load]]
+dof = "tip:x"
+amplitude = 2.0
+[[contacts]]
+name = "damper"
+law = "jenkins"
+elements = [ { a = ["platform:x", "platform:y"], b = "ground" } ]
+directions = [ [0.8660254037844386, 0.5] ]
+kt = 1.0e7
+mu = 0.5
+fn0 = 100.0
+[solver]
+harmonics = 1
+samples = 16
+[frequency]
+start = 440.0
+end = 500.0
+[continuation]
+step = {step}
+max_step = {max_step}
+[outputs]
+dofs = ["tip:x", "platform:x"]
+plot = false
+"""
+
+
+def coarse_joint_deck(step: str = "0.05", max_step: str = "STEP") -> str:
+    """The joint deck (matrices K.mtx, M.mtx, dofs.txt beside it) at H = 1, 16 samples,
+    440-500 Hz, outputs tip:x and platform:x, no plot; step and max_step as written into
+    [continuation] (the default 'STEP' is a placeholder the study tests replace)."""
+    return _COARSE_JOINT.replace("{step}", step).replace("{max_step}", max_step)

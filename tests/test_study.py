@@ -21,7 +21,7 @@ import h5py
 import numpy as np
 import pytest
 
-from _models import copy_job, small_lap_joint_deck
+from _models import coarse_joint_deck, copy_job, small_lap_joint_deck
 from frirom import InputError
 from frirom.cli import main
 from frirom.deck import load_deck
@@ -32,39 +32,7 @@ from frirom.study import curve_distance, load_study, run_study, smallest_within
 ROOT = Path(__file__).resolve().parents[1]
 JOINT = ROOT / "cases" / "joint"
 
-BASE = """title = "joint, coarse"
-[model]
-format = "mtx"
-mass = "M.mtx"
-stiffness = "K.mtx"
-dof_labels = "dofs.txt"
-[damping]
-type = "modal"
-zeta = 0.003
-[[excitation.load]]
-dof = "tip:x"
-amplitude = 2.0
-[[contacts]]
-name = "damper"
-law = "jenkins"
-elements = [ { a = ["platform:x", "platform:y"], b = "ground" } ]
-directions = [ [0.8660254037844386, 0.5] ]
-kt = 1.0e7
-mu = 0.5
-fn0 = 100.0
-[solver]
-harmonics = 1
-samples = 16
-[frequency]
-start = 440.0
-end = 500.0
-[continuation]
-step = 0.05
-max_step = STEP
-[outputs]
-dofs = ["tip:x", "platform:x"]
-plot = false
-"""
+BASE = coarse_joint_deck()
 
 STUDY = """
 [study]

@@ -17,45 +17,14 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import pytest
 
+from _models import GSI_DECK, coarse_joint_deck
 from frirom import InputError
 from frirom.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 JOINT = ROOT / "cases" / "joint"
 
-BASE = """title = "joint, coarse"
-[model]
-format = "mtx"
-mass = "M.mtx"
-stiffness = "K.mtx"
-dof_labels = "dofs.txt"
-[damping]
-type = "modal"
-zeta = 0.003
-[[excitation.load]]
-dof = "tip:x"
-amplitude = 2.0
-[[contacts]]
-name = "damper"
-law = "jenkins"
-elements = [ { a = ["platform:x", "platform:y"], b = "ground" } ]
-directions = [ [0.8660254037844386, 0.5] ]
-kt = 1.0e7
-mu = 0.5
-fn0 = 100.0
-[solver]
-harmonics = 1
-samples = 16
-[frequency]
-start = 440.0
-end = 500.0
-[continuation]
-step = 0.2
-max_step = 0.2
-[outputs]
-dofs = ["tip:x", "platform:x"]
-plot = false
-"""
+BASE = coarse_joint_deck(step="0.2", max_step="0.2")
 
 
 def study_deck(folder: Path, study: str) -> Path:
@@ -276,7 +245,7 @@ def test_tampered_cache_is_rebuilt_through_the_deck(tmp_path):
     from frirom.deck import load_deck
     block.run_ccx(block.write_block_deck(tmp_path / "block.inp", 10, 3, 3, n_ref_modes=0))
     deck = tmp_path / "d.toml"
-    deck.write_text(GSI_DECK)
+    deck.write_text(GSI_DECK.format(kt=2.0e8, mu=0.5, h=1))
     first = load_deck(deck)
     entry, = (tmp_path / ".frirom_cache").glob("rom-*.h5")
     _edit_cache(entry, "K*1.5")
@@ -287,42 +256,6 @@ def test_tampered_cache_is_rebuilt_through_the_deck(tmp_path):
     assert load_deck(deck).reduced.from_cache        # the rebuilt entry is good again
 
 
-GSI_DECK = """
-[fe_model]
-format = "calculix"
-job = "block"
-[reduction]
-interface = "IFACE"
-active = ["ACTIVE"]
-fixed_interface_modes = 30
-[reduction.interface_modes]
-method = "gsi"
-free = 6
-stick = 6
-[[contacts]]
-name = "end"
-law = "normal2d"
-a = "IFACE"
-b = "ground"
-normal = [1.0, 0.0, 0.0]
-kt = 2.0e8
-kn = 8.0e8
-mu = 0.5
-n0 = 100.0
-[damping]
-type = "modal"
-zeta = 0.01
-[[excitation.load]]
-dof = "ACTIVE:z"
-amplitude = 1.0
-[solver]
-harmonics = 1
-[frequency]
-start = 100.0
-end = 200.0
-[outputs]
-dofs = ["ACTIVE:z"]
-"""
 
 
 @pytest.fixture(scope="module")

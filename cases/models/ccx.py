@@ -37,6 +37,19 @@ def matrix_storage_steps(n_ref_modes: int = 0) -> str:
     return ref + "*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n1\n*END STEP\n"
 
 
+def write_mesh(fh, title: str, ids, xyz, elems, sets: dict, etype: str) -> None:
+    """The mesh part of a CalculiX deck into the open file fh: the title, the nodes (NSET
+    ALL), the elements of type etype (ELSET EALL) and the node sets."""
+    fh.write(f"** {title}\n*NODE, NSET=ALL\n")
+    for i, (x, y, z) in zip(ids, xyz):
+        fh.write(f"{i}, {x:.12g}, {y:.12g}, {z:.12g}\n")
+    fh.write(f"*ELEMENT, TYPE={etype}, ELSET=EALL\n")
+    for e, conn in enumerate(elems, start=1):
+        fh.write(f"{e}, " + ", ".join(str(c) for c in conn) + "\n")
+    for name, nodes in sets.items():
+        fh.write(nset(name, nodes))
+
+
 def write_tet10_deck(path, title: str, ids, xyz, elems, sets: dict, n_ref_modes: int = 0,
                      material=STEEL) -> Path:
     """A CalculiX deck of C3D10 elements (gmsh meshes): the nodes (NSET ALL), the
@@ -45,14 +58,7 @@ def write_tet10_deck(path, title: str, ids, xyz, elems, sets: dict, n_ref_modes:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "w") as fh:
-        fh.write(f"** {title}\n*NODE, NSET=ALL\n")
-        for i, (x, y, z) in zip(ids, xyz):
-            fh.write(f"{i}, {x:.12g}, {y:.12g}, {z:.12g}\n")
-        fh.write("*ELEMENT, TYPE=C3D10, ELSET=EALL\n")
-        for e, conn in enumerate(elems, start=1):
-            fh.write(f"{e}, " + ", ".join(str(c) for c in conn) + "\n")
-        for name, nodes in sets.items():
-            fh.write(nset(name, nodes))
+        write_mesh(fh, title, ids, xyz, elems, sets, "C3D10")
         fh.write(solid_material(material) + "*BOUNDARY\nFIX, 1, 3\n"
                  + matrix_storage_steps(n_ref_modes))
     return path

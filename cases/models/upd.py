@@ -29,7 +29,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from ccx import STEEL, matrix_storage_steps, nset, run_ccx, solid_material  # noqa: E402
+from ccx import (STEEL, matrix_storage_steps, run_ccx, solid_material,  # noqa: E402
+                 write_mesh)
 
 #: boxes of each body in lattice units: (x0, x1, y0, y1, z0, z1)
 def _blade(i):
@@ -99,14 +100,7 @@ def _deck(path, title, ids, xyz, elems, sets, springs=None, n_ref_modes=0, stora
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "w") as fh:
-        fh.write(f"** {title}\n*NODE, NSET=ALL\n")
-        for i, (x, y, z) in zip(ids, xyz):
-            fh.write(f"{i}, {x:.12g}, {y:.12g}, {z:.12g}\n")
-        fh.write("*ELEMENT, TYPE=C3D8, ELSET=EALL\n")
-        for e, conn in enumerate(elems, start=1):
-            fh.write(f"{e}, " + ", ".join(str(c) for c in conn) + "\n")
-        for name, nodes in sets.items():
-            fh.write(nset(name, nodes))
+        write_mesh(fh, title, ids, xyz, elems, sets, "C3D8")
         fh.write(solid_material(STEEL))
         if springs is not None:
             pairs, kt, kn = springs
