@@ -26,10 +26,10 @@ def lap(tmp_path_factory):
         pytest.skip("ccx not installed")
     pytest.importorskip("gmsh")
     import make_lap_joint
-    from test_lap_joint_case import small
+    from _models import small_lap_joint_deck
     out = tmp_path_factory.mktemp("lap_preload")
     make_lap_joint.make(out, size=0.012)
-    return out, small(None)
+    return out, small_lap_joint_deck(None)
 
 
 def _by_load(text, load, direction="[0.0, 0.0, 1.0]", body=None):
