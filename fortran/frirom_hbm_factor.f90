@@ -1,8 +1,8 @@
 !> The linear solves of a condensed system: when J is factorised (a new LU, or GMRES on
 !> J preconditioned by the LU held from an older J), the LU itself (single precision
 !> with a Woodbury correction for systems that hold it), the solves, J applied
-!> matrix-free, and the LU carried from one run to the next (hbm_lu_import/export). The
-!> LU, GMRES and Woodbury kernels are frirom_linsolve's; the policy is here.
+!> matrix-free, and forgetting the LU held (hbm_lu_forget). The LU, GMRES and Woodbury
+!> kernels are frirom_linsolve's; the policy is here.
 submodule (frirom_hbm:frirom_hbm_condensed) frirom_hbm_factor
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_ALLOC, FRIROM_ERR_LAPACK, &
                              FRIROM_ERR_SINGULAR, set_status
@@ -175,47 +175,17 @@ contains
         holds = lu_worth(sys%n, sys%nh, sys%nnl, size(sys%g, 1)) >= GN_WORTH_MIN
     end procedure holds
 
-    module procedure hbm_lu_import
+    module procedure hbm_lu_forget
         select type (sys => sysc)
         type is (hbm_condensed)
-            if (.not. holds(sys) .or. size(state) < 2) return
-            if (all(state(1) /= [1.0_wp, 2.0_wp]) .or. any(shape(lu) /= sys%n) .or. &
-                size(piv) /= sys%n) return
-            if (.not. allocated(sys%jm)) return
-            ! state(1) = 2: a single-precision LU (exact in lu)
-            sys%held%single = state(1) == 2.0_wp
-            sys%held%wb%ok = .false.
-            if (sys%held%single) then
-                sys%held%lus = real(lu, real32)
-            else
-                sys%jm = lu
-            end if
-            sys%held%ipiv = piv
-            sys%lu_any = .true.
+            sys%lu_any = .false.
             sys%lu_fresh = .false.
-            sys%gm_spent = state(2)
+            sys%gm_spent = 0.0_wp
+            sys%gm_next = .false.
+            sys%refresh = .false.
+            sys%held%wb%ok = .false.
         end select
-    end procedure hbm_lu_import
-
-    module procedure hbm_lu_export
-        if (size(state) < 2) return
-        state(1) = 0.0_wp
-        select type (sys => sysc)
-        type is (hbm_condensed)
-            if (.not. holds(sys) .or. .not. sys%lu_any .or. .not. allocated(sys%jm)) return
-            if (any(shape(lu) /= sys%n) .or. size(piv) /= sys%n) return
-            if (sys%timers(N_FACT) > 0.0_wp) then
-                if (sys%held%single) then
-                    lu = real(sys%held%lus, wp)
-                else
-                    lu = sys%jm
-                end if
-                piv = sys%held%ipiv
-            end if
-            state(1) = merge(2.0_wp, 1.0_wp, sys%held%single)
-            state(2) = sys%gm_spent
-        end select
-    end procedure hbm_lu_export
+    end procedure hbm_lu_forget
 
     !> y = J x: the assembled jcur, or matrix-free (jfree: modal route) as
     !> x + R_h G^T J_loc G x at the Jacobian's frequency, element by element and mode by

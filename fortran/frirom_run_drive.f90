@@ -3,7 +3,7 @@
 !> the stall test, and single corrector solves on the run's system.
 submodule (frirom_run) frirom_run_drive
     use frirom_newton, only: cont_options, YSCALE_RELATIVE
-    use frirom_hbm, only: hbm_condensed, hbm_run, hbm_sel_expand, hbm_sel_reduce, &
+    use frirom_hbm, only: hbm_lu_forget, hbm_run, hbm_sel_expand, hbm_sel_reduce, &
                           HBM_START_CONTINUE, HBM_START_RESUME, HBM_START_SOLVE_ONLY
     implicit none
 
@@ -229,7 +229,8 @@ contains
             return
         end if
         mx = min(k, room) + merge(1_ip, 0_ip, run%pending)
-        call forget_lu(run%sys)
+        ! a segment starts as a restored run does: without the LU a system may hold
+        call hbm_lu_forget(run%sys)
         call run_seg(run, st, run%start_mode, mx, run%yscale)
         call segment(run, st, seg, fin, dsout, info, errmsg)
         np = seg%npts
@@ -572,21 +573,6 @@ contains
         run%message = 'stopped after max_points = '//trim(buf)//' points'
     end subroutine stop_max
 
-    !> The next Jacobian is factorised afresh, as in a system just built: a segment
-    !> starts as a run restored from a checkpoint does (the LU a condensed modal system
-    !> holds as GMRES preconditioner is forgotten, its bookkeeping reset).
-    subroutine forget_lu(sys)
-        class(hbm_system), intent(inout) :: sys
-        select type (sys)
-        type is (hbm_condensed)
-            sys%lu_any = .false.
-            sys%lu_fresh = .false.
-            sys%gm_spent = 0.0_wp
-            sys%gm_next = .false.
-            sys%refresh = .false.
-            sys%held%wb%ok = .false.
-        end select
-    end subroutine forget_lu
 
     !> -1, 0 or 1 (numpy's sign).
     pure real(wp) function sgn(x)
