@@ -312,3 +312,16 @@ def coarse_joint_deck(step: str = "0.05", max_step: str = "STEP") -> str:
     440-500 Hz, outputs tip:x and platform:x, no plot; step and max_step as written into
     [continuation] (the default 'STEP' is a placeholder the study tests replace)."""
     return _COARSE_JOINT.replace("{step}", step).replace("{max_step}", max_step)
+
+
+def resume_refuses_changed_mu_and_h(deck, text: str, out, capsys, main) -> str:
+    """Write `text` with mu 0.5 -> 0.4 and harmonics 5 -> 6 to deck, run `frirom run
+    --resume` into out (after a run that stopped early there): it must exit 2 naming both
+    changes. Returns the error text."""
+    deck.write_text(text.replace("mu = 0.5", "mu = 0.4").replace("harmonics = 5",
+                                                                  "harmonics = 6"))
+    assert main(["run", str(deck), "--out", str(out), "--quiet", "--resume"]) == 2
+    err = capsys.readouterr().err
+    assert "the deck changed" in err and "contacts[0].mu: 0.5 then, 0.4 now" in err
+    assert "solver.harmonics: 5 then, 6 now" in err
+    return err

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from _models import resume_refuses_changed_mu_and_h
 from frirom.cli import main
 from frirom.deck import load_deck
 from frirom.results import FRF
@@ -106,12 +107,7 @@ def test_resume_refuses_a_changed_deck_after_a_few_points(deck, tmp_path, capsys
     deck.write_text(text)
     assert main(["run", str(deck), "--out", str(out), "--quiet"]) == 3
     capsys.readouterr()
-    deck.write_text(text.replace("mu = 0.5", "mu = 0.4").replace("harmonics = 5",
-                                                                  "harmonics = 6"))
-    assert main(["run", str(deck), "--out", str(out), "--quiet", "--resume"]) == 2
-    err = capsys.readouterr().err
-    assert "the deck changed" in err and "contacts[0].mu: 0.5 then, 0.4 now" in err
-    assert "solver.harmonics: 5 then, 6 now" in err
+    resume_refuses_changed_mu_and_h(deck, text, out, capsys, main)
 
 
 def test_resume_without_previous_run(deck, tmp_path, capsys):
