@@ -230,14 +230,15 @@ end subroutine frun_set_selection
 !> of the run that wrote it, n_before its points). hassliders = 1: start from the history
 !> sliders. timings (N_TIMERS) of the call.
 subroutine frun_start(handle, kind, lam_start, lam_end, lam0, ny, y0, tan0, yscale, ds, &
-                     lscale_old, n_before, nw, sliders, hassliders, ntim, timings, info, msg)
+                     lscale_old, n_before, nw, sliders, hassliders, nlu, lu, ntim, timings, &
+                     info, msg)
     use frirom_kinds, only: ip
     use frirom_run, only: run_t, run_from_handle, fr_start => run_start
     implicit none
     integer(8), intent(in) :: handle
-    integer(4), intent(in) :: kind, ny, n_before, nw, hassliders, ntim
+    integer(4), intent(in) :: kind, ny, n_before, nw, hassliders, nlu, ntim
     real(8), intent(in) :: lam_start, lam_end, lam0, y0(ny), tan0(ny + 1), yscale, ds, &
-                           lscale_old, sliders(nw)
+                           lscale_old, sliders(nw), lu(nlu)
     real(8), intent(out) :: timings(ntim)
     integer(4), intent(out) :: info
     character(len=512), intent(out) :: msg
@@ -248,13 +249,63 @@ subroutine frun_start(handle, kind, lam_start, lam_end, lam0, ny, y0, tan0, ysca
     timings = 0.0d0
     if (hassliders == 1) sl = sliders
     call run_from_handle(handle, r, 'run_start', linfo, msg)
-    if (linfo == 0) call fr_start(r, int(kind, ip), lam_start, lam_end, linfo, msg, &
-                                  lam0=lam0, y0=y0, tan0=tan0, yscale=yscale, ds=ds, &
-                                  lscale_old=lscale_old, n_before=int(n_before, ip), &
-                                  sliders=sl)
+    if (linfo == 0 .and. nlu > 0) then
+        ! a checkpoint's held LU (frun_lu_state)
+        call fr_start(r, int(kind, ip), lam_start, lam_end, linfo, msg, &
+                      lam0=lam0, y0=y0, tan0=tan0, yscale=yscale, ds=ds, &
+                      lscale_old=lscale_old, n_before=int(n_before, ip), sliders=sl, lu=lu)
+    else if (linfo == 0) then
+        call fr_start(r, int(kind, ip), lam_start, lam_end, linfo, msg, &
+                      lam0=lam0, y0=y0, tan0=tan0, yscale=yscale, ds=ds, &
+                      lscale_old=lscale_old, n_before=int(n_before, ip), sliders=sl)
+    end if
     if (associated(r)) timings(1:min(ntim, size(r%timers))) = r%timers(1:min(ntim, size(r%timers)))
     info = linfo
 end subroutine frun_start
+
+!> Length of a run's held-LU state (frirom_run run_lu_size); 0 for a bad handle.
+subroutine frun_lu_size(handle, n)
+    use frirom_kinds, only: ip
+    use frirom_run, only: run_t, run_from_handle, run_lu_size
+    implicit none
+    integer(8), intent(in) :: handle
+    integer(4), intent(out) :: n
+    type(run_t), pointer :: r
+    integer(ip) :: linfo
+    character(len=512) :: msg
+    n = 0
+    msg = ''
+    call run_from_handle(handle, r, 'run_lu_size', linfo, msg)
+    if (linfo == 0) n = int(run_lu_size(r), 4)
+end subroutine frun_lu_size
+
+!> The state of the LU a run's continuation holds (frirom_run run_lu_state), for a
+!> checkpoint: frun_start's lu makes it again, so a resumed run goes on bit for bit.
+subroutine frun_lu_state(handle, n, v, info, msg)
+    use frirom_kinds, only: ip
+    use frirom_status, only: FRIROM_ERR_SIZE, set_status
+    use frirom_run, only: run_t, run_from_handle, run_lu_size, run_lu_state
+    implicit none
+    integer(8), intent(in) :: handle
+    integer(4), intent(in) :: n
+    real(8), intent(out) :: v(n)
+    integer(4), intent(out) :: info
+    character(len=512), intent(out) :: msg
+    type(run_t), pointer :: r
+    integer(ip) :: linfo
+    msg = ''
+    v = 0.0d0
+    call run_from_handle(handle, r, 'run_lu_state', linfo, msg)
+    if (linfo == 0) then
+        if (n /= run_lu_size(r)) then
+            call set_status(linfo, FRIROM_ERR_SIZE, msg, 'run_lu_state: n, the state''s '// &
+                            'length (frun_lu_size), expected')
+        else
+            call run_lu_state(r, v)
+        end if
+    end if
+    info = linfo
+end subroutine frun_lu_state
 
 !> Up to k more points of a started run (frirom_run run_advance) into arrays of room
 !> maxpts >= k + 1: npts points; status (RUN_*: 0 going, 1 done, 2 max_points, 3 left the

@@ -195,6 +195,11 @@ contains
         nc = this%nc
         n = this%n
         call freq_load(this, lam, w, s)
+        if (jac) then
+            ! where a J comes from (hbm_lu_state)
+            this%jy = y
+            this%jlam = lam
+        end if
         if (w /= this%w_cache) then
             call cond_receptance(this, w, info, errmsg)
             if (info /= 0) return

@@ -6,6 +6,8 @@
 submodule (frirom_hbm:frirom_hbm_condensed) frirom_hbm_factor
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_ALLOC, FRIROM_ERR_LAPACK, &
                              FRIROM_ERR_SINGULAR, set_status
+    use frirom_aft, only: law_nslider
+    use frirom_status, only: FRIROM_ERR_SIZE
     use frirom_linsolve, only: lin_operator, fgmres, held_lu_factor, held_lu_apply, &
                                woodbury_reset, woodbury_alloc, woodbury_finish, &
                                woodbury_prepare
@@ -66,6 +68,13 @@ contains
         sys%timers(N_FACT) = sys%timers(N_FACT) + 1
         sys%lu_fresh = linfo == 0
         sys%lu_any = linfo == 0
+        if (linfo == 0 .and. allocated(sys%jy)) then
+            sys%luy = sys%jy
+            sys%lulam = sys%jlam
+            if (allocated(sys%luw)) deallocate (sys%luw)
+            allocate (sys%luw(max(n_sliders(sys), 1)))
+            call hbm_sliders(sys, sys%luw)
+        end if
         sys%gm_spent = 0.0_wp
         sys%refresh = .false.
         if (linfo > 0) then
@@ -186,6 +195,90 @@ contains
             sys%held%wb%ok = .false.
         end select
     end procedure hbm_lu_forget
+
+    module procedure hbm_lu_state_size
+        nv = 1
+        select type (sys => sysc)
+        type is (hbm_condensed)
+            nv = 8 + sys%n + n_sliders(sys)
+        end select
+    end procedure hbm_lu_state_size
+
+    module procedure hbm_lu_state
+        integer(ip) :: n, nw
+        v = 0.0_wp
+        select type (sys => sysc)
+        type is (hbm_condensed)
+            if (.not. (sys%lu_any .and. allocated(sys%luy))) return
+            n = sys%n
+            nw = n_sliders(sys)
+            v(1:8) = [1.0_wp, merge(1.0_wp, 0.0_wp, sys%held%single), sys%lulam, &
+                      sys%gm_spent, merge(1.0_wp, 0.0_wp, sys%refresh), 1.0_wp, &
+                      merge(1.0_wp, 0.0_wp, sys%lu_fresh), merge(1.0_wp, 0.0_wp, sys%gm_next)]
+            v(9:8 + n) = sys%luy
+            if (nw > 0) v(9 + n:8 + n + nw) = sys%luw(1:nw)
+        end select
+    end procedure hbm_lu_state
+
+    module procedure hbm_lu_rebuild
+        real(wp), allocatable :: r(:), rlam(:), wnow(:)
+        real(wp) :: rref
+        integer(ip) :: n, nw
+        info = FRIROM_OK
+        call hbm_lu_forget(sysc)
+        select type (sys => sysc)
+        type is (hbm_condensed)
+            n = sys%n
+            nw = n_sliders(sys)
+            if (size(v) /= 8 + n + nw .or. .not. all(abs(v) <= huge(1.0_wp))) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'held LU state: '// &
+                                'hbm_lu_state_size finite values of this system expected')
+                return
+            end if
+            if (v(1) == 0.0_wp) return
+            allocate (r(n), rlam(n), wnow(max(nw, 1)))
+            call hbm_sliders(sys, wnow)
+            call set_w0(sys, v(9 + n:8 + n + nw))
+            call sys%eval(v(9:8 + n), v(3), r, rref, .true., rlam, info, errmsg)
+            if (info == 0 .and. v(2) == 0.0_wp .and. sys%held%single) then
+                ! the double LU a single one gave way to (cond_solve)
+                call cond_factor(sys, info, errmsg, double=.true.)
+            end if
+            call set_w0(sys, wnow(1:nw))
+            if (info /= 0) return
+            sys%gm_spent = v(4)
+            sys%refresh = v(5) /= 0.0_wp
+            sys%lu_any = v(6) /= 0.0_wp
+            sys%lu_fresh = v(7) /= 0.0_wp
+            sys%gm_next = v(8) /= 0.0_wp
+        end select
+    end procedure hbm_lu_rebuild
+
+    !> Sliders of a system's contact groups (hbm_sliders' layout).
+    integer(ip) function n_sliders(sys)
+        type(hbm_condensed), intent(in) :: sys
+        integer(ip) :: g
+        n_sliders = 0
+        do g = 1, size(sys%cs%grp)
+            n_sliders = n_sliders + law_nslider(sys%cs%grp(g)%law)*sys%cs%grp(g)%ne
+        end do
+    end function n_sliders
+
+    !> The groups' contact history w0 from w (hbm_sliders' layout).
+    subroutine set_w0(sys, w)
+        type(hbm_condensed), intent(inout) :: sys
+        real(wp), intent(in) :: w(:)
+        integer(ip) :: g, k, nsl
+        k = 0
+        do g = 1, size(sys%cs%grp)
+            associate (gr => sys%cs%grp(g))
+                nsl = law_nslider(gr%law)
+                if (nsl == 0) cycle
+                gr%w0(1:nsl, :) = reshape(w(k + 1:k + nsl*gr%ne), [nsl, gr%ne])
+                k = k + nsl*gr%ne
+            end associate
+        end do
+    end subroutine set_w0
 
     !> y = J x: the assembled jcur, or matrix-free (jfree: modal route) as
     !> x + R_h G^T J_loc G x at the Jacobian's frequency, element by element and mode by

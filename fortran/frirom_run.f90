@@ -40,7 +40,8 @@ module frirom_run
               run_start, run_advance, run_solve, run_close, run_get_sliders, run_set_sliders, &
               run_advice, run_sizes, run_default_samples, settings_pack, settings_unpack, &
               run_settings_names, run_handle, run_from_handle, run_checkpoint_size, &
-              run_checkpoint, run_restore, run_contact_coords, open_run
+              run_checkpoint, run_restore, run_contact_coords, open_run, run_lu_size, &
+              run_lu_state
     public :: RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_LOAD, &
               RUN_START_COLD, RUN_START_POINT, RUN_START_RESUME, &
               RUN_GOING, RUN_DONE, RUN_MAX_POINTS, RUN_LEFT_RANGE, RUN_FAILED, RUN_STALLED, &
@@ -179,6 +180,10 @@ module frirom_run
         character(len=512) :: message = ''
         !> timers and counters of the last call (frirom_hbm T_*, N_*; N_TIMERS: wall s)
         real(wp) :: timers(N_TIMERS) = 0.0_wp
+        !> a run_solve between segments used the system: the LU the continuation held
+        !> (hbm_lu_state, kept in lu_saved) is made again before the next segment
+        logical :: lu_dirty = .false.
+        real(wp), allocatable :: lu_saved(:)
     end type run_t
 
     integer(ip), parameter, public :: RUN_MAGIC = 1718185577
@@ -253,10 +258,12 @@ module frirom_run
         !> or resumed from y0 at lam0 with its tangent tan0 in the scale yscale (and, for a
         !> checkpoint, ds > 0, the step of the run that wrote it, lscale_old > 0 its
         !> parameter range; n_before its points). sliders: the history to start from
-        !> (else the run's). The first point is made here (cold, point) and handed out by
-        !> the next run_advance, with its tangent.
+        !> (else the run's); lu: the held LU's state at the checkpoint (hbm_lu_state,
+        !> made again: the run then continues bit for bit; without it, a new LU there).
+        !> The first point is made here (cold, point) and handed out by the next
+        !> run_advance, with its tangent.
         module subroutine run_start(run, kind, lam_start, lam_end, info, errmsg, lam0, y0, &
-                                    tan0, yscale, ds, lscale_old, n_before, sliders)
+                                    tan0, yscale, ds, lscale_old, n_before, sliders, lu)
             type(run_t), intent(inout) :: run
             integer(ip), intent(in) :: kind
             real(wp), intent(in) :: lam_start, lam_end
@@ -264,7 +271,7 @@ module frirom_run
             character(len=*), intent(inout) :: errmsg
             real(wp), intent(in), optional :: lam0, y0(:), tan0(:), yscale, ds, lscale_old
             integer(ip), intent(in), optional :: n_before
-            real(wp), intent(in), optional :: sliders(:)
+            real(wp), intent(in), optional :: sliders(:), lu(:)
         end subroutine run_start
 
         !> Up to k more points (fewer at the end of the range, at max_points or a failure:
@@ -455,17 +462,41 @@ contains
                                                  .not. selected)
     end function run_contact_coords
 
-    !> Length of the run's checkpoint (run_checkpoint): 6 + 2 ny + 1 + nw.
-    pure function run_checkpoint_size(run) result(n)
+    !> Length of the run's checkpoint (run_checkpoint): 7 + 2 ny + 1 + nw + the held
+    !> LU's state (run_lu_size).
+    function run_checkpoint_size(run) result(n)
         type(run_t), intent(in) :: run
         integer(ip) :: n
-        n = 7 + 2*run%ny + run%nw
+        n = 8 + 2*run%ny + run%nw + run_lu_size(run)
     end function run_checkpoint_size
+
+    !> Length of the held LU's state (frirom_hbm hbm_lu_state) of a built run, else 0.
+    function run_lu_size(run) result(n)
+        use frirom_hbm, only: hbm_lu_state_size
+        type(run_t), intent(in) :: run
+        integer(ip) :: n
+        n = 0
+        if (run%built) n = hbm_lu_state_size(run%sys)
+    end function run_lu_size
+
+    !> The state of the LU the run's continuation holds (hbm_lu_state; after a
+    !> run_solve, the one kept for the next segment).
+    subroutine run_lu_state(run, v)
+        use frirom_hbm, only: hbm_lu_state
+        type(run_t), intent(in) :: run
+        real(wp), intent(out) :: v(:)     !! (run_lu_size)
+        if (run%lu_dirty .and. allocated(run%lu_saved)) then
+            v = run%lu_saved
+        else
+            call hbm_lu_state(run%sys, v)
+        end if
+    end subroutine run_lu_state
 
     !> Everything exact resume needs, after a run_advance (the end of a segment): the
     !> range, the point the next segment starts from (parameter, arc-length scale, step,
     !> points made, unknowns, tangent) and the contact history, as ck = [lam_start,
-    !> lam_end, lam, yscale, ds, n_points, status, y (ny), t (ny+1), sliders (nw)].
+    !> lam_end, lam, yscale, ds, n_points, status, y (ny), t (ny+1), sliders (nw), the
+    !> held LU's state (run_lu_size)].
     !> run_restore on a run opened on the same model continues bit for bit as this one.
     subroutine run_checkpoint(run, ck, info, errmsg)
         type(run_t), intent(in) :: run
@@ -496,6 +527,7 @@ contains
         ck(8:7 + ny) = run%y
         ck(8 + ny:8 + 2*ny) = run%t
         if (run%nw > 0) call run_get_sliders(run, ck(9 + 2*ny:8 + 2*ny + run%nw))
+        call run_lu_state(run, ck(9 + 2*ny + run%nw:))
     end subroutine run_checkpoint
 
     !> Continue from a checkpoint of a run on the same model (run_checkpoint): the run
@@ -530,7 +562,7 @@ contains
         end if
         call run_start(run, RUN_START_RESUME, ck(1), ck(2), info, errmsg, lam0=ck(3), &
                        y0=ck(8:7 + ny), tan0=ck(8 + ny:8 + 2*ny), yscale=ck(4), ds=ck(5), &
-                       n_before=nint(ck(6), ip))
+                       n_before=nint(ck(6), ip), lu=ck(9 + 2*ny + run%nw:))
         st = nint(ck(7), ip)
         if (info == 0 .and. st /= RUN_GOING) run%status = st
     end subroutine run_restore

@@ -3,7 +3,7 @@
 !> the stall test, and single corrector solves on the run's system.
 submodule (frirom_run) frirom_run_drive
     use frirom_newton, only: cont_options, YSCALE_RELATIVE
-    use frirom_hbm, only: hbm_lu_forget, hbm_run, hbm_sel_expand, hbm_sel_reduce, &
+    use frirom_hbm, only: hbm_lu_forget, hbm_lu_rebuild, hbm_run, hbm_sel_expand, hbm_sel_reduce, &
                           HBM_START_CONTINUE, HBM_START_RESUME, HBM_START_SOLVE_ONLY
     implicit none
 
@@ -70,6 +70,9 @@ contains
         run%lam = lam_start
         if (present(lam0)) run%lam = lam0
         if (present(y0)) run%y = y0
+        ! a run starts as one on a system just built: nothing of an earlier use is held
+        call hbm_lu_forget(run%sys)
+        run%lu_dirty = .false.
         select case (kind)
         case (RUN_START_COLD, RUN_START_POINT)
             call first_point(run, kind == RUN_START_COLD .or. .not. present(y0), info, errmsg)
@@ -102,6 +105,14 @@ contains
                         end if
                     end if
                     run%ds = ds
+                end if
+            end if
+            if (present(lu)) then
+                ! the LU the checkpointed run held there: its path goes on unchanged
+                call hbm_lu_rebuild(run%sys, lu, info, errmsg)
+                if (info /= 0) then
+                    errmsg = 'lu: '//trim(errmsg)
+                    return
                 end if
             end if
             run%start_mode = HBM_START_RESUME
@@ -229,8 +240,12 @@ contains
             return
         end if
         mx = min(k, room) + merge(1_ip, 0_ip, run%pending)
-        ! a segment starts as a restored run does: without the LU a system may hold
-        call hbm_lu_forget(run%sys)
+        if (run%lu_dirty) then
+            ! a run_solve since the last segment: the LU the continuation held, again
+            call hbm_lu_rebuild(run%sys, run%lu_saved, info, errmsg)
+            run%lu_dirty = .false.
+            if (info /= 0) return
+        end if
         call run_seg(run, st, run%start_mode, mx, run%yscale)
         call segment(run, st, seg, fin, dsout, info, errmsg)
         np = seg%npts
@@ -331,6 +346,13 @@ contains
         end if
         allocate (wsave(max(run%nw, 1)))
         call run_get_sliders(run, wsave)
+        if (run%status == RUN_GOING .and. allocated(run%y) .and. .not. run%lu_dirty) then
+            ! the continuation's LU is made again before its next segment (run_advance)
+            if (allocated(run%lu_saved)) deallocate (run%lu_saved)
+            allocate (run%lu_saved(run_lu_size(run)))
+            call run_lu_state(run, run%lu_saved)
+            run%lu_dirty = .true.
+        end if
         if (present(sliders)) then
             call run_set_sliders(run, sliders, info, errmsg)
             if (info /= 0) return

@@ -16,7 +16,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _kernels
-from ._errors import int_constant, raise_for_status
+from ._errors import SizeError, int_constant, raise_for_status
 
 #: run_start kinds, stop reasons, solve kinds and advice bits (frirom_run RUN_*, ADVISE_*)
 START_COLD, START_POINT, START_RESUME = (int_constant(f"RUN_START_{k}")
@@ -135,16 +135,34 @@ class Run:
 
     def start(self, kind: int, lam_start: float, lam_end: float, lam0: float | None = None,
               y0=None, tan0=None, yscale: float = 0.0, ds: float = 0.0,
-              lscale_old: float = 0.0, n_before: int = 0, sliders=None) -> np.ndarray:
-        """run_start; returns the call's timings; raises on failure (no first point)."""
+              lscale_old: float = 0.0, n_before: int = 0, sliders=None,
+              held_lu=None) -> np.ndarray:
+        """run_start; returns the call's timings; raises on failure (no first point).
+        held_lu: a checkpoint's :meth:`lu_state` (resume: the LU is made again)."""
         sl, has = self._sliders(sliders)
+        lu = np.zeros(0) if held_lu is None else np.asarray(held_lu, float).ravel()
+        if lu.size and lu.size != self.lu_size:
+            raise SizeError(f"held_lu: {self.lu_size} values expected (this run's "
+                            f"Run.lu_state), got {lu.size}: a checkpoint of another model?")
         timings, info, msg = _kernels.frun_start(
             self.handle, kind, lam_start, lam_end, lam_start if lam0 is None else lam0,
             np.zeros(self.ny) if y0 is None else np.asarray(y0, float),
             np.zeros(self.ny + 1) if tan0 is None else np.asarray(tan0, float),
-            yscale, ds, lscale_old, n_before, sl, has, _N_TIMERS)
+            yscale, ds, lscale_old, n_before, sl, has, lu, _N_TIMERS)
         raise_for_status(info, _text(msg))
         return timings
+
+    @property
+    def lu_size(self) -> int:
+        """Length of :meth:`lu_state`."""
+        return int(_kernels.frun_lu_size(self.handle))
+
+    def lu_state(self) -> np.ndarray:
+        """What the LU the continuation holds depends on (frirom_run run_lu_state):
+        [held, single, parameter, counters..., unknowns, sliders]; [0, ...]: none."""
+        v, info, msg = _kernels.frun_lu_state(self.handle, self.lu_size)
+        raise_for_status(info, _text(msg))
+        return v
 
     def advance(self, k: int) -> Points:
         """run_advance: up to k more points."""

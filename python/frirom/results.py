@@ -148,6 +148,9 @@ class FRFPoint:
     #: into Fortran (a checkpoint: resuming there repeats the uninterrupted run exactly);
     #: NaN for the other points
     ds_next: float = float("nan")
+    #: at a checkpoint, the state of the LU the solver holds (frirom._run.Run.lu_state):
+    #: a resumed run makes it again and continues bit for bit; None elsewhere
+    held_lu: np.ndarray | None = None
     #: travelling-wave selection (SolverOptions.selection): |contact forces off the
     #: selection| / |on it| at this point (or the preloads' own, if larger); None without one
     leak: float | None = None
@@ -574,8 +577,10 @@ class FRFWriter:
         if np.isfinite(p.ds_next):
             # the checkpoint's state goes to the slot the commit does not point at
             slot = 0 if slot != 0 else 1
+            lu = np.zeros(1) if p.held_lu is None else p.held_lu     # [0]: none held
             for name, v in (("ck_unknowns", p.unknowns), ("ck_tangent", p.tangent),
-                            ("ck_scalars", [n + 1, p.parameter, p.ds_next, p.yscale])):
+                            ("ck_scalars", [n + 1, p.parameter, p.ds_next, p.yscale]),
+                            ("ck_lu", lu)):
                 v = np.asarray(v, dtype=float)
                 if name in f and f[name].shape[1:] != v.shape:
                     del f[name]
@@ -637,6 +642,8 @@ class FRFWriter:
                 state = {"parameter": float(sc[1]), "omega": float(f["omega"][nck - 1]),
                          "unknowns": f["ck_unknowns"][slot], "tangent": f["ck_tangent"][slot],
                          "yscale": float(sc[3]), "ds": float(sc[2]), "n_points": nck}
+                if "ck_lu" in f and f["ck_lu"][slot][0] != 0.0:
+                    state["held_lu"] = f["ck_lu"][slot]
                 slider = f["slider"][nck - 1] if "slider" in f else None
                 leak = f["leak"][:nck] if "leak" in f else np.zeros(0)
                 if np.any(np.isfinite(leak)):   # the worst stored leak: the run warns on it

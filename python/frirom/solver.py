@@ -128,7 +128,8 @@ class _Continuation:
                                     lam0=lam0, y0=y0, tan0=tan, yscale=float(start["yscale"]),
                                     ds=float(start.get("ds") or 0.0),
                                     lscale_old=float(start.get("lscale") or 0.0),
-                                    n_before=self.n_before, sliders=sliders)
+                                    n_before=self.n_before, sliders=sliders,
+                                    held_lu=start.get("held_lu"))
             # the stored points' worst leak, whichever way the run goes on from them
             self.leak_before = start.get("leak")
         add_timings(self.timings, timings)
@@ -147,7 +148,11 @@ class _Continuation:
             add_timings(self.timings, res.timings)
             if res.info != 0:       # no point at all
                 raise_for_status(res.info, res.msg + self._advice(res))
-            for pt in self.packed.points(res, t_call):
+            pts = self.packed.points(res, t_call)
+            if pts and np.isfinite(pts[-1].ds_next):
+                # a checkpoint: the LU the run goes on with, for an exact resume
+                pts[-1].held_lu = run.lu_state()
+            for pt in pts:
                 self.points.append(pt)
                 self._emit(pt)
             if res.status == _run.GOING:
