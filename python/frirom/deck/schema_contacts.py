@@ -146,7 +146,7 @@ def parse_preloads(ctx: Context, raw: dict, fe: bool) -> list:
                 or not all(isinstance(x, str) for x in names)):
             raise ctx.error(f"{key}.contacts", "a non-empty list of [[contacts]] names", names)
         body = string(ctx, t, "body", f"{key}.body", default="a", choices=("a", "b"))
-        out.append(Preload(load=float(load), direction=tuple(d / np.linalg.norm(d)),
+        out.append(Preload(load=float(load), direction=tuple(_unit(d)),
                            contacts=tuple(names), body=body, key=key))
     return out
 
@@ -256,8 +256,16 @@ def _frame(ctx, frame, key, nd, dirs) -> np.ndarray:
         nrm = np.linalg.norm(D[d])
         if not np.isfinite(nrm) or nrm == 0.0:
             raise ctx.error(f"{key}[{d}]", "a non-zero finite vector", vec)
-        D[d] /= nrm
+        D[d] = _unit(D[d])
     return D
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    """v / |v|; a vector already unit to round-off is kept as written: dividing by its
+    norm (1 - 1e-16) would move it by an ulp, and C or Fortran callers given the same
+    numbers would solve another model at round-off."""
+    nrm = np.linalg.norm(v)
+    return v if abs(nrm - 1.0) <= 4.0 * np.finfo(float).eps else v / nrm
 
 
 def _law_parameters(ctx, c, key, law, ne, derived=()):
