@@ -318,7 +318,7 @@ contains
         real(wp), intent(in) :: w
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
-        integer(ip) :: h, j, k
+        integer(ip) :: h, j, k, h0
         real(wp) :: t0
         complex(wp), allocatable :: row(:)
         info = FRIROM_OK
@@ -326,10 +326,12 @@ contains
         if (sys%modal) then
             call modal_factors(sys, w)
         else
-            call receptance_banded(sys, w, info, errmsg)
+            ! harmonic 0 (D_0 = K) does not depend on w: made once (w_cache < 0: never)
+            h0 = merge(1_ip, 0_ip, sys%w_cache >= 0.0_wp .and. .not. sys%sparse_lu)
+            call receptance_banded(sys, w, h0, info, errmsg)
             if (info /= 0) return
             allocate (row(sys%nnl))
-            do h = 0, sys%nh
+            do h = h0, sys%nh
                 do j = 1, sys%nnl
                     row = (0.0_wp, 0.0_wp)
                     sys%tye0(j, h) = (0.0_wp, 0.0_wp)
@@ -350,10 +352,11 @@ contains
     end subroutine cond_receptance
 
     !> Receptance columns D_h^-1 T^T and D_h^-1 fe at frequency w from a banded LU of
-    !> D_h = K + i h w C - (h w)^2 M per harmonic.
-    subroutine receptance_banded(sys, w, info, errmsg)
+    !> D_h = K + i h w C - (h w)^2 M per harmonic h0..H (those below h0 are kept).
+    subroutine receptance_banded(sys, w, h0, info, errmsg)
         type(hbm_condensed), intent(inout) :: sys
         real(wp), intent(in) :: w
+        integer(ip), intent(in) :: h0
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
         integer(ip) :: h, i, k, j, ndof, nnl, stat
@@ -382,7 +385,7 @@ contains
             if (info /= 0) return
         end if
         allocate (rhs(ndof, nnl + 2))
-        do h = 0, sys%nh
+        do h = h0, sys%nh
             hw = h*w
             sys%d%ab = cmplx(sys%dband(:, :, 1) - hw*hw*sys%dband(:, :, 2), &
                              hw*sys%dband(:, :, 3), wp)

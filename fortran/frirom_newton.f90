@@ -165,7 +165,7 @@ contains
         real(wp), allocatable :: r(:), rlam(:), ab(:, :), y1(:), r1(:), dy(:), rlam1(:)
         real(wp) :: rref, rn, g, denom, dlam, alpha, phi0, phi1, rn1, rref1, g1, lam1, dxn
         real(wp) :: rate
-        logical :: fresh
+        logical :: fresh, jac_trial, jac_at_y
         character(len=120) :: buf
         integer(ip) :: n, k
         n = sys%n
@@ -184,9 +184,15 @@ contains
         have_fact = .true.
         rn = norm2(r)/max(rref, tiny(1.0_wp))
         g = dot_product(cy, y - yp)/opts%yscale + cl*(lam - lp)/opts%lscale
+        ! without chord steps every iteration takes J at its point: the line search's
+        ! trial evaluations take it too, and the next iteration needs no evaluation
+        jac_trial = .not. opts%reuse_jac
+        jac_at_y = .false.
         do k = 1, opts%max_iter
             iters = k
-            if (k > 1 .and. (.not. opts%reuse_jac .or. rate > opts%reuse_rate)) then
+            if (k > 1 .and. jac_at_y) then
+                fresh = .true.
+            else if (k > 1 .and. (.not. opts%reuse_jac .or. rate > opts%reuse_rate)) then
                 call sys%eval(y, lam, r, rref, .true., rlam, info, errmsg)
                 if (info /= 0) return
                 fresh = .true.
@@ -229,8 +235,9 @@ contains
             do
                 y1 = y + alpha*dy
                 lam1 = lam + alpha*dlam
-                call sys%eval(y1, lam1, r1, rref1, .false., rlam1, info, errmsg)
+                call sys%eval(y1, lam1, r1, rref1, jac_trial, rlam1, info, errmsg)
                 if (info /= 0) return
+                if (jac_trial .and. present(nfact)) nfact = nfact + 1
                 rn1 = norm2(r1)/max(rref1, tiny(1.0_wp))
                 g1 = dot_product(cy, y1 - yp)/opts%yscale + cl*(lam1 - lp)/opts%lscale
                 phi1 = rn1**2 + g1**2
@@ -248,6 +255,7 @@ contains
             rate = sqrt(phi1/max(phi0, tiny(1.0_wp)))
             y = y1
             lam = lam1
+            jac_at_y = jac_trial
             r = r1
             rlam = rlam1
             rref = rref1

@@ -35,6 +35,10 @@ POINT_ARRAYS = ("omega", "parameter", "X", "amp_max", "state_fractions", "slider
                 "iterations", "fold", "stable")
 
 
+#: a kill whose checkpoint lies after the tip's peak (test_killed_anywhere...)
+PEAK_CUT = 77
+
+
 class Killed(BaseException):
     """Stands for SIGKILL in-process: nothing after it runs, the writer is not closed."""
 
@@ -82,7 +86,9 @@ def test_killed_anywhere_then_resumed_equals_uninterrupted(joint, tmp_path):
     assert full.complete and len(ref) > 50
     stick = ref.state_fractions[:, 0, 0]
     assert stick[0] == stick[-1] == 1.0 and stick.min() < 0.6     # sticks, slips, sticks
-    for k, torn in ((5, False), (21, False), (37, False), (48, True)):
+    assert all(full.peak(j).method == "solve" for j in range(len(d.outputs)))
+    assert full.peak(0).index + 2 < PEAK_CUT - 10   # resumed after the peak's points
+    for k, torn in ((5, False), (21, False), (37, False), (48, True), (PEAK_CUT, False)):
         path = tmp_path / f"cut{k}.h5"
         w = _writer(path, d)
 
@@ -111,6 +117,10 @@ def test_killed_anywhere_then_resumed_equals_uninterrupted(joint, tmp_path):
         rest = frf(model, exc, w0, w1, opts, outputs=d.outputs, sink=w.append, start=start)
         w.close(rest.complete, rest.message)
         _same(FRF.load(path), ref, f"killed after {k}")
+        # the peaks solved on the whole curve (the points before the resume too), the
+        # uninterrupted run's to the bit
+        for j in range(len(d.outputs)):
+            assert rest.peak(j) == full.peak(j), (k, j, rest.peak(j), full.peak(j))
 
 
 def test_ctrl_c_inside_append_waits_for_the_record(joint, tmp_path, monkeypatch):
@@ -172,7 +182,11 @@ def _frirom(*args, script=None):
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
     head = ["-c", script] if script else ["-m", "frirom.cli"]
     return subprocess.Popen([sys.executable, *head, *map(str, args)], env=env,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def _peak_lines(p) -> list:
+    return [x for x in p.stdout.read().splitlines() if x.startswith("frirom: peak of")]
 
 
 #: `frirom run` that SIGKILLs itself when its file holds K points, before the next
@@ -206,6 +220,7 @@ def test_sigkill_then_resume_equals_uninterrupted(deck, tmp_path):
     for bit)."""
     ref = _frirom("run", deck, "--out", tmp_path / "ref", "--quiet")
     assert ref.wait(300) == 0, ref.stderr.read()
+    ref_peaks = _peak_lines(ref)
     ref = FRF.load(tmp_path / "ref" / "frf.h5")
     out = tmp_path / "out"
     resume = []
@@ -222,6 +237,10 @@ def test_sigkill_then_resume_equals_uninterrupted(deck, tmp_path):
     p = _frirom("run", deck, "--out", out, "--quiet", "--resume")
     assert p.wait(300) == 0, p.stderr.read()
     _same(FRF.load(out / "frf.h5"), ref, "after SIGKILLs")
+    # the resumed run reports the uninterrupted run's solved peaks (the deck's last
+    # checkpoint, 71, lies past the peaks)
+    peaks = _peak_lines(p)
+    assert peaks == ref_peaks and len(peaks) == 3 and all("(solve)" in x for x in peaks)
 
 
 def test_second_run_on_a_folder_is_refused_until_the_first_dies(deck, tmp_path, capsys):

@@ -402,7 +402,9 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
             written.append(out / name)
     print(f"frirom: {len(full)} points in {elapsed:.1f} s; wrote "
           + ", ".join(str(p) for p in written))
-    # a resumed run's own peaks cover only its part: the whole file's then (between points)
+    # a resumed run solved its peaks on the whole curve (the file's points before it too)
+    if args.resume and result.peaks is not None and start and start.get("before"):
+        full.peaks = result.peaks
     _print_peaks(full if args.resume else result, deck)
     if not full.complete:
         _print_stop(full, deck, h5)

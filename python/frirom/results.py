@@ -610,8 +610,10 @@ class FRFWriter:
     def resume_point(path) -> dict:
         """The `start` argument of frirom.solver.frf at the file's last checkpoint:
         {'parameter', 'omega', 'unknowns', 'tangent', 'yscale', 'slider', 'ds' (the step
-        the run continued with), 'n_points' (points up to it), with a travelling-wave
-        selection 'leak' (the largest stored FRFPoint.leak up to it, its omega)}. A file
+        the run continued with), 'n_points' (points up to it), 'held_lu' (the solver's
+        held factorisation there), 'before' (the points up to it, FRFPoints: the resumed
+        run solves its peaks on the whole curve), with a travelling-wave selection 'leak'
+        (the largest stored FRFPoint.leak up to it, its omega)}. A file
         written before checkpoints gives its last point without 'ds' (the run resumes with
         the deck's first step); one written before the contact history was kept gives slider None
         (the run resumes from the model's w0, with a warning: a contact stuck all cycle
@@ -645,6 +647,9 @@ class FRFWriter:
                 if "ck_lu" in f and f["ck_lu"][slot][0] != 0.0:
                     state["held_lu"] = f["ck_lu"][slot]
                 slider = f["slider"][nck - 1] if "slider" in f else None
+                before = _points_before(f, nck)
+                if before:
+                    state["before"] = before
                 leak = f["leak"][:nck] if "leak" in f else np.zeros(0)
                 if np.any(np.isfinite(leak)):   # the worst stored leak: the run warns on it
                     k = int(np.nanargmax(leak))
@@ -654,6 +659,27 @@ class FRFWriter:
                               "(sliders); resuming from the model's initial sliders w0",
                               RuntimeWarning, stacklevel=2)
             return {**state, "slider": slider}
+
+
+def _points_before(f, n: int) -> list:
+    """The first n points of an FRFWriter file as FRFPoints, for a resumed run's peak
+    solve on the whole curve (:func:`frirom.solver.frf` with a checkpoint's 'before');
+    [] when the file does not keep what a solve from a point needs (its tangent, scale and
+    history: files written before they were kept)."""
+    need = ("unknowns", "tangent", "yscale", "slider", "parameter", "X", "amp_max")
+    if n == 0 or not all(k in f and f[k].shape[0] >= n for k in need):
+        return []
+    cols = {k: f[k][:n] for k in need + ("omega", "state_fractions", "iterations")}
+    if not (np.all(np.isfinite(cols["tangent"])) and np.all(np.isfinite(cols["yscale"]))
+            and np.all(np.isfinite(cols["slider"]))):
+        return []
+    return [FRFPoint(omega=float(cols["omega"][i]), parameter=float(cols["parameter"][i]),
+                     unknowns=cols["unknowns"][i], tangent=cols["tangent"][i],
+                     X=cols["X"][i], amp_max=cols["amp_max"][i],
+                     state_fractions=cols["state_fractions"][i],
+                     iterations=int(cols["iterations"][i]), time_s=0.0,
+                     yscale=float(cols["yscale"][i]), slider=cols["slider"][i])
+            for i in range(n)]
 
 
 # ---- the readable datasets of a result file (frequency in Hz, harmonics' amplitude and
@@ -702,3 +728,6 @@ def _append_readable(f, n: int, p: FRFPoint) -> None:
     _append_row(f, "harmonic_amplitude", n, amp)
     _append_row(f, "harmonic_phase", n, ph)
     _append_row(f, "unknowns", n, p.unknowns)
+    # with the tangent and its scale, a resumed run solves its peak on the whole curve
+    _append_row(f, "tangent", n, p.tangent)
+    _append_row(f, "yscale", n, p.yscale)

@@ -77,6 +77,7 @@ class _Continuation:
     points: list = field(default_factory=list)
     timings: dict = field(default_factory=dict)
     n_before: int = 0             # points a resumed run made before (count to max_points)
+    before: list = field(default_factory=list)  # those points, when the checkpoint has them
     leak_before: tuple | None = None  # their largest leak and its omega (FRFWriter file)
     t0: float = 0.0               # perf_counter at the start of the current call
 
@@ -132,6 +133,8 @@ class _Continuation:
                                     held_lu=start.get("held_lu"))
             # the stored points' worst leak, whichever way the run goes on from them
             self.leak_before = start.get("leak")
+            if self.n_before and len(start.get("before") or ()) == self.n_before:
+                self.before = list(start["before"])
         add_timings(self.timings, timings)
 
     def _emit(self, p: FRFPoint) -> None:
@@ -238,7 +241,9 @@ def _run_curve(packed: _Packed, lam_start, lam_end, sink, start, H_start) -> FRF
     complete, message = run.batches()
     out = run.finish(complete, message)
     if packed.opts.refine_peak and packed.opts.parameter == "frequency" and run.points:
-        out.peaks, solved = refine_peaks(packed, run.points, run.lscale)
+        # a resumed run: the peak of the whole curve, as the uninterrupted run solves it
+        # (Peak.index then counts the points before the resume)
+        out.peaks, solved = refine_peaks(packed, run.before + run.points, run.lscale)
         if packed.keep is not None:
             k = int(np.argmax([q.leak for q in solved])) if solved else -1
             if k >= 0:
