@@ -617,17 +617,35 @@ contains
         call hbm_contact_forces(this, y, .false., info, errmsg, carry=.true.)
     end procedure hbm_accept
 
-    module procedure hbm_sliders
-        integer(ip) :: g, k, nsl
-        k = 0
+    module procedure hbm_slider_offsets
+        integer(ip) :: g
+        allocate (k0(size(sys%cs%grp) + 1))
+        k0(1) = 0
         do g = 1, size(sys%cs%grp)
-            associate (gr => sys%cs%grp(g))
-                nsl = law_nslider(gr%law)
-                if (nsl == 0) cycle
-                w(k + 1:k + nsl*gr%ne) = reshape(gr%w0(1:nsl, :), [nsl*gr%ne])
-                k = k + nsl*gr%ne
-            end associate
+            k0(g + 1) = k0(g) + law_nslider(sys%cs%grp(g)%law)*sys%cs%grp(g)%ne
+        end do
+    end procedure hbm_slider_offsets
+
+    module procedure hbm_sliders
+        integer(ip), allocatable :: k0(:)
+        integer(ip) :: g
+        k0 = hbm_slider_offsets(sys)
+        do g = 1, size(k0) - 1
+            if (k0(g + 1) == k0(g)) cycle
+            w(k0(g) + 1:k0(g + 1)) = reshape(sys%cs%grp(g)%w0(1:(k0(g + 1) - k0(g))/ &
+                                             sys%cs%grp(g)%ne, :), [k0(g + 1) - k0(g)])
         end do
     end procedure hbm_sliders
+
+    module procedure hbm_set_sliders
+        integer(ip), allocatable :: k0(:)
+        integer(ip) :: g, ne
+        k0 = hbm_slider_offsets(sys)
+        do g = 1, size(k0) - 1
+            ne = sys%cs%grp(g)%ne
+            if (k0(g + 1) > k0(g)) sys%cs%grp(g)%w0(1:(k0(g + 1) - k0(g))/ne, :) = &
+                reshape(w(k0(g) + 1:k0(g + 1)), [(k0(g + 1) - k0(g))/ne, ne])
+        end do
+    end procedure hbm_set_sliders
 
 end submodule frirom_hbm_contacts

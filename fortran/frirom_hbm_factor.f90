@@ -6,7 +6,6 @@
 submodule (frirom_hbm:frirom_hbm_condensed) frirom_hbm_factor
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_ALLOC, FRIROM_ERR_LAPACK, &
                              FRIROM_ERR_SINGULAR, set_status
-    use frirom_aft, only: law_nslider
     use frirom_status, only: FRIROM_ERR_SIZE
     use frirom_linsolve, only: lin_operator, fgmres, held_lu_factor, held_lu_apply, &
                                woodbury_reset, woodbury_alloc, woodbury_finish, &
@@ -72,7 +71,7 @@ contains
             sys%luy = sys%jy
             sys%lulam = sys%jlam
             if (allocated(sys%luw)) deallocate (sys%luw)
-            allocate (sys%luw(max(n_sliders(sys), 1)))
+            allocate (sys%luw(max(nsl_of(sys), 1)))
             call hbm_sliders(sys, sys%luw)
         end if
         sys%gm_spent = 0.0_wp
@@ -200,7 +199,7 @@ contains
         nv = 1
         select type (sys => sysc)
         type is (hbm_condensed)
-            nv = 8 + sys%n + n_sliders(sys)
+            nv = 8 + sys%n + nsl_of(sys)
         end select
     end procedure hbm_lu_state_size
 
@@ -211,7 +210,7 @@ contains
         type is (hbm_condensed)
             if (.not. (sys%lu_any .and. allocated(sys%luy))) return
             n = sys%n
-            nw = n_sliders(sys)
+            nw = nsl_of(sys)
             v(1:8) = [1.0_wp, merge(1.0_wp, 0.0_wp, sys%held%single), sys%lulam, &
                       sys%gm_spent, merge(1.0_wp, 0.0_wp, sys%refresh), 1.0_wp, &
                       merge(1.0_wp, 0.0_wp, sys%lu_fresh), merge(1.0_wp, 0.0_wp, sys%gm_next)]
@@ -229,7 +228,7 @@ contains
         select type (sys => sysc)
         type is (hbm_condensed)
             n = sys%n
-            nw = n_sliders(sys)
+            nw = nsl_of(sys)
             if (size(v) /= 8 + n + nw .or. .not. all(abs(v) <= huge(1.0_wp))) then
                 call set_status(info, FRIROM_ERR_SIZE, errmsg, 'held LU state: '// &
                                 'hbm_lu_state_size finite values of this system expected')
@@ -238,13 +237,13 @@ contains
             if (v(1) == 0.0_wp) return
             allocate (r(n), rlam(n), wnow(max(nw, 1)))
             call hbm_sliders(sys, wnow)
-            call set_w0(sys, v(9 + n:8 + n + nw))
+            call hbm_set_sliders(sys, v(9 + n:8 + n + nw))
             call sys%eval(v(9:8 + n), v(3), r, rref, .true., rlam, info, errmsg)
             if (info == 0 .and. v(2) == 0.0_wp .and. sys%held%single) then
                 ! the double LU a single one gave way to (cond_solve)
                 call cond_factor(sys, info, errmsg, double=.true.)
             end if
-            call set_w0(sys, wnow(1:nw))
+            call hbm_set_sliders(sys, wnow(1:nw))
             if (info /= 0) return
             sys%gm_spent = v(4)
             sys%refresh = v(5) /= 0.0_wp
@@ -255,30 +254,12 @@ contains
     end procedure hbm_lu_rebuild
 
     !> Sliders of a system's contact groups (hbm_sliders' layout).
-    integer(ip) function n_sliders(sys)
+    integer(ip) function nsl_of(sys)
         type(hbm_condensed), intent(in) :: sys
-        integer(ip) :: g
-        n_sliders = 0
-        do g = 1, size(sys%cs%grp)
-            n_sliders = n_sliders + law_nslider(sys%cs%grp(g)%law)*sys%cs%grp(g)%ne
-        end do
-    end function n_sliders
-
-    !> The groups' contact history w0 from w (hbm_sliders' layout).
-    subroutine set_w0(sys, w)
-        type(hbm_condensed), intent(inout) :: sys
-        real(wp), intent(in) :: w(:)
-        integer(ip) :: g, k, nsl
-        k = 0
-        do g = 1, size(sys%cs%grp)
-            associate (gr => sys%cs%grp(g))
-                nsl = law_nslider(gr%law)
-                if (nsl == 0) cycle
-                gr%w0(1:nsl, :) = reshape(w(k + 1:k + nsl*gr%ne), [nsl, gr%ne])
-                k = k + nsl*gr%ne
-            end associate
-        end do
-    end subroutine set_w0
+        integer(ip), allocatable :: k0(:)
+        k0 = hbm_slider_offsets(sys)
+        nsl_of = k0(size(k0))
+    end function nsl_of
 
     !> y = J x: the assembled jcur, or matrix-free (jfree: modal route) as
     !> x + R_h G^T J_loc G x at the Jacobian's frequency, element by element and mode by

@@ -385,12 +385,11 @@ contains
 
     !> Set the contact history (w: nw sliders in the layout of w0).
     subroutine run_set_sliders(run, w, info, errmsg)
-        use frirom_aft, only: law_nslider
+        use frirom_hbm, only: hbm_set_sliders
         type(run_t), intent(inout) :: run
         real(wp), intent(in) :: w(:)
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
-        integer(ip) :: g, k, nsl
         info = FRIROM_OK
         if (.not. run%built) then
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'run_set_sliders: the run is not open')
@@ -406,15 +405,7 @@ contains
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'sliders: contains NaN or Inf')
             return
         end if
-        k = 0
-        do g = 1, size(run%sys%cs%grp)
-            associate (gr => run%sys%cs%grp(g))
-                nsl = law_nslider(gr%law)
-                if (nsl == 0) cycle
-                gr%w0(1:nsl, :) = reshape(w(k + 1:k + nsl*gr%ne), [nsl, gr%ne])
-                k = k + nsl*gr%ne
-            end associate
-        end do
+        call hbm_set_sliders(run%sys, w)
     end subroutine run_set_sliders
 
     !> Settings that would change the outcome of a run stopped at ds_min (status

@@ -36,7 +36,7 @@ POINT_ARRAYS = ("omega", "parameter", "X", "amp_max", "state_fractions", "slider
 
 
 #: a kill whose checkpoint lies after the tip's peak (test_killed_anywhere...)
-PEAK_CUT = 77
+PEAK_CUT = 87
 
 
 class Killed(BaseException):
