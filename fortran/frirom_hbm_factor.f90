@@ -6,7 +6,7 @@
 submodule (frirom_hbm:frirom_hbm_condensed) frirom_hbm_factor
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_ALLOC, FRIROM_ERR_LAPACK, &
                              FRIROM_ERR_SINGULAR, set_status
-    use frirom_status, only: FRIROM_ERR_SIZE
+    use frirom_status, only: FRIROM_ERR_SIZE, FRIROM_ERR_PARAM
     use frirom_linsolve, only: lin_operator, fgmres, held_lu_factor, held_lu_apply, &
                                woodbury_reset, woodbury_alloc, woodbury_finish, &
                                woodbury_prepare
@@ -234,7 +234,19 @@ contains
                                 'hbm_lu_state_size finite values of this system expected')
                 return
             end if
+            if (.not. (all(v(1:8:1) == 0.0_wp .or. v(1:8:1) == 1.0_wp .or. &
+                           [.false., .false., .true., .true., .false., .false., .false., &
+                            .false.]) .and. v(4) >= 0.0_wp)) then
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'held LU state: flags '// &
+                                '(entries 1, 2, 5-8) 0 or 1 and a count (4) >= 0 expected')
+                return
+            end if
             if (v(1) == 0.0_wp) return
+            if (v(2) == 1.0_wp .and. .not. holds(sys)) then
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'held LU state: a '// &
+                                'single-precision LU, which this system does not hold')
+                return
+            end if
             allocate (r(n), rlam(n), wnow(max(nw, 1)))
             call hbm_sliders(sys, wnow)
             call hbm_set_sliders(sys, v(9 + n:8 + n + nw))
@@ -245,11 +257,13 @@ contains
             end if
             call hbm_set_sliders(sys, wnow(1:nw))
             if (info /= 0) return
+            ! lu_fresh and gm_next (v(7:8)) are not taken: the next evaluation with a
+            ! Jacobian sets both, as it does in the run that wrote the state
             sys%gm_spent = v(4)
             sys%refresh = v(5) /= 0.0_wp
             sys%lu_any = v(6) /= 0.0_wp
-            sys%lu_fresh = v(7) /= 0.0_wp
-            sys%gm_next = v(8) /= 0.0_wp
+            sys%lu_fresh = .false.
+            sys%gm_next = .false.
         end select
     end procedure hbm_lu_rebuild
 

@@ -384,6 +384,14 @@ def test_resume_exact_when_the_solver_carries_its_lu(tmp_path):
     rest = frf(model, exc, w0, w1, opts, outputs=out, sink=w.append, start=start)
     w.close(rest.complete, rest.message)
     _same(FRF.load(path), ref, "resumed with a carried LU")
+    # a tampered state is refused by name, not used (a flag of -1 made GMRES run on a
+    # Jacobian never formed: tests/fuzz_capi.c found it through the C checkpoint)
+    from frirom import FriromError
+    for at, junk in ((7, -1.0), (0, 0.5), (3, -2.0)):
+        bad = dict(start, held_lu=start["held_lu"].copy())
+        bad["held_lu"][at] = junk
+        with pytest.raises(FriromError, match="held LU state"):
+            frf(model, exc, w0, w1, opts, outputs=out, start=bad)
     # the same resume with a fresh LU: not the uninterrupted path (7.9e-13 off with one
     # BLAS thread; at point 21 the fresh LU happens to give the same path)
     del start["held_lu"]
