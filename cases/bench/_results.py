@@ -89,10 +89,14 @@ def machine() -> dict:
 
 def commit() -> dict:
     def git(*args):
-        r = subprocess.run(["git", "-C", str(ROOT), *args], capture_output=True, text=True)
+        try:
+            r = subprocess.run(["git", "-C", str(ROOT), *args], capture_output=True,
+                               text=True)
+        except OSError:         # no git (a source tarball): no commit recorded
+            return None
         return r.stdout.strip() if r.returncode == 0 else None
     status = git("status", "--porcelain", "--untracked-files=no")
-    return {"commit": git("rev-parse", "HEAD"), "dirty": bool(status)}
+    return {"commit": git("rev-parse", "HEAD"), "dirty": None if status is None else bool(status)}
 
 
 def write(name: str, lines: list[str], argv: list[str], seconds: float, code,
