@@ -13,6 +13,9 @@ module frirom_capi
                           RUN_SOLVE_FIXED
     implicit none
     private
+    !> The largest frequency a C caller may give (rad/s), as decks (frirom MAX_OMEGA): the
+    !> dynamic stiffness K - omega^2 M stays finite.
+    real(wp), parameter :: MAX_OMEGA = 1.0e9_wp
     public :: frirom_aft_eval_c, frirom_status_message_c, frirom_settings_default_c, frirom_frf_c
     public :: frirom_run_open_c, frirom_run_sizes_c, frirom_run_set_modes_c, &
               frirom_run_set_selection_c, frirom_run_start_c, frirom_run_advance_c, &
@@ -434,9 +437,9 @@ contains
         call get_run(run, 'frirom_run_solve_at', r, st, text)
         if (st == FRIROM_OK .and. .not. (present(xo) .and. present(amp))) call set_status(st, &
             FRIROM_ERR_PARAM, text, 'frirom_run_solve_at: xo, amp: NULL')
-        if (st == FRIROM_OK .and. .not. (omega > 0 .and. omega <= huge(omega))) &
+        if (st == FRIROM_OK .and. .not. (omega > 0 .and. omega <= MAX_OMEGA)) &
             call set_status(st, FRIROM_ERR_PARAM, text, 'frirom_run_solve_at: omega: a '// &
-                            'finite frequency > 0 (rad/s) expected')
+                            'frequency > 0 and <= 1e9 (rad/s) expected')
         if (st == FRIROM_OK) then
             allocate (ys(r%ny))
             ys = 0.0_wp
@@ -593,13 +596,14 @@ contains
         real(c_double), intent(in) :: omega_start, omega_end
         integer(ip), intent(inout) :: st
         character(len=*), intent(inout) :: text
-        if (.not. (omega_start > 0 .and. omega_start <= huge(1.0_wp))) then
+        if (.not. (omega_start > 0 .and. omega_start <= MAX_OMEGA)) then
             call set_status(st, FRIROM_ERR_PARAM, text, who//': omega_start: finite '// &
-                            'positive frequencies (rad/s) expected')
-        else if (.not. (omega_end > 0 .and. omega_end <= huge(1.0_wp) &
+                            'positive frequencies (rad/s) up to 1e9 expected')
+        else if (.not. (omega_end > 0 .and. omega_end <= MAX_OMEGA &
                         .and. omega_end /= omega_start)) then
             call set_status(st, FRIROM_ERR_PARAM, text, who//': omega_end: finite '// &
-                            'positive frequencies (rad/s), other than omega_start, expected')
+                            'positive frequencies (rad/s) up to 1e9, other than omega_start,'// &
+                            ' expected')
         end if
     end subroutine check_range
 

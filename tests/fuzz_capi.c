@@ -10,7 +10,8 @@
  * stopped process, and every refusal carries a message.
  *
  *   fuzz_capi [random cases, default 400] [seed, default 25]
- *   fuzz_capi one SEED      (one random case in this process, to debug a failure)
+ *   fuzz_capi one SEED      (one random case in this process, to debug a failure;
+ *                            FUZZ_CAPI_VERBOSE=1 prints the mutated model and the calls)
  * Exit code 0 when every case passed; prints one line per failure and a summary. */
 #include <math.h>
 #include <signal.h>
@@ -422,6 +423,9 @@ static void named_cases(void) {
     OPENED("start NaN", "omega_start", frirom_run_start(run, NAN, 200, msg, MSG));
     OPENED("start end Inf", "omega_end", frirom_run_start(run, 60, INFINITY, msg, MSG));
     OPENED("start negative", "positive", frirom_run_start(run, -60, 200, msg, MSG));
+    OPENED("start huge", "omega_start", frirom_run_start(run, 6e301, 200, msg, MSG));
+    OPENED("solve_at huge", "omega", frirom_run_solve_at(run, 1e200, NULL, NULL, out_xo,
+           out_amp, msg, MSG));
     OPENED("start equal ends", "omega", frirom_run_start(run, 60, 60, msg, MSG));
     OPENED("set_modes nmodes 0", "nmodes", frirom_run_set_modes(run, 0, x, x, x, msg, MSG));
     OPENED("set_modes phi NULL", "phi", frirom_run_set_modes(run, 1, NULL, x, x, msg, MSG));
@@ -466,6 +470,7 @@ static void named_cases(void) {
 
 #define CHECK(call, expr)                                                                 \
     msg[0] = '\0';                                                                        \
+    if (getenv("FUZZ_CAPI_VERBOSE")) printf("%s\n", #expr), fflush(stdout);              \
     rc = (expr);                                                                          \
     if (rc != 0 && msg[0] == '\0') {                                                      \
         printf("FAIL %s: %s returned %d without a message\n", what, call, rc);            \
@@ -481,6 +486,20 @@ static void random_case(const char *what) {
     model_init(&m);
     int nmut = 1 + (int)rnd(3);
     for (int k = 0; k < nmut; ++k) mutate(&m);
+    if (getenv("FUZZ_CAPI_VERBOSE")) {  /* what was mutated, for a failing seed */
+        printf("n %d nk %d nm %d ncd %d nzeta %d ngroup %d ng %d npar %d nw %d nout %d sparse %d"
+               "\nH %d samples %d formulation %d max_points %d max_iter %d batch %d reuse %d "
+               "history %d stability %d\ntol %g %g %g ds %g %g %g alpha %g beta %g\n", m.n,
+               m.nk, m.nm, m.ncd, m.nzeta, m.ngroup, m.ng, m.npar, m.nw, m.nout, m.sparse,
+               m.s.harmonics, m.s.samples, m.s.formulation, m.s.max_points, m.s.max_iter,
+               m.s.batch, m.s.reuse_jacobian, m.s.history, m.s.stability, m.s.tol_residual,
+               m.s.tol_update, m.s.tol_stall, m.s.ds, m.s.ds_min, m.s.ds_max, m.alpha, m.beta);
+        for (int i = 0; i < 4; ++i)
+            printf("k %d %d %g  m %d %d %g  g %d %d %g  p %g  fe %g  out %d  ginfo %d\n",
+                   m.kr[i], m.kc[i], m.kv[i], m.mr[i], m.mc[i], m.mv[i], m.gr[i], m.gc[i],
+                   m.gv[i], m.params[i], m.fe[i], m.outdofs[i], m.ginfo[i]);
+        fflush(stdout);
+    }
     if (rnd(4) == 0) {
         int maxpts = m.s.max_points > 0 ? m.s.max_points : 1;
         if (maxpts > room(&m, 0)) return;  /* the caller would not have the room */
@@ -504,7 +523,11 @@ static void random_case(const char *what) {
         } else if (call == 1 && nck > 0 && nck < CAP) {
             CHECK("frirom_run_checkpoint",
                   frirom_run_checkpoint(run, rnd(3) ? nck : bad_count(nck), ck, msg, MSG));
-            if (rnd(2)) ck[rnd((unsigned)nck)] = bad_double(1.0);
+            if (rnd(2)) {
+                unsigned at = rnd((unsigned)nck);
+                ck[at] = bad_double(1.0);
+                if (getenv("FUZZ_CAPI_VERBOSE")) printf("ck[%u] = %g\n", at, ck[at]);
+            }
             CHECK("frirom_run_restore", frirom_run_restore(run, nck, ck, msg, MSG));
         } else {
             CHECK("frirom_run_advance", frirom_run_advance(run, k, &npts, out_omega, out_xo,
