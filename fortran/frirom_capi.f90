@@ -13,6 +13,9 @@ module frirom_capi
                           RUN_SOLVE_FIXED
     implicit none
     private
+    !> The largest frequency a C caller may give (rad/s), as decks (frirom MAX_OMEGA): the
+    !> dynamic stiffness K - omega^2 M stays finite.
+    real(wp), parameter :: MAX_OMEGA = 1.0e9_wp
     public :: frirom_aft_eval_c, frirom_status_message_c, frirom_settings_default_c, frirom_frf_c
     public :: frirom_run_open_c, frirom_run_sizes_c, frirom_run_set_modes_c, &
               frirom_run_set_selection_c, frirom_run_start_c, frirom_run_advance_c, &
@@ -90,6 +93,7 @@ contains
                 wp0 => wzero
             end if
             call aft_plan_create(plan, int(nharm, ip), int(nsamp, ip), st, text)
+            if (st /= FRIROM_OK) text = 'frirom_aft_eval: nsamp: '//trim(text)
         end if
         if (st == FRIROM_OK) then
             if (c_associated(jac)) then
@@ -98,6 +102,7 @@ contains
             else
                 call aft_eval(plan, int(law, ip), xp, pp, wp0, fp, st, text, periods=per)
             end if
+            if (st /= FRIROM_OK) text = 'frirom_aft_eval (x, params, w0): '//trim(text)
             if (c_associated(periods)) then
                 call c_f_pointer(periods, perp, [ne])
                 perp = int(per, c_int)
@@ -110,8 +115,8 @@ contains
 
     !> void frirom_settings_default(struct frirom_settings *s)
     subroutine frirom_settings_default_c(s) bind(c, name='frirom_settings_default')
-        type(frf_settings), intent(out) :: s
-        s = frf_settings()
+        type(frf_settings), intent(out), optional :: s
+        if (present(s)) s = frf_settings()
     end subroutine frirom_settings_default_c
 
     !> int frirom_frf(...): the whole forced-response solve of frirom_solve frf_solve for C
@@ -124,13 +129,13 @@ contains
         integer(c_int), value :: n, nk, nm, ncd, nzeta, ngroup, ng, npar, nw, nout, maxpts, &
                                  nycap, msglen
         real(c_double), value :: alpha, beta, omega_start, omega_end
-        integer(c_int), intent(in) :: kr(*), kc(*), mr(*), mc(*), cr(*), cc(*), ginfo(*), &
-                                      gr(*), gc(*), outdofs(*)
-        real(c_double), intent(in) :: kv(*), mv(*), cv(*), zeta(*), gv(*), params(*), w0(*), &
-                                      fe(*)
-        type(frf_settings), intent(in) :: s
-        integer(c_int), intent(out) :: npts, complete, ny
-        real(c_double), intent(out) :: omega(*), xo(*), amp(*)
+        integer(c_int), intent(in), optional :: kr(*), kc(*), mr(*), mc(*), cr(*), cc(*), &
+                                                ginfo(*), gr(*), gc(*), outdofs(*)
+        real(c_double), intent(in), optional :: kv(*), mv(*), cv(*), zeta(*), gv(*), &
+                                                params(*), w0(*), fe(*)
+        type(frf_settings), intent(in), optional :: s
+        integer(c_int), intent(out), optional :: npts, complete, ny
+        real(c_double), intent(out), optional :: omega(*), xo(*), amp(*)
         type(c_ptr), value :: y, msg
         integer(c_int) :: info
         type(frf_result) :: res
@@ -138,22 +143,35 @@ contains
         integer(ip) :: nc, k, st
         character(len=512) :: text
 
+        text = ''
+        st = FRIROM_OK
+        if (.not. (present(npts) .and. present(complete) .and. present(ny))) then
+            call set_status(st, FRIROM_ERR_PARAM, text, 'frirom_frf: npts, complete, ny: '// &
+                            'NULL (pointers to the results expected)')
+            call to_c_string(text, msg, msglen)
+            info = int(st, c_int)
+            return
+        end if
         npts = 0
         complete = 0
         ny = 0
-        nc = 2*s%harmonics + 1
-        text = ''
-        st = FRIROM_OK
-        call check_counts('frirom_frf', [n, nk, nm, ncd, nzeta, ngroup, ng, npar, nw, nout, &
-                                         maxpts, nycap, s%harmonics], 'n nk nm ncd nzeta '// &
-                          'ngroup ng npar nw nout maxpts nycap settings.harmonics', st, text)
+        call check_model('frirom_frf', n, nk, kr, kc, kv, nm, mr, mc, mv, ncd, cr, cc, cv, &
+                         alpha, beta, nzeta, zeta, ngroup, ginfo, ng, gr, gc, gv, npar, &
+                         params, nw, w0, fe, nout, outdofs, s, st, text)
+        if (st == FRIROM_OK) call check_counts('frirom_frf', [maxpts, nycap], &
+                                               'maxpts nycap', st, text)
+        if (st == FRIROM_OK) call check_range('frirom_frf', omega_start, omega_end, st, text)
         if (st /= FRIROM_OK) then
             continue
+        else if (.not. (present(omega) .and. present(xo) .and. present(amp))) then
+            call set_status(st, FRIROM_ERR_PARAM, text, 'frirom_frf: omega, xo, amp: NULL '// &
+                            '(room for maxpts points expected)')
         else if (maxpts < s%max_points) then
             call set_status(st, FRIROM_ERR_SIZE, text, 'frirom_frf: maxpts (the room in '// &
                             'omega, xo, amp, y) must be >= settings.max_points')
         end if
         if (st == FRIROM_OK) then
+            nc = 2*s%harmonics + 1
             if (nw > 0) then
                 call frf_solve(n, kr(:nk) + 1, kc(:nk) + 1, kv(:nk), mr(:nm) + 1, mc(:nm) + 1, &
                                mv(:nm), cr(:ncd) + 1, cc(:ncd) + 1, cv(:ncd), alpha, beta, &
@@ -199,29 +217,35 @@ contains
                                alpha, beta, nzeta, zeta, ngroup, ginfo, ng, gr, gc, gv, npar, &
                                params, nw, w0, fe, nout, outdofs, s, sparse, msg, msglen) &
         result(info) bind(c, name='frirom_run_open')
-        type(c_ptr), intent(out) :: run
+        type(c_ptr), intent(out), optional :: run
         integer(c_int), value :: n, nk, nm, ncd, nzeta, ngroup, ng, npar, nw, nout, sparse, &
                                  msglen
         real(c_double), value :: alpha, beta
-        integer(c_int), intent(in) :: kr(*), kc(*), mr(*), mc(*), cr(*), cc(*), ginfo(*), &
-                                      gr(*), gc(*), outdofs(*)
-        real(c_double), intent(in) :: kv(*), mv(*), cv(*), zeta(*), gv(*), params(*), w0(*), &
-                                      fe(*)
-        type(frf_settings), intent(in) :: s
+        integer(c_int), intent(in), optional :: kr(*), kc(*), mr(*), mc(*), cr(*), cc(*), &
+                                                ginfo(*), gr(*), gc(*), outdofs(*)
+        real(c_double), intent(in), optional :: kv(*), mv(*), cv(*), zeta(*), gv(*), &
+                                                params(*), w0(*), fe(*)
+        type(frf_settings), intent(in), optional :: s
         type(c_ptr), value :: msg
         integer(c_int) :: info
         type(run_t), pointer :: r
         integer(ip) :: st, nc
         character(len=512) :: text
-        run = c_null_ptr
         text = ''
         st = FRIROM_OK
-        nc = 2*s%harmonics + 1
-        call check_counts('frirom_run_open', [n, nk, nm, ncd, nzeta, ngroup, ng, npar, nw, &
-                                              nout, s%harmonics], &
-                          'n nk nm ncd nzeta ngroup ng npar nw nout settings.harmonics', &
-                          st, text)
+        if (.not. present(run)) then
+            call set_status(st, FRIROM_ERR_PARAM, text, 'frirom_run_open: run: NULL '// &
+                            '(the address of a frirom_run pointer expected)')
+            call to_c_string(text, msg, msglen)
+            info = int(st, c_int)
+            return
+        end if
+        run = c_null_ptr
+        call check_model('frirom_run_open', n, nk, kr, kc, kv, nm, mr, mc, mv, ncd, cr, cc, &
+                         cv, alpha, beta, nzeta, zeta, ngroup, ginfo, ng, gr, gc, gv, npar, &
+                         params, nw, w0, fe, nout, outdofs, s, st, text)
         if (st == FRIROM_OK) then
+            nc = 2*s%harmonics + 1
             allocate (r)
             call frf_open(r, int(n, ip), kr(:nk) + 1, kc(:nk) + 1, kv(:nk), mr(:nm) + 1, &
                           mc(:nm) + 1, mv(:nm), cr(:ncd) + 1, cc(:ncd) + 1, cv(:ncd), alpha, &
@@ -244,11 +268,13 @@ contains
     function frirom_run_sizes_c(run, ny, nw, ne, nck) result(info) &
         bind(c, name='frirom_run_sizes')
         type(c_ptr), value :: run
-        integer(c_int), intent(out) :: ny, nw, ne, nck
+        integer(c_int), intent(out), optional :: ny, nw, ne, nck
         integer(c_int) :: info
         type(run_t), pointer :: r
         integer(ip) :: st
         character(len=512) :: text
+        info = FRIROM_ERR_PARAM
+        if (.not. (present(ny) .and. present(nw) .and. present(ne) .and. present(nck))) return
         ny = 0
         nw = 0
         ne = 0
@@ -270,12 +296,15 @@ contains
         bind(c, name='frirom_run_set_modes')
         type(c_ptr), value :: run, msg
         integer(c_int), value :: nmodes, msglen
-        real(c_double), intent(in) :: phi(*), omega(*), zeta(*)
+        real(c_double), intent(in), optional :: phi(*), omega(*), zeta(*)
         integer(c_int) :: info
         type(run_t), pointer :: r
         integer(ip) :: st, n
         character(len=512) :: text
         call get_run(run, 'frirom_run_set_modes', r, st, text, nmodes, 'nmodes')
+        if (st == FRIROM_OK .and. .not. (present(phi) .and. present(omega) .and. &
+                                         present(zeta))) call set_status(st, &
+            FRIROM_ERR_PARAM, text, 'frirom_run_set_modes: phi, omega, zeta: NULL')
         if (st == FRIROM_OK) then
             n = r%m%ndof
             call run_set_modes(r, reshape(phi(:n*nmodes), [n, int(nmodes, ip)]), &
@@ -291,13 +320,15 @@ contains
         result(info) bind(c, name='frirom_run_set_selection')
         type(c_ptr), value :: run, pair, msg
         integer(c_int), value :: nnl, orbits, msglen
-        integer(c_int), intent(in) :: keep(*)
+        integer(c_int), intent(in), optional :: keep(*)
         integer(c_int) :: info
         type(run_t), pointer :: r
         integer(c_int), pointer :: pp(:)
         integer(ip) :: st, h1
         character(len=512) :: text
         call get_run(run, 'frirom_run_set_selection', r, st, text, nnl, 'nnl')
+        if (st == FRIROM_OK .and. .not. present(keep)) call set_status(st, FRIROM_ERR_PARAM, &
+            text, 'frirom_run_set_selection: keep: NULL')
         if (st == FRIROM_OK) then
             h1 = r%m%nh + 1
             if (c_associated(pair)) then
@@ -327,6 +358,8 @@ contains
         character(len=512) :: text
         text = ''
         call get_run(run, 'frirom_run_start', r, st, text)
+        if (st == FRIROM_OK) call check_range('frirom_run_start', omega_start, omega_end, st, &
+                                              text)
         if (st == FRIROM_OK) call run_start(r, RUN_START_COLD, omega_start, omega_end, st, text)
         call to_c_string(text, msg, msglen)
         info = int(st, c_int)
@@ -340,8 +373,8 @@ contains
         result(info) bind(c, name='frirom_run_advance')
         type(c_ptr), value :: run, y, msg
         integer(c_int), value :: k, msglen
-        integer(c_int), intent(out) :: npts, status
-        real(c_double), intent(out) :: omega(*), xo(*), amp(*)
+        integer(c_int), intent(out), optional :: npts, status
+        real(c_double), intent(out), optional :: omega(*), xo(*), amp(*)
         integer(c_int) :: info
         type(run_t), pointer :: r
         type(run_points) :: p
@@ -349,9 +382,14 @@ contains
         integer(ip) :: st, nout, nc, j, o
         character(len=512) :: text
         text = ''
-        npts = 0
-        status = 0
-        call get_run(run, 'frirom_run_advance', r, st, text)
+        if (present(npts)) npts = 0
+        if (present(status)) status = 0
+        call get_run(run, 'frirom_run_advance', r, st, text, k, 'k')
+        if (st == FRIROM_OK .and. .not. (present(npts) .and. present(status))) &
+            call set_status(st, FRIROM_ERR_PARAM, text, 'frirom_run_advance: npts, status: NULL')
+        if (st == FRIROM_OK .and. .not. (present(omega) .and. present(xo) .and. present(amp))) &
+            call set_status(st, FRIROM_ERR_PARAM, text, 'frirom_run_advance: omega, xo, amp:'// &
+                            ' NULL (room for k + 1 points expected)')
         if (st == FRIROM_OK) call run_advance(r, int(k, ip), p, st, text)
         if (st == FRIROM_OK) then
             nout = r%nout
@@ -387,7 +425,7 @@ contains
         type(c_ptr), value :: run, y0, y, msg
         real(c_double), value :: omega
         integer(c_int), value :: msglen
-        real(c_double), intent(out) :: xo(*), amp(*)
+        real(c_double), intent(out), optional :: xo(*), amp(*)
         integer(c_int) :: info
         type(run_t), pointer :: r
         type(run_points) :: p
@@ -397,13 +435,22 @@ contains
         character(len=512) :: text
         text = ''
         call get_run(run, 'frirom_run_solve_at', r, st, text)
+        if (st == FRIROM_OK .and. .not. (present(xo) .and. present(amp))) call set_status(st, &
+            FRIROM_ERR_PARAM, text, 'frirom_run_solve_at: xo, amp: NULL')
+        if (st == FRIROM_OK .and. .not. (omega > 0 .and. omega <= MAX_OMEGA)) &
+            call set_status(st, FRIROM_ERR_PARAM, text, 'frirom_run_solve_at: omega: a '// &
+                            'frequency > 0 and <= 1e9 (rad/s) expected')
         if (st == FRIROM_OK) then
             allocate (ys(r%ny))
             ys = 0.0_wp
             if (c_associated(y0)) then
                 call c_f_pointer(y0, yv, [r%ny])
                 ys = yv
+                if (.not. all(abs(ys) <= huge(1.0_wp))) call set_status(st, &
+                    FRIROM_ERR_PARAM, text, 'frirom_run_solve_at: y0: NaN or Inf')
             end if
+        end if
+        if (st == FRIROM_OK) then
             call run_solve(r, RUN_SOLVE_FIXED, omega, ys, p, st, text, &
                            cold=.not. c_associated(y0))
         end if
@@ -488,12 +535,13 @@ contains
 
     !> int frirom_run_close(frirom_run **run): free the run, *run = NULL (NULL: nothing)
     function frirom_run_close_c(run) result(info) bind(c, name='frirom_run_close')
-        type(c_ptr), intent(inout) :: run
+        type(c_ptr), intent(inout), optional :: run
         integer(c_int) :: info
         type(run_t), pointer :: r
         integer(ip) :: st
         character(len=512) :: text
         info = 0
+        if (.not. present(run)) return
         if (.not. c_associated(run)) return
         text = ''
         call get_run(run, 'frirom_run_close', r, st, text)
@@ -541,4 +589,184 @@ contains
             a = b + 2
         end do
     end subroutine check_counts
+    !> FRIROM_ERR_PARAM naming omega_start or omega_end unless both are finite, positive
+    !> and different.
+    subroutine check_range(who, omega_start, omega_end, st, text)
+        character(len=*), intent(in) :: who
+        real(c_double), intent(in) :: omega_start, omega_end
+        integer(ip), intent(inout) :: st
+        character(len=*), intent(inout) :: text
+        if (.not. (omega_start > 0 .and. omega_start <= MAX_OMEGA)) then
+            call set_status(st, FRIROM_ERR_PARAM, text, who//': omega_start: finite '// &
+                            'positive frequencies (rad/s) up to 1e9 expected')
+        else if (.not. (omega_end > 0 .and. omega_end <= MAX_OMEGA &
+                        .and. omega_end /= omega_start)) then
+            call set_status(st, FRIROM_ERR_PARAM, text, who//': omega_end: finite '// &
+                            'positive frequencies (rad/s) up to 1e9, other than omega_start,'// &
+                            ' expected')
+        end if
+    end subroutine check_range
+
+    !> The C side of a model's arguments (frirom_frf, frirom_run_open), each failure naming
+    !> the argument: settings not NULL, counts >= 0 (n >= 1), no NULL array that a count
+    !> asks for, 0-based indices in range, finite values, npar and nw that fit the groups.
+    subroutine check_model(who, n, nk, kr, kc, kv, nm, mr, mc, mv, ncd, cr, cc, cv, alpha, &
+                           beta, nzeta, zeta, ngroup, ginfo, ng, gr, gc, gv, npar, params, &
+                           nw, w0, fe, nout, outdofs, s, st, text)
+        character(len=*), intent(in) :: who
+        integer(c_int), intent(in) :: n, nk, nm, ncd, nzeta, ngroup, ng, npar, nw, nout
+        real(c_double), intent(in) :: alpha, beta
+        integer(c_int), intent(in), optional :: kr(*), kc(*), mr(*), mc(*), cr(*), cc(*), &
+                                                ginfo(*), gr(*), gc(*), outdofs(*)
+        real(c_double), intent(in), optional :: kv(*), mv(*), cv(*), zeta(*), gv(*), &
+                                                params(*), w0(*), fe(*)
+        type(frf_settings), intent(in), optional :: s
+        integer(ip), intent(out) :: st
+        character(len=*), intent(inout) :: text
+        integer(ip) :: g, nrows, np, nsl, nc
+        st = FRIROM_OK
+        if (.not. present(s)) then
+            call set_status(st, FRIROM_ERR_PARAM, text, who//': settings: NULL '// &
+                            '(frirom_settings_default fills one)')
+            return
+        end if
+        call check_counts(who, [n, nk, nm, ncd, nzeta, ngroup, ng, npar, nw, nout, &
+                                s%harmonics], 'n nk nm ncd nzeta ngroup ng npar nw nout '// &
+                          'settings.harmonics', st, text)
+        if (st /= FRIROM_OK) return
+        nc = 2*s%harmonics + 1
+        if (n < 1) then
+            call bad('n: expected >= 1 DoF')
+        else if (nzeta > n) then
+            call bad('nzeta: at most n modal damping ratios expected')
+        else if (nk > 0 .and. .not. (present(kr) .and. present(kc) .and. present(kv))) then
+            call bad('kr, kc, kv: NULL with nk > 0')
+        else if (nm > 0 .and. .not. (present(mr) .and. present(mc) .and. present(mv))) then
+            call bad('mr, mc, mv: NULL with nm > 0')
+        else if (ncd > 0 .and. .not. (present(cr) .and. present(cc) .and. present(cv))) then
+            call bad('cr, cc, cv: NULL with ncd > 0')
+        else if (nzeta > 0 .and. .not. present(zeta)) then
+            call bad('zeta: NULL with nzeta > 0')
+        else if (ngroup > 0 .and. .not. present(ginfo)) then
+            call bad('ginfo: NULL with ngroup > 0')
+        else if (ng > 0 .and. .not. (present(gr) .and. present(gc) .and. present(gv))) then
+            call bad('gr, gc, gv: NULL with ng > 0')
+        else if (npar > 0 .and. .not. present(params)) then
+            call bad('params: NULL with npar > 0')
+        else if (nw > 0 .and. .not. present(w0)) then
+            call bad('w0: NULL with nw > 0')
+        else if (.not. present(fe)) then
+            call bad('fe: NULL (n x (2H+1) excitation harmonics expected)')
+        else if (nout > 0 .and. .not. present(outdofs)) then
+            call bad('outdofs: NULL with nout > 0')
+        end if
+        if (st /= FRIROM_OK) return
+        if (nk > 0) call triplets('kr', 'kc', 'kv', kr(:nk), kc(:nk), kv(:nk), int(n, ip))
+        if (nm > 0 .and. st == FRIROM_OK) &
+            call triplets('mr', 'mc', 'mv', mr(:nm), mc(:nm), mv(:nm), int(n, ip))
+        if (ncd > 0 .and. st == FRIROM_OK) &
+            call triplets('cr', 'cc', 'cv', cr(:ncd), cc(:ncd), cv(:ncd), int(n, ip))
+        if (st /= FRIROM_OK) return
+        nrows = 0
+        np = 0
+        nsl = 0
+        do g = 1, ngroup
+            call law_check(int(ginfo(3*g - 2), ip), st, text)
+            if (st /= FRIROM_OK) then
+                text = who//': ginfo: '//trim(text)
+                return
+            end if
+            if (ginfo(3*g - 1) < 1 .or. ginfo(3*g) < 1 .or. ginfo(3*g - 1) > huge(1_c_int)/ &
+                max(ginfo(3*g), 1_c_int)/8) then
+                call bad('ginfo: every group needs >= 1 element and direction')
+                return
+            end if
+            nrows = nrows + int(ginfo(3*g - 1), ip)*ginfo(3*g)
+            np = np + law_npar(int(ginfo(3*g - 2), ip))*ginfo(3*g - 1)
+            nsl = nsl + law_nslider(int(ginfo(3*g - 2), ip))*ginfo(3*g - 1)
+        end do
+        if (ng > 0) call triplets('gr', 'gc', 'gv', gr(:ng), gc(:ng), gv(:ng), nrows, &
+                                  int(n, ip))
+        if (st /= FRIROM_OK) return
+        if (npar /= np) then
+            call bad('npar: the groups of ginfo need npar = sum of their elements x '// &
+                     'the parameters of their law')
+        else if (nw > nsl) then
+            call bad('nw: more sliders than the groups of ginfo have')
+        else if (npar > 0) then
+            if (.not. all(abs(params(:npar)) <= huge(1.0_wp))) call bad('params: NaN or Inf')
+        end if
+        if (st /= FRIROM_OK) return
+        call group_params(st)
+        if (st /= FRIROM_OK) return
+        if (nw > 0) then
+            if (.not. all(abs(w0(:nw)) <= huge(1.0_wp))) call bad('w0: NaN or Inf')
+        end if
+        if (st == FRIROM_OK .and. int(n, ip)*nc < huge(1_c_int)) then
+            if (.not. all(abs(fe(:n*nc)) <= huge(1.0_wp))) call bad('fe: NaN or Inf')
+        end if
+        if (st == FRIROM_OK .and. nout > 0) then
+            if (any(outdofs(:nout) < 0 .or. outdofs(:nout) >= n)) &
+                call bad('outdofs: 0-based DoFs below n expected')
+        end if
+    contains
+        !> Each group's parameters as its law admits them (frirom_aft's checks, run on
+        !> one AFT sample of zero motion per element).
+        subroutine group_params(st)
+            integer(ip), intent(inout) :: st
+            type(aft_plan) :: plan
+            integer(ip) :: law, ne, nd, npl, p0
+            real(wp), allocatable :: x(:, :, :), f(:, :, :), w(:, :)
+            character(len=256) :: why
+            call aft_plan_create(plan, 0_ip, 1_ip, st, why)
+            p0 = 0
+            do g = 1, ngroup
+                if (st /= FRIROM_OK) exit
+                law = ginfo(3*g - 2)
+                ne = ginfo(3*g - 1)
+                nd = law_ndir(law)
+                npl = law_npar(law)
+                allocate (x(1, nd, ne), f(1, nd, ne), w(max(law_nslider(law), 1_ip), ne))
+                x = 0.0_wp
+                w = 0.0_wp
+                why = ''
+                call aft_eval(plan, law, x, reshape(params(p0 + 1:p0 + npl*ne), [npl, ne]), &
+                              w, f, st, why)
+                if (st /= FRIROM_OK) text = who//': params of contact group '// &
+                                            trim(itoa(g))//': '//trim(why)
+                p0 = p0 + npl*ne
+                deallocate (x, f, w)
+            end do
+            call aft_plan_destroy(plan)
+        end subroutine group_params
+
+        subroutine bad(what)
+            character(len=*), intent(in) :: what
+            call set_status(st, FRIROM_ERR_PARAM, text, who//': '//what)
+        end subroutine bad
+
+        subroutine triplets(rn, cn, vn, r, c, v, nr, ncol)
+            character(len=*), intent(in) :: rn, cn, vn
+            integer(c_int), intent(in) :: r(:), c(:)
+            real(c_double), intent(in) :: v(:)
+            integer(ip), intent(in) :: nr
+            integer(ip), intent(in), optional :: ncol
+            integer(ip) :: nco
+            nco = nr
+            if (present(ncol)) nco = ncol
+            if (any(r < 0 .or. r >= nr)) then
+                call bad(rn//': a row index outside 0..'//trim(itoa(nr - 1)))
+            else if (any(c < 0 .or. c >= nco)) then
+                call bad(cn//': a column index outside 0..'//trim(itoa(nco - 1)))
+            else if (.not. all(abs(v) <= huge(1.0_wp))) then
+                call bad(vn//': NaN or Inf')
+            end if
+        end subroutine triplets
+    end subroutine check_model
+
+    pure function itoa(i) result(t)
+        integer(ip), intent(in) :: i
+        character(len=24) :: t
+        write (t, '(i0)') i
+    end function itoa
 end module frirom_capi

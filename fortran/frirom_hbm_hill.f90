@@ -9,7 +9,7 @@ submodule (frirom_hbm) frirom_hbm_hill
     use frirom_banded, only: band_init, band_add, band_factor, band_solve
     implicit none
 
-    !> Arnoldi: eigenvalues wanted per shift at first, at most.
+    !> Eigenvalues Arnoldi wants per shift at first, at most.
     integer(ip), parameter :: NEV0 = 16, NEV_MAX = 256
 
     interface

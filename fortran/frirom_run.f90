@@ -50,14 +50,14 @@ module frirom_run
               ADVISE_TOL_STALL, ADVISE_MAX_ITER, ADVISE_DS_MIN, ADVISE_SAMPLES, &
               N_ISET, N_RSET, COORD_AUTO, COORD_DOFS, COORD_CONTACT
 
-    !> Formulations: unknowns are the contact DoFs' harmonics (Eq. 5-9) or all DoFs'
+    !> The formulations (unknowns): the contact DoFs' harmonics (Eq. 5-9) or all DoFs'
     !> harmonics (banded LU in RCM order).
     integer(ip), parameter :: RUN_CONDENSED = 1, RUN_BANDED = 2
     !> The parameter: the frequency (rad/s), or a load factor at a fixed frequency.
     integer(ip), parameter :: RUN_FREQUENCY = 1, RUN_LOAD = 2
-    !> run_start: from nothing (Newton from the linear solution, then the homotopy start);
-    !> from a point solved at its parameter first; from a point with its tangent (a
-    !> checkpoint when its step is given).
+    !> How run_start begins: from nothing (Newton from the linear solution, then the
+    !> homotopy start); from a point solved at its parameter first; from a point with
+    !> its tangent (a checkpoint when its step is given).
     integer(ip), parameter :: RUN_START_COLD = 0, RUN_START_POINT = 1, RUN_START_RESUME = 2
     !> Why a run stopped (run_t%status): still going, reached the end of its range, made
     !> max_points points, turned back and left the range, a corrector failed.

@@ -42,6 +42,7 @@ int main(void) {
     if (info != 11 || strstr(msg, "law 9 (expected 1 jenkins, 2 normal1d") == NULL) {
         fprintf(stderr, "bad law: info %d msg %s\n", info, msg); return 1;
     }
+    params[0] = kt;
     {   /* frirom_frf: an output DoF out of range, no point computed */
         const int kr[] = {0}, md[] = {0}, ginfo[] = {FRIROM_LAW_JENKINS, 1, 1}, gr[] = {0};
         const int out[] = {3};

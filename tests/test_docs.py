@@ -1,5 +1,6 @@
 """The documentation builds with warnings as errors (scripts/docs.sh: myst pages, the API
-reference from the docstrings, the deck reference) and its examples gallery runs.
+reference from the docstrings, the deck reference), its examples gallery runs, and FORD
+writes the Fortran modules' reference (docs/ford.md).
 
 Slow: a whole Sphinx build from scratch (-E) that executes every examples/plot_*.py.
 """
@@ -41,3 +42,9 @@ def test_docs_build_without_warnings_and_gallery_runs():
     api = (HTML / "api.html").read_text()
     for name in ("frirom.Model", "frirom.frf", "frirom.load_deck", "frirom.craig_bampton"):
         assert f'id="{name}"' in api, name
+    # FORD: a page per Fortran module, linked from the API page, with the comments
+    assert 'href="fortran/index.html"' in api
+    for module in ("frirom_run", "frirom_capi", "frirom_aft", "frirom_hbm"):
+        assert (HTML / "fortran" / "module" / f"{module}.html").is_file(), module
+    run = (HTML / "fortran" / "module" / "frirom_run.html").read_text()
+    assert "How run_start begins" in run

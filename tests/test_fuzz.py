@@ -124,3 +124,31 @@ def test_mutated_results_files_load_or_raise_frirom_errors(results_file, tmp_pat
         from frirom.results import FRF
         f = FRF.load(dst)
         assert np.all(np.isfinite(f.omega)) and np.all(np.isfinite(f.amp_max)), what
+
+
+@pytest.mark.parametrize("kind", range(8))
+def test_every_dataset_junk_without_checksum_is_refused_or_read(results_file, tmp_path,
+                                                                 kind):
+    """Each dataset of a results file replaced by each kind of junk (NaN, text, other
+    shapes, Inf, a scalar, int8, no rows, ones), its checksum removed: read as --resume
+    does or refused by a frirom error. The 10 000-deck campaign found a scalar or empty
+    checkpoint dataset (ck_lu, yscale) and NaN iterations reaching an IndexError."""
+    import shutil
+    import h5py
+    from _mutate import _junk
+
+    class Kind:
+        def randrange(self, n):
+            return kind
+    with h5py.File(results_file) as f:
+        names = sorted(k for k in f if isinstance(f[k], h5py.Dataset))
+    for name in names:
+        dst = tmp_path / f"{name}.h5"
+        shutil.copyfile(results_file, dst)
+        with h5py.File(dst, "a") as f:
+            del f.attrs["content_sha256"]
+            shape = f[name].shape
+            del f[name]
+            f[name] = _junk(Kind(), shape)
+        outcome, exc = try_input(lambda: results_check(dst))
+        _check(outcome, exc, f"{name} junk {kind}")

@@ -208,4 +208,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import record
+    record("aft", main)

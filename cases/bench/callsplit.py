@@ -126,4 +126,5 @@ def main(argv=None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import record
+    record("callsplit", main)

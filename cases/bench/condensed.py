@@ -174,4 +174,5 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    from _results import record
+    record("condensed", main)

@@ -180,4 +180,5 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from _results import record
+    sys.exit(record("fuzz", main))

@@ -140,4 +140,5 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    from _results import record
+    record("gsi", main)

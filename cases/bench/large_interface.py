@@ -504,4 +504,5 @@ def main(a):
 
 
 if __name__ == "__main__":
-    main(ARGS)
+    from _results import record
+    record("large_interface", main, ARGS)

@@ -12,7 +12,7 @@ Models:
   system set up at every call) and on one open run (Run.solve: set up once).
 
 Prints a table (CPU seconds, min of --repeat) and the ratios measured in the same process,
-and writes them with the machine to --json (default cases/bench/results/run.json). Last
+and writes them with the machine to cases/bench/results/run.json (_results.py). Last
 line: the beam's FRF CPU seconds and the per-call speed-up of the open run.
 
     OPENBLAS_NUM_THREADS=1 .venv/bin/python cases/bench/run.py [--repeat 5]
@@ -24,7 +24,6 @@ set-up-every-call lines are measured, for before/after figures.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import platform
 import sys
@@ -98,8 +97,8 @@ def cpu(fn, repeat: int) -> tuple[float, object]:
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--json", default=str(ROOT / "cases" / "bench" / "results" / "run.json"))
     a = ap.parse_args(argv)
+    from _results import add
     import warnings
     warnings.simplefilter("ignore", RuntimeWarning)
     try:
@@ -152,14 +151,7 @@ def main(argv=None) -> None:
         print(f"{'joint: 100 x Run.solve on one open run':<52}{t_run:>10.4f}"
               f"   ({rows['joint_run_vs_solve_point']:.1f}x; same answers to "
               f"{rows['joint_run_max_rel_diff']:.1e})")
-    out = Path(a.json)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps({"machine": {"processor": platform.processor(),
-                                           "machine": platform.machine(),
-                                           "python": sys.version.split()[0],
-                                           "cpus": os.cpu_count(),
-                                           "load": os.getloadavg()},
-                               "results": rows}, indent=1) + "\n")
+    add(results=rows)
     last = f"beam FRF {t:.4f} s CPU ({len(r)} points)"
     if _run is not None:
         last += f"; one-point solves on an open run {rows['joint_run_vs_solve_point']:.1f}x " \
@@ -168,4 +160,5 @@ def main(argv=None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import record
+    record("run", main)

@@ -211,4 +211,5 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    from _results import record
+    record("solver", main)

@@ -182,4 +182,5 @@ def main(argv=None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    from _results import record
+    record("study", main)

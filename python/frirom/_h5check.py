@@ -208,6 +208,10 @@ _ROWS = {"omega": (1, True), "parameter": (1, True), "X": (3, True), "amp_max": 
          "iterations": (1, False), "time_s": (1, True), "slider": (2, False),
          "unknowns": (2, False), "leak": (1, False), "frequency_hz": (1, True),
          "harmonic_amplitude": (3, True), "harmonic_phase": (3, True)}
+#: datasets of a results file whose rows are not the points (the checkpoint slots) or that
+#: may hold more rows than points: their number of dimensions
+_NDIM = {"tangent": 2, "yscale": 1, "ck_scalars": 2, "ck_unknowns": 2, "ck_tangent": 2,
+         "ck_lu": 2}
 #: text attributes of a results file (META_KEYS among them)
 _TEXT = ("parameter_name", "message", "solver_info", "deck_path", "deck_text",
          "solver_settings", "model_fingerprint", "frirom_version", "auto")
@@ -228,8 +232,9 @@ def check_results(f, path) -> None:
         if d.dtype.kind not in "biuf":
             raise InputError(f"{path}: dataset {name!r}: expected numbers, got "
                              f"{'text' if d.dtype.kind in 'SUO' else d.dtype.str}")
-        if name in _ROWS and d.ndim != _ROWS[name][0]:
-            raise InputError(f"{path}: dataset {name!r}: expected {_ROWS[name][0]} "
+        want = _ROWS[name][0] if name in _ROWS else _NDIM.get(name)
+        if want is not None and d.ndim != want:
+            raise InputError(f"{path}: dataset {name!r}: expected {want} "
                              f"dimensions, got shape {d.shape}")
     if "output_dofs" in f and f["output_dofs"].ndim != 1:
         raise InputError(f"{path}: dataset 'output_dofs': expected a list, got shape "

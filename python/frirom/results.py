@@ -637,6 +637,14 @@ class FRFWriter:
                 raise InputError(f"{path}: no point to resume from (the run stopped "
                                  "before its first checkpoint)")
             else:
+                for k in ("ck_scalars", "ck_unknowns", "ck_tangent", "ck_lu"):
+                    if k in f and f[k].shape[0] <= slot or k not in f and k != "ck_lu":
+                        raise InputError(f"{path}: dataset {k!r}: no checkpoint slot {slot} "
+                                         f"(shape {f[k].shape if k in f else 'absent'}); "
+                                         "start a new run (without --resume)")
+                if f["ck_scalars"].shape[1] < 4:
+                    raise InputError(f"{path}: dataset 'ck_scalars': expected 4 values per "
+                                     f"checkpoint, got shape {f['ck_scalars'].shape}")
                 sc = f["ck_scalars"][slot]
                 if int(sc[0]) != nck:
                     raise InputError(f"{path}: inconsistent file: the checkpoint is at point "
@@ -644,7 +652,7 @@ class FRFWriter:
                 state = {"parameter": float(sc[1]), "omega": float(f["omega"][nck - 1]),
                          "unknowns": f["ck_unknowns"][slot], "tangent": f["ck_tangent"][slot],
                          "yscale": float(sc[3]), "ds": float(sc[2]), "n_points": nck}
-                if "ck_lu" in f and f["ck_lu"][slot][0] != 0.0:
+                if "ck_lu" in f and f["ck_lu"].shape[1] and f["ck_lu"][slot][0] != 0.0:
                     state["held_lu"] = f["ck_lu"][slot]
                 slider = f["slider"][nck - 1] if "slider" in f else None
                 before = _points_before(f, nck)
@@ -667,11 +675,11 @@ def _points_before(f, n: int) -> list:
     [] when the file does not keep what a solve from a point needs (its tangent, scale and
     history: files written before they were kept)."""
     need = ("unknowns", "tangent", "yscale", "slider", "parameter", "X", "amp_max")
-    if n == 0 or not all(k in f and f[k].shape[0] >= n for k in need):
+    if n == 0 or not all(k in f and f[k].ndim and f[k].shape[0] >= n for k in need):
         return []
     cols = {k: f[k][:n] for k in need + ("omega", "state_fractions", "iterations")}
-    if not (np.all(np.isfinite(cols["tangent"])) and np.all(np.isfinite(cols["yscale"]))
-            and np.all(np.isfinite(cols["slider"]))):
+    if not all(np.all(np.isfinite(cols[k])) for k in ("tangent", "yscale", "slider",
+                                                        "iterations")):
         return []
     return [FRFPoint(omega=float(cols["omega"][i]), parameter=float(cols["parameter"][i]),
                      unknowns=cols["unknowns"][i], tangent=cols["tangent"][i],
