@@ -290,8 +290,10 @@ program test_newton
     ! Newton at fixed lam = -4, a fresh J every iteration, the update test deciding (tol_r
     ! loose, as where a large static term sets rref): the 4th update (4.7e-8 < tol_x),
     ! taken once R met tol_r (9.7e-8 < 1e-6), is not followed by an evaluation that could
-    ! only confirm it (before: 2 evaluations per iteration, 8; now 7), and the point is
-    ! on the curve to quadratic convergence's next error (|R| 5e-14; tolerance 1e-12)
+    ! only confirm it, and each iteration's J comes from the line search's evaluation at
+    ! its point (one evaluation per iteration: 4; at first 2 per iteration, 8; then 7),
+    ! and the point is on the curve to quadratic convergence's next error (|R| 5e-14;
+    ! tolerance 1e-12)
     sq%n = 2
     o = cont_options(tol_r=1.0e-6_wp, tol_x=1.0e-7_wp, reuse_jac=.false.)
     y = [-2.0_wp, 4.0_wp]
@@ -300,7 +302,8 @@ program test_newton
     call newton_correct(sq, y, lam, y, lam, [0.0_wp, 0.0_wp], 1.0_wp, o, iters, info, msg, hf)
     print '(a,i0,a,i0)', 'fixed-lam Newton: iterations ', iters, ', evaluations ', sq%neval
     call check(info == 0 .and. iters >= 3, 'fixed-lam Newton converged: '//trim(msg))
-    call check(sq%neval == 2*iters - 1, 'no evaluation after the last, converged update')
+    call check(sq%neval == iters, 'one evaluation per iteration, none after the last '// &
+               'converged update')
     call check(abs(y(1)**3 - 3*y(1) + 4.0_wp) < 1.0e-12_wp .and. &
                abs(y(2) - y(1)**2) < 1.0e-11_wp, 'fixed-lam Newton: on the curve')
     call check_done('test_newton')
