@@ -4,8 +4,9 @@ The monodromy matrix of frirom's explicit time integration (:func:`frirom.timein
 central differences) over one period, started on a periodic solution (a harmonic balance
 point), by central finite differences: the discrete map takes the state (x_k, x_{k-1})
 over N steps (here as (x_k, (x_k - x_{k-1}) / dt)), so the initial states of the perturbed
-runs (x_0 and the Taylor step x_{-1} that integrate builds from x0, v0) are read back from integrate itself (zero periods) and
-the matrix is Phi = dOut dIn^-1 in those coordinates. All perturbed runs go as one batch
+runs (x_0 and the Taylor step x_{-1} that integrate builds from x0, v0) are read back
+from integrate itself (zero periods) and the matrix is Phi = dOut dIn^-1 in those
+coordinates. All perturbed runs go as one batch
 (integrate's batch axis), each with the point's contact history (sliders).
 
 For hysteretic contacts the map is piecewise linear in the perturbation (a slider sticks or
