@@ -209,8 +209,9 @@ def main(argv=None):
     last = [r for r in rows if r["model"] == "flange ROM_I"]
     if last:
         r = last[0]
-        print(f"paper ROM_I: stability costs {r['hill_per_solve']:.2f}x its solve per point "
-              f"(target <= 1x), {r['memory_bytes'] / 2**30:.2f} GiB (target <= 2 GiB)")
+        print(f"{'paper' if r['n_dof'] > 1000 else 'coarse (--quick)'} flange ROM_I "
+              f"({r['n_dof']} DoFs): stability costs {r['hill_per_solve']:.2f}x its solve "
+              f"per point (target <= 1x), {r['memory_bytes'] / 2**30:.2f} GiB (target <= 2 GiB)")
     out = HERE / "results" / "hill.json"
     out.parent.mkdir(exist_ok=True)
     out.write_text(json.dumps(rows, indent=1))
