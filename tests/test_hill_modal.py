@@ -90,3 +90,27 @@ def test_modal_hill_flags_the_saddle_branch_as_the_dense_path():
     expected[f1:f2] = True
     np.testing.assert_array_equal(~big.stable, expected)
     np.testing.assert_array_equal(big.stable, small.stable)
+
+
+def test_truncated_modes_give_the_truncated_models_exponents():
+    """Receptances from the lowest 75 of 80 modes: the exponents are those of the modal
+    model itself (I, diag(w^2), diag(2 zeta w), contacts G Phi), solved here in the
+    banded formulation (banded Arnoldi path), to 1e-8 of w."""
+    import scipy.linalg as sla
+    model, ex = dense_reduced()
+    nm, H, w = 75, 3, 1.1
+    w2, phi = sla.eigh(model.K.toarray() if sp.issparse(model.K) else model.K,
+                       model.M.toarray() if sp.issparse(model.M) else model.M,
+                       subset_by_index=[0, nm - 1])
+    wn = np.sqrt(w2)
+    zeta = (0.01 + 2e-4 * w2) / (2 * wn)
+    groups = [ContactGroup(g.law, sp.csr_matrix(g.G @ phi), g.params, name=g.name)
+              for g in model.contacts]
+    reduced = Model(np.eye(nm), np.diag(w2), Damping.matrix(np.diag(2 * zeta * wn)), groups)
+    red_ex = Excitation(phi.T @ ex.F)
+    base = dict(harmonics=H, samples=128, stability=True)
+    pm = solve_point(model, ex, w, SolverOptions(formulation="condensed", modes=nm, **base))
+    pr = solve_point(reduced, red_ex, w, SolverOptions(formulation="banded", **base))
+    assert 2 * nm * (2 * H + 1) > HILL_MAX
+    assert abs(pm.floquet_max_re - pr.floquet_max_re) < 1e-8 * w, \
+        (pm.floquet_max_re, pr.floquet_max_re)
