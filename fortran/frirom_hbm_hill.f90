@@ -149,7 +149,13 @@ contains
             info = FRIROM_OK
             mh%sg = 1.0e-3_wp*w
         end do
-        nev = min(NEV0, n2 - 2)
+        ! start from the count of undamped modal copies i(w_r + h w) in the disc: the
+        ! contacts move them, the doubling below catches the rest
+        nev = 0
+        do k = -mh%nh - 1, mh%nh + 1
+            nev = nev + 2*count(abs(mh%om + k*w) <= w/sqrt(2.0_wp))
+        end do
+        nev = min(max(NEV0, nev + 4), NEV_MAX, n2 - 2)
         do
             call shift_invert(cmplx(mh%sg, 0.0_wp, wp), nev, ev, vec, nconv, info, errmsg, &
                               mh=mh)
