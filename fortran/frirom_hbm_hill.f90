@@ -1,7 +1,9 @@
 !> Hill stability of frirom_hbm's periodic solutions: Floquet exponents from the
 !> linearised harmonic balance equations over all DoFs x harmonics, dense (dgeev) up to
-!> 2n = HILL_DENSE_MAX unknowns, shift-invert Arnoldi (ARPACK znaupd) on the banded
-!> matrices above.
+!> 2n = HILL_DENSE_MAX unknowns, shift-invert Arnoldi (ARPACK znaupd) above: on the
+!> modal coordinates of a condensed system with real modes (the modal part diagonal per
+!> harmonic, the contact coupling by a Woodbury identity on the contact DoFs: memory and
+!> cost of the order of one Newton evaluation's), else on the banded matrices.
 submodule (frirom_hbm) frirom_hbm_hill
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_ALLOC, FRIROM_ERR_LAPACK, &
                              FRIROM_ERR_SINGULAR, FRIROM_ERR_ARPACK, FRIROM_ERR_MODEL, &
@@ -11,6 +13,21 @@ submodule (frirom_hbm) frirom_hbm_hill
 
     !> Eigenvalues Arnoldi wants per shift at first, at most.
     integer(ip), parameter :: NEV0 = 16, NEV_MAX = 256
+
+    !> The modal Hill problem of a condensed system with real modes (T = P) at a real
+    !> shift sg: unknowns q(r + nm (c-1)), slot c of mode r; Q(s) = Lam(s) + E^T Jc E,
+    !> Lam per mode and harmonic [[a, b], [-b, a]] (a = w_r^2 - (h w)^2 + 2 z_r w_r s + s^2,
+    !> b = h w (2 z_r w_r + 2 s)), E = phr on every slot; Q(sg)^-1 by Woodbury:
+    !> Lam^-1 - Lam^-1 E^T S^-1 Jc E Lam^-1 with S = I + Jc E Lam^-1 E^T (LU in s).
+    type :: modal_hill
+        integer(ip) :: nm = 0, nnl = 0, nc = 0, nh = 0
+        real(wp) :: w = 0.0_wp, sg = 0.0_wp
+        real(wp), allocatable :: phr(:, :)    !! (nnl, nm) modes on the contact DoFs
+        real(wp), allocatable :: om(:), ze(:) !! (nm) rad/s, damping ratios
+        real(wp), allocatable :: jc(:, :)     !! (m, m) contact Jacobian, m = nnl nc
+        real(wp), allocatable :: s(:, :)      !! (m, m) LU of S
+        integer, allocatable :: ipiv(:)
+    end type modal_hill
 
     interface
         subroutine znaupd(ido, bmat, n, which, nev, tol, resid, ncv, v, ldv, iparam, ipntr, &
@@ -70,10 +87,243 @@ contains
         if (info /= 0) return
         if (2*n <= HILL_DENSE_MAX) then
             call hill_dense(sys, w, expo, maxre, info, errmsg)
-        else
-            call hill_arnoldi(sys, w, expo, maxre, info, errmsg)
+            return
         end if
+        select type (sys)
+        type is (hbm_condensed)
+            if (hill_modal_route(sys)) then
+                call hill_modal(sys, w, expo, maxre, info, errmsg)
+                return
+            end if
+        end select
+        call hill_arnoldi(sys, w, expo, maxre, info, errmsg)
     end procedure hbm_hill
+
+    !> Whether a condensed system's Hill problem goes by its modes (hill_modal): real
+    !> modes (the same for every harmonic) and the unknowns on the contact DoFs.
+    logical function hill_modal_route(sys)
+        type(hbm_condensed), intent(in) :: sys
+        hill_modal_route = sys%modal .and. allocated(sys%phr) .and. .not. sys%tcontact
+    end function hill_modal_route
+
+    !> The exponents of the strip |Im s| <= w/2 by shift-invert Arnoldi on the modal
+    !> coordinates (modal_hill), as hill_arnoldi does on the banded matrices: memory
+    !> 2 (nnl nc)^2 reals and the Arnoldi basis, not a band of every DoF.
+    subroutine hill_modal(sys, w, expo, maxre, info, errmsg)
+        type(hbm_condensed), intent(inout) :: sys
+        real(wp), intent(in) :: w
+        complex(wp), intent(out) :: expo(:)
+        real(wp), intent(out) :: maxre
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        type(modal_hill) :: mh
+        complex(wp), allocatable :: ev(:), vec(:, :)
+        integer(ip) :: m, nev, nconv, nk, k, t, stat, n2
+        info = FRIROM_OK
+        mh%nm = size(sys%phr, 2)
+        mh%nnl = sys%nnl
+        mh%nc = sys%nc
+        mh%nh = sys%nh
+        mh%w = w
+        m = mh%nnl*mh%nc
+        n2 = 2*mh%nm*mh%nc
+        allocate (mh%jc(m, m), mh%s(m, m), mh%ipiv(m), stat=stat)
+        if (stat /= 0) then
+            call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'Hill (modal): contact matrices')
+            return
+        end if
+        mh%phr = sys%phr(1:mh%nnl, :)
+        mh%om = sys%wm(:, 0)
+        mh%ze = sys%zm(:, 0)
+        mh%jc = 0.0_wp
+        call contact_assemble(sys%cs, kd=mh%jc, info=info, errmsg=errmsg, ldc=mh%nnl)
+        if (info /= 0) return
+        expo = cmplx(-huge(1.0_wp), 0.0_wp, wp)
+        maxre = -huge(1.0_wp)
+        mh%sg = 0.0_wp
+        do t = 1, 2
+            call modal_factor(mh, info, errmsg)
+            if (info == 0) exit
+            ! an exponent exactly on the shift (a fold): move the shift off the axis
+            if (t == 2) return
+            info = FRIROM_OK
+            mh%sg = 1.0e-3_wp*w
+        end do
+        ! start from the count of undamped modal copies i(w_r + h w) in the disc: the
+        ! contacts move them, the doubling below catches the rest
+        nev = 0
+        do k = -mh%nh - 1, mh%nh + 1
+            nev = nev + 2*count(abs(mh%om + k*w) <= w/sqrt(2.0_wp))
+        end do
+        nev = min(max(NEV0, nev + 4), NEV_MAX, n2 - 2)
+        do
+            call shift_invert(cmplx(mh%sg, 0.0_wp, wp), nev, ev, vec, nconv, info, errmsg, &
+                              mh=mh)
+            if (info /= 0) return
+            if (nconv == 0) exit
+            if (maxval(abs(ev(1:nconv))) >= w/sqrt(2.0_wp) .or. &
+                nev >= min(NEV_MAX, n2 - 2)) exit
+            nev = min(2*nev, NEV_MAX, n2 - 2)
+        end do
+        nk = 0
+        do k = 1, nconv
+            if (.not. kept(ev(k), 0.0_wp, w, sys%nh)) cycle
+            nk = nk + 1
+            if (nk <= size(expo)) expo(nk) = ev(k)
+            maxre = max(maxre, real(ev(k), wp))
+        end do
+    end subroutine hill_modal
+
+    !> a, b of Lam(sg) (see modal_hill) for every mode at harmonic h; b = 0 at h = 0.
+    pure subroutine modal_ab(mh, h, a, b)
+        type(modal_hill), intent(in) :: mh
+        integer(ip), intent(in) :: h
+        real(wp), intent(out) :: a(:), b(:)
+        real(wp) :: hw
+        hw = h*mh%w
+        a = mh%om**2 - hw*hw + 2.0_wp*mh%ze*mh%om*mh%sg + mh%sg**2
+        b = hw*(2.0_wp*mh%ze*mh%om + 2.0_wp*mh%sg)
+    end subroutine modal_ab
+
+    !> S = I + Jc R, R = E Lam(sg)^-1 E^T harmonic by harmonic (R_h = phr diag(.) phr^T),
+    !> and its LU; FRIROM_ERR_SINGULAR when Lam or S is singular at sg.
+    subroutine modal_factor(mh, info, errmsg)
+        type(modal_hill), intent(inout) :: mh
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        real(wp), allocatable :: a(:), b(:), det(:), tmp(:, :), pa(:, :), pb(:, :)
+        integer(ip) :: h, nl, m, i, c
+        integer :: linfo
+        info = FRIROM_OK
+        nl = mh%nnl
+        m = nl*mh%nc
+        allocate (a(mh%nm), b(mh%nm), det(mh%nm), tmp(nl, mh%nm), pa(nl, nl), pb(nl, nl))
+        mh%s = 0.0_wp
+        do h = 0, mh%nh
+            call modal_ab(mh, h, a, b)
+            det = a*a + b*b
+            if (any(det <= 0.0_wp)) then
+                call set_status(info, FRIROM_ERR_SINGULAR, errmsg, 'Hill (modal): a mode '// &
+                                'on the shift')
+                return
+            end if
+            tmp = mh%phr*spread(a/det, 1, nl)
+            call dgemm('N', 'T', int(nl), int(nl), int(mh%nm), 1.0_wp, tmp, int(nl), mh%phr, &
+                       int(nl), 0.0_wp, pa, int(nl))
+            if (h == 0) then
+                call dgemm('N', 'N', int(m), int(nl), int(nl), 1.0_wp, mh%jc, int(m), pa, &
+                           int(nl), 0.0_wp, mh%s, int(m))
+                cycle
+            end if
+            tmp = mh%phr*spread(b/det, 1, nl)
+            call dgemm('N', 'T', int(nl), int(nl), int(mh%nm), 1.0_wp, tmp, int(nl), mh%phr, &
+                       int(nl), 0.0_wp, pb, int(nl))
+            ! column blocks 2h (cos) and 2h+1 (sin): S(:, 2h) = Jc_2h Pa + Jc_2h+1 Pb,
+            ! S(:, 2h+1) = -Jc_2h Pb + Jc_2h+1 Pa
+            call blk(2*h, 2*h, pa, 1.0_wp, 0.0_wp)
+            call blk(2*h, 2*h + 1, pb, 1.0_wp, 1.0_wp)
+            call blk(2*h + 1, 2*h, pb, -1.0_wp, 0.0_wp)
+            call blk(2*h + 1, 2*h + 1, pa, 1.0_wp, 1.0_wp)
+        end do
+        do i = 1, m
+            mh%s(i, i) = mh%s(i, i) + 1.0_wp
+        end do
+        call dgetrf(int(m), int(m), mh%s, int(m), mh%ipiv, linfo)
+        if (linfo /= 0) then
+            call set_status(info, FRIROM_ERR_SINGULAR, errmsg, 'Hill (modal): I + Jc R '// &
+                            'singular at the shift')
+            return
+        end if
+    contains
+        !> S(:, block cs) = beta S(:, block cs) + alpha Jc(:, block cj) p
+        subroutine blk(cs, cj, p, alpha, beta)
+            integer(ip), intent(in) :: cs, cj
+            real(wp), intent(in) :: p(:, :), alpha, beta
+            c = nl*(cs - 1) + 1
+            call dgemm('N', 'N', int(m), int(nl), int(nl), alpha, mh%jc(1, nl*(cj - 1) + 1), &
+                       int(m), p, int(nl), beta, mh%s(1, c), int(m))
+        end subroutine blk
+    end subroutine modal_factor
+
+    !> x := Lam(sg)^-1 x for x(nm, nc, k) (k real columns).
+    pure subroutine modal_lam_solve(mh, x)
+        type(modal_hill), intent(in) :: mh
+        real(wp), intent(inout) :: x(:, :, :)
+        real(wp) :: a(mh%nm), b(mh%nm), det(mh%nm), xc(mh%nm)
+        integer(ip) :: h, k
+        do h = 0, mh%nh
+            call modal_ab(mh, h, a, b)
+            det = a*a + b*b
+            do k = 1, size(x, 3)
+                if (h == 0) then
+                    x(:, 1, k) = x(:, 1, k)/a
+                else
+                    xc = x(:, 2*h, k)
+                    x(:, 2*h, k) = (a*xc - b*x(:, 2*h + 1, k))/det
+                    x(:, 2*h + 1, k) = (b*xc + a*x(:, 2*h + 1, k))/det
+                end if
+            end do
+        end do
+    end subroutine modal_lam_solve
+
+    !> x := Q(sg)^-1 x for x(nm, nc, 2) (real and imaginary parts), by Woodbury.
+    subroutine modal_q_solve(mh, x, info, errmsg)
+        type(modal_hill), intent(in) :: mh
+        real(wp), intent(inout) :: x(:, :, :)
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        real(wp), allocatable :: z(:, :), t(:, :), y(:, :, :)
+        integer :: nl, nm, m, nk, linfo
+        info = FRIROM_OK
+        nl = int(mh%nnl)
+        nm = int(mh%nm)
+        m = nl*int(mh%nc)
+        nk = int(mh%nc)*size(x, 3)
+        allocate (z(m, size(x, 3)), t(m, size(x, 3)), y(nm, mh%nc, size(x, 3)))
+        call modal_lam_solve(mh, x)
+        ! z = E x (every slot), t = Jc z, t := S^-1 t, y = E^T t
+        call dgemm('N', 'N', nl, nk, nm, 1.0_wp, mh%phr, nl, x, nm, 0.0_wp, z, nl)
+        call dgemm('N', 'N', m, size(x, 3), m, 1.0_wp, mh%jc, m, z, m, 0.0_wp, t, m)
+        call dgetrs('N', m, size(x, 3), mh%s, m, mh%ipiv, t, m, linfo)
+        if (linfo /= 0) then
+            call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'Hill (modal): dgetrs')
+            return
+        end if
+        call dgemm('T', 'N', nm, nk, nl, 1.0_wp, mh%phr, nl, t, nl, 0.0_wp, y, nm)
+        call modal_lam_solve(mh, y)
+        x = x - y
+    end subroutine modal_q_solve
+
+    !> (A - sg)^-1 [u; v] = [x; u + sg x], Q(sg) x = -(v + sg u) - D1 u on the modal
+    !> coordinates (M = I; D1 = 2 z_r w_r per slot and the +-2 h w couplings).
+    subroutine modal_op(mh, u, v, ox, oy, info, errmsg)
+        type(modal_hill), intent(in) :: mh
+        complex(wp), intent(in) :: u(:), v(:)
+        complex(wp), intent(out) :: ox(:), oy(:)
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        complex(wp), allocatable :: b(:, :), uu(:, :)
+        real(wp), allocatable :: x(:, :, :)
+        integer(ip) :: h, nm, nc, c
+        nm = mh%nm
+        nc = mh%nc
+        uu = reshape(u, [nm, nc])
+        b = -reshape(v, [nm, nc]) - mh%sg*uu
+        do c = 1, nc
+            b(:, c) = b(:, c) - 2.0_wp*mh%ze*mh%om*uu(:, c)
+        end do
+        do h = 1, mh%nh
+            b(:, 2*h) = b(:, 2*h) - 2.0_wp*h*mh%w*uu(:, 2*h + 1)
+            b(:, 2*h + 1) = b(:, 2*h + 1) + 2.0_wp*h*mh%w*uu(:, 2*h)
+        end do
+        allocate (x(nm, nc, 2))
+        x(:, :, 1) = real(b, wp)
+        x(:, :, 2) = aimag(b)
+        call modal_q_solve(mh, x, info, errmsg)
+        if (info /= 0) return
+        ox = reshape(cmplx(x(:, :, 1), x(:, :, 2), wp), [nm*nc])
+        oy = u + mh%sg*ox
+    end subroutine modal_op
 
     !> All 2n exponents (dgeev with eigenvectors), then those `kept`; expo: the kept ones,
     !> then (-huge, 0).
@@ -236,7 +486,7 @@ contains
         end do
         nev = min(NEV0, 2*n - 2)
         do
-            call shift_invert(q, dr, mr, sg, nev, ev, vec, nconv, info, errmsg)
+            call shift_invert(sg, nev, ev, vec, nconv, info, errmsg, q=q, dr=dr, mr=mr)
             if (info /= 0) return
             ! enough when the disc reached covers the square |Im s|, |Re s| <= w/2
             ! (period doubling sits at its edge, Im s = w/2)
@@ -255,16 +505,18 @@ contains
     end subroutine hill_arnoldi
 
     !> nev eigenpairs of A nearest sigma (ev, vec(2n, nconv), converged first) by ARPACK
-    !> on (A - sigma)^-1 [u; v] = [x; u + sigma x], Q(sigma) x = -M (v + sigma u) - D1 u.
-    subroutine shift_invert(q, dr, mr, sg, nev, ev, vec, nconv, info, errmsg)
-        type(zband_matrix), intent(in) :: q           !! Q(sigma), factored
-        type(band_matrix), intent(in) :: dr, mr       !! D1 and M over harmonics, banded
+    !> on (A - sigma)^-1 [u; v] = [x; u + sigma x], Q(sigma) x = -M (v + sigma u) - D1 u:
+    !> banded (q, dr, mr) or modal (mh, modal_op).
+    subroutine shift_invert(sg, nev, ev, vec, nconv, info, errmsg, q, dr, mr, mh)
         complex(wp), intent(in) :: sg                 !! shift sigma, 1/s
         integer(ip), intent(in) :: nev
         complex(wp), allocatable, intent(out) :: ev(:)      !! (nconv) eigenvalues, 1/s
         complex(wp), allocatable, intent(out) :: vec(:, :)  !! (2n, nconv) eigenvectors
         integer(ip), intent(out) :: nconv, info
         character(len=*), intent(inout) :: errmsg
+        type(zband_matrix), intent(in), optional :: q      !! Q(sigma), factored
+        type(band_matrix), intent(in), optional :: dr, mr  !! D1 and M over harmonics, banded
+        type(modal_hill), intent(in), optional :: mh       !! the modal problem, factored
         complex(wp), allocatable :: resid(:), v(:, :), workd(:), workl(:), workev(:), d(:), &
                                     x(:, :)
         real(wp), allocatable :: rwork(:)
@@ -274,7 +526,11 @@ contains
         real(wp) :: tol
         character(len=24) :: buf
         info = FRIROM_OK
-        n = q%n
+        if (present(mh)) then
+            n = mh%nm*mh%nc
+        else
+            n = q%n
+        end if
         n2 = int(2*n)
         nv = int(nev)
         ncv = int(min(2*n, max(2*nev + 1, nev + 20)))
@@ -297,6 +553,11 @@ contains
                        vv => workd(ipntr(1) + n:ipntr(1) + 2*n - 1), &
                        ox => workd(ipntr(2):ipntr(2) + n - 1), &
                        oy => workd(ipntr(2) + n:ipntr(2) + 2*n - 1))
+                if (present(mh)) then
+                    call modal_op(mh, u, vv, ox, oy, info, errmsg)
+                    if (info /= 0) return
+                    cycle
+                end if
                 x(:, 1) = 0.0_wp
                 call band_matvec(mr, vv + sg*u, x(:, 1))
                 call band_matvec(dr, u, x(:, 1))

@@ -8,7 +8,17 @@ eigenvectors: the cost of the eigenvectors the selection needs for the modes abo
 (H + 1/2) omega); above HILL_MAX frirom uses shift-invert Arnoldi about s = 0, and the
 dense numpy solve is timed for scale only with --dense-ref (minutes at these sizes).
 
-    python cases/bench/hill.py [--quick] [--repeat 3]
+    python cases/bench/hill.py [--quick] [--repeat 3] [--flange WORK [--rom1]]
+
+Above HILL_MAX a condensed system with receptances from real modes (a reduced model)
+takes Hill's modal route (the modes diagonal per harmonic, the contacts by Woodbury on
+the contact DoFs), the others the banded one. Per model the table gives the Hill
+unknowns, the route, its memory (frirom._routes.hill_bytes), seconds per point with and
+without stability, and |max Re s - the banded path's| where that path fits (dense ROM of
+80 DoFs). --flange WORK: the paper flange's ROM_II (WORK/rom2.toml, made by
+cases/paper_flange/paper_flange.py make --work WORK) and, with --rom1, ROM_I, one point
+each mid-band; the last line is ROM_I's stability cost per point relative to its solve
+and its memory (targets <= 1x, <= 2 GiB). Writes cases/bench/results/hill.json.
 
 Models: the Duffing oscillator plus n uncoupled linear oscillators (sparse), a chain of n
 masses with a cubic spring (banded), and the tet10 cantilever of
@@ -19,6 +29,7 @@ One core (OPENBLAS_NUM_THREADS=1 is set before numpy loads).
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 import tempfile
@@ -75,6 +86,34 @@ def cantilever(H, tmp):
     return d.model(), d.excitation(), 2 * np.pi * 503.0
 
 
+def dense_rom(n, seed=3):
+    """A reduced-model-like system (tests/test_hill_modal.dense_reduced): dense M, K of n
+    DoFs, Rayleigh damping, a Jenkins element and a cubic spring; forced near mode 1."""
+    sys.path.insert(0, str(HERE.parents[1] / "tests"))
+    from test_hill_modal import dense_reduced
+    model, ex = dense_reduced(n, seed)
+    return model, ex, 1.1
+
+
+def flange_deck(work: Path, rom: str):
+    from frirom.deck import load_deck
+    d = load_deck(work / f"{rom}.toml")
+    return d.model(), d.excitation(), 0.5 * (d.omega_start + d.omega_end), d.options()
+
+
+def route_memory(model, H, o):
+    """Hill's route and memory [bytes] for this model and options (as _pack decides)."""
+    import frirom._routes as rt
+    n = model.n_dof
+    nl = model.nonlinear_dofs().size
+    modal = o.get("formulation", "condensed") == "condensed" and (
+        o.get("receptances") == "modes" or "flange" in o.get("_tag", ""))
+    route = rt._hill_route(n, H, 1 if modal else 0, nl)
+    if route == "modal":
+        return route, rt.hill_bytes(n, H, 0, (n, nl))
+    return route, rt.hill_bytes(n, H, n - 1 if route == "banded" else 0)
+
+
 def timed(model, ex, w, o, repeat):
     best = np.inf
     for _ in range(repeat):
@@ -100,6 +139,8 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--dense-ref", action="store_true",
                     help="time numpy's dense eig above HILL_MAX too (slow)")
+    ap.add_argument("--flange", help="paper flange work folder (rom2.toml, rom1.toml)")
+    ap.add_argument("--rom1", action="store_true", help="with --flange: ROM_I too")
     a = ap.parse_args(argv)
     cases = [("duffing+osc", 80, 3), ("duffing+osc", 400, 3), ("chain", 80, 3),
              ("chain", 400, 3)]
@@ -113,28 +154,78 @@ def main(argv=None):
             cases += [("cantilever", 33, 3), ("cantilever", 33, 7)]
     except ImportError:
         pass
+    if not a.quick:
+        cases += [("dense-rom", 80, 3), ("dense-rom", 300, 3)]
+    else:
+        cases += [("dense-rom", 80, 3)]
+    if a.flange:
+        cases += [("flange ROM_II", 0, 3)] + ([("flange ROM_I", 0, 3)] if a.rom1 else [])
+    rows = []
     print(f"HILL_MAX = {HILL_MAX} (dense up to 2 n_dof (2H+1))")
-    print(f"{'model':>12} {'n_dof':>6} {'H':>2} {'2n':>6} {'path':>8} {'solve s':>8} "
-          f"{'Hill s':>8} {'Hill/solve':>10} {'max Re':>10} {'eigvals s':>9} {'eig s':>8}")
+    print(f"{'model':>14} {'n_dof':>6} {'H':>2} {'Hill n':>7} {'route':>7} {'MiB':>8} "
+          f"{'solve s':>8} {'Hill s':>8} {'Hill/solve':>10} {'max Re':>10} {'|dRe|':>9}")
     for name, n, H in cases:
+        ref = None
+        rep = a.repeat
         if name == "duffing+osc":
             model, ex, w = duffing_plus(n)
             o = dict(harmonics=H, samples=32, formulation="condensed")
         elif name == "chain":
             model, ex, w = cubic_chain(n)
             o = dict(harmonics=H, samples=32, formulation="banded")
+        elif name == "dense-rom":
+            model, ex, w = dense_rom(n)
+            o = dict(harmonics=H, samples=128, formulation="condensed", receptances="modes")
+            if n <= 100:
+                ref = dict(harmonics=H, samples=128, formulation="banded")
+        elif name.startswith("flange"):
+            model, ex, w, dopts = flange_deck(Path(a.flange),
+                                              "rom1" if name.endswith("_I") else "rom2")
+            H = dopts.harmonics
+            o = {f: getattr(dopts, f) for f in ("harmonics", "samples", "formulation",
+                                                 "receptances", "modes")}
+            o["_tag"] = "flange"
+            rep = 1
         else:
             model, ex, w = cantilever(H, tmp)
             o = dict(harmonics=H, samples=128)
-        t0, _ = timed(model, ex, w, SolverOptions(**o, stability=False), a.repeat)
-        t1, p = timed(model, ex, w, SolverOptions(**o, stability=True), a.repeat)
-        m = 2 * model.n_dof * (2 * H + 1)
-        path = "dense" if m <= HILL_MAX else "arnoldi"
-        tn = te = float("nan")
-        if path == "dense" or a.dense_ref:
-            tn, te = numpy_dense(m)
-        print(f"{name:>12} {model.n_dof:6d} {H:2d} {m:6d} {path:>8} {t0:8.3f} {t1 - t0:8.3f} "
-              f"{(t1 - t0) / t0:10.1f} {p.floquet_max_re:+10.3e} {tn:9.3f} {te:8.3f}")
+        tag = o.pop("_tag", "")
+        route, mem = route_memory(model, H, dict(o, _tag=tag))
+        t0, _ = timed(model, ex, w, SolverOptions(**o, stability=False), rep)
+        t1, p = timed(model, ex, w, SolverOptions(**o, stability=True), rep)
+        d_re = float("nan")
+        if ref is not None:
+            pr = solve_point(model, ex, w, SolverOptions(**ref, stability=True))
+            d_re = abs(pr.floquet_max_re - p.floquet_max_re)
+        nh = model.n_dof * (2 * H + 1)
+        row = dict(model=name, n_dof=model.n_dof, H=H, hill_unknowns=2 * nh, route=route,
+                   memory_bytes=int(mem), solve_s=t0, hill_s=t1 - t0,
+                   hill_per_solve=(t1 - t0) / t0, max_re=p.floquet_max_re,
+                   stable=bool(p.stable), abs_diff_re_banded=d_re, omega=w)
+        rows.append(row)
+        print(f"{name:>14} {model.n_dof:6d} {H:2d} {2 * nh:7d} {route:>7} {mem / 2**20:8.1f} "
+              f"{t0:8.3f} {t1 - t0:8.3f} {(t1 - t0) / t0:10.2f} {p.floquet_max_re:+10.3e} "
+              f"{d_re:9.1e}", flush=True)
+    try:
+        # the common results file (cases/bench/_results.py, record() in __main__) where
+        # there is one: the rows as its data
+        from _results import add
+    except ImportError:
+        add = None
+    if add is not None:
+        add(models=rows)
+    else:
+        out = HERE / "results" / "hill.json"
+        out.parent.mkdir(exist_ok=True)
+        out.write_text(json.dumps(rows, indent=1))
+        print(f"wrote {out}")
+    last = [r for r in rows if r["model"] == "flange ROM_I"]
+    if last:
+        r = last[0]
+        print(f"{'paper' if r['n_dof'] > 1000 else 'coarse (--quick)'} flange ROM_I "
+              f"({r['n_dof']} DoFs): stability costs {r['hill_per_solve']:.2f}x its solve "
+              f"per point (target <= 1x), {r['memory_bytes'] / 2**30:.2f} GiB "
+              f"(target <= 2 GiB)")
 
 
 if __name__ == "__main__":

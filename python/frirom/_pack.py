@@ -17,7 +17,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ._errors import ParameterError, SizeError, int_constant
-from ._routes import _Band, _check_hill_memory, _contact_coords, _Modes, _receptance_route
+from ._routes import (HILL_ROUTES, _Band, _check_hill_memory, _contact_coords, _hill_route,
+                      _Modes, _receptance_route)
 from .contact import LAWS
 from .model import CyclicModel, Excitation, Model
 from .results import FRFPoint, amplitude_max
@@ -407,8 +408,6 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
     out = _check_outputs((np.arange(n) if n <= 100 else nl) if outputs is None else outputs, n)
     tcontact, sparse, info = False, False, f"banded: {n * (2 * H + 1)} unknowns"
     modes = _Modes.none(n, H)
-    if opts.stability:
-        _check_hill_memory(n, H, band.bw)
     if opts.formulation == "condensed":
         nrows = c.G.shape[0]
         tcontact = _contact_coords(opts, nrows, nl.size)
@@ -417,6 +416,13 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
         info = (f"condensed: {nu * (2 * H + 1)} unknowns, "
                 + (f"{nu} contact coordinates G x" if tcontact else f"{nu} contact DoFs")
                 + f"; {route}")
+    if opts.stability:
+        hill = _hill_route(n, H, modes.nmodes if not tcontact else 0, nl.size)
+        if hill == "banded":
+            _check_hill_memory(n, H, band.bw)
+        else:
+            _check_hill_memory(n, H, 0, modal=(modes.nmodes, nl.size))
+        info += "; " + HILL_ROUTES[hill]
     if modes.nmodes and not opts.stability:
         # modal receptances without Hill's method: Fortran reads neither K, M, C nor the
         # order (frirom_hbm_receptances, _condensed; hbm_setup checks that perm is a

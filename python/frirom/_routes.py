@@ -228,27 +228,54 @@ def _contact_coords(opts: SolverOptions, nrows: int, nnl: int) -> bool:
                                         int(opts.selection is not None)))
 
 
-def hill_bytes(n_dof: int, H: int, bw: int) -> int:
+#: How Hill's method goes (fortran/frirom_hbm_hill.f90 hbm_hill's rule), as logged
+HILL_ROUTES = {
+    "dense": "stability: Hill, dense (all exponents)",
+    "modal": "stability: Hill by shift-invert Arnoldi on the modes, the contacts by "
+             "Woodbury on the contact DoFs",
+    "banded": "stability: Hill by shift-invert Arnoldi on the banded matrices",
+}
+
+
+def _hill_route(n_dof: int, H: int, nmodes: int, nnl: int) -> str:
+    """'dense', 'modal' or 'banded': Fortran's rule (hbm_hill): dense up to HILL_MAX
+    unknowns, then by the modes when a condensed system takes its receptances from real
+    modes on the contact DoFs (nmodes > 0: pass 0 otherwise), else banded."""
+    if 2 * n_dof * (2 * H + 1) <= HILL_MAX:
+        return "dense"
+    return "modal" if nmodes > 0 and nnl > 0 else "banded"
+
+
+def hill_bytes(n_dof: int, H: int, bw: int, modal: tuple[int, int] | None = None) -> int:
     """Memory [bytes] Hill's method needs at one point for n_dof DoFs (band half-width bw
-    after RCM) and H harmonics: the dense 2n(2H+1) eigenproblem up to HILL_MAX, else the
-    banded J, D1, M and the factored complex Q(s) (LAPACK band storage, 2 kl + ku + 1 rows)
-    and the Arnoldi basis (fortran/frirom_hbm_hill.f90, NEV_MAX = 256)."""
+    after RCM) and H harmonics: the dense 2n(2H+1) eigenproblem up to HILL_MAX; by the
+    modes (modal = (modes, contact DoFs)): the contact Jacobian and the LU of I + Jc R
+    (m = contact DoFs x (2H+1) squared, twice) and the Arnoldi basis; else the banded J,
+    D1, M and the factored complex Q(s) (LAPACK band storage, 2 kl + ku + 1 rows) and the
+    Arnoldi basis (fortran/frirom_hbm_hill.f90, NEV_MAX = 256)."""
     nh = n_dof * (2 * H + 1)
     if 2 * nh <= HILL_MAX:
         return 16 * (2 * nh) ** 2 * 3
+    if modal is not None:
+        nm, nnl = modal
+        m = nnl * (2 * H + 1)
+        return 16 * m * m + 2 * nm * (2 * H + 1) * 520 * 16
     kl = min((2 * H + 1) * (bw + 1) - 1, nh - 1)
     return nh * (3 * kl + 1) * (3 * 8 + 16) + 2 * nh * 513 * 16
 
 
-def _check_hill_memory(n_dof: int, H: int, bw: int) -> None:
+def _check_hill_memory(n_dof: int, H: int, bw: int,
+                       modal: tuple[int, int] | None = None) -> None:
     """Refuse Hill's method (ParameterError naming options.stability) when it needs more
     than half of this machine's memory: a dense reduced model of thousands of DoFs fills
     its band, and the Linux kernel would kill the run rather than fail the allocation."""
-    need = hill_bytes(n_dof, H, bw)
+    need = hill_bytes(n_dof, H, bw, modal)
     avail = _physical_memory()
     if avail and need > avail // 2:
         raise ParameterError(
             f"options.stability: Hill's method on this model needs {need / 2**30:.3g} GiB "
-            f"({n_dof} DoFs x {2 * H + 1} harmonic coefficients, band half-width {bw} after "
-            f"reordering), more than half of this machine's {avail / 2**30:.3g} GiB; set "
+            f"({n_dof} DoFs x {2 * H + 1} harmonic coefficients, "
+            + (f"{modal[0]} modes, {modal[1]} contact DoFs" if modal else
+               f"band half-width {bw} after reordering")
+            + f"), more than half of this machine's {avail / 2**30:.3g} GiB; set "
             "stability = false (`[solver] stability = false` in a deck)")
