@@ -105,21 +105,28 @@ class MistunedDisk:
             res = Response(np.asarray(r.omega), np.asarray(r.amp_max))
         else:
             w = np.linspace(self.band[0], self.band[1], self.n_linear)
-            amp = np.abs(linear_response(model, ex.F[:, 1], w, out))
-            w, amp = _refine_peak(model, ex.F[:, 1], w, amp, out)
+            modes = linear_modes(model)
+            amp = np.abs(linear_response(model, ex.F[:, 1], w, out, modes))
+            w, amp = _refine_peak(model, ex.F[:, 1], w, amp, out, modes=modes)
             res = Response(w, amp)
         res.seconds = time.perf_counter() - t0
         return res
 
 
-def linear_response(model, f, omegas, outputs) -> np.ndarray:
-    """(n_w, n_out) complex harmonic response (K - w^2 M + i w C) x = f at the outputs."""
+def linear_response(model, f, omegas, outputs, modes=None) -> np.ndarray:
+    """(n_w, n_out) complex harmonic response (K - w^2 M + i w C) x = f at the outputs.
+
+    Rayleigh damping and up to 4000 DoFs: through the modes of (K, M) (``modes`` = (lam,
+    phi) if already known, see :func:`linear_modes`); otherwise one sparse LU per
+    frequency."""
     K, M, C = model.K.tocsc(), model.M.tocsc(), model.C.tocsc()
     omegas = np.asarray(omegas, dtype=float)
     d = model.damping
-    if d.kind == "rayleigh" and K.shape[0] <= 4000:
+    if modes is None:
+        modes = linear_modes(model)
+    if modes is not None:
         # modal: C = alpha M + beta K is diagonal in the modes of (K, M)
-        lam, phi = sla.eigh(K.toarray(), M.toarray())
+        lam, phi = modes
         g = phi.T @ np.asarray(f, complex)
         den = (lam[None, :] - omegas[:, None] ** 2
                + 1j * omegas[:, None] * (d.alpha + d.beta * lam[None, :]))
@@ -131,14 +138,22 @@ def linear_response(model, f, omegas, outputs) -> np.ndarray:
     return out
 
 
-def _refine_peak(model, f, w, amp, out, rounds: int = 3):
+def linear_modes(model):
+    """(lam, phi) of (K, M) when the damping is Rayleigh and the model small enough for a
+    dense eigen-solve (<= 4000 DoFs), else None."""
+    if model.damping.kind != "rayleigh" or model.K.shape[0] > 4000:
+        return None
+    return sla.eigh(model.K.toarray(), model.M.toarray())
+
+
+def _refine_peak(model, f, w, amp, out, rounds: int = 3, modes=None):
     """Add points around the largest blade peak until the grid step there is 1e-3 of the
     band's, so that the peak is found to ~1e-6 relative."""
     for _ in range(rounds):
         i = int(np.argmax(amp.max(axis=1)))
         lo, hi = w[max(i - 1, 0)], w[min(i + 1, w.size - 1)]
         wn = np.linspace(lo, hi, 21)[1:-1]
-        an = np.abs(linear_response(model, f, wn, out))
+        an = np.abs(linear_response(model, f, wn, out, modes))
         w = np.concatenate([w, wn])
         amp = np.concatenate([amp, an])
         order = np.argsort(w)
@@ -170,13 +185,15 @@ def _save(out: Path, tag: str, res: dict) -> None:
 
 def monte_carlo(disk: MistunedDisk, n_samples: int, std: float, seed: int = 0,
                 interfaces: str = "friction", out=None, scheduler: str | None = None,
-                workers: int | None = None, progress=None) -> dict:
+                workers: int | None = None, progress=None, tuned: Response | None = None
+                ) -> dict:
     """Amplification factors of ``n_samples`` mistuning samples.
 
     out: folder of per-sample files (resumable; default none); scheduler: address of a
     running ``distributed`` scheduler, or 'local' for a LocalCluster of ``workers``
     processes, or None (serial); progress: callable(done, total, partial_af) after every
-    sample. Returns {'tuned': Response, 'af': (n,), 'samples': [dict], 'stats': ...}.
+    sample; tuned: the tuned disk's Response in the same interface state if already known.
+    Returns {'tuned': Response, 'af': (n,), 'samples': [dict], 'stats': ...}.
     """
     if interfaces not in ("friction", "stuck", "free"):
         raise ParameterError(f"interfaces: expected 'friction', 'stuck' or 'free', got "
@@ -184,7 +201,8 @@ def monte_carlo(disk: MistunedDisk, n_samples: int, std: float, seed: int = 0,
     n = int(n_samples)
     if n < 1:
         raise ParameterError(f"n_samples: expected >= 1, got {n_samples}")
-    tuned = disk.response(None, interfaces)
+    if tuned is None:
+        tuned = disk.response(None, interfaces)
     tag = f"sample_{interfaces}"
     done = {}
     if out is not None:
