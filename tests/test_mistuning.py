@@ -197,3 +197,21 @@ def test_single_family_monte_carlo_below_whitehead():
 def sp_csr(a):
     import scipy.sparse as sp
     return sp.csr_matrix(a)
+
+
+def test_mistuning_table(tmp_path):
+    from frirom import InputError
+    from frirom.reduction.mistuning import deviations_from_table
+    assert np.array_equal(deviations_from_table({"std": 0.02, "seed": 4}, 8),
+                          deviations(8, 0.02, seed=4))
+    assert np.array_equal(deviations_from_table({"deviations": [0.01, -0.01]}, 2),
+                          [0.01, -0.01])
+    (tmp_path / "f.txt").write_text("99\n101\n")
+    assert np.allclose(deviations_from_table({"frequencies": "f.txt", "reference": 100.0}, 2,
+                                             tmp_path), [0.99**2 - 1, 1.01**2 - 1])
+    with pytest.raises(InputError, match="exactly one of"):
+        deviations_from_table({"std": 0.1, "deviations": [0, 0]}, 2)
+    with pytest.raises(InputError, match=r"unknown key\(s\) \['sed'\]"):
+        deviations_from_table({"std": 0.1, "sed": 3}, 2)
+    with pytest.raises(InputError, match="seed"):
+        deviations_from_table({"std": 0.1, "seed": -1}, 2)

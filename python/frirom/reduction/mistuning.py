@@ -41,6 +41,7 @@ from .cb import craig_bampton
 from .cyclic import CyclicSector, axis_rotation
 
 __all__ = ["MistuningSector", "mistuning_sector", "deviations", "blade_deviations_from_file",
+           "deviations_from_table",
            "whitehead_bound"]
 
 
@@ -353,3 +354,43 @@ def mistuning_sector(sector: CyclicSector, K, M, n_modes: int | None, blade_dofs
                            left=where(left), right=where(right), n_sectors=sector.n_sectors,
                            axis=np.asarray(sector.axis, float), U=U, blade_lambda=lam,
                            master_dofs=masters)
+
+
+def deviations_from_table(table: dict, n_blades: int, folder=".") -> np.ndarray:
+    """Blade deviations from a deck's ``[mistuning]`` table (its keys, one of three forms):
+
+    - ``std`` (fraction, e.g. 0.02) and optional ``seed`` (integer, default 0) and
+      ``mean`` (default 0): normal scatter;
+    - ``deviations``: one value per blade;
+    - ``frequencies``: a file (relative to ``folder``) of measured blade frequencies, one
+      per line, with optional ``reference`` [Hz] (default: their mean).
+    """
+    if not isinstance(table, dict):
+        raise InputError("[mistuning]: expected a table")
+    forms = [k for k in ("std", "deviations", "frequencies") if k in table]
+    if len(forms) != 1:
+        raise InputError("[mistuning]: give exactly one of 'std', 'deviations' or "
+                         f"'frequencies' (got {forms or 'none'})")
+    allowed = {"std": {"std", "seed", "mean"}, "deviations": {"deviations"},
+               "frequencies": {"frequencies", "reference"}}[forms[0]]
+    extra = sorted(set(table) - allowed)
+    if extra:
+        raise InputError(f"[mistuning]: unknown key(s) {extra} with '{forms[0]}' (allowed: "
+                         f"{sorted(allowed)})")
+    if forms[0] == "std":
+        seed = table.get("seed", 0)
+        if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+            raise InputError(f"[mistuning].seed: expected an integer >= 0, got {seed!r}")
+        try:
+            std, mean = float(table["std"]), float(table.get("mean", 0.0))
+        except (TypeError, ValueError):
+            raise InputError("[mistuning].std and .mean: expected numbers") from None
+        return deviations(n_blades, std, seed=seed, mean=mean)
+    if forms[0] == "deviations":
+        try:
+            vals = np.asarray(table["deviations"], dtype=float)
+        except (TypeError, ValueError):
+            raise InputError("[mistuning].deviations: expected a list of numbers") from None
+        return deviations(n_blades, values=vals)
+    return blade_deviations_from_file(Path(folder) / str(table["frequencies"]), n_blades,
+                                      table.get("reference"))
