@@ -144,6 +144,13 @@ def test_linear_states_on_the_lattice(built):
     md.n_linear = 101
     tuned = md.response(None, "stuck")
     assert np.ptp(tuned.blade_peaks) < 1e-6 * tuned.peak
+    delta = deviations(N, 0.04, seed=9)
+    for state in ("stuck", "free"):      # the modal Woodbury solve = a sparse LU per point
+        w = md.band[0] + np.array([0.3, 0.6]) * (md.band[1] - md.band[0])
+        ref = linear_response(md.model(delta, state), md.excitation().F[:, 1], w,
+                              md.outputs(), modes=False)
+        got = md.linear(delta, state).solve(md.excitation().F[:, 1], w, md.outputs())
+        assert np.abs(got - ref).max() < 1e-9 * np.abs(ref).max()
     for state in ("stuck", "free"):
         res = monte_carlo(md, 3, 0.04, seed=1, interfaces=state)
         assert res["af"].mean() > 1.0, res["af"]
@@ -215,3 +222,28 @@ def test_mistuning_table(tmp_path):
         deviations_from_table({"std": 0.1, "sed": 3}, 2)
     with pytest.raises(InputError, match="seed"):
         deviations_from_table({"std": 0.1, "seed": -1}, 2)
+
+
+def test_tuned_linear_annulus_equals_cyclic_sector(built):
+    """No friction: the annulus with its contacts replaced by their stick stiffness
+    (interfaces='stuck', solved linearly through its modes) against the cyclic sector with
+    mu = 1e8 under a load 1e-3 times smaller (every contact stuck, none lifts off: the
+    sector's solution is linear): first harmonic of every blade tip to 1e-8."""
+    d, ms = built
+    groups = [ContactGroup(g.law, g.G, np.where(np.array(g.params) == 0.3, 1e8, g.params),
+                           name=g.name) for g in ms.reduce_contacts(d["contacts"])]
+    cm = _cyclic(d, ms, groups)
+    F = 1e-3 * (ms.T.T @ d["F"])
+    tip_r = list(ms.reduced(d["tip"]))
+    ann = ms.model(None, Damping.rayleigh(ALPHA, BETA), groups, interfaces="stuck")
+    ex = ms.excitation(F, EO)
+    out = [ms.position(p, s) for s in range(N) for p in tip_r]
+    w1 = cm.modes_of((-EO) % N).omega[0]
+    for w in (0.95 * w1, 1.1 * w1):
+        pc = solve_point(cm, Excitation(F), w, SolverOptions(**OPTS), outputs=tip_r)
+        assert np.all(pc.state_fractions[:, 0] == 1.0)          # all stuck
+        xa = linear_response(ann, ex.F[:, 1], [w], out)[0].reshape(N, 3)
+        for s in range(N):
+            ph = np.exp(-1j * EO * s * 2 * np.pi / N)
+            err = np.abs(xa[s] - _complex(pc.X, 1) * ph).max() / np.abs(pc.X[:, 1:]).max()
+            assert err < 1e-8, (w, s, err)

@@ -73,12 +73,12 @@ def build() -> tuple[MistunedDisk, dict]:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="4 friction samples, 40 linear")
+    ap.add_argument("--quick", action="store_true", help="4 friction samples, 40 linear (else 100)")
     ap.add_argument("--samples", type=int, default=None, help="friction samples (default 20)")
     ap.add_argument("--docs", action="store_true", help="copy the figures to docs/_static")
     a = ap.parse_args(argv)
     n_fr = a.samples or (4 if a.quick else 20)
-    n_lin = 40 if a.quick else 200
+    n_lin = 40 if a.quick else 100
     out = HERE / "results"
     out.mkdir(exist_ok=True)
     md, sizes = build()

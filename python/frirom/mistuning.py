@@ -26,12 +26,14 @@ from pathlib import Path
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.stats import binom
 
 from ._errors import InputError, ParameterError
 from .model import Damping
-from .reduction.mistuning import MistuningSector, deviations, whitehead_bound
+from .reduction.mistuning import (MistuningSector, deviations, stick_stiffnesses,
+                                  whitehead_bound)
 
 __all__ = ["MistunedDisk", "Response", "monte_carlo", "statistics", "sample_deviations",
            "whitehead_bound"]
@@ -90,14 +92,23 @@ class MistunedDisk:
     def excitation(self):
         return self.sector.excitation(self.F, self.engine_order)
 
+    def linear(self, delta=None, interfaces: str = "stuck") -> "LinearAnnulus":
+        """The annulus with stuck or free interfaces in its structural modes."""
+        if self.damping.kind != "rayleigh":
+            raise ParameterError("MistunedDisk: the linear states take Rayleigh damping")
+        K = self.sector.stiffness(delta)
+        groups = self.sector.contacts(self.contacts) if interfaces == "stuck" else []
+        return LinearAnnulus(K, self.sector.mass(), self.damping.alpha, self.damping.beta,
+                             groups)
+
     def response(self, delta=None, interfaces: str = "friction") -> Response:
         """Every blade's response over the band for deviations ``delta`` (None: tuned)."""
         t0 = time.perf_counter()
-        model = self.model(delta, interfaces)
         ex = self.excitation()
         out = self.outputs()
         if interfaces == "friction":
             from .solver import SolverOptions, frf
+            model = self.model(delta, interfaces)
             r = frf(model, ex, self.band[0], self.band[1], SolverOptions(**self.options),
                     outputs=out)
             if not r.complete:
@@ -105,9 +116,9 @@ class MistunedDisk:
             res = Response(np.asarray(r.omega), np.asarray(r.amp_max))
         else:
             w = np.linspace(self.band[0], self.band[1], self.n_linear)
-            modes = linear_modes(model)
-            amp = np.abs(linear_response(model, ex.F[:, 1], w, out, modes))
-            w, amp = _refine_peak(model, ex.F[:, 1], w, amp, out, modes=modes)
+            lin = self.linear(delta, interfaces)
+            amp = np.abs(lin.solve(ex.F[:, 1], w, out))
+            w, amp = _refine_peak(lin, ex.F[:, 1], w, amp, out)
             res = Response(w, amp)
         res.seconds = time.perf_counter() - t0
         return res
@@ -117,14 +128,14 @@ def linear_response(model, f, omegas, outputs, modes=None) -> np.ndarray:
     """(n_w, n_out) complex harmonic response (K - w^2 M + i w C) x = f at the outputs.
 
     Rayleigh damping and up to 4000 DoFs: through the modes of (K, M) (``modes`` = (lam,
-    phi) if already known, see :func:`linear_modes`); otherwise one sparse LU per
-    frequency."""
+    phi) if already known, see :func:`linear_modes`; False: never); otherwise one sparse LU
+    per frequency."""
     K, M, C = model.K.tocsc(), model.M.tocsc(), model.C.tocsc()
     omegas = np.asarray(omegas, dtype=float)
     d = model.damping
     if modes is None:
         modes = linear_modes(model)
-    if modes is not None:
+    if modes is not None and modes is not False:
         # modal: C = alpha M + beta K is diagonal in the modes of (K, M)
         lam, phi = modes
         g = phi.T @ np.asarray(f, complex)
@@ -146,14 +157,44 @@ def linear_modes(model):
     return sla.eigh(model.K.toarray(), model.M.toarray())
 
 
-def _refine_peak(model, f, w, amp, out, rounds: int = 3, modes=None):
+class LinearAnnulus:
+    """(K + G^T k G - w^2 M + i w (alpha M + beta K)) x = f through the modes of (K, M):
+    the stick stiffness of the contacts (rank r, not damped) enters by the Woodbury
+    identity, an r x r solve per frequency."""
+
+    def __init__(self, K, M, alpha, beta, groups=()):
+        self.lam, self.phi = sla.eigh(K.toarray(), M.toarray())
+        self.alpha, self.beta = alpha, beta
+        if groups:
+            G = sp.vstack([g.G for g in groups]).tocsr()
+            self.k = np.concatenate([stick_stiffnesses(g) for g in groups])
+            self.V = np.asarray((G @ self.phi))          # (r, n_modes) = G Phi
+        else:
+            self.k, self.V = np.zeros(0), np.zeros((0, self.lam.size))
+
+    def solve(self, f, omegas, outputs) -> np.ndarray:
+        g = self.phi.T @ np.asarray(f, complex)
+        P = self.phi[np.asarray(outputs)]
+        out = np.empty((len(omegas), len(outputs)), complex)
+        for i, w in enumerate(np.asarray(omegas, float)):
+            dinv = 1.0 / (self.lam - w * w + 1j * w * (self.alpha + self.beta * self.lam))
+            q = dinv * g
+            if self.k.size:
+                # (D + V^T k V)^-1 = D^-1 - D^-1 V^T (k^-1 + V D^-1 V^T)^-1 V D^-1
+                S = np.diag(1.0 / self.k) + (self.V * dinv) @ self.V.T
+                q = q - dinv * (self.V.T @ np.linalg.solve(S, self.V @ q))
+            out[i] = P @ q
+        return out
+
+
+def _refine_peak(lin, f, w, amp, out, rounds: int = 3):
     """Add points around the largest blade peak until the grid step there is 1e-3 of the
     band's, so that the peak is found to ~1e-6 relative."""
     for _ in range(rounds):
         i = int(np.argmax(amp.max(axis=1)))
         lo, hi = w[max(i - 1, 0)], w[min(i + 1, w.size - 1)]
         wn = np.linspace(lo, hi, 21)[1:-1]
-        an = np.abs(linear_response(model, f, wn, out, modes))
+        an = np.abs(lin.solve(f, wn, out))
         w = np.concatenate([w, wn])
         amp = np.concatenate([amp, an])
         order = np.argsort(w)

@@ -269,29 +269,39 @@ class MistuningSector:
 
         contacts: reduced-sector groups (see :meth:`contacts`); interfaces: 'friction'
         (the contact laws), 'stuck' (each contact replaced by its stick stiffness: kt
-        tangential, kn normal, k1 for 'cubic') or 'free' (contacts removed).
+        tangential, kn normal, k1 for 'cubic'; Rayleigh damping stays that of the structure,
+        as with friction) or 'free' (contacts removed).
         """
         if interfaces not in ("friction", "stuck", "free"):
             raise ParameterError(f"interfaces: expected 'friction', 'stuck' or 'free', got "
                                  f"{interfaces!r}")
         K = self.stiffness(delta)
         groups = self.contacts(contacts)
+        damping = damping or Damping.rayleigh(0.0, 0.0)
+        M = self.mass()
         if interfaces == "stuck":
+            if damping.kind == "rayleigh":    # the structure's damping, not the contacts'
+                damping = Damping.matrix(damping.alpha * M + damping.beta * K)
             K = (K + sum(stick_matrix(g) for g in groups)).tocsr()
         if interfaces != "friction":
             groups = []
-        return Model(self.mass(), K, damping or Damping.rayleigh(0.0, 0.0), groups)
+        return Model(M, K, damping, groups)
 
 
-def stick_matrix(g: ContactGroup) -> sp.csr_matrix:
-    """G^T diag(k) G: the contact stuck (tangential kt, normal kn, cubic k1)."""
+def stick_stiffnesses(g: ContactGroup) -> np.ndarray:
+    """(n_elem n_dir,) stiffness of each row of G with the contact stuck: kt tangential,
+    kn normal ('v'), k1 for 'cubic'."""
     law = LAWS[g.law]
     col = dict(zip(law.parameters, g.params.T))
     k = np.empty((g.n_elem, g.n_dir))
     for d, name in enumerate(law.directions):
-        key = "kn" if name == "v" else ("k1" if g.law == "cubic" else "kt")
-        k[:, d] = col[key]
-    return (g.G.T @ sp.diags(k.ravel()) @ g.G).tocsr()
+        k[:, d] = col["kn" if name == "v" else ("k1" if g.law == "cubic" else "kt")]
+    return k.ravel()
+
+
+def stick_matrix(g: ContactGroup) -> sp.csr_matrix:
+    """G^T diag(k) G: the contact stuck (see :func:`stick_stiffnesses`)."""
+    return (g.G.T @ sp.diags(stick_stiffnesses(g)) @ g.G).tocsr()
 
 
 def mistuning_sector(sector: CyclicSector, K, M, n_modes: int | None, blade_dofs, keep=(),
