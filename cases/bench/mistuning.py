@@ -73,7 +73,8 @@ def build() -> tuple[MistunedDisk, dict]:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="4 friction samples, 40 linear (else 100)")
+    ap.add_argument("--quick", action="store_true",
+                    help="4 friction samples, 40 linear (else 100)")
     ap.add_argument("--samples", type=int, default=None, help="friction samples (default 20)")
     ap.add_argument("--docs", action="store_true", help="copy the figures to docs/_static")
     a = ap.parse_args(argv)
@@ -136,7 +137,8 @@ def main(argv=None):
            "points_mistuned_frf": int(one.omega.size),
            "friction_samples": n_fr, "serial_samples_per_min": rate_s,
            "dask2_samples_per_min": rate_d, "dask_speedup": rate_d / rate_s,
-           "worker_memory_mb": mem, "linear_samples": n_lin, "seconds_per_linear_sample": t_lin, "statistics": stats,
+           "worker_memory_mb": mem, "linear_samples": n_lin,
+           "seconds_per_linear_sample": t_lin, "statistics": stats,
            "cpu_count": os.cpu_count()}
     (out / "mistuning.json").write_text(json.dumps(res, indent=1))
     print(f"seconds per mistuned FRF {one.seconds:.2f}, Dask speed-up "
