@@ -7,12 +7,20 @@
 !> K' = K + G^T Ks G, and free_subtract takes it back off the contact forces and their
 !> Jacobian, f' = f(G x) - Ks G x at every harmonic: K' x + G^T f' = K x + G^T f exactly,
 !> so the solution is unchanged while every D_h' = K' + i h w C - (h w)^2 M is regular (K'
-!> is the stuck structure's stiffness). free_subtract also holds each contact's mean
-!> relative displacement (harmonic 0) by a spring FREE_PIN Ks anchored at the assembled
-!> position (zero): where a body slips on every contact (gross slip), the equations leave
-!> its mean free (a family of solutions at one frequency, J singular) and the pin picks
-!> the member nearest the assembled position; where a contact sticks or slips partly, it
-!> moves that contact's mean by about FREE_PIN of itself.
+!> is the stuck structure's stiffness).
+!>
+!> free_subtract also holds each contact's mean relative displacement (harmonic 0) by a
+!> spring FREE_PIN Ks anchored at the assembled position (zero). Where a body slips on
+!> every contact (gross slip), the equations leave its mean free: a family of solutions at
+!> one frequency, J singular along it, and a continuation that drifts along the family
+!> instead of moving in frequency (the stall of issue 29). The pin picks the member whose
+!> contacts' means are nearest the assembled position; its force there is zero, so the
+!> member solves the true equations. Where a contact sticks or slips partly, the pin adds
+!> FREE_PIN Ks to its mean stiffness and moves its mean, which the preload balance keeps
+!> small: the UPD case's peak moves by 0.1-0.3 % for FREE_PIN from 1e-3 to 1e-1. Weaker
+!> pins (1e-6), a hold in the Jacobian alone and an anchor at the previous point's mean
+!> (not a solution of the next point's equations) all failed on that case. Stateless:
+!> a run restored from a checkpoint sees the same equations.
 submodule (frirom_hbm) frirom_hbm_free
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_ALLOC, FRIROM_ERR_SIZE, set_status
     use frirom_aft, only: law_stuck_stiffness
