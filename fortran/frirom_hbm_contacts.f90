@@ -134,9 +134,9 @@ contains
                 if (allocated(gr%ks)) then        ! free bodies: f - Ks x, restored below
                     fkeep = gr%f
                     if (jac .and. .not. upd) then
-                        call free_subtract(gr%ks, gr%x, gr%f, gr%jac)
+                        call free_subtract(gr%ks, gr%kp, gr%x, gr%f, gr%jac)
                     else
-                        call free_subtract(gr%ks, gr%x, gr%f)
+                        call free_subtract(gr%ks, gr%kp, gr%x, gr%f)
                     end if
                 end if
                 if (gr%gx_mode == 3) then

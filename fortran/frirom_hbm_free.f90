@@ -9,9 +9,10 @@
 !> so the solution is unchanged while every D_h' = K' + i h w C - (h w)^2 M is regular (K'
 !> is the stuck structure's stiffness).
 !>
-!> free_subtract also holds each contact's mean relative displacement (harmonic 0) by a
-!> spring FREE_PIN Ks anchored at the assembled position (zero). Where a body slips on
-!> every contact (gross slip), the equations leave its mean free: a family of solutions at
+!> free_subtract also holds each contact's mean tangential relative displacement
+!> (harmonic 0) by a spring FREE_PIN Ks anchored at the assembled position (zero); the
+!> normal mean of a pressed body is fixed by its load (a cubic spring needs no pin).
+!> Where a body slips on every contact (gross slip), the equations leave its mean free: a family of solutions at
 !> one frequency, J singular along it, and a continuation that drifts along the family
 !> instead of moving in frequency (the stall of issue 29). The pin picks the member whose
 !> contacts' means are nearest the assembled position; its force there is zero, so the
@@ -23,7 +24,7 @@
 !> a run restored from a checkpoint sees the same equations.
 submodule (frirom_hbm) frirom_hbm_free
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_ALLOC, FRIROM_ERR_SIZE, set_status
-    use frirom_aft, only: law_stuck_stiffness
+    use frirom_aft, only: law_stuck_stiffness, LAW_NORMAL1D, LAW_NORMAL2D, LAW_CUBIC
     implicit none
 
 contains
@@ -43,9 +44,16 @@ contains
         allocate (ks(nrows))
         do g = 1, size(sys%cs%grp)
             associate (gr => sys%cs%grp(g))
-                allocate (gr%ks(gr%ndir, gr%ne))
+                allocate (gr%ks(gr%ndir, gr%ne), gr%kp(gr%ndir, gr%ne))
                 do e = 1, gr%ne
                     call law_stuck_stiffness(gr%law, gr%params(:, e), gr%ks(:, e))
+                    gr%kp(:, e) = FREE_PIN*gr%ks(:, e)
+                    select case (gr%law)
+                    case (LAW_NORMAL1D, LAW_NORMAL2D)
+                        gr%kp(gr%ndir, e) = 0.0_wp
+                    case (LAW_CUBIC)
+                        gr%kp(:, e) = 0.0_wp
+                    end select
                     r = gr%row0 + (e - 1)*gr%ndir
                     ks(r + 1:r + gr%ndir) = gr%ks(:, e)
                 end do
@@ -145,14 +153,14 @@ contains
         do e = 1, size(x, 3)
             do d = 1, size(x, 2)
                 f(:, d, e) = f(:, d, e) - ks(d, e)*x(:, d, e)
-                f(1, d, e) = f(1, d, e) + FREE_PIN*ks(d, e)*x(1, d, e)
+                f(1, d, e) = f(1, d, e) + kp(d, e)*x(1, d, e)
                 if (.not. present(jac)) cycle
                 do c = 1, nc
                     q = c + nc*(d - 1)
                     jac(q, q, e) = jac(q, q, e) - ks(d, e)
                 end do
                 q = 1 + nc*(d - 1)
-                jac(q, q, e) = jac(q, q, e) + FREE_PIN*ks(d, e)
+                jac(q, q, e) = jac(q, q, e) + kp(d, e)
             end do
         end do
     end procedure free_subtract

@@ -344,9 +344,9 @@ contains
                 if (info /= 0) return
                 if (allocated(gr%ks)) then
                     if (jac) then
-                        call free_subtract(gr%ks(:, og%rep), og%x, og%f, og%jac)
+                        call free_subtract(gr%ks(:, og%rep), gr%kp(:, og%rep), og%x, og%f, og%jac)
                     else
-                        call free_subtract(gr%ks(:, og%rep), og%x, og%f)
+                        call free_subtract(gr%ks(:, og%rep), gr%kp(:, og%rep), og%x, og%f)
                     end if
                 end if
                 do r = 1, nr
