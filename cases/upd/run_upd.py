@@ -78,7 +78,6 @@ def plot_design(loads, peaks, limits, opt, ok):
             label=f"optimum: {opt[0]:.3g} N, {opt[1] * 1e6:.3g} um")
     ax.set_xlabel("damper normal load [N]")
     ax.set_ylabel("peak amplitude of TIP_0 x [um]")
-    ax.set_yscale("log")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(loc="upper right", fontsize=8)
     ax.set_title("Under-platform damper: design curve")
@@ -98,8 +97,9 @@ def main(argv=None):
     work = a.work or HERE
     if work != HERE:
         work.mkdir(parents=True, exist_ok=True)
-        for name in ("upd.toml", "upd_design.toml"):
-            shutil.copy(HERE / name, work / name)
+        for name in ("upd.toml", "upd_design.toml"):      # kept if there (edited)
+            if not (work / name).exists():
+                shutil.copy(HERE / name, work / name)
     if not (work / "upd.sti").exists():
         make_upd.make(work, stride=a.stride)
     res = run_study(work / "upd_design.toml", a.out, scheduler="serial")
