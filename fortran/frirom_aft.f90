@@ -50,7 +50,8 @@ module frirom_aft
 
     public :: aft_plan, aft_plan_create, aft_plan_destroy, aft_eval, aft_time
     public :: LAW_JENKINS, LAW_NORMAL1D, LAW_NORMAL2D, LAW_CUBIC, LAW_CODES
-    public :: law_info, law_check, law_ndir, law_npar, law_nslider, law_rest_force
+    public :: law_info, law_check, law_ndir, law_npar, law_nslider, law_rest_force, &
+              law_stuck_stiffness
 
     ! The contact-law table: the one source of the codes and sizes (the Python package
     ! checks its own table, with the names of directions and parameters, against it).
@@ -267,7 +268,26 @@ contains
         end do
     end function law_list
 
-    !> Number of directions of a law (0 for an unknown code).
+    !> The element's stiffness when closed and stuck, per direction (N/m): kt along the
+    !> tangents, kn along the normal, k1 of a cubic spring. The linear part a body held
+    !> only by its contacts borrows (hbm_setup's free bodies: G^T Ks G moved from the
+    !> contact forces into K and subtracted back in contact_eval); any positive value
+    !> would do in exact arithmetic, this one keeps D_h as well conditioned as the stuck
+    !> structure's.
+    pure subroutine law_stuck_stiffness(law, p, ks)
+        integer(ip), intent(in) :: law
+        real(wp), intent(in) :: p(:)        !! (npar) the element's parameters
+        real(wp), intent(out) :: ks(:)      !! (ndir) N/m
+        ks = 0.0_wp
+        select case (law)
+        case (LAW_JENKINS, LAW_CUBIC)
+            ks(1) = abs(p(1))
+        case (LAW_NORMAL1D, LAW_NORMAL2D)
+            ks(1:size(ks) - 1) = abs(p(1))
+            ks(size(ks)) = abs(p(2))
+        end select
+    end subroutine law_stuck_stiffness
+
     !> The local force f(ndir) of one element at rest (zero relative displacement): the
     !> normal preload max(n0, 0) of normal1d / normal2d on their normal direction (the
     !> last), zero otherwise (Jenkins' fn0 has no normal direction; the tangential force
@@ -280,6 +300,7 @@ contains
         if (law == LAW_NORMAL1D .or. law == LAW_NORMAL2D) f(size(f)) = max(p(4), 0.0_wp)
     end subroutine law_rest_force
 
+    !> Number of directions of a law (0 for an unknown code).
     pure integer(ip) function law_ndir(law)
         integer(ip), intent(in) :: law
         law_ndir = 0

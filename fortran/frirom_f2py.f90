@@ -197,6 +197,23 @@ subroutine frun_set_modes(handle, harmonic, ndof, nmodes, nh1, phi, psi, npsi, w
     info = linfo
 end subroutine frun_set_modes
 
+!> Bodies held only by their contacts (on = 1): frirom_run run_set_free_bodies.
+subroutine frun_set_free_bodies(handle, on, info, msg)
+    use frirom_kinds, only: ip
+    use frirom_run, only: run_t, run_from_handle, fr_free => run_set_free_bodies
+    implicit none
+    integer(8), intent(in) :: handle
+    integer(4), intent(in) :: on
+    integer(4), intent(out) :: info
+    character(len=512), intent(out) :: msg
+    type(run_t), pointer :: r
+    integer(ip) :: linfo
+    msg = ''
+    call run_from_handle(handle, r, 'run_set_free_bodies', linfo, msg)
+    if (linfo == 0) call fr_free(r, on == 1, linfo, msg)
+    info = linfo
+end subroutine frun_set_free_bodies
+
 !> A travelling-wave selection keep(j, h + 1) = 1 of the nonlinear DoFs' harmonics; with
 !> haspair = 1 its direction pair (0: none); with orbits = 1 Newton's evaluations on one
 !> element per orbit (matched to orbtol). orbinfo: elements the AFT runs on, misfit.
@@ -729,6 +746,21 @@ subroutine law_info(law, ndir, npar, nslider, name, nlaw)
     nslider = int(ns, 4)
     nlaw = int(size(LAW_CODES), 4)
 end subroutine law_info
+
+!> The stuck stiffness ks (ndir, ne) [N/m] of ne elements of one law (frirom_aft
+!> law_stuck_stiffness): what a body held only by its contacts borrows (frirom_hbm_free).
+subroutine stuck_stiffness(law, npar, ndir, ne, params, ks)
+    use frirom_kinds, only: ip
+    use frirom_aft, only: law_stuck_stiffness
+    implicit none
+    integer(4), intent(in) :: law, npar, ndir, ne
+    real(8), intent(in) :: params(npar, ne)
+    real(8), intent(out) :: ks(ndir, ne)
+    integer :: e
+    do e = 1, ne
+        call law_stuck_stiffness(int(law, ip), params(:, e), ks(:, e))
+    end do
+end subroutine stuck_stiffness
 
 ! ---- peak amplitude and modal damping --------------------------------------------------
 

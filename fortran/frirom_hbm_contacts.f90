@@ -70,7 +70,7 @@ contains
     module procedure contact_eval
         integer(ip) :: g, e, d, row, k, c, nc, nrg, ns
         real(wp) :: acc
-        real(wp), allocatable :: wnew(:, :)
+        real(wp), allocatable :: wnew(:, :), fkeep(:, :, :)
         logical :: upd
         info = FRIROM_OK
         upd = .false.
@@ -131,6 +131,14 @@ contains
                                   states=gr%states, relative=.true.)
                 end if
                 if (info /= 0) return
+                if (allocated(gr%ks)) then        ! free bodies: f - Ks x, restored below
+                    fkeep = gr%f
+                    if (jac .and. .not. upd) then
+                        call free_subtract(gr%ks, gr%kp, gr%x, gr%f, gr%jac)
+                    else
+                        call free_subtract(gr%ks, gr%kp, gr%x, gr%f)
+                    end if
+                end if
                 if (gr%gx_mode == 3) then
                     call gtf_dir(gr, fd)
                 else if (gr%gx_mode == 2) then
@@ -150,6 +158,7 @@ contains
                         end do
                     end do
                 end if
+                if (allocated(gr%ks)) call move_alloc(fkeep, gr%f)
             end associate
         end do
     end procedure contact_eval

@@ -342,6 +342,13 @@ contains
                                   errmsg, states=og%states, relative=.true.)
                 end if
                 if (info /= 0) return
+                if (allocated(gr%ks)) then
+                    if (jac) then
+                        call free_subtract(gr%ks(:, og%rep), gr%kp(:, og%rep), og%x, og%f, og%jac)
+                    else
+                        call free_subtract(gr%ks(:, og%rep), gr%kp(:, og%rep), og%x, og%f)
+                    end if
+                end if
                 do r = 1, nr
                     og%f(:, :, r) = og%mult(r)*og%f(:, :, r)
                 end do

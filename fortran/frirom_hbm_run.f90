@@ -211,6 +211,10 @@ contains
         call aft_plan_create(sys%plan, nh, nsamp, info, errmsg)
         if (info /= 0) return
         call rest_shift(sys)
+        if (present(free_bodies)) then
+            if (free_bodies) call hbm_free_bodies(sys, gp, gi, gx, info, errmsg)
+            if (info /= 0) return
+        end if
         ! contact couplings widen the band of the full formulation
         do g = 1, ng
             associate (gr => sys%cs%grp(g), gg => sys%cs%g)

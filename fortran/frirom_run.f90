@@ -41,7 +41,7 @@ module frirom_run
               run_advice, run_sizes, run_default_samples, settings_pack, settings_unpack, &
               run_settings_names, run_handle, run_from_handle, run_checkpoint_size, &
               run_checkpoint, run_restore, run_contact_coords, open_run, run_lu_size, &
-              run_lu_state
+              run_lu_state, run_set_free_bodies
     public :: RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_LOAD, &
               RUN_START_COLD, RUN_START_POINT, RUN_START_RESUME, &
               RUN_GOING, RUN_DONE, RUN_MAX_POINTS, RUN_LEFT_RANGE, RUN_FAILED, RUN_STALLED, &
@@ -122,6 +122,8 @@ module frirom_run
         integer(ip), allocatable :: keep(:, :), pair(:, :)
         logical :: orbits = .false.
         real(wp) :: orbtol = 1.0e-9_wp
+        !> bodies held only by their contacts (run_set_free_bodies)
+        logical :: free = .false.
     end type run_model
 
     !> Points of a run (run_advance, run_solve), in the full layout of the unknowns.
@@ -238,6 +240,17 @@ module frirom_run
             integer(ip), intent(out) :: info
             character(len=*), intent(inout) :: errmsg
         end subroutine run_set_modes_harmonic
+
+        !> Bodies held only by their contacts (on): the contacts' stuck stiffness moved
+        !> into the linear part and taken back off the contact forces, each contact's mean
+        !> relative displacement held by a weak spring (frirom_hbm_free); rebuilds the
+        !> system. The solution is unchanged where it is determined.
+        module subroutine run_set_free_bodies(run, on, info, errmsg)
+            type(run_t), intent(inout) :: run
+            logical, intent(in) :: on
+            integer(ip), intent(out) :: info
+            character(len=*), intent(inout) :: errmsg
+        end subroutine run_set_free_bodies
 
         !> A travelling-wave selection keep (nnl, H+1) of the condensed unknowns; with
         !> pair (nnl, H+1) its direction; with orbits, Newton's evaluations on one element

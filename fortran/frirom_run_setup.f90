@@ -95,7 +95,7 @@ contains
                            m%mx, m%cp, m%ci, m%cx, m%perm, m%nl, m%fe0, m%fe1, m%mode, &
                            m%omega_fix, m%ginfo, m%gp, m%gi, m%gx, m%params, m%w0, &
                            m%outdofs, info, errmsg, contact_coords=m%tcontact, &
-                           krylov=m%krylov, sparse_lu=m%sparse)
+                           krylov=m%krylov, sparse_lu=m%sparse, free_bodies=m%free)
             if (info /= 0) return
             if (allocated(m%phi)) call hbm_set_modes(run%sys, m%phi, m%wm, m%zm, info, errmsg)
             if (info /= 0) return
@@ -190,6 +190,13 @@ contains
             call hbm_set_modes_harmonic(run%sys, run%m%psi, run%m%wh, run%m%zh, info, errmsg)
         end if
     end subroutine apply_modes
+
+    module procedure run_set_free_bodies
+        info = FRIROM_OK
+        if (.not. open_run(run, 'run_set_free_bodies', info, errmsg)) return
+        run%m%free = on
+        call run_build(run, info, errmsg)
+    end procedure run_set_free_bodies
 
     module procedure run_set_selection
         info = FRIROM_OK

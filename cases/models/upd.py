@@ -64,9 +64,11 @@ def _body(boxes):
     return np.array(pts), hexes
 
 
-def upd_mesh(h=0.002, damper=True):
+def upd_mesh(h=0.002, damper=True, stride=1):
     """Node ids, coordinates [m], C3D8 connectivity and node sets of the two blades (and
-    the damper)."""
+    the damper). stride: the contact patches' node sets take every stride-th lattice
+    point along x and z (2: 3 x 5 pairs a patch instead of 5 x 9; a coarse contact model
+    for quick tests, the mesh is the same)."""
     bodies = [_blade(0), _blade(1)] + ([DAMPER] if damper else [])
     ids, xyz, elems, lat = [], [], [], []
     for boxes in bodies:
@@ -86,7 +88,8 @@ def upd_mesh(h=0.002, damper=True):
             fix = node[y == 0]
             sets["FIX"] = np.union1d(sets.get("FIX", []), fix).astype(np.int64)
         for side, (x0, x1, blade) in PATCHES.items():
-            on = (y == 10) & (x >= x0) & (x <= x1) & (z >= 1) & (z <= 9)
+            on = ((y == 10) & (x >= x0) & (x <= x1) & (z >= 1) & (z <= 9)
+                  & ((x - x0) % stride == 0) & ((z - 1) % stride == 0))
             if b == 2:
                 sets[f"DAMPER_{side}"] = node[on]
             elif b == blade:
@@ -130,11 +133,11 @@ def contact_pairs(xyz, sets):
     return out
 
 
-def write_upd(out, h=0.002, kt=2.0e6, kn=5.0e6, n_ref_modes=12):
+def write_upd(out, h=0.002, kt=2.0e6, kn=5.0e6, n_ref_modes=12, stride=1):
     """The matrices (upd.sti/.mas/.dof + upd.inp) and the two references (free.dat,
-    stuck.dat); returns the job path."""
+    stuck.dat); returns the job path. stride: see upd_mesh."""
     out = Path(out)
-    ids, xyz, elems, sets = upd_mesh(h)
+    ids, xyz, elems, sets = upd_mesh(h, stride=stride)
     job = run_ccx(_deck(out / "upd.inp", f"UPD, C3D8, h = {h} m", ids, xyz, elems, sets))
     pairs = contact_pairs(xyz, sets)
     run_ccx(_deck(out / "stuck.inp", "UPD stuck: patches joined by springs", ids, xyz,

@@ -21,17 +21,20 @@ sys.path.insert(0, str(HERE.parent / "models"))
 from upd import write_upd  # noqa: E402
 
 
-def make(out=HERE, h: float = 0.002) -> Path:
-    """Mesh, run ccx three times; returns the job path (out/upd)."""
-    return write_upd(Path(out), h)
+def make(out=HERE, h: float = 0.002, stride: int = 1) -> Path:
+    """Mesh, run ccx three times; returns the job path (out/upd). stride 2: every other
+    lattice point of the contact patches (a coarse contact model for quick tests)."""
+    return write_upd(Path(out), h, stride=stride)
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--h", type=float, default=0.002, help="lattice spacing [m]")
     ap.add_argument("--out", type=Path, default=HERE, help="folder (default: this one)")
+    ap.add_argument("--stride", type=int, default=1,
+                    help="contact pairs at every stride-th lattice point (2: coarse)")
     a = ap.parse_args(argv)
-    print(f"wrote {make(a.out, a.h)}.sti/.mas/.dof, free.dat, stuck.dat")
+    print(f"wrote {make(a.out, a.h, a.stride)}.sti/.mas/.dof, free.dat, stuck.dat")
 
 
 if __name__ == "__main__":

@@ -9,6 +9,7 @@ from Fortran at import (``int_constant``), so no number of the boundary is typed
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, NamedTuple
@@ -172,6 +173,9 @@ class _Packed:
     #: the frequency of a load continuation, rad/s (0 for frequency)
     omega_fix: float = 0.0
     orbit_tol: float = ORBIT_TOL
+    #: a body held only by its contacts: the run moves their stuck stiffness into K
+    #: (frirom_hbm_free); the modes of the receptance route are K + G^T Ks G's
+    free: bool = False
     _run: object = field(default=None, repr=False)
 
     @property
@@ -408,10 +412,18 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
     out = _check_outputs((np.arange(n) if n <= 100 else nl) if outputs is None else outputs, n)
     tcontact, sparse, info = False, False, f"banded: {n * (2 * H + 1)} unknowns"
     modes = _Modes.none(n, H)
+    free = model.free_bodies()
+    if free:
+        note += ("; a body held only by its contacts: their stuck stiffness moved into the "
+                 "linear part")
     if opts.formulation == "condensed":
         nrows = c.G.shape[0]
         tcontact = _contact_coords(opts, nrows, nl.size)
-        modes, route, sparse = _receptance_route(model, opts, H, band)
+        rmodel = model
+        if free:        # the receptances' modes are the stuck structure's
+            rmodel = copy.copy(model)
+            rmodel.K = sp.csr_matrix(model.K + model.stuck_stiffness())
+        modes, route, sparse = _receptance_route(rmodel, opts, H, band)
         nu = nrows if tcontact else nl.size
         info = (f"condensed: {nu * (2 * H + 1)} unknowns, "
                 + (f"{nu} contact coordinates G x" if tcontact else f"{nu} contact DoFs")
@@ -437,7 +449,7 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
                    G=_csr(c.G), ginfo=c.ginfo, params=c.params, w0=c.w0, nw=c.nw,
                    group_names=c.names, group_sizes=c.sizes, outputs=out, out_f=out,
                    stability=bool(opts.stability), modes=modes, tcontact=tcontact, sparse=sparse,
-                   info=info + note)
+                   info=info + note, free=free)
 
 
 def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Packed:

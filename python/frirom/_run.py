@@ -102,6 +102,8 @@ class Run:
         self.ny, self.nw, self.netot = int(ny), int(nw), int(netot)
         self.nout, self.nc = p.out_f.size, 2 * p.H + 1
         self.orbits = None
+        if getattr(p, "free", False):
+            raise_for_status(*self._msg(_kernels.frun_set_free_bodies(self.handle, 1)))
         if m.nmodes:
             raise_for_status(*self._msg(_kernels.frun_set_modes(
                 self.handle, 0, np.asfortranarray(m.phi),

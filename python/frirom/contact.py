@@ -138,6 +138,16 @@ def get_law(law: str | Law) -> Law:
                              f"{', '.join(LAWS)}") from None
 
 
+def stuck_stiffness(law: str | Law, params) -> np.ndarray:
+    """(n_elem, n_dir) stiffness [N/m] of each element closed and stuck (kt along the
+    tangents, kn along the normal, k1 of a cubic spring): frirom_aft's
+    law_stuck_stiffness, what a body held only by its contacts borrows."""
+    law = get_law(law)
+    p = np.atleast_2d(np.asarray(params, dtype=float))
+    ks = _kernels.stuck_stiffness(law.code, law.n_dir, np.asfortranarray(p.T))
+    return np.asarray(ks).T
+
+
 def _params_array(law: Law, params, n_elem: int) -> np.ndarray:
     """(n_par, n_elem) Fortran-ordered parameters from a dict or an (n_elem, n_par) array."""
     if isinstance(params, dict):

@@ -324,6 +324,32 @@ class Model:
     def n_dof(self) -> int:
         return self.M.shape[0]
 
+    def free_bodies(self) -> bool:
+        """True when K alone does not hold the structure: a body held only by its
+        contacts (check_definite has checked that the contacts, tied, hold it). Tested
+        by a Cholesky of K - sigma M, sigma = 1e-10 max|K| / max|M|: a zero eigenvalue
+        fails it, and so would a mount 1e-5 times softer than the stiffest mode (the
+        solver's regularisation is exact, so the few such models lose nothing)."""
+        if getattr(self, "_free", None) is None:
+            kmax = abs(self.K).max() if self.K.nnz else 0.0
+            mmax = abs(self.M).max() if self.M.nnz else 1.0
+            self._free = bool(self.contacts) and kmax > 0 and not _positive_definite(
+                (self.K - (1e-10 * kmax / mmax) * self.M).tocsr())
+        return self._free
+
+    def stuck_stiffness(self) -> sp.csr_matrix:
+        """G^T Ks G of every contact group: their stiffness closed and stuck
+        (frirom.contact.stuck_stiffness), the stiffness K + G^T Ks G of a structure with
+        free bodies the solver factorises."""
+        from .contact import stuck_stiffness
+        n = self.n_dof
+        out = sp.csr_matrix((n, n))
+        for g in self.contacts:
+            ks = stuck_stiffness(g.law, g.params).ravel()
+            G = sp.csr_matrix(g.G)
+            out = out + (G.T @ sp.diags(ks) @ G)
+        return sp.csr_matrix(out)
+
     def nonlinear_dofs(self) -> np.ndarray:
         """Sorted DoFs in the column support of all contact G (0-based)."""
         cols = [np.unique(g.G.indices) for g in self.contacts]

@@ -115,7 +115,7 @@ def _forces_and_tangent(law: str, p: list, u: np.ndarray, w: np.ndarray):
         Dtt = np.where(stick, kt[..., None, None] * eye,
                        ratio[..., None, None] * (eye - n[..., :, None] * n[..., None, :]))
         D[..., :2, :2] = Dtt
-        D[..., :2, 2] = np.where(slip[..., None], mu * kn[..., None] * n, 0.0)
+        D[..., :2, 2] = np.where(slip[..., None], (mu * kn)[..., None] * n, 0.0)
     else:
         raise InputError(f"timeint: unknown law {law!r}")
     return f, w_new, state, D
