@@ -10,7 +10,8 @@ same points (count and completion), frequencies and peak amplitudes within 1e-12
 largest value: the programs and Python run the same driver on the same numbers (measured
 0: bit for bit). It was 1e-7 while the deck normalised the already-unit contact direction
 (cos 30, sin 30) by its norm 1 - 1e-16, one ulp off the programs' G, which the continuation
-carried along the 164 points to 4e-10.
+carried along the 164 points to 4e-10. tests/test_install.py builds the library again with
+the README's commands (other compiler flags) and allows 1e-8 (measured 7.2e-10).
 """
 
 import dataclasses
@@ -37,7 +38,10 @@ def run(program):
     return np.array(rows), complete
 
 
-def main(programs):
+def main(programs, tol: float = TOL):
+    """0 when every program reproduces Python's FRF within tol (TOL: the same build of
+    the library as the Python extension; another build, with its own compiler flags,
+    differs by its round-off carried along the curve)."""
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     from frirom.deck import load_deck
     from frirom.solver import frf
@@ -60,10 +64,10 @@ def main(programs):
             continue
         e_om = np.abs(rows[:, 0] - ref.omega).max() / np.abs(ref.omega).max()
         e_amp = (np.abs(rows[:, 1:] - ref.amp_max).max(axis=0) / ref.amp_max.max(axis=0)).max()
-        ok = e_om <= TOL and e_amp <= TOL
+        ok = e_om <= tol and e_amp <= tol
         bad += not ok
         print(f"{name}: {rows.shape[0]} points, complete {complete[0]}; relative error "
-              f"omega {e_om:.1e}, amplitude {e_amp:.1e} (tolerance {TOL:g}) "
+              f"omega {e_om:.1e}, amplitude {e_amp:.1e} (tolerance {tol:g}) "
               f"{'ok' if ok else 'FAILED'}")
     return 1 if bad else 0
 

@@ -8,7 +8,10 @@ element against the linear spring (exact) and the first eigenvalue of a spring c
 against its closed form (1e-10; ARPACK + MUMPS through the static library). The whole-solve
 programs of examples/ (frf_joint.f90 through frirom_solve, frf_joint.c through frirom.h)
 are built by the README's own commands and must reproduce the Python FRF of the joint deck
-(tests/capi_compare.py: same points, 1e-7); no test program is built or installed by a
+(tests/capi_compare.py: same points; 1e-8 here, where the library is built again by the
+README's commands with their own compiler flags: measured 7.2e-10, the round-off of
+differently compiled arithmetic carried along 164 points; the meson test on the build
+Python uses holds 1e-12); no test program is built or installed by a
 plain build.
 """
 
@@ -124,7 +127,7 @@ def test_readme_fortran_c_block_and_legacy_programs(tmp_path):
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     assert run.stdout.count("complete") == 2, run.stdout[-2000:]
     exe_f, exe_c = src / "build" / "frf_joint", src / "build" / "frf_joint_c"
-    assert capi_compare.main([str(exe_f), str(exe_c)]) == 0
+    assert capi_compare.main([str(exe_f), str(exe_c)], tol=1e-8) == 0
 
     prefix = home / ".local"
     pcs = list(prefix.rglob("frirom.pc"))

@@ -403,7 +403,8 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
     print(f"frirom: {len(full)} points in {elapsed:.1f} s; wrote "
           + ", ".join(str(p) for p in written))
     # a resumed run solved its peaks on the whole curve (the file's points before it too)
-    if args.resume and result.peaks is not None and start and start.get("before"):
+    if (args.resume and result is not None and result.peaks is not None and start
+            and start.get("before")):
         full.peaks = result.peaks
     _print_peaks(full if args.resume else result, deck)
     if not full.complete:
