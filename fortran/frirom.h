@@ -18,7 +18,9 @@ enum frirom_law {
     FRIROM_LAW_JENKINS = 1,   /* u;         kt, mu, fn0 */
     FRIROM_LAW_NORMAL1D = 2,  /* u, v;      kt, kn, mu, n0 */
     FRIROM_LAW_NORMAL2D = 3,  /* u1, u2, v; kt, kn, mu, n0 */
-    FRIROM_LAW_CUBIC = 4      /* u;         k1, k3 */
+    FRIROM_LAW_CUBIC = 4,     /* u;         k1, k3 */
+    FRIROM_LAW_IWAN4 = 5,     /* u;         fs, kt, chi, beta (31 sliders) */
+    FRIROM_LAW_IWAN = 6       /* u;         k1, fs1, ..., k10, fs10 (10 sliders) */
 };
 
 /* frirom_settings.formulation: unknowns are the contact DoFs' harmonics (Eq. 5-9) or all

@@ -49,9 +49,11 @@ module frirom_aft
     private
 
     public :: aft_plan, aft_plan_create, aft_plan_destroy, aft_eval, aft_time
-    public :: LAW_JENKINS, LAW_NORMAL1D, LAW_NORMAL2D, LAW_CUBIC, LAW_CODES
+    public :: LAW_JENKINS, LAW_NORMAL1D, LAW_NORMAL2D, LAW_CUBIC, LAW_IWAN4, LAW_IWAN, LAW_CODES
+    public :: IWAN4_BINS, IWAN_MAX
     public :: law_info, law_check, law_ndir, law_npar, law_nslider, law_rest_force, &
               law_stuck_stiffness
+    public :: iwan_sliders
 
     ! The contact-law table: the one source of the codes and sizes (the Python package
     ! checks its own table, with the names of directions and parameters, against it).
@@ -59,15 +61,22 @@ module frirom_aft
     integer(ip), parameter :: LAW_NORMAL1D = 2  !! u, v; kt, kn, mu, n0
     integer(ip), parameter :: LAW_NORMAL2D = 3  !! u1, u2, v; kt, kn, mu, n0
     integer(ip), parameter :: LAW_CUBIC = 4     !! u; k1, k3
-    integer(ip), parameter :: NLAW = 4
+    integer(ip), parameter :: LAW_IWAN4 = 5     !! u; fs, kt, chi, beta (Segalman 2005)
+    integer(ip), parameter :: LAW_IWAN = 6      !! u; k1, fs1, ..., k10, fs10 (parallel Jenkins)
+    !> The four-parameter Iwan's density, discretised (frirom_aft_iwan): IWAN4_BINS Jenkins
+    !> sliders for its power-law part plus one for its Dirac part at phi_max.
+    integer(ip), parameter :: IWAN4_BINS = 30
+    integer(ip), parameter :: IWAN_MAX = 10     !! sliders of the discrete Iwan
+    integer(ip), parameter :: NLAW = 6
     !> Every law code, in the order of the tables below (code k at position k).
     integer(ip), parameter :: LAW_CODES(NLAW) = [LAW_JENKINS, LAW_NORMAL1D, LAW_NORMAL2D, &
-                                                 LAW_CUBIC]
+                                                 LAW_CUBIC, LAW_IWAN4, LAW_IWAN]
     character(len=*), parameter :: LAW_NAMES(NLAW) = [character(len=8) :: 'jenkins', &
-                                                      'normal1d', 'normal2d', 'cubic']
-    integer(ip), parameter :: NDIR_OF(NLAW) = [1, 2, 3, 1]     !! relative displacements
-    integer(ip), parameter :: NPAR_OF(NLAW) = [3, 4, 4, 2]     !! parameters per element
-    integer(ip), parameter :: NSLIDER_OF(NLAW) = [1, 1, 2, 0]  !! slider components
+                                                      'normal1d', 'normal2d', 'cubic', &
+                                                      'iwan4', 'iwan']
+    integer(ip), parameter :: NDIR_OF(NLAW) = [1, 2, 3, 1, 1, 1]  !! relative displacements
+    integer(ip), parameter :: NPAR_OF(NLAW) = [3, 4, 4, 2, 4, 2*IWAN_MAX]  !! parameters
+    integer(ip), parameter :: NSLIDER_OF(NLAW) = [1, 1, 2, 0, IWAN4_BINS + 1, IWAN_MAX]
 
     integer(ip), parameter :: DEFAULT_BATCH = 16
     real(wp), parameter :: DEFAULT_TOL = 1.0e-12_wp
@@ -130,7 +139,7 @@ module frirom_aft
         !> jumping back to w0. relative: f less the force at rest (law_rest_force: the
         !> normal preload on harmonic 0), its samples computed as kn v (-n0 open), not as
         !> (n0 + kn v) - n0: no rounding of the size eps n0 (a large preload).
-        module subroutine aft_forces(plan, law, x, params, w0, f, info, errmsg, jac, periods, &
+        recursive module subroutine aft_forces(plan, law, x, params, w0, f, info, errmsg, jac, periods, &
                                      states, tol, max_periods, index_base, slider, relative)
             type(aft_plan), intent(inout) :: plan
             integer(ip), intent(in) :: law                !! LAW_*
@@ -154,7 +163,7 @@ module frirom_aft
     interface aft_time
         !> Time histories of the closed cycle: relative displacements xt and forces ft at
         !> the N samples, for hysteresis loops and contact-state plots.
-        module subroutine aft_histories(plan, law, x, params, w0, xt, ft, info, errmsg, tol, &
+        recursive module subroutine aft_histories(plan, law, x, params, w0, xt, ft, info, errmsg, tol, &
                                         max_periods, index_base)
             type(aft_plan), intent(inout) :: plan
             integer(ip), intent(in) :: law
@@ -170,6 +179,49 @@ module frirom_aft
             integer(ip), intent(in), optional :: index_base
         end subroutine aft_histories
     end interface aft_time
+
+    ! The Iwan laws (frirom_aft_iwan): each element is a set of parallel Jenkins sliders
+    ! marched, transformed and differentiated by the Jenkins AFT; forces and Jacobians sum.
+    interface
+        !> aft_forces for LAW_IWAN4 / LAW_IWAN (arguments checked by aft_forces).
+        recursive module subroutine iwan_forces(plan, law, x, params, w0, f, info, errmsg, &
+                                                jac, periods, states, tol, max_periods, &
+                                                index_base, slider)
+            type(aft_plan), intent(inout) :: plan
+            integer(ip), intent(in) :: law
+            real(wp), intent(in) :: x(:, :, :), params(:, :), w0(:, :)
+            real(wp), intent(out) :: f(:, :, :)
+            integer(ip), intent(out) :: info
+            character(len=*), intent(inout), optional :: errmsg
+            real(wp), intent(out), optional :: jac(:, :, :)
+            integer(ip), intent(out), optional :: periods(:)
+            real(wp), intent(out), optional :: states(:, :)
+            real(wp), intent(in) :: tol
+            integer(ip), intent(in) :: max_periods, index_base
+            real(wp), intent(out), optional :: slider(:, :)
+        end subroutine iwan_forces
+
+        !> aft_histories for LAW_IWAN4 / LAW_IWAN.
+        recursive module subroutine iwan_histories(plan, law, x, params, w0, xt, ft, info, &
+                                                   errmsg, tol, max_periods, index_base)
+            type(aft_plan), intent(inout) :: plan
+            integer(ip), intent(in) :: law
+            real(wp), intent(in) :: x(:, :, :), params(:, :), w0(:, :)
+            real(wp), intent(out) :: xt(:, :, :), ft(:, :, :)
+            integer(ip), intent(out) :: info
+            character(len=*), intent(inout), optional :: errmsg
+            real(wp), intent(in) :: tol
+            integer(ip), intent(in) :: max_periods, index_base
+        end subroutine iwan_histories
+
+        !> The Jenkins sliders of one Iwan element: stiffness k(s) and slip force fs(s),
+        !> s = 1..NSLIDER_OF(law); k(s) = 0 marks an unused slider.
+        pure module subroutine iwan_sliders(law, p, k, fs)
+            integer(ip), intent(in) :: law
+            real(wp), intent(in) :: p(:)
+            real(wp), intent(out) :: k(:), fs(:)
+        end subroutine iwan_sliders
+    end interface
 
     ! Private procedures that one submodule calls in another. (A private procedure of the
     ! parent that only submodules call must be declared here too: gfortran drops private
@@ -285,6 +337,10 @@ contains
         case (LAW_NORMAL1D, LAW_NORMAL2D)
             ks(1:size(ks) - 1) = abs(p(1))
             ks(size(ks)) = abs(p(2))
+        case (LAW_IWAN4)
+            ks(1) = abs(p(2))
+        case (LAW_IWAN)
+            ks(1) = sum(max(p(1::2), 0.0_wp))
         end select
     end subroutine law_stuck_stiffness
 

@@ -20,6 +20,11 @@ contains
                         index_base, slider)
         if (info /= FRIROM_OK) return
         call defaults(tol, max_periods, index_base, tl, mp, base)
+        if (law == LAW_IWAN4 .or. law == LAW_IWAN) then
+            call iwan_forces(plan, law, x, params, w0, f, info, errmsg, jac, periods, states, &
+                             tl, mp, base, slider)
+            return
+        end if
         want_jac = present(jac)
         rel = .false.
         if (present(relative)) rel = relative .and. (law == LAW_NORMAL1D .or. &
@@ -106,6 +111,10 @@ contains
             return
         end if
         call defaults(tol, max_periods, index_base, tl, mp, base)
+        if (law == LAW_IWAN4 .or. law == LAW_IWAN) then
+            call iwan_histories(plan, law, x, params, w0, xt, ft, info, errmsg, tl, mp, base)
+            return
+        end if
         nd = NDIR_OF(law)
         ne = size(x, 3)
         nb = plan%fp%nbatch
@@ -253,6 +262,15 @@ contains
             if (p(1) <= 0.0_wp) why = 'kt must be > 0'
             if (p(2) < 0.0_wp) why = 'kn must be >= 0'
             if (p(3) < 0.0_wp) why = 'mu must be >= 0'
+        case (LAW_IWAN4)
+            if (p(1) <= 0.0_wp) why = 'fs (the macroslip force) must be > 0'
+            if (p(2) <= 0.0_wp) why = 'kt must be > 0'
+            if (p(3) <= -1.0_wp) why = 'chi must be > -1'
+            if (p(4) < 0.0_wp) why = 'beta must be >= 0'
+        case (LAW_IWAN)
+            if (any(p(1::2) < 0.0_wp)) why = 'slider stiffnesses k1..k10 must be >= 0'
+            if (any(p(2::2) < 0.0_wp)) why = 'slip forces fs1..fs10 must be >= 0'
+            if (all(p(1::2) <= 0.0_wp)) why = 'at least one slider stiffness must be > 0'
         end select
     end subroutine check_params
 

@@ -56,7 +56,39 @@ def _forces(law: str, p: list, u: np.ndarray, w: np.ndarray):
         w_new = np.where(slip[..., None], x - ft / kt[..., None], w)
         state = np.where(fn <= 0.0, 2, slip.astype(np.int8)).astype(np.int8)
         return np.concatenate([ft, fn[..., None]], axis=-1), w_new, state
+    if law in ("iwan", "iwan4"):
+        k, fs = _iwan_sliders(law, p)           # (ne, nslider)
+        x = u[..., 0][..., None]                # (nb, ne, 1)
+        used = k > 0.0
+        trial = k * (x - w)
+        slip = np.abs(trial) > fs
+        fj = np.where(slip, np.sign(trial) * fs, trial)
+        w_new = np.where(slip & used, x - fj / np.where(used, k, 1.0), w)
+        return fj.sum(axis=-1)[..., None], w_new, (slip & used).any(axis=-1).astype(np.int8)
     raise InputError(f"timeint: unknown law {law!r}")
+
+
+def _iwan_sliders(law: str, p: list):
+    """(k, fs), each (ne, nslider): the Jenkins sliders of Iwan elements.
+
+    iwan: the given pairs. iwan4 (Segalman's density R phi^chi on (0, phi_max) plus
+    S delta(phi - phi_max)): 30 geometric bins phi_max 10^(-3 (30 - i)/29), each a slider
+    with the bin's moments int rho and int rho phi, and the Dirac slider (S, S phi_max).
+    """
+    if law == "iwan":
+        return np.stack(p[0::2], axis=-1), np.stack(p[1::2], axis=-1)
+    fsm, ktm, chi, beta = (np.asarray(a, float)[:, None] for a in p)
+    den = beta + (chi + 1.0) / (chi + 2.0)
+    phimax = fsm * (1.0 + beta) / (ktm * den)
+    r = fsm * (chi + 1.0) / (phimax ** (chi + 2.0) * den)
+    s = fsm * beta / (phimax * den)
+    nb = 30
+    edges = phimax * np.concatenate([[0.0], 10.0 ** (-3.0 * (nb - np.arange(1, nb + 1))
+                                                    / (nb - 1))])[None, :]
+    a, b = edges[:, :-1], edges[:, 1:]
+    k = r * (b ** (chi + 1.0) - a ** (chi + 1.0)) / (chi + 1.0)
+    fs = r * (b ** (chi + 2.0) - a ** (chi + 2.0)) / (chi + 2.0)
+    return np.concatenate([k, s], axis=1), np.concatenate([fs, s * phimax], axis=1)
 
 
 def period_change(last, prev, may_stop: bool, tol: float):

@@ -64,9 +64,15 @@ _NAMES: dict[str, tuple[tuple[str, ...], tuple[str, ...], str]] = {
     "normal2d": (("u1", "u2", "v"), ("kt", "kn", "mu", "n0"),
                  "in-plane tangential, circular limit"),
     "cubic": (("u",), ("k1", "k3"), "f = k1 u + k3 u^3"),
+    "iwan4": (("u",), ("fs", "kt", "chi", "beta"),
+              "four-parameter Iwan (Segalman 2005), 31 Jenkins sliders"),
+    "iwan": (("u",), tuple(p for s in range(1, 11) for p in (f"k{s}", f"fs{s}")),
+             "discrete Iwan: up to 10 parallel Jenkins sliders (k = 0: unused)"),
 }
 # Units of the parameters, for the table in the module docstring.
-_UNITS = {"kt": "N/m", "kn": "N/m", "fn0": "N", "n0": "N", "k1": "N/m", "k3": "N/m^3"}
+_UNITS = {"kt": "N/m", "kn": "N/m", "fn0": "N", "n0": "N", "k1": "N/m", "k3": "N/m^3",
+          "fs": "N", **{f"k{s}": "N/m" for s in range(1, 11)},
+          **{f"fs{s}": "N" for s in range(1, 11)}}
 
 
 def _build_laws() -> dict[str, Law]:

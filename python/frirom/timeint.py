@@ -120,6 +120,10 @@ class TimeContact:
         p = self.params
         if self.law == "jenkins":
             k = p[:, [0]]
+        elif self.law == "iwan":
+            k = p[:, 0::2].sum(axis=1, keepdims=True)
+        elif self.law == "iwan4":
+            k = p[:, [1]]
         elif self.law == "normal1d":
             k = p[:, [0, 1]]
         elif self.law == "normal2d":
