@@ -1,4 +1,4 @@
-!> CSR helpers and the contact set of frirom_hbm: G x, the AFT of every contact group,
+!> The contact set of frirom_hbm: G x, the AFT of every contact group,
 !> G^T f and G^T J G, and the sliders a converged point hands on.
 submodule (frirom_hbm) frirom_hbm_contacts
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, FRIROM_ERR_MODEL, &
@@ -8,64 +8,6 @@ submodule (frirom_hbm) frirom_hbm_contacts
     implicit none
 
 contains
-
-    module procedure csr_matvec_add_real
-        integer(ip) :: i, k
-        real(wp) :: s
-        do i = 1, a%nrow
-            s = 0.0_wp
-            do k = a%p(i), a%p(i + 1) - 1
-                s = s + a%x(k)*x(a%i(k))
-            end do
-            y(i) = y(i) + alpha*s
-        end do
-    end procedure csr_matvec_add_real
-
-    module procedure csr_matvec_add_cplx
-        real(wp), allocatable :: sr(:), si(:)
-        allocate (sr(a%nrow), si(a%nrow))
-        sr = 0.0_wp
-        si = 0.0_wp
-        call csr_matvec_add_real(a, x%re, sr, 1.0_wp)
-        call csr_matvec_add_real(a, x%im, si, 1.0_wp)
-        y(:a%nrow) = y(:a%nrow) + alpha*cmplx(sr, si, wp)
-    end procedure csr_matvec_add_cplx
-
-    module procedure csr_set
-        integer(ip) :: nnz, k, bad
-        info = FRIROM_OK
-        if (size(p) /= nrow + 1) then
-            call set_status(info, FRIROM_ERR_SIZE, errmsg, name//': row pointer length')
-            return
-        end if
-        nnz = p(nrow + 1) - 1
-        if (p(1) /= 1 .or. nnz < 0 .or. nnz > size(i) .or. nnz > size(x) .or. &
-            any(p(2:) < p(:nrow))) then
-            call set_status(info, FRIROM_ERR_SIZE, errmsg, name//': malformed CSR pointers')
-            return
-        end if
-        ! one pass that checks and copies (a reduced model's K, M, C are dense, and set once
-        ! per call into Fortran)
-        allocate (a%i(nnz), a%x(nnz))
-        bad = 0
-        do k = 1, nnz
-            a%i(k) = i(k)
-            a%x(k) = x(k)
-            if (i(k) < 1 .or. i(k) > ncol) bad = ior(bad, 1)
-            if (.not. abs(x(k)) <= huge(1.0_wp)) bad = ior(bad, 2)
-        end do
-        if (iand(bad, 1) /= 0) then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, name//': column out of range')
-            return
-        end if
-        if (bad /= 0) then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, name//': non-finite value')
-            return
-        end if
-        a%nrow = nrow
-        a%ncol = ncol
-        a%p = p
-    end procedure csr_set
 
     module procedure contact_eval
         integer(ip) :: g, e, d, row, k, c, nc, nrg, ns
