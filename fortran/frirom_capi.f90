@@ -764,9 +764,4 @@ contains
         end subroutine triplets
     end subroutine check_model
 
-    pure function itoa(i) result(t)
-        integer(ip), intent(in) :: i
-        character(len=24) :: t
-        write (t, '(i0)') i
-    end function itoa
 end module frirom_capi

@@ -117,8 +117,7 @@ contains
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
         type(modal_hill) :: mh
-        complex(wp), allocatable :: ev(:), vec(:, :)
-        integer(ip) :: m, nev, nconv, nk, k, t, stat, n2
+        integer(ip) :: m, nev, k, t, stat, n2
         info = FRIROM_OK
         mh%nm = size(sys%phr, 2)
         mh%nnl = sys%nnl
@@ -156,22 +155,8 @@ contains
             nev = nev + 2*count(abs(mh%om + k*w) <= w/sqrt(2.0_wp))
         end do
         nev = min(max(NEV0, nev + 4), NEV_MAX, n2 - 2)
-        do
-            call shift_invert(cmplx(mh%sg, 0.0_wp, wp), nev, ev, vec, nconv, info, errmsg, &
-                              mh=mh)
-            if (info /= 0) return
-            if (nconv == 0) exit
-            if (maxval(abs(ev(1:nconv))) >= w/sqrt(2.0_wp) .or. &
-                nev >= min(NEV_MAX, n2 - 2)) exit
-            nev = min(2*nev, NEV_MAX, n2 - 2)
-        end do
-        nk = 0
-        do k = 1, nconv
-            if (.not. kept(ev(k), 0.0_wp, w, sys%nh)) cycle
-            nk = nk + 1
-            if (nk <= size(expo)) expo(nk) = ev(k)
-            maxre = max(maxre, real(ev(k), wp))
-        end do
+        call disc_exponents(cmplx(mh%sg, 0.0_wp, wp), nev, n2 - 2, w, sys%nh, expo, maxre, &
+                            info, errmsg, mh=mh)
     end subroutine hill_modal
 
     !> a, b of Lam(sg) (see modal_hill) for every mode at harmonic h; b = 0 at h = 0.
@@ -440,10 +425,9 @@ contains
         character(len=*), intent(inout) :: errmsg
         type(band_matrix) :: jr, dr, mr
         type(zband_matrix) :: q
-        complex(wp), allocatable :: ev(:), vec(:, :)
         integer(ip), allocatable :: ipc(:)
         complex(wp) :: sg
-        integer(ip) :: nd, nc, n, kl, i, k, nev, nconv, nk, t
+        integer(ip) :: nd, nc, n, kl, i, t
         logical :: ok
         info = FRIROM_OK
         nd = sys%ndof
@@ -484,25 +468,45 @@ contains
             info = FRIROM_OK
             sg = cmplx(1.0e-3_wp*w, 0.0_wp, wp)
         end do
-        nev = min(NEV0, 2*n - 2)
+        call disc_exponents(sg, min(NEV0, 2*n - 2), 2*n - 2, w, sys%nh, expo, maxre, info, &
+                            errmsg, q=q, dr=dr, mr=mr)
+    end subroutine hill_arnoldi
+
+    !> The exponents in the disc |s - sg| < w / sqrt(2) by shift_invert (banded: q, dr, mr;
+    !> modal: mh), nev doubled from nev0 up to min(NEV_MAX, nmax) until the disc is covered;
+    !> the kept ones (one copy of each exponent) into expo, the largest real part into maxre.
+    subroutine disc_exponents(sg, nev0, nmax, w, nh, expo, maxre, info, errmsg, q, dr, mr, mh)
+        complex(wp), intent(in) :: sg
+        integer(ip), intent(in) :: nev0, nmax, nh
+        real(wp), intent(in) :: w
+        complex(wp), intent(inout) :: expo(:)
+        real(wp), intent(inout) :: maxre
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        type(zband_matrix), intent(in), optional :: q
+        type(band_matrix), intent(in), optional :: dr, mr
+        type(modal_hill), intent(in), optional :: mh
+        complex(wp), allocatable :: ev(:), vec(:, :)
+        integer(ip) :: nev, nconv, nk, k
+        nev = nev0
         do
-            call shift_invert(sg, nev, ev, vec, nconv, info, errmsg, q=q, dr=dr, mr=mr)
+            call shift_invert(sg, nev, ev, vec, nconv, info, errmsg, q=q, dr=dr, mr=mr, mh=mh)
             if (info /= 0) return
             ! enough when the disc reached covers the square |Im s|, |Re s| <= w/2
             ! (period doubling sits at its edge, Im s = w/2)
             if (nconv == 0) exit
             if (maxval(abs(ev(1:nconv))) >= w/sqrt(2.0_wp) .or. &
-                nev >= min(NEV_MAX, 2*n - 2)) exit
-            nev = min(2*nev, NEV_MAX, 2*n - 2)
+                nev >= min(NEV_MAX, nmax)) exit
+            nev = min(2*nev, NEV_MAX, nmax)
         end do
         nk = 0
         do k = 1, nconv
-            if (.not. kept(ev(k), 0.0_wp, w, sys%nh)) cycle
+            if (.not. kept(ev(k), 0.0_wp, w, nh)) cycle
             nk = nk + 1
             if (nk <= size(expo)) expo(nk) = ev(k)
             maxre = max(maxre, real(ev(k), wp))
         end do
-    end subroutine hill_arnoldi
+    end subroutine disc_exponents
 
     !> nev eigenpairs of A nearest sigma (ev, vec(2n, nconv), converged first) by ARPACK
     !> on (A - sigma)^-1 [u; v] = [x; u + sigma x], Q(sigma) x = -M (v + sigma u) - D1 u:

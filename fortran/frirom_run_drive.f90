@@ -2,6 +2,7 @@
 !> homotopy start), segments of points (frirom_hbm hbm_run), fold flags, stop reasons and
 !> the stall test, and single corrector solves on the run's system.
 submodule (frirom_run) frirom_run_drive
+    use frirom_status, only: itoa
     use frirom_newton, only: cont_options, YSCALE_RELATIVE
     use frirom_hbm, only: hbm_lu_forget, hbm_lu_rebuild, hbm_run, hbm_sel_expand, hbm_sel_reduce, &
                           HBM_START_CONTINUE, HBM_START_RESUME, HBM_START_SOLVE_ONLY
@@ -581,11 +582,6 @@ contains
         end if
     end function stalled
 
-    pure function itoa(k) result(t)
-        integer(ip), intent(in) :: k
-        character(len=16) :: t
-        write (t, '(i0)') k
-    end function itoa
 
     subroutine stop_max(run)
         type(run_t), intent(inout) :: run

@@ -5,7 +5,7 @@ module frirom_status
     use frirom_kinds, only: ip
     implicit none
     private
-    public :: frirom_status_message, frirom_status_code, set_status
+    public :: frirom_status_message, frirom_status_code, set_status, itoa
     public :: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, FRIROM_ERR_NONFINITE, &
               FRIROM_ERR_SAMPLES, FRIROM_ERR_ALLOC, FRIROM_ERR_FFTW, FRIROM_ERR_LAPACK, &
               FRIROM_ERR_ARPACK, FRIROM_ERR_NOCONV, FRIROM_ERR_SINGULAR, FRIROM_ERR_LAW, &
@@ -127,4 +127,11 @@ contains
         info = code
         if (present(errmsg)) errmsg = frirom_status_message(code)//': '//detail
     end subroutine set_status
+
+    !> An integer as text without blanks, for messages (trim the result).
+    pure function itoa(i) result(t)
+        integer(ip), intent(in) :: i
+        character(len=24) :: t
+        write (t, '(i0)') i
+    end function itoa
 end module frirom_status

@@ -65,9 +65,10 @@ program test_aft
     call aft_eval(plan, LAW_JENKINS, x, p, w0, f, info, msg)
     if (info /= FRIROM_ERR_PARAM .or. index(msg, 'kt must be > 0') == 0) error stop 'kt < 0'
     p(1, 1) = kt
-    call aft_eval(plan, 7_ip, x, p, w0, f, info, msg)
+    call aft_eval(plan, 9_ip, x, p, w0, f, info, msg)
     if (info /= FRIROM_ERR_LAW) error stop 'unknown law'
-    if (index(msg, 'law 7 (expected 1 jenkins, 2 normal1d, 3 normal2d, 4 cubic)') == 0) &
+    if (index(msg, 'law 9 (expected 1 jenkins, 2 normal1d, 3 normal2d, 4 cubic, 5 iwan4, '// &
+                  '6 iwan)') == 0) &
         error stop 'unknown law: the message lists the laws of the table'
     call aft_eval(plan, LAW_NORMAL1D, x, p, w0, f, info, msg)
     if (info /= FRIROM_ERR_SIZE) error stop 'wrong number of directions'
