@@ -27,6 +27,7 @@ ROOT = Path(__file__).resolve().parents[1]
 pytestmark = pytest.mark.skipif(shutil.which("ccx") is None, reason="needs ccx")
 
 
+@pytest.mark.slow
 def test_hooks_path_is_the_same_for_batch_10_and_1000(tmp_path):
     """Coarse hooks ROM_II at 300 N (40 % slip at the peak): batch = 1 000 (one call) and
     batch = 10 (a call boundary, with its checkpoint, every 10 points) make the same

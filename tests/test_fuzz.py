@@ -109,6 +109,7 @@ def results_file(tmp_path_factory):
     return make_results(tmp_path_factory.mktemp("results"))
 
 
+@pytest.mark.slow
 @settings(max_examples=100, **FUZZ)
 @given(rnd=st.randoms(use_true_random=False))
 def test_mutated_results_files_load_or_raise_frirom_errors(results_file, tmp_path, rnd):

@@ -53,6 +53,7 @@ def run(case, name, text, capsys, complete=True):
         capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_gsi_lap_joint_reuses_its_reduction_and_cb_agrees_at_its_peak(tmp_path, lap_joint_mesh,
                                                                       capsys):
     """The fast variant of the next test: the GSI-40 deck's reduction is built, `frirom

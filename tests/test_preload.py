@@ -64,6 +64,7 @@ def test_preload_builds_the_hand_written_bolt(lap, tmp_path, monkeypatch):
                                atol=1e-12 * np.abs(hand.F[:, 0]).max())
 
 
+@pytest.mark.slow
 def test_preload_refuses_a_wrong_normal_and_a_given_n0(lap, tmp_path, monkeypatch):
     case, text = lap
     monkeypatch.setenv("FRIROM_CACHE", str(tmp_path / "cache"))

@@ -243,6 +243,7 @@ def test_sigkill_then_resume_equals_uninterrupted(deck, tmp_path):
     assert peaks == ref_peaks and len(peaks) == 3 and all("(solve)" in x for x in peaks)
 
 
+@pytest.mark.slow
 def test_second_run_on_a_folder_is_refused_until_the_first_dies(deck, tmp_path, capsys):
     """A run holding OUT's lock (another process) makes a second run on OUT exit 2 with
     frf.h5 untouched; once the holder dies (SIGKILL), the lock is gone."""
@@ -312,6 +313,7 @@ def test_resume_refuses_an_unreadable_file(deck, tmp_path, capsys):
     assert "cannot be read as HDF5" in err and "run without --resume" in err
 
 
+@pytest.mark.slow
 def test_exit_code_3_says_where_and_why(deck, tmp_path, capsys):
     """A continuation that stops at its minimum step exits 3 with the frequency and the
     reason; the points are kept; --resume with the same deck stops at the same point."""
@@ -340,6 +342,7 @@ def test_help_documents_exit_codes(capsys):
         assert f"\n  {code}" in text, code
 
 
+@pytest.mark.slow
 def test_resume_exact_when_the_solver_carries_its_lu(tmp_path):
     """A large condensed system carries its LU (the GMRES preconditioner) from point to
     point and across calls into Fortran; a checkpoint keeps what that LU depends on (the

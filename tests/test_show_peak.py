@@ -10,6 +10,7 @@ from pathlib import Path
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
+import pytest
 
 import frirom.show
 from frirom._errors import ConvergenceError
@@ -19,6 +20,7 @@ from frirom.results import FRF
 JOINT = Path(__file__).resolve().parents[1] / "cases" / "joint"
 
 
+@pytest.mark.slow
 def test_show_peak_falls_back_to_the_highest_stored_point(tmp_path, monkeypatch, capsys):
     for f in ("M.mtx", "K.mtx", "dofs.txt"):
         shutil.copy(JOINT / f, tmp_path / f)

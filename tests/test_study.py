@@ -81,6 +81,7 @@ def test_key_paths_and_errors(tmp_path):
     assert "study" not in member_raw({"study": {}, "a": 1}, {})
 
 
+@pytest.mark.slow
 def test_member_equals_deck_run_alone(tmp_path):
     """A member's curve equals the deck edited by hand (text) and run by `frirom run`
     (1e-10: the same computation, so the same numbers up to round-off; measured 0)."""

@@ -64,6 +64,7 @@ def test_stuck_jenkins_and_open_gap_are_linear():
     assert np.all(r2.state_fractions[:, 0, 2] == 1.0)
 
 
+@pytest.mark.slow
 def test_jenkins_energy_per_cycle_in_full_slip():
     # A massless-like check of the return map: in gross slip at low frequency the element
     # dissipates 4 mu fn0 (2 u_amp - 2 mu fn0 / kt) per cycle (hysteresis loop area), and
@@ -110,6 +111,7 @@ def test_bad_input_raises():
         integrate(M, C, K, [], np.ones((2, 2)), -1.0)
 
 
+@pytest.mark.slow
 def test_normal2d_in_one_plane_equals_normal1d():
     # motion confined to the first tangential direction: the circular friction limit
     # reduces to the 1-D one, so both laws must give the same response

@@ -149,6 +149,7 @@ def test_duffing_against_explicit():
     assert err < 1e-2, err
 
 
+@pytest.mark.slow
 def test_auto_takes_implicit_on_stiff_models_only():
     # A 2-DoF with a stiff, lightly damped second mode 1000 times the forcing (a reduced FE
     # model's residual mode, here excited through a stuck Jenkins contact): "auto" must

@@ -93,6 +93,7 @@ def test_deck_alone_cannot_choose_a_scheduler(tmp_path, capsys, monkeypatch):
         srv.close()
 
 
+@pytest.mark.slow
 def test_not_a_scheduler_fails_fast(tmp_path, capsys, monkeypatch):
     """A port that answers like no Dask scheduler (eight 0xff bytes: a first message of
     2^64 - 1 bytes, as an HTTP or SSH banner read as a length is) is refused within
@@ -411,6 +412,7 @@ def test_read_only_out(tmp_path, capsys, monkeypatch):
     assert str(tmp_path / "ro") in err and "read-only" in err, err
 
 
+@pytest.mark.slow
 def test_full_disk_keeps_every_committed_point(tmp_path, capsys, monkeypatch):
     """The disk fills up at the 6th point (ENOSPC from the writer, simulated): exit code 4
     naming frf.h5 and --resume, no crash; the 5 committed points are in the file, and
@@ -465,6 +467,7 @@ def test_two_studies_on_one_folder(tmp_path, capsys):
 
 
 # ---- 4. studies that survive a bad member ------------------------------------------------
+@pytest.mark.slow
 def test_a_failing_member_does_not_stop_the_study(tmp_path, capsys):
     """Member m001's deck cannot be built (a DoF label the model lacks, found only when
     that member runs): the other members run and are kept, each equal to its deck run

@@ -44,6 +44,7 @@ def test_static_position_against_stuck_static_solve(coarse):
     assert r["lift_hbm"] > 0                                        # pressed outwards
 
 
+@pytest.mark.slow
 def test_free_damper_solves_in_both_formulations(coarse):
     """At the optimum load near the peak: condensed and banded give the same point; the
     blade's amplitude lies below both linear limits (the damper dissipates)."""
