@@ -116,6 +116,7 @@ def test_bad_auto_keys_name_the_field(solver, key):
         parse_deck(JOINT / "joint.toml", raw)
 
 
+@pytest.mark.slow
 def test_frirom_run_logs_and_stores_the_choice(tmp_path, capsys):
     text = (JOINT / "joint.toml").read_text()
     for f in ("M.mtx", "K.mtx", "dofs.txt"):
@@ -227,6 +228,7 @@ def test_interface_modes_auto_meets_tolerance_on_lap_joint(lap, tmp_path, monkey
     assert load_deck(case / "auto.toml").settings.reduction.free == 5    # first rung
 
 
+@pytest.mark.slow
 def test_interface_modes_auto_not_reached_uses_largest(lap, tmp_path, monkeypatch):
     # Two rungs (5 and 10 modes per key) cannot meet 1e-3: the largest is used, and the
     # log, the summary and the plot's title say so.
@@ -263,6 +265,7 @@ def test_bad_interface_auto_keys_name_the_field(lap, keys, key):
         parse_deck(case / "bad.toml")
 
 
+@pytest.mark.slow
 def test_ms_time_harmonics_auto_on_the_flange(tmp_path, monkeypatch):
     # The paper's flange, quick (6 + 6 sectors), F0 = 300 N (slip and lift-off), MS with
     # engine order 2 and time_harmonics = "auto": the rung j = 1 (indices 2, 4) is far off

@@ -98,6 +98,7 @@ def test_bad_deck_gives_clear_error(deck, tmp_path, capsys):
     assert "contacts[0].mu" in err and ">= 0" in err and str(deck) in err
 
 
+@pytest.mark.slow
 def test_resume_refuses_a_changed_deck_after_a_few_points(deck, tmp_path, capsys):
     """The fast variant of tests/test_resume.py's test_resume_refuses_a_changed_deck: a run
     stopped at max_points after 5 points (exit 3), then --resume with another friction

@@ -31,6 +31,7 @@ def decks(tmp_path):
     return folder
 
 
+@pytest.mark.slow
 def test_batch_runs_each_deck_as_alone(decks, tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["run", str(decks), "--out", str(out), "--quiet"]) == 0

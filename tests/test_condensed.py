@@ -211,6 +211,7 @@ def test_start_from_the_other_coordinates_is_explained(models):
     assert np.abs(q.X - p.X).max() / np.abs(p.X).max() < TOL
 
 
+@pytest.mark.slow
 def test_large_system_solves_by_gmres_on_the_held_lu():
     """Above some thousand unknowns an LU is worth many GMRES iterations: a Jacobian after
     the first is applied matrix-free and solved by GMRES preconditioned by the LU held

@@ -100,6 +100,7 @@ def test_residual_holds_with_inherited_and_left_history(sweeps):
     assert worst < 1e-7, worst
 
 
+@pytest.mark.slow
 def test_stuck_points_match_time_integration_from_previous_state(sweeps):
     r, r0 = sweeps
     stuck = r.state_fractions[:, 0, 0] == 1.0
@@ -147,6 +148,7 @@ def test_formulations_and_load_continuation_carry_the_same_history(sweeps):
 
 
 
+@pytest.mark.slow
 def test_resume_restores_history_and_reads_files_from_before(tmp_path):
     """A run stopped in the stuck range after the resonance resumes with the slider it
     stopped at: the resumed points equal the uninterrupted run's. A file written before

@@ -456,6 +456,7 @@ def _die(p):
     raise Killed
 
 
+@pytest.mark.slow
 def test_leak_is_stored_per_point(fam, tmp_path):
     """frf.h5 (FRFWriter and FRF.save_h5) and the CSV keep each point's leak, the very
     floats of the run (tolerance 0 in the file; the CSV's 3 digits to 5e-3 relative); a

@@ -56,6 +56,7 @@ def test_hooks_gsi_error_decreases_and_40_modes_match_with_the_lug_apart(hooks_c
     assert fo == pytest.approx(fp, rel=1e-5)
 
 
+@pytest.mark.slow
 @needs_ccx
 def test_lug_kept_physical_points_are_converged_not_accepted_at_the_preloads_round_off(hooks_case):
     """The lug kept physical (48 DoFs), everything stuck (10 000 N): its 300 kN preload's

@@ -36,6 +36,7 @@ def test_linear_two_dof_matches_closed_form():
     assert np.abs(r.harmonics[:, :, 3:]).max() < 1e-8 * np.abs(X).max()
 
 
+@pytest.mark.slow
 def test_stuck_jenkins_and_open_gap_are_linear():
     # mu*fn0 far above any spring force: the Jenkins element is a spring kt (exactly).
     # 128 steps per period: central differences shift the frequencies by (2 pi/N)^2/24 =

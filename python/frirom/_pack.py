@@ -259,19 +259,18 @@ class _Packed:
         if self.out_map is not None:
             xo = np.einsum("oj,jcp->ocp", self.out_map, xo)
         amps = amplitude_max(np.moveaxis(xo, 2, 0))
+        # contact-state fractions of every group at every point: (npts, ngroups, 3)
+        st_all = np.zeros((res.npts, len(self.group_sizes), 3))
+        e0 = 0
+        for g, ne in enumerate(self.group_sizes):
+            st_all[:, g, :] = res.states[:, e0:e0 + ne, :res.npts].mean(axis=1).T
+            e0 += ne
         for k in range(res.npts):
-            st = np.zeros((len(self.group_sizes), 3))
-            e0 = 0
-            for g, ne in enumerate(self.group_sizes):
-                st[g] = res.states[:, e0:e0 + ne, k].mean(axis=1)
-                e0 += ne
-            X = np.array(res.xo[:, :, k])
-            if self.out_map is not None:
-                X = self.out_map @ X
             om = res.lams[k] if self.opts.parameter == "frequency" else omega_fix
             pts.append(FRFPoint(omega=float(om), parameter=float(res.lams[k]),
                                 unknowns=res.ys[:, k].copy(), tangent=res.tans[:, k].copy(),
-                                X=X, amp_max=amps[k], state_fractions=st,
+                                X=np.array(xo[:, :, k]), amp_max=amps[k],
+                                state_fractions=st_all[k],
                                 iterations=int(res.iters[k]), time_s=t_call / max(res.npts, 1),
                                 stable=bool(res.hill_re[k] <= 1e-7 * max(abs(om), 1.0)),
                                 floquet_max_re=float(res.hill_re[k]),

@@ -119,6 +119,10 @@ def _all_modes(model: Model, H: int, need_diagonal: bool) -> _Modes | str:
     return m
 
 
+#: Models up to this many DoFs have their band pattern formed densely (_Band).
+SMALL_DENSE = 300
+
+
 class _Band:
     """The RCM order of a model (K, M, C and the contact couplings G^T G) and its
     half-bandwidth under it, computed at the first use: the banded formulation, Hill's
@@ -145,10 +149,20 @@ class _Band:
 
     def _order(self) -> None:
         model, G, n = self._model, self._G, self._model.n_dof
-        pat = (abs(model.K) + abs(model.M) + abs(model.C)).tocsr()
-        if model.contacts:
-            pat = pat + (abs(G).T @ abs(G))
-        pat = (pat + pat.T + sp.identity(n)).tocsr()
+        if n <= SMALL_DENSE:
+            # a small model's pattern densely: scipy.sparse's per-call cost would dominate
+            d = (model.K.toarray() != 0) | (model.M.toarray() != 0) | (model.C.toarray() != 0)
+            if model.contacts:
+                gd = G.toarray() != 0
+                d |= (gd.T.astype(np.int64) @ gd.astype(np.int64)) != 0
+            d |= d.T
+            d[np.diag_indices(n)] = True
+            pat = sp.csr_matrix(d)
+        else:
+            pat = (abs(model.K) + abs(model.M) + abs(model.C)).tocsr()
+            if model.contacts:
+                pat = pat + (abs(G).T @ abs(G))
+            pat = (pat + pat.T + sp.identity(n)).tocsr()
         pat.sort_indices()
         perm, info, msg = _kernels.hbm_rcm(pat.indptr.astype(np.int32) + 1,
                                            pat.indices.astype(np.int32) + 1)
