@@ -165,6 +165,7 @@ class _Packed:
     #: (nnl, H+1) bool: the travelling-wave selection over the nonlinear DoFs nl
     #: (SolverOptions.selection), None: every unknown
     keep: np.ndarray | None = None
+    sel_label: str = "travelling-wave selection"   # or "harmonic selection" (the leak's text)
     #: (nnl, H+1) int32: SolverOptions.pairs over nl (s (position in nl + 1)), None: none
     pair: np.ndarray | None = None
     #: SolverOptions.orbits as the run found them: (elements the AFT runs on, largest
@@ -311,6 +312,13 @@ def pack(model: Model | CyclicModel, excitation: Excitation, opts: SolverOptions
     if not isinstance(excitation, Excitation):
         raise ParameterError("excitation: expected a frirom.model.Excitation")
     opts.check()
+    label = "travelling-wave selection"
+    if opts.harmonics_kept is not None:
+        if isinstance(model, CyclicModel):
+            raise ParameterError("options.harmonics_kept: not for a cyclic sector (its "
+                                 "harmonics already live on their own nodal diameters)")
+        opts = dataclasses.replace(opts, selection=harmonic_selection(model, opts))
+        label = "harmonic selection"
     fe = excitation.real_harmonic(model.n_dof, opts.harmonics)
     if load_part not in ("static", "dynamic"):
         raise ParameterError("load_part: expected 'static' or 'dynamic'")
@@ -326,11 +334,47 @@ def pack(model: Model | CyclicModel, excitation: Excitation, opts: SolverOptions
     if P is not None:
         packed.out_map, packed.outputs = P, _map_dofs(P, packed.outputs)
     if opts.selection is not None:
-        _select(packed, model, opts.selection, opts.pairs)
+        _select(packed, model, opts.selection, opts.pairs, label)
     return packed
 
 
-def _select(packed: _Packed, model, selection, pairs=None) -> None:
+def harmonic_selection(model: Model, opts: SolverOptions) -> np.ndarray:
+    """SolverOptions.harmonics_kept as a selection (n_dof, H+1) bool, combined with
+    SolverOptions.selection when both are given."""
+    from .options import kept_harmonics
+    H, n, spec = opts.harmonics, model.n_dof, opts.harmonics_kept
+    sel = (np.ones((n, H + 1), bool) if opts.selection is None
+           else np.asarray(opts.selection, bool))
+    if sel.shape != (n, H + 1):
+        raise SizeError(f"options.selection: expected (n_dof, H+1) = ({n}, {H + 1}), got "
+                        f"{sel.shape}")
+    if not isinstance(spec, dict):
+        return sel & kept_harmonics(spec, H, "options.harmonics_kept")[None, :]
+    names = [g.name for g in model.contacts]
+    per = {}
+    for key, s in spec.items():
+        if isinstance(key, str):
+            if key not in names:
+                raise ParameterError(f"options.harmonics_kept: no contact group named "
+                                     f"{key!r} (groups: {names})")
+            idx = names.index(key)
+        elif isinstance(key, (int, np.integer)) and 0 <= key < len(names):
+            idx = int(key)
+        else:
+            raise ParameterError(f"options.harmonics_kept: {key!r} is neither a contact "
+                                 f"group's name nor its index 0..{len(names) - 1}")
+        per[idx] = kept_harmonics(s, H, f"options.harmonics_kept[{key!r}]")
+    keep = np.zeros((n, H + 1), bool)
+    touched = np.zeros(n, bool)
+    for idx, g in enumerate(model.contacts):
+        dofs = np.unique(sp.csr_matrix(g.G).indices)
+        keep[dofs] |= per.get(idx, np.ones(H + 1, bool))
+        touched[dofs] = True
+    return sel & np.where(touched[:, None], keep, True)
+
+
+def _select(packed: _Packed, model, selection, pairs=None,
+            label: str = "travelling-wave selection") -> None:
     """Check SolverOptions.selection against the packed model and set packed.keep: the
     rows of the nonlinear DoFs; loads on them outside the selection are refused (a
     travelling wave of the selection's engine order has none)."""
@@ -356,8 +400,9 @@ def _select(packed: _Packed, model, selection, pairs=None) -> None:
                     f"{int(packed.nl[np.argmax(off)])} at harmonic {h}, outside the "
                     "selection (not a travelling wave of the selection's engine order)")
     packed.keep = keep
+    packed.sel_label = label
     n = kept_unknowns(keep)
-    packed.info += f"; travelling-wave selection: {n} of {packed.ny} unknowns"
+    packed.info += f"; {label}: {n} of {packed.ny} unknowns"
     if pairs is not None:
         packed.pair = _pairs_on_nl(packed, pairs)
         packed.info += f", {n - 2 * int(np.count_nonzero(packed.pair))} in one direction"

@@ -117,6 +117,20 @@ class SolverOptions:
         (:func:`frirom.reduction.multistage.travelling_wave_pairs`); 0: no pair. Exact
         when the selection is, for one travelling direction; the leak then also counts
         the other direction.
+    harmonics_kept : str, sequence of int, dict or None
+        Harmonic selection: the harmonics the nonlinear DoFs are solved for, the others held
+        at zero and their equations dropped (Galerkin on the kept harmonics; outputs are
+        the linear response to the contact forces on the kept harmonics). ``"odd"``
+        (1, 3, 5, ...: a symmetric nonlinearity under a harmonic load, e.g. Duffing or a
+        friction contact without preload, has no even harmonics), ``"even"``, or a list
+        such as ``[0, 1, 2, 3, 5]``; or a dict from contact group (name or 0-based index)
+        to such a spec, for the DoFs of that group only (a DoF in several groups keeps what
+        any of them keeps; DoFs of groups not named keep every harmonic). The linear part
+        is exact at every harmonic (receptances); what the selection neglects is reported
+        per point as its leak (``FRFPoint.leak``, the contact forces on the dropped
+        harmonics over those on the kept ones), with a warning above :data:`LEAK_TOL`. A
+        load on a dropped harmonic of a nonlinear DoF is refused. Same requirements as
+        ``selection`` (with which it combines: both must keep a harmonic).
     orbits : bool
         With ``pairs``: Newton's evaluations run the contact law (AFT) on one contact
         element per orbit, the elements whose motion on the wave is another's turned in
@@ -154,6 +168,7 @@ class SolverOptions:
     selection: np.ndarray | None = field(default=None, repr=False)
     pairs: np.ndarray | None = field(default=None, repr=False)
     orbits: bool = True
+    harmonics_kept: object = None
 
     def check(self) -> None:
         """Raise ParameterError naming the first invalid field."""
@@ -191,15 +206,21 @@ class SolverOptions:
         if self.coordinates == "contact" and self.stability:
             raise ParameterError("options.coordinates: 'contact' cannot be used with "
                                  "stability (Hill's method needs the contact DoFs)")
-        if self.selection is not None:
+        if self.harmonics_kept is not None:
+            specs = (self.harmonics_kept.values() if isinstance(self.harmonics_kept, dict)
+                     else [self.harmonics_kept])
+            for spec in specs:
+                kept_harmonics(spec, self.harmonics, "options.harmonics_kept")
+        if self.selection is not None or self.harmonics_kept is not None:
+            what = ("options.selection: a travelling-wave selection" if self.selection
+                    is not None else "options.harmonics_kept: a harmonic selection")
             for bad, why in ((self.formulation != "condensed", "the 'condensed' formulation"),
                              (self.stability, "stability = false (Hill's method would see "
                                               "only perturbations inside the selection)"),
                              (self.krylov, "krylov = false (direct solves)"),
                              (self.coordinates == "contact", "coordinates 'dofs' or 'auto'")):
                 if bad:
-                    raise ParameterError(f"options.selection: a travelling-wave selection "
-                                         f"needs {why}")
+                    raise ParameterError(f"{what} needs {why}")
         if self.pairs is not None and self.selection is None:
             raise ParameterError("options.pairs: needs options.selection")
         for nm, allowed in (("coordinates", ("auto", "dofs", "contact")),
@@ -213,3 +234,28 @@ class SolverOptions:
         """AFT time samples per period actually used: `samples`, else the measured default
         :func:`frirom.harmonics.default_samples` (1e-4 relative on a friction resonance)."""
         return self.samples or default_samples(self.harmonics)
+
+
+def kept_harmonics(spec, H: int, where: str = "harmonics_kept") -> np.ndarray:
+    """The harmonics 0..H a selection spec keeps (SolverOptions.harmonics_kept): 'odd',
+    'even' or a list of distinct integers in 0..H; (H+1,) bool. ParameterError naming
+    ``where`` otherwise."""
+    keep = np.zeros(H + 1, dtype=bool)
+    if isinstance(spec, str):
+        if spec not in ("odd", "even"):
+            raise ParameterError(f"{where}: expected 'odd', 'even' or a list of harmonics "
+                                 f"in 0..{H}, got {spec!r}")
+        keep[(1 if spec == "odd" else 0)::2] = True
+    else:
+        try:
+            hs = [int(h) for h in spec]
+            ok = all(float(h) == float(g) for h, g in zip(hs, spec))
+        except (TypeError, ValueError):
+            ok = False
+        if not ok or not hs or len(set(hs)) != len(hs) or min(hs) < 0 or max(hs) > H:
+            raise ParameterError(f"{where}: expected 'odd', 'even' or a list of distinct "
+                                 f"harmonics in 0..{H} (harmonics = {H}), got {spec!r}")
+        keep[hs] = True
+    if not keep.any():
+        raise ParameterError(f"{where}: {spec!r} keeps no harmonic of 0..{H}")
+    return keep

@@ -47,16 +47,26 @@ from .results import FRF, FRFPoint
 LEAK_TOL = 1e-6
 
 
-def warn_leak(leak: float, omega: float, stacklevel: int, what: str = "") -> None:
-    """Warn (RuntimeWarning) when a travelling-wave selection's leak (FRFPoint.leak) is
-    above LEAK_TOL; omega: rad/s, where; stacklevel: 1 = the caller of warn_leak, 2 = its
-    caller, and so on; what: names the point when it is not one of the run's."""
-    if leak > LEAK_TOL:
-        warnings.warn(f"frirom: the travelling-wave selection leaks: contact forces off "
-                      f"the selection reach {leak:.2g} of those on it at "
-                      f"{omega / 2 / np.pi:.6g} Hz{f' ({what})' if what else ''} (tolerance "
-                      f"{LEAK_TOL:g}); the rotor, its "
-                      "contacts, its load or the contact history carried from point "
+def warn_leak(leak: float, omega: float, stacklevel: int, what: str = "",
+              label: str = "travelling-wave selection") -> None:
+    """Warn (RuntimeWarning) when a selection's leak (FRFPoint.leak) is above LEAK_TOL;
+    omega: rad/s, where; stacklevel: 1 = the caller of warn_leak, 2 = its caller, and so
+    on; what: names the point when it is not one of the run's; label: the kind of
+    selection (_Packed.sel_label)."""
+    if leak <= LEAK_TOL:
+        return
+    where = (f"contact forces off the selection reach {leak:.2g} of those on it at "
+             f"{omega / 2 / np.pi:.6g} Hz{f' ({what})' if what else ''} (tolerance "
+             f"{LEAK_TOL:g})")
+    if label == "harmonic selection":
+        warnings.warn(f"frirom: the harmonic selection leaks: {where}; the dropped "
+                      "harmonics carry that much of the contact forces there, and the "
+                      "selected solution is not the full one (keep more harmonics, or "
+                      "solve without options.harmonics_kept to see how far)",
+                      RuntimeWarning, stacklevel=stacklevel + 1)
+    else:
+        warnings.warn(f"frirom: the travelling-wave selection leaks: {where}; the rotor, "
+                      "its contacts, its load or the contact history carried from point "
                       "to point (sliders frozen at different phases) are not a "
                       "travelling wave there, and the selected solution is not the "
                       "full one (solve without the selection to see how far)",
@@ -195,7 +205,7 @@ class _Continuation:
             if self.leak_before is not None and self.leak_before[0] > worst:
                 worst, at = self.leak_before      # a point stored before the resume
             out.solver_info += f"; leak max {worst:.1e}"
-            warn_leak(worst, at, stacklevel=4)
+            warn_leak(worst, at, stacklevel=4, label=p.sel_label)
         return out
 
 
@@ -248,7 +258,7 @@ def _run_curve(packed: _Packed, lam_start, lam_end, sink, start, H_start) -> FRF
             k = int(np.argmax([q.leak for q in solved])) if solved else -1
             if k >= 0:
                 warn_leak(solved[k].leak, solved[k].omega, stacklevel=3,
-                          what="a peak solved between points")
+                          what="a peak solved between points", label=packed.sel_label)
     return out
 
 
@@ -378,7 +388,7 @@ def solve_point(model: Model | CyclicModel, excitation: Excitation, omega: float
     raise_for_status(res.info, res.msg)
     pt = packed.points(res, time.perf_counter() - t0)[0]
     if pt.leak is not None:
-        warn_leak(pt.leak, pt.omega, stacklevel=2)
+        warn_leak(pt.leak, pt.omega, stacklevel=2, label=packed.sel_label)
     pt.output_dofs = packed.outputs
     pt.timings = {}
     add_timings(pt.timings, res.timings)

@@ -178,7 +178,8 @@ class Deck:
               "formulation": self.formulation}
         for key, name in (("tol_residual", "tol_residual"), ("tol_update", "tol_update"),
                           ("max_iterations", "max_iter"), ("stability", "stability"),
-                          ("tol_stall", "tol_stall"), ("history", "history")):
+                          ("tol_stall", "tol_stall"), ("history", "history"),
+                          ("harmonics_kept", "harmonics_kept")):
             if key in self.solver:
                 kw[name] = self.solver[key]
         for key, name in (("step", "ds"), ("min_step", "ds_min"), ("max_step", "ds_max"),
@@ -341,6 +342,8 @@ class _Builder:
                   if getattr(sol, k) is not None}
         solver["stability"] = sol.stability
         solver["history"] = sol.history
+        if sol.harmonics_kept is not None:
+            solver["harmonics_kept"] = sol.harmonics_kept
         cont = {k: v for k, v in vars(s.continuation).items() if v is not None}
         return Deck(path=s.path, title=s.title, M=M, K=K, damping=damping, F=F,
                     contacts=contacts, harmonics=H, samples=sol.samples,

@@ -73,6 +73,10 @@ class SolverSettings:
         Relative error on the response amplitude that the chosen H and N must meet.
     max_harmonics, max_samples : int
         The largest H and N the choice may use.
+    harmonics_kept : str, list, dict or None
+        Harmonic selection (``SolverOptions.harmonics_kept``): ``"odd"``, ``"even"``, a list
+        of harmonics, or a table from contact group name to such a spec; stability is
+        then off (Hill's method would see only the kept harmonics).
     """
 
     harmonics: int
@@ -89,6 +93,7 @@ class SolverSettings:
     tolerance_auto: float = 1e-3
     max_harmonics: int = 15
     max_samples: int = 4096
+    harmonics_kept: object = None
 
 
 @dataclass(frozen=True)
@@ -293,6 +298,12 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
     outputs = _outputs(ctx, table(ctx, raw, "outputs"), fe, labels)
     if spec is not None and spec.travelling_wave:
         check_travelling_wave(ctx, raw, solver)
+    if isinstance(solver.harmonics_kept, dict):
+        names = [c.name for c in contacts]
+        for name in solver.harmonics_kept:
+            if name not in names:
+                raise ctx.error(f"solver.harmonics_kept.{name}", f"a contact group's name "
+                                f"(groups: {names})", name)
     return DeckSettings(path=path, title=title, model=model, fe_model=source, reduction=spec,
                         cyclic=cyc, solver=solver, damping=damping, loads=tuple(loads),
                         contacts=tuple(contacts), frequency=frequency,
@@ -317,7 +328,7 @@ def _solver(ctx, sol, cyc) -> SolverSettings:
     unknown(ctx, sol, {"harmonics", "samples", "formulation", "tol_residual",
                        "tol_update", "max_iterations", "stability", "tolerance_auto",
                        "max_harmonics", "max_samples", "tol_stall", "history",
-                       *ALIASES["solver"]}, "solver")
+                       "harmonics_kept", *ALIASES["solver"]}, "solver")
     sol = _aliased(ctx, sol, "solver")
     auto = _auto(ctx, sol, cyc)
     H = auto["max_harmonics"] if auto["auto_harmonics"] else number(
@@ -341,6 +352,19 @@ def _solver(ctx, sol, cyc) -> SolverSettings:
     stability = boolean(ctx, sol, "stability", "solver.stability", SOLVER_DEFAULTS.stability)
     stall = number(ctx, sol, "tol_stall", "solver.tol_stall", nonneg=True)
     history = boolean(ctx, sol, "history", "solver.history", SOLVER_DEFAULTS.history)
+    kept = _harmonics_kept(ctx, sol.get("harmonics_kept"), H)
+    if kept is not None:
+        if cyc is not None:
+            raise ctx.error("solver.harmonics_kept", "no harmonic selection with "
+                            "[reduction.cyclic] (a sector's harmonics live on their own nodal "
+                            "diameters)", sol["harmonics_kept"])
+        if form != "condensed":
+            raise ctx.error("solver.formulation", "'condensed' with solver.harmonics_kept",
+                            form)
+        if sol.get("stability") is True:
+            raise ctx.error("solver.stability", "false with solver.harmonics_kept (Hill's "
+                            "method would see only the kept harmonics)", True)
+        stability = False
     if cyc is not None:
         if form != "condensed":
             raise ctx.error("solver.formulation", "'condensed' with [reduction.cyclic] "
@@ -352,7 +376,31 @@ def _solver(ctx, sol, cyc) -> SolverSettings:
     return SolverSettings(harmonics=H, samples=N, formulation=form, tol_residual=tols[0],
                           tol_update=tols[1], max_iterations=max_it, stability=stability,
                           tol_stall=None if stall is None else float(stall), history=history,
-                          **auto)
+                          harmonics_kept=kept, **auto)
+
+
+def _harmonics_kept(ctx, kept, H: int):
+    """``solver.harmonics_kept``: "odd", "even", a list of harmonics in 0..H, or a table
+    from contact group name to one of those; checked, None when absent."""
+    from ..options import kept_harmonics
+    from .._errors import ParameterError
+    if kept is None:
+        return None
+    expected = f"'odd', 'even' or a list of distinct harmonics in 0..{H} (harmonics = {H})"
+    items = kept.items() if isinstance(kept, dict) else [(None, kept)]
+    if isinstance(kept, dict) and not kept:
+        raise ctx.error("solver.harmonics_kept", "a table naming at least one contact group",
+                        kept)
+    for name, spec in items:
+        key = "solver.harmonics_kept" + ("" if name is None else f".{name}")
+        if isinstance(spec, (bool, dict)):
+            raise ctx.error(key, expected, spec)
+        try:
+            kept_harmonics(spec, H, key)
+        except ParameterError:
+            raise ctx.error(key, expected, spec) from None
+    return dict(kept) if isinstance(kept, dict) else (list(kept) if isinstance(kept, list)
+                                                      else kept)
 
 
 def _auto(ctx, sol, cyc) -> dict:
