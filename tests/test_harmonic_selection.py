@@ -16,6 +16,7 @@ from frirom._errors import InputError, ParameterError
 from frirom.deck import load_deck
 from frirom.model import ContactGroup, Damping, Excitation, Model
 from frirom.options import kept_harmonics
+from frirom.results import FRF
 from frirom.solver import SolverOptions, frf, solve_point
 
 TIGHT = dict(tol_residual=1e-13, tol_update=1e-13)
@@ -150,3 +151,79 @@ def test_deck_refuses_bad_selections_naming_the_key(tmp_path, extra, key):
         path.write_text(path.read_text().replace("stability = false\n", "", 1))
     with pytest.raises(InputError, match=re.escape(f"{path}: {key}: expected")):
         load_deck(path)
+
+
+# ---- automatic selection (frirom.auto_kept) ---------------------------------------------
+
+def test_auto_selection_finds_the_odd_harmonics_of_duffing():
+    from frirom.auto_kept import choose_kept
+    model, ex = duffing()
+    opts = SolverOptions(harmonics=5, samples=64, **TIGHT)
+    ch = choose_kept(model, ex.F, 0.6, 2.0, opts, tolerance=1e-6)
+    assert ch.selection is not None, ch.notes
+    assert ch.selection[0].tolist() == [False, True, False, True, False, True]
+    assert ch.unknowns == (6, 11) and ch.leak <= 1e-6
+    assert "6 of 11 unknowns" in ch.summary() and "dropped h0 on 1" in ch.summary()
+    a = frf(model, ex, 0.6, 2.0, opts)
+    b = frf(model, ex, 0.6, 2.0, dataclasses.replace(opts, harmonics_kept=ch.selection))
+    assert abs(b.peaks[0].amplitude / a.peaks[0].amplitude - 1) < 1e-9
+    assert "harmonic selection: 6 of 11 unknowns" in b.solver_info
+
+
+def test_auto_selection_keeps_what_saves_nothing(tmp_path):
+    # the joint's one Jenkins element: 1 contact coordinate against 2 contact DoFs, so a
+    # selection on the DoFs (12 of 22) would solve more than the run without it (11)
+    from frirom.auto import resolve_deck
+    deck = resolve_deck(load_deck(_joint_deck(tmp_path, 'harmonics_kept = "auto"')),
+                        lambda s: None)
+    kc = deck.auto.kept
+    assert kc.selection is None and deck.kept_auto is None
+    assert "nothing saved" in kc.summary()
+    assert deck.options().harmonics_kept is None
+
+
+@pytest.mark.slow
+def test_a_selection_that_leaks_along_the_curve_is_restored(tmp_path, monkeypatch, capsys):
+    # a selection that drops harmonic 3 on the joint's contact DoFs: the slipping
+    # damper's force has a third harmonic, so the leak grows past the tolerance and
+    # `frirom run` runs the curve again with every harmonic (its file: the full curve)
+    import frirom.auto_kept as ak
+    from frirom.cli import main
+
+    def bad_choice(model, F, w0, w1, options, outputs=None, tolerance=1e-3, probes=None):
+        sel = np.ones((model.n_dof, options.harmonics + 1), bool)
+        sel[model.nonlinear_dofs(), 3] = False
+        return ak.KeptChoice(selection=sel, tolerance=tolerance, unknowns=(18, 11),
+                             dropped={3: 2}, leak=0.0, change=0.0, threshold=tolerance)
+
+    monkeypatch.setattr(ak, "choose_kept", bad_choice)
+    path = _joint_deck(tmp_path, 'harmonics_kept = "auto"\ntolerance_auto = 1e-6')
+    assert main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    err = capsys.readouterr().err
+    assert "run again with every harmonic" in err and "leak" in err
+    got = FRF.load(tmp_path / "o" / "frf.h5")
+    full = load_deck(_joint_deck(tmp_path, ""))
+    ref = frf(full.model(), full.excitation(), full.omega_start, full.omega_end,
+              full.options(), outputs=full.solver_outputs)
+    assert got.leak is None or np.all(np.isnan(np.asarray(got.leak, float)))
+    # the file holds the full curve, point for point
+    assert np.array_equal(got.omega, ref.omega) and np.array_equal(got.X, ref.X)
+    import h5py
+    with h5py.File(tmp_path / "o" / "frf.h5", "r") as f:
+        auto = f.attrs["auto"]
+    assert "RESTORED every harmonic" in (auto.decode() if isinstance(auto, bytes) else auto)
+
+
+def test_restore_rule():
+    from frirom.auto_kept import KeptChoice, restore
+    sel = np.ones((1, 4), bool)
+
+    class R:
+        leak = np.array([1e-9, 3e-3, 1e-8])
+        omega = np.array([1.0, 2.0, 3.0]) * 2 * np.pi
+
+    ch = KeptChoice(selection=sel, tolerance=1e-3)
+    assert restore(ch, R) and "3.0e-03" in ch.restored and "2 Hz" in ch.restored
+    assert not restore(KeptChoice(selection=None, tolerance=1e-3), R)
+    R.leak = np.array([1e-9, 1e-4])
+    assert not restore(KeptChoice(selection=sel, tolerance=1e-3), R)

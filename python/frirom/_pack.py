@@ -348,6 +348,11 @@ def harmonic_selection(model: Model, opts: SolverOptions) -> np.ndarray:
     if sel.shape != (n, H + 1):
         raise SizeError(f"options.selection: expected (n_dof, H+1) = ({n}, {H + 1}), got "
                         f"{sel.shape}")
+    if isinstance(spec, np.ndarray) and spec.dtype == bool:
+        if spec.shape != (n, H + 1):
+            raise SizeError(f"options.harmonics_kept: a mask must be (n_dof, H+1) = ({n}, "
+                            f"{H + 1}), got {spec.shape}")
+        return sel & spec
     if not isinstance(spec, dict):
         return sel & kept_harmonics(spec, H, "options.harmonics_kept")[None, :]
     names = [g.name for g in model.contacts]

@@ -320,6 +320,12 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
     if not done:
         shutil.copyfile(deck.path, out / "deck.toml")
 
+    kept = getattr(deck.auto, "kept", None) if deck.auto is not None else None
+    if kept is not None and kept.selection is not None and args.resume and \
+            _stored_restored(h5):
+        # the stored run had given the selection up: it goes on with every harmonic
+        kept.restored = "(the stored run's: its leak had grown)"
+        deck.kept_auto = None
     model, excitation, options = deck.model(), deck.excitation(), deck.options()
     print(f"frirom: {model.n_dof} coordinates, {len(model.nonlinear_dofs())} in contact, "
           f"{sum(g.n_elem for g in model.contacts)} contact elements, H = {deck.harmonics}")
@@ -373,6 +379,23 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
             raise
         progress.close()
         writer.close(complete=result.complete, message=result.message)
+        if kept is not None and reuse is None and _restore_kept(kept, result):
+            # harmonics_kept = "auto": the selection leaked along the curve beyond what
+            # the probes saw: the whole curve again with every harmonic, the file replaced
+            print(f"frirom: auto: the harmonic selection's {kept.restored}: the curve is "
+                  "run again with every harmonic", file=sys.stderr)
+            deck.kept_auto = None
+            options = deck.options()
+            writer = FRFWriter(h5, deck.outputs, names, deck.harmonics, append=False,
+                               attrs={"deck_fingerprint": fingerprint,
+                                      "omega_range": [deck.omega_start, deck.omega_end],
+                                      "auto": "\n".join(deck.auto.lines())},
+                               output_labels=deck.output_names, meta=deck.result_meta())
+            progress = _Progress(deck, args.quiet)
+            result = frf(model, excitation, deck.omega_start, deck.omega_end, options,
+                         outputs=deck.solver_outputs, sink=sink)
+            progress.close()
+            writer.close(complete=result.complete, message=result.message)
         elapsed = time.perf_counter() - t0
         if deck.auto is not None:
             result.solver_info += f"; {deck.auto.summary()}"
@@ -411,6 +434,24 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
         _print_stop(full, deck, h5)
         return EXIT_STOPPED
     return EXIT_OK
+
+
+def _restore_kept(kept, result) -> bool:
+    from .auto_kept import restore
+    return restore(kept, result)
+
+
+def _stored_restored(h5: Path) -> bool:
+    """Whether a stored run gave its automatic harmonic selection up (frirom.auto_kept
+    restore): its 'auto' lines say so."""
+    import h5py
+    try:
+        with h5py.File(h5, "r") as f:
+            text = f.attrs.get("auto", "")
+    except (OSError, KeyError):
+        return False
+    text = text.decode() if isinstance(text, bytes) else str(text)
+    return "RESTORED every harmonic" in text
 
 
 def _resume_start(h5: Path, deck, fingerprint: str):

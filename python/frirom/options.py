@@ -125,7 +125,9 @@ class SolverOptions:
         friction contact without preload, has no even harmonics), ``"even"``, or a list
         such as ``[0, 1, 2, 3, 5]``; or a dict from contact group (name or 0-based index)
         to such a spec, for the DoFs of that group only (a DoF in several groups keeps what
-        any of them keeps; DoFs of groups not named keep every harmonic). The linear part
+        any of them keeps; DoFs of groups not named keep every harmonic); or a bool mask
+        (n_dof, H+1) per DoF and harmonic (what :func:`frirom.auto_kept.choose_kept`
+        gives). The linear part
         is exact at every harmonic (receptances); what the selection neglects is reported
         per point as its leak (``FRFPoint.leak``, the contact forces on the dropped
         harmonics over those on the kept ones), with a warning above :data:`LEAK_TOL`. A
@@ -168,7 +170,7 @@ class SolverOptions:
     selection: np.ndarray | None = field(default=None, repr=False)
     pairs: np.ndarray | None = field(default=None, repr=False)
     orbits: bool = True
-    harmonics_kept: object = None
+    harmonics_kept: object = field(default=None, repr=False)
 
     def check(self) -> None:
         """Raise ParameterError naming the first invalid field."""
@@ -206,10 +208,9 @@ class SolverOptions:
         if self.coordinates == "contact" and self.stability:
             raise ParameterError("options.coordinates: 'contact' cannot be used with "
                                  "stability (Hill's method needs the contact DoFs)")
-        if self.harmonics_kept is not None:
-            specs = (self.harmonics_kept.values() if isinstance(self.harmonics_kept, dict)
-                     else [self.harmonics_kept])
-            for spec in specs:
+        kh = self.harmonics_kept
+        if kh is not None and not (isinstance(kh, np.ndarray) and kh.dtype == bool):
+            for spec in (kh.values() if isinstance(kh, dict) else [kh]):
                 kept_harmonics(spec, self.harmonics, "options.harmonics_kept")
         if self.selection is not None or self.harmonics_kept is not None:
             what = ("options.selection: a travelling-wave selection" if self.selection

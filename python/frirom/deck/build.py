@@ -90,6 +90,9 @@ class Deck:
     #: (n_out, n_dof) with [fe_model]: x_out = output_map @ x, the rows of the reduction
     #: basis T of the FE DoFs named in [outputs] (sector 0's with [reduction.cyclic])
     output_map: np.ndarray | None = None
+    #: with ``harmonics_kept = "auto"``: the chosen selection (n_dof, H+1) bool (None:
+    #: every harmonic), set by frirom.auto.resolve_deck
+    kept_auto: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def n_dof(self) -> int:
@@ -180,7 +183,7 @@ class Deck:
                           ("max_iterations", "max_iter"), ("stability", "stability"),
                           ("tol_stall", "tol_stall"), ("history", "history"),
                           ("harmonics_kept", "harmonics_kept")):
-            if key in self.solver:
+            if key in self.solver and self.solver[key] != "auto":
                 kw[name] = self.solver[key]
         for key, name in (("step", "ds"), ("min_step", "ds_min"), ("max_step", "ds_max"),
                           ("max_points", "max_points")):
@@ -190,6 +193,8 @@ class Deck:
         if red is not None and red.travelling_wave:
             kw["selection"] = self.travelling_wave_selection()
             kw["pairs"] = self.travelling_wave_pairs()
+        if self.kept_auto is not None:
+            kw["harmonics_kept"] = np.asarray(self.kept_auto, bool)
         opts = SolverOptions(**kw)
         if opts.ds_min > opts.ds_max or not opts.ds_min <= opts.ds <= opts.ds_max:
             # keep the user's steps consistent with the solver's defaults for the others

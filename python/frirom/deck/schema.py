@@ -75,8 +75,10 @@ class SolverSettings:
         The largest H and N the choice may use.
     harmonics_kept : str, list, dict or None
         Harmonic selection (``SolverOptions.harmonics_kept``): ``"odd"``, ``"even"``, a list
-        of harmonics, or a table from contact group name to such a spec; stability is
-        then off (Hill's method would see only the kept harmonics).
+        of harmonics, or a table from contact group name to such a spec; ``"auto"``:
+        chosen per unknown before the run (:mod:`frirom.auto_kept`, to
+        ``tolerance_auto``); stability is then off (Hill's method would see only the kept
+        harmonics).
     """
 
     harmonics: int
@@ -384,9 +386,10 @@ def _harmonics_kept(ctx, kept, H: int):
     from contact group name to one of those; checked, None when absent."""
     from ..options import kept_harmonics
     from .._errors import ParameterError
-    if kept is None:
-        return None
-    expected = f"'odd', 'even' or a list of distinct harmonics in 0..{H} (harmonics = {H})"
+    if kept is None or kept == "auto":
+        return kept
+    expected = (f"'auto', 'odd', 'even' or a list of distinct harmonics in 0..{H} "
+                f"(harmonics = {H})")
     items = kept.items() if isinstance(kept, dict) else [(None, kept)]
     if isinstance(kept, dict) and not kept:
         raise ctx.error("solver.harmonics_kept", "a table naming at least one contact group",
@@ -411,9 +414,13 @@ def _auto(ctx, sol, cyc) -> dict:
             raise ctx.error(f"solver.{k}", 'an integer or "auto"', sol[k])
     on = out["auto_harmonics"] or out["auto_samples"]
     given = [k for k in ("tolerance_auto", "max_harmonics", "max_samples") if k in sol]
+    kept = sol.get("harmonics_kept") == "auto"
+    if kept and given == ["tolerance_auto"]:
+        given = []              # harmonics_kept = "auto" reads the tolerance too
     if given and not on:
-        raise ctx.error(f"solver.{given[0]}", 'harmonics = "auto" or samples = "auto" '
-                        "(it only bounds that choice)", sol[given[0]])
+        raise ctx.error(f"solver.{given[0]}", 'harmonics = "auto", samples = "auto" or '
+                        'harmonics_kept = "auto" (it only bounds that choice)',
+                        sol[given[0]])
     if on and cyc is not None:
         key = "harmonics" if out["auto_harmonics"] else "samples"
         raise ctx.error(f"solver.{key}", "an integer with [reduction.cyclic] (\"auto\" is "
