@@ -3,15 +3,19 @@
 ! integer(4) dummies, `info` plus the library's message.
 
 !> A run opened with mode 3 (nonlinear mode): the linear mode phi (ndof) and its natural
-!> frequency omega0 (rad/s) the EPMC starts from. Out: ny, the unknowns per point
-!> (ndof (2H+1) + 2: the harmonics, omega / omega0, xi / omega0).
-subroutine frun_set_nonlinear_mode(handle, ndof, phi, omega0, ny, info, msg)
+!> frequency omega0 (rad/s) the EPMC starts from; a condensed run (formulation 1) the nm
+!> modes of its receptances (modal = 1: modes, wm rad/s, zm ratios; modal = 0, a banded
+!> run: 1-column dummies). Out:
+!> ny, the unknowns per point (rows (2H+1) + 2: the harmonics of every DoF or of the
+!> contact DoFs, omega / omega0, xi / omega0).
+subroutine frun_set_nonlinear_mode(handle, ndof, phi, omega0, modal, nm, modes, wm, zm, ny, &
+                                   info, msg)
     use frirom_kinds, only: ip
     use frirom_run, only: run_t, run_from_handle, fr_nlm => run_set_nonlinear_mode
     implicit none
     integer(8), intent(in) :: handle
-    integer(4), intent(in) :: ndof
-    real(8), intent(in) :: phi(ndof), omega0
+    integer(4), intent(in) :: ndof, modal, nm
+    real(8), intent(in) :: phi(ndof), omega0, modes(ndof, nm), wm(nm), zm(nm)
     integer(4), intent(out) :: ny, info
     character(len=512), intent(out) :: msg
     type(run_t), pointer :: r
@@ -19,7 +23,11 @@ subroutine frun_set_nonlinear_mode(handle, ndof, phi, omega0, ny, info, msg)
     msg = ''
     ny = 0
     call run_from_handle(handle, r, 'run_set_nonlinear_mode', linfo, msg)
-    if (linfo == 0) call fr_nlm(r, phi, omega0, linfo, msg)
+    if (linfo == 0 .and. modal == 1) then
+        call fr_nlm(r, phi, omega0, linfo, msg, modes=modes, wm=wm, zm=zm)
+    else if (linfo == 0) then
+        call fr_nlm(r, phi, omega0, linfo, msg)
+    end if
     if (linfo == 0) ny = int(r%ny, 4)
     info = linfo
 end subroutine frun_set_nonlinear_mode

@@ -74,6 +74,14 @@ contains
             y(sys%ndof + 1:2*sys%ndof) = sys%phi
             y(sys%nf + 1) = 1.0_wp
             y(sys%nf + 2) = dot_product(sys%phi, cphi)/sys%w0
+        type is (hbm_epmc_modal)
+            if (.not. allocated(sys%phi0)) return
+            allocate (cphi(sys%ndof))
+            cphi = 0.0_wp
+            call csr_matvec_add(sys%c, sys%phi0, cphi, 1.0_wp)
+            y(sys%nnl + 1:2*sys%nnl) = sys%phi0(sys%nl)
+            y(sys%nf + 1) = 1.0_wp
+            y(sys%nf + 2) = dot_product(sys%phi0, cphi)/sys%w0
         end select
     end procedure hbm_epmc_guess
 
@@ -85,6 +93,17 @@ contains
         jm = 0.0_wp
         select type (sys => sysc)
         type is (hbm_epmc)
+            if (size(y) /= sys%n .or. size(r) /= sys%n .or. size(rlam) /= sys%n .or. &
+                any(shape(jm) /= [sys%n, sys%n])) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'hbm_epmc_jacobian: y, r, '// &
+                                'rlam (n) and jm (n, n) expected')
+                return
+            end if
+            sys%factor = .false.
+            call sys%eval(y, lam, r, rref, .true., rlam, info, errmsg)
+            sys%factor = .true.
+            if (info == 0) jm = sys%jd
+        type is (hbm_epmc_modal)
             if (size(y) /= sys%n .or. size(r) /= sys%n .or. size(rlam) /= sys%n .or. &
                 any(shape(jm) /= [sys%n, sys%n])) then
                 call set_status(info, FRIROM_ERR_SIZE, errmsg, 'hbm_epmc_jacobian: y, r, '// &

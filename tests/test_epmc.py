@@ -76,20 +76,22 @@ def two_dof(zeta=1e-3):
     return Model(M, K, Damping.modal([zeta, zeta]), [g])
 
 
+@pytest.mark.parametrize("formulation", ["condensed", "banded"])
 @pytest.mark.parametrize("law", ["jenkins", "normal1d"])
-def test_jacobian_against_central_differences(law):
+def test_jacobian_against_central_differences(law, formulation):
     """dR/dy (harmonics, omega, xi) and dR/d log10 a of the mode run against central
-    differences in microslip (H = 3): relative 1e-6 of the largest entry."""
+    differences in microslip (H = 3), both formulations: relative 1e-6 of the largest
+    entry."""
     model = two_dof()
     if law == "normal1d":
         model.contacts = [ContactGroup(law="normal1d", G=np.array([[1.0, 0.0], [0.0, 1.0]]),
                                        params=np.array([[2e4, 3e4, 0.3, 10.0]]), name="n")]
-    opts = frirom.SolverOptions(harmonics=3, samples=256)
+    opts = frirom.SolverOptions(harmonics=3, samples=256, formulation=formulation)
     bb = nonlinear_mode(model, 0, (1e-6, 1e-3), "stuck", opts)
     i = int(np.argmax(bb.damping_ratio))
     assert bb.damping_ratio[i] > 0.01
     o2 = dataclasses.replace(opts, formulation="banded", stability=False)
-    _, run, _, _ = _open(model, 0, "stuck", o2)
+    _, run, _, _ = _open(model, 0, "stuck", o2, condensed=formulation == "condensed")
     y, lam = bb.y[i], np.log10(bb.amplitude[i])
 
     def res(yy, ll):
@@ -108,6 +110,37 @@ def test_jacobian_against_central_differences(law):
     assert np.abs(J - Jfd).max() < 1e-6 * np.abs(J).max()
     assert np.abs(rl - rlfd).max() < 1e-6 * np.abs(rl).max()
     run.close()
+
+
+LAW_GROUPS = {
+    "normal1d": dict(G=[[1.0, 0.0], [0.0, 1.0]], params=[[2e4, 3e4, 0.3, 10.0]]),
+    "cubic": dict(G=[[1.0, 0.0]], params=[[2e4, 4e12]]),
+}
+
+
+@pytest.mark.parametrize("law", ["jenkins", "normal1d", "cubic"])
+def test_formulations_agree(law):
+    """The condensed (all modes: exact) and banded mode runs end on the same point:
+    frequency, damping and the harmonics of every DoF to 1e-8, at three amplitudes from
+    microslip to gross slip (H = 3; a cubic spring: hardening, no damping)."""
+    model = two_dof()
+    if law in LAW_GROUPS:
+        g = LAW_GROUPS[law]
+        model.contacts = [ContactGroup(law=law, G=np.array(g["G"]),
+                                       params=np.array(g["params"]), name=law)]
+    for a1 in (3e-5, 1e-4, 1e-3):
+        ends = []
+        for formulation in ("condensed", "banded"):
+            opts = frirom.SolverOptions(harmonics=3, samples=256, formulation=formulation,
+                                        tol_residual=1e-11, tol_update=1e-11)
+            bb = nonlinear_mode(model, 0, (1e-6, a1), "stuck", opts)
+            assert bb.status == "done" and bb.amplitude[-1] == pytest.approx(a1, rel=1e-12)
+            ends.append(bb)
+        c, b = ends
+        assert c.omega[-1] == pytest.approx(b.omega[-1], rel=1e-8)
+        assert c.xi[-1] == pytest.approx(b.xi[-1], rel=1e-8, abs=1e-10 * b.omega[-1])
+        assert np.abs(c.harmonics[-1] - b.harmonics[-1]).max() < 1e-8 * np.abs(
+            b.harmonics[-1]).max()
 
 
 def test_forced_responses_peak_on_the_backbone():
@@ -143,10 +176,11 @@ def test_forced_responses_peak_on_the_backbone():
 
 
 def test_free_start_and_bad_input():
-    """From the free mode (contact open: K alone) a friction backbone at large amplitude
-    has the free frequency; bad arguments name themselves."""
+    """From the free mode (contact open: K alone) down from gross slip, the SDOF backbone
+    follows the describing function (N = 1024 samples: 1e-4); bad arguments name
+    themselves."""
     model = jenkins_sdof()
-    opts = frirom.SolverOptions(harmonics=1, samples=1024)
+    opts = frirom.SolverOptions(harmonics=1, samples=1024, formulation="banded")
     bb = nonlinear_mode(model, 0, (10.0, 1.0), "free", opts)
     assert bb.omega0 == pytest.approx(np.sqrt(K0 / M1))
     w, xi = describing_function(bb.amplitude)
@@ -208,3 +242,40 @@ def test_deck_run_and_resume(tmp_path):
     deck.write_text(text + '\n[[excitation.load]]\ndof = "tip:x"\nharmonic = 1\n'
                     'amplitude = 1.0\n')
     assert main(["run", str(deck), "--out", str(tmp_path / "bad"), "--quiet"]) == 2
+
+
+@pytest.mark.slow
+def test_reduced_fe_deck(block_dir):
+    """A nonlinear-mode deck on a reduced FE model (the ccx block, Craig-Bampton + GSI,
+    2-D friction with a normal preload; outputs are FE DoFs recovered through the basis):
+    the friction lowers the frequency of the stuck structure's third mode and adds
+    damping, and both formulations end on the same point (1e-7). (Modes 1 and 2 of the
+    square block are a pair 1e-6 apart: a 1:1 resonance whose nonlinear mode the EPMC
+    leaves undetermined; Newton stalls there.)"""
+    import time
+
+    from _models import GSI_DECK
+    from frirom.backbone import load_h5
+    from frirom.cli import main
+    text = (GSI_DECK.format(kt="2.0e8", h=2, mu=0.5)
+            .replace("harmonics = 2", "harmonics = 2\nsamples = 64")
+            .replace('[[excitation.load]]\ndof = "ACTIVE:z"\namplitude = 1.0\n', "")
+            .replace("[frequency]\nstart = 100.0\nend = 200.0\n", "")
+            + '\n[analysis]\nkind = "nonlinear_mode"\nmode = 3\namplitudes = [1e-7, 1e-3]\n'
+              'output = "ACTIVE:z"\n')
+    ends = {}
+    for form in ("condensed", "banded"):
+        deck = block_dir / f"mode_{form}.toml"
+        deck.write_text(text.replace("samples = 64", f'samples = 64\nformulation = "{form}"'))
+        t0 = time.perf_counter()
+        assert main(["run", str(deck), "--out", str(block_dir / f"out_{form}"),
+                     "--quiet"]) == 0
+        bb, _ = load_h5(block_dir / f"out_{form}" / "backbone.h5")
+        print(form, len(bb), "points", round(time.perf_counter() - t0, 2), "s",
+              bb.frequency[[0, -1]], bb.damping_ratio.max())
+        assert bb.frequency[-1] < bb.frequency[0] and bb.damping_ratio.max() > 0.011
+        assert bb.outputs.shape[1] == 3            # ACTIVE:z put first, then [outputs]
+        ends[form] = bb
+    c, b = ends["condensed"], ends["banded"]
+    assert c.omega[-1] == pytest.approx(b.omega[-1], rel=1e-7)
+    assert c.damping_ratio[-1] == pytest.approx(b.damping_ratio[-1], rel=1e-6)

@@ -19,6 +19,7 @@ energy the structure dissipates per cycle is pi xi w a^2 sum_h h^2 (|Xc_h|_M^2 +
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -38,18 +39,29 @@ _DENSE_EIG = 400
 
 @dataclass
 class Backbone:
-    """The backbone of a nonlinear mode: one entry per point, amplitude ascending along the
+    """The backbone of a nonlinear mode, one entry per point in the order of the
     continuation.
 
-    amplitude : (n,) modal amplitude a (harmonic 1 mass-normalised: sqrt(kg) m)
-    omega : (n,) frequency, rad/s; ``frequency`` in Hz
-    xi : (n,) artificial damping, 1/s; ``damping_ratio`` = xi / (2 omega)
-    energy : (n,) energy dissipated per cycle, J
-    harmonics : (n, n_dof, 2H+1) the motion's real harmonics [a0, a1, b1, ...] of every DoF
-    outputs : (n, n_out, 2H+1) the same at the output DoFs (``output_dofs``)
-    states : (n, 3, n_elements) stick, slip, lift-off fractions of each contact element
-    omega0 : the linear mode's natural frequency (rad/s); start: 'stuck' or 'free'
-    status, message : why the run stopped (frirom._run stop reasons)
+    Attributes
+    ----------
+    amplitude : ndarray
+        (n,) modal amplitude a (harmonic 1 mass-normalised), sqrt(kg) m.
+    omega : ndarray
+        (n,) frequency, rad/s (``frequency``: Hz).
+    xi : ndarray
+        (n,) artificial damping, 1/s (``damping_ratio`` = xi / (2 omega)).
+    energy : ndarray
+        (n,) energy dissipated per cycle, J.
+    harmonics : ndarray
+        (n, n_dof, 2H+1) real harmonics [a0, a1, b1, ...] of every DoF.
+    outputs : ndarray
+        (n, n_out, 2H+1) the same at the outputs (``output_dofs``).
+    states : ndarray
+        (n, 3, n_elements) stick, slip, lift-off fractions of each contact element.
+    omega0 : float
+        The linear mode's natural frequency, rad/s (``start``: 'stuck' or 'free').
+    status, message : str
+        Why the run stopped ('done', 'max_points', 'failed', ...).
     """
 
     amplitude: np.ndarray
@@ -169,6 +181,12 @@ def linear_mode(model: Model, mode: int = 0, start: str = "stuck") -> tuple[np.n
     if mode >= lam.size:
         raise ParameterError(f"mode: index {mode}, the {start} structure has {lam.size} "
                              "modes with a nonzero frequency")
+    near = [lam[j] for j in (mode - 1, mode + 1) if 0 <= j < lam.size]
+    if near and min(abs(x / lam[mode] - 1) for x in near) < 1e-4:
+        warnings.warn(f"mode {mode} of the {start} structure has a neighbour within 1e-4 "
+                      "of its frequency (a symmetric pair): their nonlinear modes interact "
+                      "1:1 and the EPMC may not converge; choose another mode or break the "
+                      "symmetry", stacklevel=3)
     v = phi[:, mode]
     v = v / np.sqrt(v @ (model.M @ v))
     v = v * np.sign(v[np.argmax(np.abs(v))])
@@ -179,19 +197,44 @@ def nonlinear_mode(model: Model, mode: int = 0, amplitudes=(1e-6, 1e-2), start: 
                    options: SolverOptions | None = None, outputs=None, static=None,
                    max_points: int | None = None, batch: int | None = None,
                    callback=None, resume: dict | None = None) -> Backbone:
-    """The backbone of nonlinear mode `mode` by the EPMC, from modal amplitude
-    amplitudes[0] to amplitudes[1] (log scale; harmonic 1 mass-normalised).
+    """The backbone of a nonlinear mode by the extended periodic motion concept.
 
-    model : frirom.Model (every contact law, any damping matrix)
-    start : 'stuck' or 'free': the linear mode it starts from (:func:`linear_mode`)
-    options : SolverOptions (harmonics, samples, tolerances, steps; the mode run solves on
-        all DoFs: its formulation is the banded one, Hill's method off)
-    outputs : DoF indices reported in Backbone.outputs (default: all up to 100)
-    static : (n_dof,) static load (a preload), or None
-    callback : called with each batch's Backbone so far (progress, a file kept up to date)
-    resume : a :meth:`Backbone.checkpoint` of an earlier run of the same settings: the
-        run continues from it exactly as the uninterrupted run did; the Backbone returned
-        holds the points after it
+    The run object's mode 3 (frirom_run RUN_MODE) from modal amplitude amplitudes[0] to
+    amplitudes[1] in log steps (harmonic 1 mass-normalised).
+
+    Parameters
+    ----------
+    model : Model
+        Any contact law and damping; a cyclic sector is not supported yet.
+    mode : int
+        Index of the linear mode it starts from, 0 = the lowest with a nonzero frequency.
+    amplitudes : (float, float)
+        Modal amplitudes from and to, sqrt(kg) m.
+    start : {'stuck', 'free'}
+        The linear limit of that mode (:func:`linear_mode`).
+    options : SolverOptions, optional
+        Harmonics, samples, tolerances, steps and the formulation: 'condensed' (the
+        default) takes the contact DoFs' harmonics as unknowns with receptances by modal
+        superposition of the free structure's modes (all of them up to 400 DoFs: exact;
+        above, ``options.modes`` of them), the artificial damping a change of each mode's
+        damping term; 'banded' every DoF's harmonics (a dense Jacobian: small or reduced
+        models). Hill's method is off.
+    outputs : array_like of int or (n_out, n_dof) array, optional
+        Reported in Backbone.outputs; default all DoFs up to 100, else the contact DoFs.
+    static : array_like, optional
+        (n_dof,) static load (a preload).
+    max_points, batch : int, optional
+        Points at most; points per segment (default ``options.batch``).
+    callback : callable, optional
+        Called with the Backbone so far after every segment.
+    resume : dict, optional
+        A :meth:`Backbone.checkpoint` of an earlier run with the same settings: the run
+        continues from it as the uninterrupted run did, and the Backbone returned holds
+        the points after it.
+
+    Returns
+    -------
+    Backbone
     """
     from ._run import GOING, START_COLD, START_RESUME
 
@@ -206,11 +249,15 @@ def nonlinear_mode(model: Model, mode: int = 0, amplitudes=(1e-6, 1e-2), start: 
         raise ParameterError("options: expected a frirom.SolverOptions")
     if opts.harmonics < 1:
         raise ParameterError("options.harmonics: a nonlinear mode needs H >= 1")
+    condensed = opts.formulation == "condensed" and bool(model.contacts)
+    n_modes = opts.modes
     opts = dataclasses.replace(opts, formulation="banded", stability=False, modes=None,
-                               parameter="frequency", selection=None, pairs=None)
+                               parameter="frequency", selection=None, pairs=None,
+                               krylov=False, receptances="auto")
     if max_points is not None:
         opts = dataclasses.replace(opts, max_points=int(max_points))
-    packed, run, phi, w0 = _open(model, mode, start, opts, outputs, static)
+    packed, run, phi, w0 = _open(model, mode, start, opts, outputs, static,
+                                 condensed=condensed, n_modes=n_modes)
     if resume is None:
         run.start(START_COLD, np.log10(a0), np.log10(a1))
     else:
@@ -248,20 +295,64 @@ def nonlinear_mode(model: Model, mode: int = 0, amplitudes=(1e-6, 1e-2), start: 
     return bb
 
 
-def _open(model, mode, start, opts, outputs=None, static=None):
+def receptance_modes(model: Model, n_modes: int | None = None):
+    """(Phi (n_dof, nm) mass-normalised, omega (nm,) rad/s, zeta (nm,)) of the free
+    structure (K, M) for the condensed mode run: all modes up to _DENSE_EIG DoFs, else the
+    n_modes lowest; zeta_r = phi_r^T C phi_r / (2 omega_r) (exact for modal and Rayleigh
+    damping, the diagonal part of another C)."""
+    n = model.n_dof
+    if n <= _DENSE_EIG and n_modes is None:
+        lam, Phi = sla.eigh(np.asarray(sp.csr_matrix(model.K).todense()),
+                            np.asarray(sp.csr_matrix(model.M).todense()))
+    else:
+        if n_modes is None:
+            raise ParameterError(f"options.modes: the condensed nonlinear mode of a model "
+                                 f"of {n} DoFs needs the number of modes of its receptances "
+                                 f"(or options.formulation = 'banded')")
+        k = int(n_modes)
+        if not 1 <= k < n - 1:
+            raise ParameterError(f"options.modes: expected 1..{n - 2}")
+        lam, Phi = spla.eigsh(sp.csc_matrix(model.K), k=k, M=sp.csc_matrix(model.M),
+                              sigma=0.0)
+    if lam.min() <= 1e-10 * max(abs(lam).max(), 1e-300):
+        raise ParameterError("the free structure (contacts open) has a rigid-body mode: "
+                             "its receptances have no modal form; use options.formulation "
+                             "= 'banded'")
+    Phi = Phi / np.sqrt(np.einsum("ir,ir->r", Phi, model.M @ Phi))
+    w = np.sqrt(lam)
+    zeta = np.einsum("ir,ir->r", Phi, model.C @ Phi) / (2 * w)
+    return Phi, w, np.maximum(zeta, 0.0)
+
+
+def _open(model, mode, start, opts, outputs=None, static=None, condensed=False,
+          n_modes=None):
     """The packed model, a mode run opened on it (frirom._run.Run, RUN_MODE) and the linear
-    mode (phi, omega0) it starts from; opts: the mode run's SolverOptions."""
-    from ._pack import pack
+    mode (phi, omega0) it starts from; opts: the mode run's SolverOptions (banded: the
+    model's K, M, C go to Fortran as they are); condensed: by the free structure's modes
+    (:func:`receptance_modes`). The run's outputs are all DoFs (the Backbone's harmonics);
+    `outputs` selects from them (Backbone.outputs)."""
+    from ._pack import _output_map, pack
     from ._run import Run
     phi, w0 = linear_mode(model, mode, start)
+    modes = receptance_modes(model, n_modes) if condensed else None
     F = np.zeros((model.n_dof, 1))
     if static is not None:
         st = np.asarray(static, float).ravel()
         if st.size != model.n_dof or not np.all(np.isfinite(st)):
             raise ParameterError(f"static: {model.n_dof} finite values expected")
         F[:, 0] = st
-    packed = pack(model, Excitation(F), opts, outputs)
-    return packed, Run(packed, mode_shape=(phi, w0)), phi, w0
+    n = model.n_dof
+    out, P = _output_map(outputs, n)
+    if P is None:
+        if out is None:
+            out = np.arange(n) if n <= 100 else model.nonlinear_dofs()
+        P = np.eye(n)[np.asarray(out, dtype=int)]
+    packed = pack(model, Excitation(F), opts, np.arange(n))
+    packed.select = P
+    packed.select_dofs = np.asarray(out) if out is not None else np.zeros(0, int)
+    run = Run(packed, mode_shape=(phi, w0, modes))
+    packed.mode_ny = run.ny
+    return packed, run, phi, w0
 
 
 #: frirom._run stop reasons by name
@@ -275,32 +366,29 @@ def _backbone(model, packed, phi, w0, mode, start, ys, lams, xos, sts, its, cks,
               message) -> Backbone:
     """A Backbone from the run's points so far."""
     n, H = model.n_dof, packed.H
-    nc, nf = 2 * H + 1, model.n_dof * (2 * H + 1)
-    y = np.concatenate(ys, axis=1).T if ys else np.zeros((0, nf + 2))
+    nc = 2 * H + 1
+    ny = packed.mode_ny
+    y = np.concatenate(ys, axis=1).T if ys else np.zeros((0, ny))
     a = 10.0 ** np.concatenate(lams) if lams else np.zeros(0)
-    X = y[:, :nf].reshape(-1, nc, n).transpose(0, 2, 1)        # unit-amplitude harmonics
-    omega, xi = w0 * y[:, nf], w0 * y[:, nf + 1]
+    omega, xi = w0 * y[:, -2], w0 * y[:, -1]
+    # the motion's harmonics at every DoF (the run's outputs)
+    Xp = (np.concatenate(xos, axis=2).transpose(2, 0, 1) if xos else np.zeros((0, n, nc)))
     M = model.M
     h2 = np.zeros(nc)
     h2[1::2] = h2[2::2] = np.arange(1, H + 1) ** 2
-    mnorm = np.einsum("pic,pic->pc", X, np.stack([M @ X[p] for p in range(len(a))])
-                      if len(a) else X)
-    energy = np.pi * xi * omega * a ** 2 * (mnorm * h2).sum(axis=1)
-    Xp = X.copy()
-    Xp[:, :, 1:] *= a[:, None, None]
-    xo = np.concatenate(xos, axis=2).transpose(2, 0, 1) if xos else np.zeros((0, 0, nc))
-    if packed.out_map is not None and xo.size:
-        xo = np.einsum("oj,pjc->poc", packed.out_map, xo)
+    mnorm = np.einsum("pic,pic->pc", Xp, np.stack([M @ Xp[p] for p in range(len(a))])
+                      if len(a) else Xp)
+    energy = np.pi * xi * omega * (mnorm * h2).sum(axis=1)
+    xo = np.einsum("oj,pjc->poc", packed.select, Xp)
     st = (np.concatenate(sts, axis=2).transpose(2, 0, 1) if sts else np.zeros((0, 3, 0)))
     st = st[:, :, :packed.ne_tot]
-    ny = nf + 2
     tans = (np.concatenate([c[0] for c in cks], axis=1).T if cks else np.zeros((0, ny + 1)))
     ysc = np.concatenate([c[1] for c in cks]) if cks else np.zeros(0)
     dsn = np.concatenate([c[2] for c in cks]) if cks else np.zeros(0)
     sl = (np.concatenate([c[3] for c in cks], axis=1).T if cks
           else np.zeros((0, max(packed.nw, 1))))
     return Backbone(amplitude=a, omega=omega, xi=xi, energy=energy, harmonics=Xp,
-                    outputs=xo, output_dofs=np.asarray(packed.outputs), states=st,
+                    outputs=xo, output_dofs=packed.select_dofs, states=st,
                     mode=int(mode), start=start, omega0=w0, H=H,
                     status=_status_name(status), message=message,
                     iterations=np.concatenate(its) if its else np.zeros(0, int), y=y,
