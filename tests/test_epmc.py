@@ -279,3 +279,30 @@ def test_reduced_fe_deck(block_dir):
     c, b = ends["condensed"], ends["banded"]
     assert c.omega[-1] == pytest.approx(b.omega[-1], rel=1e-7)
     assert c.damping_ratio[-1] == pytest.approx(b.damping_ratio[-1], rel=1e-6)
+
+
+@pytest.mark.parametrize("analysis, field", [
+    ('kind = "backbone"', "analysis.kind"),
+    ('kind = "nonlinear_mode"\namplitudes = [1e-3, 1e-3]', "analysis.amplitudes"),
+    ('kind = "nonlinear_mode"\nmode = 0', "analysis.mode"),
+    ('kind = "nonlinear_mode"\nstart = "open"', "analysis.start"),
+    ('kind = "nonlinear_mode"\nmodes = 1', "analysis"),
+    ('kind = "nonlinear_mode"\noutput = "nowhere:x"', "analysis.output"),
+])
+def test_analysis_table_errors_name_the_field(tmp_path, analysis, field):
+    """A bad [analysis] key is an InputError naming the deck and the field."""
+    from pathlib import Path
+
+    from frirom import InputError
+    from frirom.deck import load_deck
+    src = Path(__file__).parents[1] / "cases" / "joint"
+    for name in ("M.mtx", "K.mtx", "dofs.txt"):
+        (tmp_path / name).write_bytes((src / name).read_bytes())
+    text = (src / "joint_mode.toml").read_text()
+    start = text.index("[analysis]")
+    end = text.index("[model]")
+    deck = tmp_path / "d.toml"
+    deck.write_text(text[:start] + "[analysis]\n" + analysis + "\n\n" + text[end:])
+    with pytest.raises(InputError, match=field.replace(".", r"\.")) as err:
+        load_deck(deck)
+    assert "d.toml" in str(err.value)
