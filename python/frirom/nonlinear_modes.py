@@ -251,9 +251,11 @@ def nonlinear_mode(model: Model, mode: int = 0, amplitudes=(1e-6, 1e-2), start: 
         raise ParameterError("options.harmonics: a nonlinear mode needs H >= 1")
     condensed = opts.formulation == "condensed" and bool(model.contacts)
     n_modes = opts.modes
+    # a harmonic selection (harmonics_kept, where SolverOptions has it) is not for modes
+    extra = {"harmonics_kept": None} if hasattr(opts, "harmonics_kept") else {}
     opts = dataclasses.replace(opts, formulation="banded", stability=False, modes=None,
                                parameter="frequency", selection=None, pairs=None,
-                               krylov=False, receptances="auto")
+                               krylov=False, receptances="auto", **extra)
     if max_points is not None:
         opts = dataclasses.replace(opts, max_points=int(max_points))
     packed, run, phi, w0 = _open(model, mode, start, opts, outputs, static,
