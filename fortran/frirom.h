@@ -140,6 +140,31 @@ int frirom_run_checkpoint(const frirom_run *run, int nck, double *ck, char *msg,
 int frirom_run_restore(frirom_run *run, int nck, const double *ck, char *msg, int msglen);
 int frirom_run_close(frirom_run **run);
 
+/* Nonlinear modes by the extended periodic motion concept (EPMC, Krack 2015) on the same
+ * run object: the backbone of one mode, its frequency and damping against its amplitude.
+ *
+ *   frirom_run_set_nonlinear_mode  makes an open run a mode run starting from the linear
+ *                        mode phi (n) at omega0 (rad/s; mass-normalised here): on all
+ *                        DoFs (nmodes = 0), or condensed to the contact DoFs by nmodes
+ *                        real modes (n, nmodes) of the free structure with omega (rad/s)
+ *                        and zeta (the artificial damping changes their damping term)
+ *   frirom_run_start_mode  from modal amplitude a_start to a_end (> 0, log steps; harmonic
+ *                        1 mass-normalised): solves the first point
+ *   frirom_run_advance_mode  up to k more points into amplitude, omega (rad/s), xi (the
+ *                        artificial damping, 1/s; damping ratio xi / (2 omega)) (k+1 each)
+ *                        and xo (nout, 2H+1, k+1) the output harmonics; status as
+ *                        frirom_run_advance
+ *
+ * frirom_run_checkpoint, _restore, _sizes and _close work on a mode run as on any run. */
+int frirom_run_set_nonlinear_mode(frirom_run *run, const double *phi, double omega0,
+                                  int nmodes, const double *modes, const double *omega,
+                                  const double *zeta, char *msg, int msglen);
+int frirom_run_start_mode(frirom_run *run, double a_start, double a_end, char *msg,
+                          int msglen);
+int frirom_run_advance_mode(frirom_run *run, int k, int *npts, double *amplitude,
+                            double *omega, double *xi, double *xo, int *status, char *msg,
+                            int msglen);
+
 #ifdef __cplusplus
 }
 #endif

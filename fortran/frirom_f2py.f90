@@ -170,7 +170,7 @@ end subroutine default_samples
 subroutine int_constant(name, value, info, msg)
     use frirom_kinds, only: ip
     use frirom_status, only: FRIROM_ERR_PARAM, frirom_status_code, set_status
-    use frirom_run, only: RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_LOAD, &
+    use frirom_run, only: RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_LOAD, RUN_MODE, &
                           RUN_START_COLD, RUN_START_POINT, RUN_START_RESUME, RUN_GOING, &
                           RUN_DONE, RUN_MAX_POINTS, RUN_LEFT_RANGE, RUN_FAILED, RUN_STALLED, &
                           RUN_SOLVE_FIXED, RUN_SOLVE_STEP, ADVISE_TOL_STALL, ADVISE_MAX_ITER, &
@@ -195,6 +195,8 @@ subroutine int_constant(name, value, info, msg)
         value = RUN_FREQUENCY
     case ('RUN_LOAD')
         value = RUN_LOAD
+    case ('RUN_MODE')
+        value = RUN_MODE
     case ('RUN_START_COLD')
         value = RUN_START_COLD
     case ('RUN_START_POINT')

@@ -2,7 +2,9 @@
 !> system built from them (hbm_setup), its receptance modes and its travelling-wave
 !> selection (with the orbits), and the settings' ranges.
 submodule (frirom_run) frirom_run_setup
-    use frirom_hbm, only: hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
+    use frirom_hbm, only: hbm_condensed, hbm_full, hbm_epmc, hbm_epmc_set, hbm_setup, &
+                          hbm_epmc_modal, hbm_epmc_modal_set, &
+                          hbm_set_modes, &
                           hbm_set_modes_harmonic, hbm_set_selection, hbm_set_orbits
     use frirom_aft, only: aft_plan_destroy, law_nslider
     implicit none
@@ -17,9 +19,12 @@ contains
         if (formulation /= RUN_CONDENSED .and. formulation /= RUN_BANDED) then
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'formulation: expected 1 '// &
                             '(condensed) or 2 (banded)')
-        else if (mode /= RUN_FREQUENCY .and. mode /= RUN_LOAD) then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'mode: expected 1 (frequency) '// &
-                            'or 2 (load)')
+        else if (mode /= RUN_FREQUENCY .and. mode /= RUN_LOAD .and. mode /= RUN_MODE) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'mode: expected 1 (frequency), '// &
+                            '2 (load) or 3 (nonlinear mode)')
+        else if (mode == RUN_MODE .and. (krylov == 1 .or. sparse)) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'mode 3 (nonlinear mode): '// &
+                            'dense solves only (krylov and sparse off)')
         else if (ndof < 1) then
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'ndof: expected at least 1 DoF')
         else if (nsamp < 0) then
@@ -86,13 +91,18 @@ contains
         end if
         run%built = .false.
         associate (m => run%m)
-            if (m%formulation == RUN_CONDENSED) then
+            if (m%mode == RUN_MODE .and. m%formulation == RUN_CONDENSED) then
+                allocate (hbm_epmc_modal :: run%sys)
+            else if (m%mode == RUN_MODE) then
+                allocate (hbm_epmc :: run%sys)
+            else if (m%formulation == RUN_CONDENSED) then
                 allocate (hbm_condensed :: run%sys)
             else
                 allocate (hbm_full :: run%sys)
             end if
             call hbm_setup(run%sys, m%nh, m%nsamp, m%ndof, m%kp, m%ki, m%kx, m%mp, m%mi, &
-                           m%mx, m%cp, m%ci, m%cx, m%perm, m%nl, m%fe0, m%fe1, m%mode, &
+                           m%mx, m%cp, m%ci, m%cx, m%perm, m%nl, m%fe0, m%fe1, &
+                           merge(RUN_FREQUENCY, m%mode, m%mode == RUN_MODE), &
                            m%omega_fix, m%ginfo, m%gp, m%gi, m%gx, m%params, m%w0, &
                            m%outdofs, info, errmsg, contact_coords=m%tcontact, &
                            krylov=m%krylov, sparse_lu=m%sparse, free_bodies=m%free)
@@ -101,6 +111,13 @@ contains
             if (info /= 0) return
             if (allocated(m%psi)) call hbm_set_modes_harmonic(run%sys, m%psi, m%wh, m%zh, &
                                                               info, errmsg)
+            if (info /= 0) return
+            if (allocated(m%mode_modes)) then
+                call hbm_epmc_modal_set(run%sys, m%mode_phi, m%mode_w0, m%mode_modes, &
+                                        m%mode_wm, m%mode_zm, m%nl, info, errmsg)
+            else if (allocated(m%mode_phi)) then
+                call hbm_epmc_set(run%sys, m%mode_phi, m%mode_w0, info, errmsg)
+            end if
             if (info /= 0) return
             run%netot = sum(m%ginfo(2, :))
             if (allocated(m%keep)) call apply_selection(run, info, errmsg)

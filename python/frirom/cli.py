@@ -293,7 +293,9 @@ def cmd_run(args) -> int:
     deck = load_deck(args.deck)
     for line in deck.log:
         print(f"frirom: {line}")
-    linear = _linear_lines(deck)
+    analysis = getattr(deck.settings, "analysis", None)
+    mode_deck = analysis is not None and analysis.nonlinear_mode
+    linear = None if mode_deck else _linear_lines(deck)
     deck = resolve_deck(deck, lambda s: print(f"frirom: {s}"))
     out = args.out if args.out is not None else Path("results") / deck.path.stem
     if out.exists() and not out.is_dir():
@@ -301,6 +303,9 @@ def cmd_run(args) -> int:
     out.mkdir(parents=True, exist_ok=True)
     lock = ResultsLock(out)     # before anything in out is opened or replaced
     try:
+        if mode_deck:
+            from .cli_modes import run_mode_deck
+            return run_mode_deck(args, deck, out)
         return _run_locked(args, deck, out, linear)
     finally:
         lock.release()

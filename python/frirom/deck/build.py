@@ -330,7 +330,8 @@ class _Builder:
             log.append(self.add_preload(F, contacts, pl))
         if s.fe:
             log.extend(self.normal_warnings(F, contacts))
-        if not np.any(F[:, 1:]):
+        mode_deck = s.analysis is not None and s.analysis.nonlinear_mode
+        if not np.any(F[:, 1:]) and not mode_deck:
             raise ctx.error("excitation", "at least one load on a harmonic >= 1 "
                             "([[excitation.load]] or [[excitation.engine_order]])")
         outputs = [self.coordinate(ref) for ref in s.outputs.dofs]
@@ -352,8 +353,10 @@ class _Builder:
         cont = {k: v for k, v in vars(s.continuation).items() if v is not None}
         return Deck(path=s.path, title=s.title, M=M, K=K, damping=damping, F=F,
                     contacts=contacts, harmonics=H, samples=sol.samples,
-                    formulation=sol.formulation, omega_start=s.frequency.omega_start,
-                    omega_end=s.frequency.omega_end, frequency_unit=s.frequency.unit,
+                    formulation=sol.formulation,
+                    omega_start=s.frequency.omega_start if s.frequency else 0.0,
+                    omega_end=s.frequency.omega_end if s.frequency else 0.0,
+                    frequency_unit=s.frequency.unit if s.frequency else "hz",
                     continuation=cont, solver=solver, outputs=outputs, output_names=onames,
                     dof_labels=labels if not s.fe else list(rom.labels),
                     plot=s.outputs.plot, csv=s.outputs.csv, raw=s.raw, reduced=rom, log=log,

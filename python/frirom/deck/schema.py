@@ -8,6 +8,7 @@ in ``model.dof_labels``, a node of a node set) is checked by :mod:`frirom.deck.b
 from __future__ import annotations
 
 import math
+import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -18,6 +19,7 @@ from ..io._common import read_text
 from ..reduction.rom import FESource, ReductionSpec
 from .fields import Context, DofRef, boolean, dof_ref, file, number, string, table, unknown
 from ..solver import SolverOptions
+from .schema_analysis import parse_analysis
 from .schema_contacts import parse_contacts, parse_preloads
 from .schema_model import (CyclicSettings, MatrixModel, check_travelling_wave, parse_fe_model,
                            parse_matrix_model, parse_reduction)
@@ -237,6 +239,8 @@ class DeckSettings:
     raw: dict = field(default_factory=dict, repr=False)
     modes_auto: object = None
     preloads: tuple = ()
+    #: ``[analysis]`` (schema_analysis.AnalysisSettings): a forced response by default
+    analysis: object = None
 
     @property
     def fe(self) -> bool:
@@ -273,7 +277,7 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
     ctx = Context(path)
     unknown(ctx, raw, {"title", "model", "fe_model", "reduction", "damping", "excitation",
                        "contacts", "solver", "frequency", "continuation", "outputs",
-                       "study", "preload"}, "")
+                       "study", "preload", "analysis"}, "")
     title = string(ctx, raw, "title", "title", default=path.stem)
 
     # structure: [model] (matrices as they are) or [fe_model] + [reduction]
@@ -289,15 +293,30 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
     fe = model is None
     labels = not fe and model.dof_labels is not None
 
+    analysis = parse_analysis(ctx, raw, fe, labels)
+    nlm = analysis.nonlinear_mode
+    if nlm and cyc is not None:
+        raise ctx.error("analysis.kind", "'forced_response' with [reduction.cyclic] (a "
+                        "nonlinear mode of a cyclic sector: not yet)", analysis.kind)
     solver = _solver(ctx, table(ctx, raw, "solver"), cyc)
     H = solver.harmonics
     damping = _damping(ctx, table(ctx, raw, "damping"), fe)
-    loads = _excitation(ctx, table(ctx, raw, "excitation"), H, fe, labels, cyc)
+    loads = _excitation(ctx, table(ctx, raw, "excitation", required=not nlm), H, fe, labels,
+                        cyc)
+    if nlm:
+        for ld in loads:
+            if ld.harmonic != 0:
+                raise ctx.error("excitation.load", "static loads only (harmonic = 0) in a "
+                                "nonlinear-mode deck ([analysis] kind = "
+                                "\"nonlinear_mode\")", ld.harmonic)
     preloads = parse_preloads(ctx, raw, fe)
     contacts = parse_contacts(ctx, raw, fe, labels, cyc, preloads)
-    frequency = _frequency(ctx, table(ctx, raw, "frequency"))
+    frequency = (None if nlm and "frequency" not in raw else
+                 _frequency(ctx, table(ctx, raw, "frequency")))
     continuation = _continuation(ctx, table(ctx, raw, "continuation", required=False))
     outputs = _outputs(ctx, table(ctx, raw, "outputs"), fe, labels)
+    if analysis.output is not None:
+        outputs = dataclasses.replace(outputs, dofs=(analysis.output,) + outputs.dofs)
     if spec is not None and spec.travelling_wave:
         check_travelling_wave(ctx, raw, solver)
     if isinstance(solver.harmonics_kept, dict):
@@ -310,7 +329,8 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
                         cyclic=cyc, solver=solver, damping=damping, loads=tuple(loads),
                         contacts=tuple(contacts), frequency=frequency,
                         continuation=continuation, outputs=outputs, raw=raw,
-                        modes_auto=modes_auto, preloads=tuple(preloads))
+                        modes_auto=modes_auto, preloads=tuple(preloads),
+                        analysis=analysis)
 
 
 def _aliased(ctx, d: dict, table_name: str) -> dict:
