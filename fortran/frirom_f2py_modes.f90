@@ -38,7 +38,7 @@ end subroutine frun_set_nonlinear_mode
 subroutine frun_mode_jacobian(handle, lam, ny, y, r, rlam, jm, info, msg)
     use frirom_kinds, only: ip
     use frirom_run, only: run_t, run_from_handle
-    use frirom_hbm, only: hbm_epmc_jacobian
+    use frirom_epmc, only: hbm_epmc_jacobian
     implicit none
     integer(8), intent(in) :: handle
     integer(4), intent(in) :: ny

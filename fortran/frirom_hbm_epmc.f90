@@ -4,10 +4,13 @@
 !> nonconservative motion periodic. The amplitude a is the parameter (lam = log10 a), the
 !> harmonics >= 1 are those of the unit modal amplitude (harmonic 1 mass-normalised), and
 !> the phase is fixed against the linear mode the run starts from. See hbm_epmc.
-submodule (frirom_hbm) frirom_hbm_epmc
+submodule (frirom_epmc) frirom_hbm_epmc
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, &
                              FRIROM_ERR_SINGULAR, FRIROM_ERR_LAPACK, set_status
-    use frirom_lapack, only: dgetrf
+    use frirom_lapack, only: dgetrf, dgetrs, dgemm
+    use frirom_csr, only: csr_matvec_add
+    use frirom_hbm, only: csr_matrix, contact_assemble, contact_eval, wtime, T_AFT, T_ASM, T_FACT, &
+                          T_SOLVE, N_EVAL, N_FACT
     implicit none
 
     real(wp), parameter :: LN10 = log(10.0_wp)

@@ -3,10 +3,13 @@
 !> damping xi a change of each mode's damping term, the amplitude and phase conditions on
 !> the modal coordinates of harmonic 1. Harmonic h's complex amplitude is z = a - i b for
 !> x = a cos + b sin.
-submodule (frirom_hbm) frirom_hbm_epmc_modal
+submodule (frirom_epmc) frirom_hbm_epmc_modal
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, &
                              FRIROM_ERR_SINGULAR, FRIROM_ERR_LAPACK, set_status
-    use frirom_lapack, only: dgetrf
+    use frirom_lapack, only: dgetrf, dgetrs, dgemm
+    use frirom_csr, only: csr_matvec_add
+    use frirom_hbm, only: contact_assemble, contact_eval, wtime, T_AFT, T_ASM, T_FACT, T_SOLVE, &
+                          N_EVAL, N_FACT
     implicit none
 
     real(wp), parameter :: LN10 = log(10.0_wp)

@@ -5,8 +5,8 @@ submodule (frirom_run) frirom_run_drive
     use frirom_status, only: itoa
     use frirom_newton, only: cont_options, YSCALE_RELATIVE
     use frirom_hbm, only: hbm_lu_forget, hbm_lu_rebuild, hbm_run, hbm_sel_expand, hbm_sel_reduce, &
-                          hbm_epmc_guess, &
                           HBM_START_CONTINUE, HBM_START_RESUME, HBM_START_SOLVE_ONLY
+    use frirom_epmc, only: hbm_epmc_guess
     implicit none
 
     !> Where a segment (one hbm_run call) starts and how far it may go.

@@ -3,7 +3,7 @@
 !> log10 of the modal amplitude. run_set_nonlinear_mode gives the run the linear mode it
 !> starts from; run_start (cold) then starts from that mode, run_advance continues.
 submodule (frirom_run) frirom_run_modes
-    use frirom_hbm, only: hbm_epmc_set, hbm_epmc_modal_set
+    use frirom_epmc, only: hbm_epmc_set, hbm_epmc_modal_set
     implicit none
 
 contains

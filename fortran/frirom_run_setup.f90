@@ -2,10 +2,9 @@
 !> system built from them (hbm_setup), its receptance modes and its travelling-wave
 !> selection (with the orbits), and the settings' ranges.
 submodule (frirom_run) frirom_run_setup
-    use frirom_hbm, only: hbm_condensed, hbm_full, hbm_epmc, hbm_epmc_set, hbm_setup, &
-                          hbm_epmc_modal, hbm_epmc_modal_set, &
-                          hbm_set_modes, &
+    use frirom_hbm, only: hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
                           hbm_set_modes_harmonic, hbm_set_selection, hbm_set_orbits
+    use frirom_epmc, only: hbm_epmc, hbm_epmc_set, hbm_epmc_modal, hbm_epmc_modal_set
     use frirom_aft, only: aft_plan_destroy, law_nslider
     implicit none
 
