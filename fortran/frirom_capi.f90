@@ -21,6 +21,7 @@ module frirom_capi
               frirom_run_set_selection_c, frirom_run_start_c, frirom_run_advance_c, &
               frirom_run_solve_at_c, frirom_run_checkpoint_c, frirom_run_restore_c, &
               frirom_run_close_c
+    public :: to_c_string
 
 contains
 

@@ -102,6 +102,11 @@ class Run:
         self.ny, self.nw, self.netot = int(ny), int(nw), int(netot)
         self.nout, self.nc = p.out_f.size, 2 * p.H + 1
         self.orbits = None
+        if np.any(p.ginfo[0] < 0):
+            from .laws import solver_callback
+            self._user_law = solver_callback(p.group_laws)   # kept alive with the run
+            raise_for_status(*self._msg(_kernels.frun_set_user_law(
+                self.handle, self._user_law.address, 0)))
         if getattr(p, "free", False):
             raise_for_status(*self._msg(_kernels.frun_set_free_bodies(self.handle, 1)))
         if m.nmodes:

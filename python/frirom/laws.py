@@ -222,6 +222,81 @@ def c_law(name: str, library: str, symbol: str, directions, parameters,
     return UserLaw(name, directions, parameters, int(n_slider), force)
 
 
+# --- user laws in the solver -----------------------------------------------------------
+
+#: The solver's law callback (frirom_user_law user_law_fn, frirom.h frirom_user_law_fn):
+#: int law(void *ctx, int group, int ne, int ndir, int nsamp, int npar, int nslider,
+#: const double *u, const double *params, double *w, double *f), column-major arrays
+#: u, f (ne, ndir, N), params (ne, npar), w (ne, nslider): the :data:`C_LAW` march with
+#: the context and the 1-based contact group in front.
+SOLVER_LAW = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, *([ctypes.c_int] * 6),
+                              *([ctypes.POINTER(ctypes.c_double)] * 4))
+
+#: User laws by name, as contact groups name them (:func:`register`); their entries in
+#: :data:`frirom.contact.LAWS` carry the negative code the solver evaluates through
+#: the run's callback.
+USER_LAWS: dict[str, UserLaw] = {}
+
+
+def register(law: UserLaw) -> str:
+    """Make ``law`` usable as a contact group's law (by its name) and return the name.
+
+    The law table :data:`frirom.contact.LAWS` gets an entry with the law's directions,
+    parameters and slider size and a negative code (frirom_aft law_user_code); the solver
+    evaluates such groups through the run's callback (:func:`solver_callback`).
+    """
+    from . import _kernels
+    from .contact import LAWS, Law
+    if not isinstance(law, UserLaw):
+        raise ParameterError(f"register: expected a frirom.laws.UserLaw, got {type(law)}")
+    old = LAWS.get(law.name)
+    if old is not None and (old.code > 0 or USER_LAWS.get(law.name) is not law):
+        if old.code > 0 or USER_LAWS[law.name].force is not law.force:
+            raise ParameterError(f"user law {law.name!r}: the name is taken by "
+                                 f"{'a built-in law' if old.code > 0 else 'another user law'}")
+    code = int(_kernels.law_user_code(law.n_dir, len(law.parameters), law.n_slider))
+    if code == 0:
+        raise ParameterError(f"user law {law.name!r}: the solver takes 1..7 directions, "
+                             f"<= 255 parameters and <= 1e6 slider components")
+    LAWS[law.name] = Law(law.name, code, law.directions, law.parameters, law.n_slider)
+    USER_LAWS[law.name] = law
+    return law.name
+
+
+class _SolverCallback:
+    """The ctypes function a run evaluates its user-law groups with; ``address`` goes to
+    the run (frun_set_user_law), the object must live as long as the run."""
+
+    def __init__(self, group_laws):
+        self.laws = [USER_LAWS.get(name) for name in group_laws]
+        self.error: BaseException | None = None
+        self._fn = SOLVER_LAW(self._call)
+        self.address = ctypes.cast(self._fn, ctypes.c_void_p).value
+
+    def _call(self, ctx, group, ne, nd, n, npar, nsl, u, p, w, f):
+        try:
+            law = self.laws[group - 1]
+            def arr(ptr, shape):
+                size = int(np.prod(shape))
+                a = np.ctypeslib.as_array(ptr, shape=(max(size, 1),))[:size]
+                return a.reshape(shape, order="F")
+            ua, pa, wa, fa = arr(u, (ne, nd, n)), arr(p, (ne, npar)), arr(w, (ne, nsl)), \
+                arr(f, (ne, nd, n))
+            fo, wo = _call(law, ua, pa, wa.copy())
+            fa[...] = fo
+            wa[...] = wo
+            return 0
+        except Exception as exc:        # reported by the run as the law's failure
+            self.error = exc
+            return 1
+
+
+def solver_callback(group_laws) -> _SolverCallback:
+    """The callback a run registers for the contact groups whose laws are user laws
+    (``group_laws``: each group's law name, in the run's group order)."""
+    return _SolverCallback(group_laws)
+
+
 # --- laws named from a deck -------------------------------------------------------------
 
 class CodeNotAllowedError(ParameterError):
