@@ -285,9 +285,14 @@ contains
         integer(ip), intent(out) :: npar                  !! parameters per element
         integer(ip), intent(out) :: nslider               !! slider components
         character(len=*), intent(out), optional :: name  !! e.g. 'jenkins'
-        ndir = law_ndir(law)
-        npar = law_npar(law)
-        nslider = law_nslider(law)
+        ndir = 0
+        npar = 0
+        nslider = 0
+        if (known(law)) then            ! the table only (a user law's code: zeros)
+            ndir = law_ndir(law)
+            npar = law_npar(law)
+            nslider = law_nslider(law)
+        end if
         if (present(name)) then
             name = ''
             if (known(law)) name = LAW_NAMES(law)
