@@ -80,6 +80,10 @@ def _add_run(sub) -> None:
                    "it names changed, except frequency.end and continuation.max_points, "
                    "which may extend the run (each deck's own folder with several decks)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--allow-code", action="append", default=[], metavar="MODULE",
+                   help="let the decks' contact laws 'MODULE:function' import MODULE (a "
+                   "deck that names code runs code: never without this, or an installed "
+                   "entry point in the group frirom.laws; docs/security.md)")
     p.set_defaults(func=cmd_run_decks)
 
 
@@ -290,7 +294,7 @@ def cmd_run(args) -> int:
     from .auto import resolve_deck
     from .deck import load_deck
 
-    deck = load_deck(args.deck)
+    deck = load_deck(args.deck, allow_code=getattr(args, "allow_code", ()))
     for line in deck.log:
         print(f"frirom: {line}")
     linear = _linear_lines(deck)

@@ -27,7 +27,11 @@ Jacobian d(force harmonics)/d(displacement harmonics):
   max(amplitude of the element's displacement, 1e-12 m) (per element), and the
   perturbed AFT is closed again from the closed cycle's state. Cost: 2 n_dir (2H+1) AFTs;
   accuracy O(h^2) where the forces are smooth in x and O(h) at a contact event within
-  h of a sample (about 1e-8 relative).
+  h of a sample (about 1e-8 relative). Where one side is flat (a one-sided difference
+  below 1e-3 of the other: an element stuck at its friction limit, slipping on one side)
+  the flat side is taken, the slipping side the built-in analytical Jacobians take, so
+  that Newton converges on the kink (the central mean would halve the error per
+  iteration). The solver's user laws use the same scheme (frirom_user_law).
 
 Code from a deck. A deck may name a law ``"package.module:function"`` (a function returning
 a :class:`UserLaw`, or a :class:`UserLaw` object). A deck that names code runs code, so
@@ -61,6 +65,9 @@ class UserLaw:
     n_slider: int
     force: Callable
     jacobian: Callable | None = None
+    #: address of a C function of the solver's signature (:data:`SOLVER_LAW`) the solver
+    #: calls directly, without Python, when every user-law group of a run has it
+    native: int | None = None
 
     def __post_init__(self):
         if not callable(self.force):
@@ -162,8 +169,20 @@ def aft(law: UserLaw, x, params, n_samples: int | None = None, w0=None,
             dx[:, j // nc, j % nc] = step
             fp, _, _ = _close(law, (x + dx) @ E.T, p, wc, scale, tol, max_periods)
             fm, _, _ = _close(law, (x - dx) @ E.T, p, wc, scale, tol, max_periods)
-            jac[:, :, j] = ((fp - fm) @ Ep.T).reshape(ne, nd * nc) / (2.0 * step[:, None])
+            dp = ((fp @ Ep.T) - fh).reshape(ne, nd * nc) / step[:, None]
+            dm = (fh - (fm @ Ep.T)).reshape(ne, nd * nc) / step[:, None]
+            jac[:, :, j] = _kink_column(dp, dm)
     return UserAftResult(forces=fh, jacobian=jac, periods=periods, slider=wc)
+
+
+def _kink_column(dp, dm, kink: float = 1e-3):
+    """Jacobian columns (ne, m) from the one-sided differences: central, or where one
+    side is flat (below ``kink`` of the other: an element at its friction limit, stuck
+    on one side) the flat side (slipping, as the built-in analytical Jacobians)."""
+    np_, nm = np.linalg.norm(dp, axis=1), np.linalg.norm(dm, axis=1)
+    smooth = np.minimum(np_, nm) > kink * np.maximum(np_, nm)
+    side = np.where((np_ <= nm)[:, None], dp, dm)
+    return np.where(smooth[:, None], 0.5 * (dp + dm), side)
 
 
 def _params(law: UserLaw, params, ne: int) -> np.ndarray:
@@ -197,10 +216,14 @@ C_LAW = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_int,
 
 
 def c_law(name: str, library: str, symbol: str, directions, parameters,
-          n_slider: int) -> UserLaw:
+          n_slider: int, solver_symbol: str | None = None) -> UserLaw:
     """A :class:`UserLaw` whose period march is the C function ``symbol`` of the shared
-    library ``library`` (signature :data:`C_LAW`)."""
+    library ``library`` (signature :data:`C_LAW`); with ``solver_symbol``, the function of
+    the solver's signature (:data:`SOLVER_LAW`) the solver then calls directly."""
     lib = ctypes.CDLL(library)
+    native = None
+    if solver_symbol is not None:
+        native = ctypes.cast(getattr(lib, solver_symbol), ctypes.c_void_p).value
     fn = getattr(lib, symbol)
     fn.restype = ctypes.c_int
     fn.argtypes = C_LAW._argtypes_
@@ -219,7 +242,9 @@ def c_law(name: str, library: str, symbol: str, directions, parameters,
             raise ParameterError(f"C law {name!r} ({symbol} in {library}) returned {rc}")
         return ff, wf
 
-    return UserLaw(name, directions, parameters, int(n_slider), force)
+    law = UserLaw(name, directions, parameters, int(n_slider), force, native=native)
+    object.__setattr__(law, "_library", lib)        # the library lives as long as the law
+    return law
 
 
 # --- user laws in the solver -----------------------------------------------------------
@@ -270,6 +295,11 @@ class _SolverCallback:
     def __init__(self, group_laws):
         self.laws = [USER_LAWS.get(name) for name in group_laws]
         self.error: BaseException | None = None
+        native = {law.native for law in self.laws if law is not None}
+        if len(native) == 1 and None not in native:      # C all the way: no Python
+            self._keep = [law for law in self.laws if law is not None]
+            self.address = native.pop()
+            return
         self._fn = SOLVER_LAW(self._call)
         self.address = ctypes.cast(self._fn, ctypes.c_void_p).value
 
