@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from frirom import laws
+from frirom import InputError, laws
 from frirom.deck import load_deck
 from frirom.solver import solve_point
 
@@ -76,9 +76,42 @@ def test_c_user_law_in_solver_equals_builtin(tmp_path, formulation):
 
 def test_deck_naming_code_is_refused_without_allow_code(tmp_path):
     path = _deck(tmp_path, "joint.toml", "jenkins", "frirom.laws:jenkins_law")
-    with pytest.raises(laws.ParameterError,
+    with pytest.raises(InputError,
                        match=r"joint.toml: contacts\[0\].law = 'frirom.laws:jenkins_law' "
                              r"names Python code.*--allow-code frirom.laws"):
         load_deck(path)
     from frirom.cli import main
     assert main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 2
+    assert not (tmp_path / "o" / "frf.h5").exists()
+
+
+def _peak(tmp_path, law, params):
+    """Resonance (omega, amplitude of tip:x) of the joint deck with the damper's law and
+    parameters replaced."""
+    from frirom.solver import frf
+    src = ROOT / "cases" / "joint"
+    for f in ("M.mtx", "K.mtx", "dofs.txt"):
+        shutil.copy(src / f, tmp_path / f)
+    text = (src / "joint.toml").read_text()
+    text = re.sub(r'law = "jenkins".*\n', f'law = "{law}"\n', text)
+    text = re.sub(r"kt = .*\nmu = .*\nfn0 = .*\n", params, text)
+    text = text.replace("stability = true", "stability = false")
+    path = tmp_path / f"{law}.toml"
+    path.write_text(text)
+    d = load_deck(path)
+    r = frf(d.model(), d.excitation(), d.omega_start, d.omega_end, d.options())
+    assert r.complete, r.message
+    i = int(np.argmax(r.amp_max[:, 0]))
+    return r.omega[i], r.amp_max[i, 0]
+
+
+def test_iwan_deck_between_stuck_and_free(tmp_path):
+    """The four-parameter Iwan in microslip: its resonance lies between the linear ones of
+    the joint stuck (Jenkins with a slip force beyond reach) and free (mu = 0)."""
+    stuck = _peak(tmp_path, "jenkins", "kt = 1.0e7\nmu = 1.0e6\nfn0 = 100.0\n")
+    free = _peak(tmp_path, "jenkins", "kt = 1.0e7\nmu = 0.0\nfn0 = 100.0\n")
+    iwan = _peak(tmp_path, "iwan4", "fs = 20.0\nkt = 1.0e7\nchi = -0.5\nbeta = 0.1\n")
+    assert free[0] < iwan[0] < stuck[0], (free, iwan, stuck)
+    # microslip: shifted by a visible fraction of the stuck-free gap, and damped
+    assert 0.02 < (stuck[0] - iwan[0]) / (stuck[0] - free[0]) < 0.98
+    assert iwan[1] < min(stuck[1], free[1])

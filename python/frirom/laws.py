@@ -268,17 +268,16 @@ def register(law: UserLaw) -> str:
 
     The law table :data:`frirom.contact.LAWS` gets an entry with the law's directions,
     parameters and slider size and a negative code (frirom_aft law_user_code); the solver
-    evaluates such groups through the run's callback (:func:`solver_callback`).
+    evaluates such groups through the run's callback (:func:`solver_callback`). A name
+    registered again names the latest law from then on (runs opened before keep theirs).
     """
     from . import _kernels
     from .contact import LAWS, Law
     if not isinstance(law, UserLaw):
         raise ParameterError(f"register: expected a frirom.laws.UserLaw, got {type(law)}")
     old = LAWS.get(law.name)
-    if old is not None and (old.code > 0 or USER_LAWS.get(law.name) is not law):
-        if old.code > 0 or USER_LAWS[law.name].force is not law.force:
-            raise ParameterError(f"user law {law.name!r}: the name is taken by "
-                                 f"{'a built-in law' if old.code > 0 else 'another user law'}")
+    if old is not None and old.code > 0:
+        raise ParameterError(f"user law {law.name!r}: the name is a built-in law's")
     code = int(_kernels.law_user_code(law.n_dir, len(law.parameters), law.n_slider))
     if code == 0:
         raise ParameterError(f"user law {law.name!r}: the solver takes 1..7 directions, "
