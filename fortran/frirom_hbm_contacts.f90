@@ -62,8 +62,11 @@ contains
                 if (gr%law < 0) then            ! a user law: through the run's callback
                     gr%states = 0.0_wp
                     if (upd) then
+                        wnew = gr%w0
                         call user_aft(cs%ulaw, g, plan%fp%nsamp, law_nslider(gr%law), gr%x, &
-                                      gr%params, gr%w0, gr%f, info, errmsg, slider=gr%w0)
+                                      gr%params, gr%w0, gr%f, info, errmsg, slider=wnew)
+                        if (info == 0) gr%w0 = wnew
+                        deallocate (wnew)
                     else if (jac) then
                         call user_aft(cs%ulaw, g, plan%fp%nsamp, law_nslider(gr%law), gr%x, &
                                       gr%params, gr%w0, gr%f, info, errmsg, jac=gr%jac)

@@ -294,7 +294,8 @@ def cmd_run(args) -> int:
     from .auto import resolve_deck
     from .deck import load_deck
 
-    deck = load_deck(args.deck, allow_code=getattr(args, "allow_code", ()))
+    allow = getattr(args, "allow_code", None)
+    deck = load_deck(args.deck, allow_code=allow) if allow else load_deck(args.deck)
     for line in deck.log:
         print(f"frirom: {line}")
     linear = _linear_lines(deck)
