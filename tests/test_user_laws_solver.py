@@ -115,3 +115,18 @@ def test_iwan_deck_between_stuck_and_free(tmp_path):
     # microslip: shifted by a visible fraction of the stuck-free gap, and damped
     assert 0.02 < (stuck[0] - iwan[0]) / (stuck[0] - free[0]) < 0.98
     assert iwan[1] < min(stuck[1], free[1])
+
+
+def test_python_law_that_raises_is_reported():
+    from frirom import FriromError
+    from frirom.model import ContactGroup, Damping, Excitation, Model
+
+    def force(u, p, w):
+        raise ValueError("no friction table for this temperature")
+
+    law = laws.UserLaw("raising_law", ("u",), ("kt",), 0, force)
+    m = Model(np.eye(1), np.eye(1), Damping.matrix(0.02 * np.eye(1)),
+              [ContactGroup(law=law, G=np.eye(1), params=[[1.0]])])
+    with pytest.warns(RuntimeWarning, match="raising_law.*no friction table"):
+        with pytest.raises(FriromError, match="contact group 1: the user law returned 1"):
+            solve_point(m, Excitation(np.array([[0.0, 0.3]], complex)), 1.0)

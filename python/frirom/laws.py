@@ -315,8 +315,13 @@ class _SolverCallback:
             fa[...] = fo
             wa[...] = wo
             return 0
-        except Exception as exc:        # reported by the run as the law's failure
+        except Exception as exc:        # the run reports the law's failure (code 1)
+            import warnings
             self.error = exc
+            name = getattr(self.laws[group - 1], "name", "?") if 0 < group <= len(self.laws) \
+                else "?"
+            warnings.warn(f"user law {name!r} (contact group {group}) raised "
+                          f"{type(exc).__name__}: {exc}", RuntimeWarning, stacklevel=1)
             return 1
 
 
