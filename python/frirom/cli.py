@@ -214,6 +214,9 @@ def _add_modes(sub) -> None:
     p.add_argument("deck", type=Path, help="the TOML deck (see docs/deck.md)")
     p.add_argument("--out", type=Path, default=None,
                    help="output folder (default: results/<deck name>)")
+    p.add_argument("--allow-code", action="append", default=[], metavar="MODULE",
+                   help="let the deck's contact laws 'MODULE:function' import MODULE "
+                   "(as frirom run --allow-code)")
     p.set_defaults(func=_modes)
 
 
@@ -225,7 +228,8 @@ def _modes(args) -> int:
     from .deck import load_deck
     from .modes import linear_check
     from .plots import plot_frf
-    deck = load_deck(args.deck)
+    allow = getattr(args, "allow_code", None)
+    deck = load_deck(args.deck, allow_code=allow) if allow else load_deck(args.deck)
     for line in deck.log:
         print(f"frirom: {line}")
     check = linear_check(deck)
