@@ -165,6 +165,25 @@ int frirom_run_advance_mode(frirom_run *run, int k, int *npts, double *amplitude
                             double *omega, double *xi, double *xo, int *status, char *msg,
                             int msglen);
 
+/* Contact laws written by the user (docs/tutorials/user_laws.md). A contact group whose
+ * ginfo law code is frirom_law_user_code(ndir, npar, nslider) (negative; 0 when a size is
+ * out of range: 1 <= ndir <= 7, 0 <= npar <= 255, 0 <= nslider <= 1e6) is evaluated by the
+ * function registered with frirom_run_set_user_law, in every formulation. The function
+ * marches one period of the group's ne elements: u (ne, ndir, nsamp) relative
+ * displacements, params (ne, npar), w (ne, nslider) the state at the period's start in
+ * and at its end out, f (ne, ndir, nsamp) the forces against u; column-major, element
+ * fastest. It returns 0, or a nonzero code the run reports as a law error. ctx is
+ * passed back untouched; group is the contact group, 1-based. frirom closes the cycle
+ * (repeats the period until w returns to its start), takes the force harmonics, and builds
+ * the Jacobian by central differences (2 ndir (2H+1) closed periods). The run keeps the
+ * pointers only: keep ctx alive until frirom_run_close. */
+typedef int (*frirom_user_law_fn)(void *ctx, int group, int ne, int ndir, int nsamp,
+                                  int npar, int nslider, const double *u,
+                                  const double *params, double *w, double *f);
+int frirom_law_user_code(int ndir, int npar, int nslider);
+int frirom_run_set_user_law(frirom_run *run, frirom_user_law_fn fn, void *ctx, char *msg,
+                            int msglen);
+
 #ifdef __cplusplus
 }
 #endif

@@ -673,7 +673,7 @@ contains
         np = 0
         nsl = 0
         do g = 1, ngroup
-            call law_check(int(ginfo(3*g - 2), ip), st, text)
+            call law_check(int(ginfo(3*g - 2), ip), st, text, user=.true.)
             if (st /= FRIROM_OK) then
                 text = who//': ginfo: '//trim(text)
                 return
@@ -728,6 +728,10 @@ contains
                 ne = ginfo(3*g - 1)
                 nd = law_ndir(law)
                 npl = law_npar(law)
+                if (law < 0) then           ! a user law: its own checks, at evaluation
+                    p0 = p0 + npl*ne
+                    cycle
+                end if
                 allocate (x(1, nd, ne), f(1, nd, ne), w(max(law_nslider(law), 1_ip), ne))
                 x = 0.0_wp
                 w = 0.0_wp

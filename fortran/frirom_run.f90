@@ -33,6 +33,7 @@ module frirom_run
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, FRIROM_ERR_CONT, &
                              FRIROM_ERR_ALLOC, set_status
     use frirom_hbm, only: hbm_system, N_TIMERS
+    use frirom_user_law, only: user_law
     implicit none
     private
     public :: run_t, run_model, run_settings, run_points
@@ -41,7 +42,8 @@ module frirom_run
               run_advice, run_sizes, run_default_samples, settings_pack, settings_unpack, &
               run_settings_names, run_handle, run_from_handle, run_checkpoint_size, &
               run_checkpoint, run_restore, run_contact_coords, open_run, run_lu_size, &
-              run_lu_state, run_set_free_bodies, run_set_nonlinear_mode, run_to_mode
+              run_lu_state, run_set_free_bodies, run_set_nonlinear_mode, run_to_mode, &
+              run_set_user_law
     public :: RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_LOAD, RUN_MODE, &
               RUN_START_COLD, RUN_START_POINT, RUN_START_RESUME, &
               RUN_GOING, RUN_DONE, RUN_MAX_POINTS, RUN_LEFT_RANGE, RUN_FAILED, RUN_STALLED, &
@@ -132,6 +134,9 @@ module frirom_run
         real(wp) :: mode_w0 = 0.0_wp
         !> a condensed mode run: the modes of its receptances (ndof, nm), rad/s, ratios
         real(wp), allocatable :: mode_modes(:, :), mode_wm(:), mode_zm(:)
+        !> the callback of the user laws (run_set_user_law): kept with the model, so that
+        !> a rebuilt system and a homotopy's child run evaluate them too
+        type(user_law) :: ulaw
     end type run_model
 
     !> Points of a run (run_advance, run_solve), in the full layout of the unknowns.
@@ -284,6 +289,18 @@ module frirom_run
             integer(ip), intent(out) :: info
             character(len=*), intent(inout) :: errmsg
         end subroutine run_set_free_bodies
+
+        !> The function (and its context, passed back untouched) that evaluates the
+        !> contact groups whose law is a user law (frirom_user_law user_law_fn; a negative
+        !> law code, frirom_aft law_user_code), in every formulation. The run keeps only
+        !> the pointers: the caller keeps the function and its context alive until
+        !> run_close.
+        module subroutine run_set_user_law(run, ulaw, info, errmsg)
+            type(run_t), intent(inout) :: run
+            type(user_law), intent(in) :: ulaw
+            integer(ip), intent(out) :: info
+            character(len=*), intent(inout) :: errmsg
+        end subroutine run_set_user_law
 
         !> A travelling-wave selection keep (nnl, H+1) of the condensed unknowns; with
         !> pair (nnl, H+1) its direction; with orbits, Newton's evaluations on one element

@@ -106,6 +106,7 @@ contains
                            m%outdofs, info, errmsg, contact_coords=m%tcontact, &
                            krylov=m%krylov, sparse_lu=m%sparse, free_bodies=m%free)
             if (info /= 0) return
+            run%sys%cs%ulaw = m%ulaw
             if (allocated(m%phi)) call hbm_set_modes(run%sys, m%phi, m%wm, m%zm, info, errmsg)
             if (info /= 0) return
             if (allocated(m%psi)) call hbm_set_modes_harmonic(run%sys, m%psi, m%wh, m%zh, &
@@ -213,6 +214,13 @@ contains
         run%m%free = on
         call run_build(run, info, errmsg)
     end procedure run_set_free_bodies
+
+    module procedure run_set_user_law
+        info = FRIROM_OK
+        if (.not. open_run(run, 'run_set_user_law', info, errmsg)) return
+        run%m%ulaw = ulaw
+        if (allocated(run%sys)) run%sys%cs%ulaw = ulaw
+    end procedure run_set_user_law
 
     module procedure run_set_selection
         info = FRIROM_OK

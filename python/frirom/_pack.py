@@ -64,13 +64,14 @@ class _Contacts(NamedTuple):
     nw: int                  # sliders in all
     names: list[str]
     sizes: list[int]         # n_elem per group
+    laws: tuple = ()         # the law of each group (names; user laws: frirom.laws.USER_LAWS)
 
 
 def _pack_contacts(groups, ncol: int) -> _Contacts:
     names, sizes = [g.name for g in groups], [g.n_elem for g in groups]
     if not groups:
         return _Contacts(sp.csr_matrix((0, ncol)), np.zeros((3, 0), np.int32, order="F"),
-                         np.zeros(1), np.zeros(1), 0, names, sizes)
+                         np.zeros(1), np.zeros(1), 0, names, sizes, ())
     ginfo = np.array([[LAWS[g.law].code, g.n_elem, g.n_dir] for g in groups],
                      dtype=np.int32).T.copy(order="F")
     params = np.concatenate([g.params.ravel() for g in groups])
@@ -80,7 +81,7 @@ def _pack_contacts(groups, ncol: int) -> _Contacts:
                    else sp.hstack([g.G, sp.csr_matrix((g.G.shape[0], ncol - g.G.shape[1]))])
                    for g in groups]).tocsr()
     return _Contacts(G, ginfo, params, np.concatenate(w0) if nw else np.zeros(1), nw,
-                     names, sizes)
+                     names, sizes, tuple(g.law for g in groups))
 
 
 def _output_map(outputs, n: int):
@@ -173,6 +174,8 @@ class _Packed:
     orbits: tuple | None = None
     #: the frequency of a load continuation, rad/s (0 for frequency)
     omega_fix: float = 0.0
+    #: the law of each contact group (user laws evaluated through the run's callback)
+    group_laws: tuple = ()
     orbit_tol: float = ORBIT_TOL
     #: a body held only by its contacts: the run moves their stuck stiffness into K
     #: (frirom_hbm_free); the modes of the receptance route are K + G^T Ks G's
@@ -496,7 +499,8 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
     return _Packed(opts=opts, H=H, n_dof=n, fe0=fe0, fe1=fe1,
                    K=K, M=M, C=C, perm=perm, nl=nl,
                    G=_csr(c.G), ginfo=c.ginfo, params=c.params, w0=c.w0, nw=c.nw,
-                   group_names=c.names, group_sizes=c.sizes, outputs=out, out_f=out,
+                   group_names=c.names, group_sizes=c.sizes, group_laws=c.laws,
+                   outputs=out, out_f=out,
                    stability=bool(opts.stability), modes=modes, tcontact=tcontact, sparse=sparse,
                    info=info + note, free=free)
 
@@ -550,7 +554,8 @@ def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Pa
     return _Packed(opts=o, H=H, n_dof=nr, fe0=fe0_r, fe1=fe1_r,
                    K=empty, M=empty, C=empty, perm=np.arange(1, nr + 1, dtype=np.int32),
                    nl=at[cols], G=_csr(G), ginfo=c.ginfo, params=c.params, w0=c.w0,
-                   nw=c.nw, group_names=c.names, group_sizes=c.sizes, outputs=out,
+                   nw=c.nw, group_names=c.names, group_sizes=c.sizes, group_laws=c.laws,
+                   outputs=out,
                    out_f=at[out], stability=False, modes=modes, tcontact=tcontact,
                    info=f"condensed: {nu * (2 * H + 1)} unknowns, {nu} "
                         + ("contact coordinates G x" if tcontact else "contact DoFs")

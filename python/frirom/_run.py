@@ -16,7 +16,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _kernels
-from ._errors import SizeError, int_constant, raise_for_status
+from ._errors import ParameterError, SizeError, int_constant, raise_for_status
 
 #: run_start kinds, stop reasons, solve kinds and advice bits (frirom_run RUN_*, ADVISE_*)
 START_COLD, START_POINT, START_RESUME = (int_constant(f"RUN_START_{k}")
@@ -109,6 +109,15 @@ class Run:
         self.ny, self.nw, self.netot = int(ny), int(nw), int(netot)
         self.nout, self.nc = p.out_f.size, 2 * p.H + 1
         self.orbits = None
+        if np.any(p.ginfo[0] < 0):
+            if p.keep is not None and p.pair is not None and o.orbits:
+                raise ParameterError("orbits: the AFT on one element per orbit takes the "
+                                     "built-in laws only; a contact group has a user law "
+                                     "(set orbits = false)")
+            from .laws import solver_callback
+            self._user_law = solver_callback(p.group_laws)   # kept alive with the run
+            raise_for_status(*self._msg(_kernels.frun_set_user_law(
+                self.handle, self._user_law.address, 0)))
         if getattr(p, "free", False):
             raise_for_status(*self._msg(_kernels.frun_set_free_bodies(self.handle, 1)))
         if mode_shape is not None:

@@ -80,6 +80,10 @@ def _add_run(sub) -> None:
                    "it names changed, except frequency.end and continuation.max_points, "
                    "which may extend the run (each deck's own folder with several decks)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--allow-code", action="append", default=[], metavar="MODULE",
+                   help="let the decks' contact laws 'MODULE:function' import MODULE (a "
+                   "deck that names code runs code: never without this, or an installed "
+                   "entry point in the group frirom.laws; docs/security.md)")
     p.set_defaults(func=cmd_run_decks)
 
 
@@ -210,6 +214,9 @@ def _add_modes(sub) -> None:
     p.add_argument("deck", type=Path, help="the TOML deck (see docs/deck.md)")
     p.add_argument("--out", type=Path, default=None,
                    help="output folder (default: results/<deck name>)")
+    p.add_argument("--allow-code", action="append", default=[], metavar="MODULE",
+                   help="let the deck's contact laws 'MODULE:function' import MODULE "
+                   "(as frirom run --allow-code)")
     p.set_defaults(func=_modes)
 
 
@@ -221,7 +228,8 @@ def _modes(args) -> int:
     from .deck import load_deck
     from .modes import linear_check
     from .plots import plot_frf
-    deck = load_deck(args.deck)
+    allow = getattr(args, "allow_code", None)
+    deck = load_deck(args.deck, allow_code=allow) if allow else load_deck(args.deck)
     for line in deck.log:
         print(f"frirom: {line}")
     check = linear_check(deck)
@@ -290,7 +298,8 @@ def cmd_run(args) -> int:
     from .auto import resolve_deck
     from .deck import load_deck
 
-    deck = load_deck(args.deck)
+    allow = getattr(args, "allow_code", None)
+    deck = load_deck(args.deck, allow_code=allow) if allow else load_deck(args.deck)
     for line in deck.log:
         print(f"frirom: {line}")
     analysis = getattr(deck.settings, "analysis", None)

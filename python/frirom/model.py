@@ -225,6 +225,9 @@ class ContactGroup:
     name: str = "contact"
 
     def __post_init__(self):
+        from .laws import UserLaw, register
+        if isinstance(self.law, UserLaw):
+            self.law = register(self.law)
         if self.law not in LAWS:
             raise ParameterError(f"contact {self.name!r}: law {self.law!r} unknown; expected "
                                  f"one of {sorted(LAWS)}")

@@ -264,17 +264,18 @@ def read_toml(path: Path) -> dict:
         raise InputError(f"{path}: not valid TOML: {exc}") from None
 
 
-def parse_deck(path, raw: dict | None = None) -> DeckSettings:
+def parse_deck(path, raw: dict | None = None, allow_code=()) -> DeckSettings:
     """Read and check a deck file; raises :class:`frirom.InputError` on any bad field.
 
     ``raw``: the deck's TOML as a dict, used instead of reading ``path`` (a study member:
     the deck with some keys replaced, :mod:`frirom.study`); relative file names stay
     relative to ``path``. A ``[study]`` table is checked by :func:`frirom.study.parse_study`
-    and ignored here.
+    and ignored here. ``allow_code``: modules a user contact law may import (load_deck).
     """
     path = Path(path)
     raw = read_toml(path) if raw is None else raw
     ctx = Context(path)
+    ctx.allow_code = tuple(allow_code)
     unknown(ctx, raw, {"title", "model", "fe_model", "reduction", "damping", "excitation",
                        "contacts", "solver", "frequency", "continuation", "outputs",
                        "study", "preload", "analysis"}, "")

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._errors import InputError
 from ..contact import LAWS
 from .fields import Context, dof_ref, finite, number, per_element, string, unknown, vector
 from .schema_model import CyclicSettings
@@ -191,7 +192,10 @@ def parse_contacts(ctx: Context, raw: dict, fe: bool, labels: bool,
 def _contact(ctx, c, key, fe, labels, cyclic, derived=frozenset()):
     if not isinstance(c, dict):
         raise ctx.error(key, "a table [[contacts]]", c)
-    law = string(ctx, c, "law", f"{key}.law", required=True, choices=tuple(LAWS))
+    law = _user_law(ctx, c, key)
+    if law is None:
+        law = string(ctx, c, "law", f"{key}.law", required=True,
+                     choices=tuple(k for k, v in LAWS.items() if v.code > 0))
     if fe:
         return _node_set_contact(ctx, c, key, law, cyclic, derived)
     dirs, pnames = LAWS[law].directions, LAWS[law].parameters
@@ -266,6 +270,22 @@ def _unit(v: np.ndarray) -> np.ndarray:
     numbers would solve another model at round-off."""
     nrm = np.linalg.norm(v)
     return v if abs(nrm - 1.0) <= 4.0 * np.finfo(float).eps else v / nrm
+
+
+def _user_law(ctx, c, key):
+    """The name of the user law a contact's ``law = "module:function"`` names (loaded
+    and registered: frirom.laws.load_law, register), None for a built-in law's name."""
+    from ..laws import load_law, register
+    v = c.get("law")
+    if not (isinstance(v, str) and ":" in v):
+        return None
+    try:
+        return register(load_law(v, allowed=ctx.allow_code, where=f"{key}.law"))
+    except ImportError as exc:
+        raise ctx.error(f"{key}.law", "an importable 'module:function'", f"{v} ({exc})") \
+            from None
+    except InputError as exc:
+        raise InputError(f"{ctx.path}: {exc}") from None
 
 
 def _law_parameters(ctx, c, key, law, ne, derived=()):
