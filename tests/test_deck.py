@@ -301,3 +301,13 @@ def test_deck_defaults_are_the_solvers_and_documented(deckdir):
             assert got == str(want).lower(), key
         else:
             assert float(got) == float(want), key
+
+
+def test_contact_patch_key(deckdir):
+    """[[contacts]] patch (issue 29 item 1): the patch extent reaches the model's group;
+    without it none (not checked); a non-positive one is refused by key path."""
+    d = load_deck(write(deckdir, _with(BASE, "[contacts]", ["patch = 9e-3"])))
+    assert d.model().contacts[0].patch == 9e-3
+    assert load_deck(write(deckdir, BASE)).model().contacts[0].patch is None
+    with pytest.raises(InputError, match=r"contacts\[0\]\.patch"):
+        load_deck(write(deckdir, _with(BASE, "[contacts]", ["patch = -1.0"])))
