@@ -77,7 +77,7 @@ class _Killed(BaseException):
     """Stands for SIGKILL in-process: nothing after it runs, the writer is not closed."""
 
 
-@pytest.mark.parametrize("form", ["condensed", "banded"])
+@pytest.mark.parametrize("form", ["condensed", pytest.param("banded", marks=pytest.mark.slow)])
 def test_free_body_killed_and_resumed_equals_uninterrupted(form, tmp_path):
     """Issue 29: bit-for-bit resume with a free body. The gross-slip sweep (the damper's
     mean held by the pin, its stuck stiffness moved into K) killed after 27 points and
