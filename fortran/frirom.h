@@ -98,6 +98,10 @@ int frirom_frf(int n, int nk, const int *kr, const int *kc, const double *kv,
  *   frirom_run_set_selection  a travelling-wave selection keep (nnl, H+1) of the contact
  *                        DoFs' harmonics (1 = kept), its direction pair (nnl, H+1) or
  *                        NULL, orbits = 1: AFT on one element per orbit (optional)
+ *   frirom_run_set_free_bodies  on = 1: a body held only by its contacts (K singular):
+ *                        the contacts' stuck stiffness moved into the linear part and a
+ *                        pin of FREE_PIN = 1e-2 of it on each contact's mean (the Python
+ *                        Model.free_bodies() case; docs/cases/upd.md) (optional)
  *   frirom_run_start     from omega_start to omega_end (rad/s): solves the first point
  *   frirom_run_advance   up to k more points into omega (k+1), xo (nout, 2H+1, k+1), amp
  *                        (nout, k+1) and y (ny, k+1) or NULL; status: 0 going, 1 done
@@ -130,6 +134,7 @@ int frirom_run_set_modes(frirom_run *run, int nmodes, const double *phi,
                          const double *omega, const double *zeta, char *msg, int msglen);
 int frirom_run_set_selection(frirom_run *run, int nnl, const int *keep, const int *pair,
                              int orbits, char *msg, int msglen);
+int frirom_run_set_free_bodies(frirom_run *run, int on, char *msg, int msglen);
 int frirom_run_start(frirom_run *run, double omega_start, double omega_end, char *msg,
                      int msglen);
 int frirom_run_advance(frirom_run *run, int k, int *npts, double *omega, double *xo,

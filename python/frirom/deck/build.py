@@ -46,6 +46,8 @@ class ContactSpec:
         Law parameters (SI units).
     w0 : ndarray, (n_elem, n_slider), or None
         Initial slider positions [m].
+    patch : float, ndarray (n_tangential,) or None
+        The contact patch's extent along the tangents [m] (frirom.held.patch_warnings).
     """
 
     name: str
@@ -53,6 +55,7 @@ class ContactSpec:
     G: sp.csr_matrix
     params: np.ndarray
     w0: np.ndarray | None
+    patch: object = None
 
 
 @dataclass
@@ -143,8 +146,8 @@ class Deck:
 
     def model(self):
         """The solver's Model, or its CyclicModel with [reduction.cyclic]."""
-        groups = [ContactGroup(law=c.law, G=c.G, params=c.params, w0=c.w0, name=c.name)
-                  for c in self.contacts]
+        groups = [ContactGroup(law=c.law, G=c.G, params=c.params, w0=c.w0, name=c.name,
+                               patch=c.patch) for c in self.contacts]
         if self.cyclic is not None:
             c = self.cyclic
             return CyclicModel(n_dof=self.n_dof, n_sectors=c["sector"].n_sectors,
@@ -440,7 +443,8 @@ class _Builder:
                             cols.append(b[j])
                             vals.append(-D[d, j])
         G = sp.csr_matrix((vals, (rows, cols)), shape=(len(c.elements) * ndir, self.n))
-        return ContactSpec(name=c.name, law=c.law, G=G, params=c.params, w0=c.w0)
+        return ContactSpec(name=c.name, law=c.law, G=G, params=c.params, w0=c.w0,
+                           patch=c.patch)
 
     # ---- [fe_model]: node sets of the reduced model ----
     def reduced_contact(self, c) -> ContactSpec:
@@ -448,7 +452,20 @@ class _Builder:
         G = self.rom.contact_matrix(c.name)
         ne = self.rom.pairs[c.name].n_elem
         return ContactSpec(name=c.name, law=c.law, G=G, params=np.tile(c.params, (ne, 1)),
-                           w0=None if c.w0 is None else np.tile(c.w0, (ne, 1)))
+                           w0=None if c.w0 is None else np.tile(c.w0, (ne, 1)),
+                           patch=c.patch if c.patch is not None else self._patch(c))
+
+    def _patch(self, c):
+        """Side a's node set's extent [m] along each tangent of the pairs' first frame
+        (the contact patch as meshed); None where the nodes' coordinates are not kept."""
+        try:
+            xyz = self.rom.coordinates(self.rom.node_sets[c.a.upper()])
+            frame = np.asarray(self.rom.pairs[c.name].frames, float)[0]
+        except (InputError, KeyError, IndexError, AttributeError):
+            return None
+        dirs = LAWS[c.law].directions
+        t = frame[[d for d, nm in enumerate(dirs) if nm != "v"]]
+        return np.ptp(xyz @ t.T, axis=0)
 
     def add_preload(self, F, contacts: list, pl) -> str:
         """A ``[[preload]]``: the normal preload n0 of each pair of its contacts and the

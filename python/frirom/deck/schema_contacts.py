@@ -48,6 +48,9 @@ class DofContact:
         Law parameters in the order of ``LAWS[law].parameters`` (SI units).
     w0 : ndarray, (n_elem, n_slider), or None
         Initial slider positions [m] (None: zeros).
+    patch : float or None
+        The contact patch's extent along the tangents [m] (key ``patch``): a relative
+        tangential displacement beyond it is warned about (frirom.held).
     """
 
     name: str
@@ -55,6 +58,7 @@ class DofContact:
     elements: tuple
     params: np.ndarray
     w0: np.ndarray | None
+    patch: float | None = None
 
 
 @dataclass(frozen=True)
@@ -81,6 +85,9 @@ class NodeSetContact:
         Key path of the table (``contacts[0]``).
     b_sector : int
         0: side b in sector 0; 1: side b in the next sector (cyclic).
+    patch : float or None
+        The contact patch's extent along the tangents [m] (key ``patch``; None: side a's
+        node set's extent along each tangent, frirom.deck.build).
     """
 
     name: str
@@ -95,6 +102,7 @@ class NodeSetContact:
     stick: tuple
     key: str
     b_sector: int = 0
+    patch: float | None = None
 
 
 @dataclass(frozen=True)
@@ -200,7 +208,8 @@ def _contact(ctx, c, key, fe, labels, cyclic, derived=frozenset()):
         return _node_set_contact(ctx, c, key, law, cyclic, derived)
     dirs, pnames = LAWS[law].directions, LAWS[law].parameters
     ndir = len(dirs)
-    unknown(ctx, c, {"name", "law", "elements", "directions", "w0"} | set(pnames), key)
+    unknown(ctx, c, {"name", "law", "elements", "directions", "w0", "patch"} | set(pnames),
+            key)
     name = string(ctx, c, "name", f"{key}.name", default=key)
     els = c.get("elements")
     if not isinstance(els, list) or not els:
@@ -227,7 +236,8 @@ def _contact(ctx, c, key, fe, labels, cyclic, derived=frozenset()):
         elements.append(ContactElement(a=a, b=b, frame=_frame(ctx, frame, fk, len(a), dirs),
                                        key=ek))
     params, w0 = _law_parameters(ctx, c, key, law, len(els))
-    return DofContact(name=name, law=law, elements=tuple(elements), params=params, w0=w0)
+    return DofContact(name=name, law=law, elements=tuple(elements), params=params, w0=w0,
+                      patch=number(ctx, c, "patch", f"{key}.patch", positive=True))
 
 
 def _side(ctx, v, key, labels, allow_ground):
@@ -318,7 +328,7 @@ def _node_set_contact(ctx, c, key, law, cyclic, derived=frozenset()):
     """A [[contacts]] table of a reduced model: node sets a, b, a normal."""
     pnames = LAWS[law].parameters
     unknown(ctx, c, {"name", "law", "a", "b", "b_sector", "normal", "tangent", "tol",
-                     "w0"} | set(pnames), key)
+                     "w0", "patch"} | set(pnames), key)
     name = string(ctx, c, "name", f"{key}.name", default=f"contacts{key[9:-1]}")
     a = string(ctx, c, "a", f"{key}.a", required=True)
     b = string(ctx, c, "b", f"{key}.b", default="ground")
@@ -350,4 +360,5 @@ def _node_set_contact(ctx, c, key, law, cyclic, derived=frozenset()):
     stick = (params[0, 0], params[0, 1] if "kn" in pnames else 0.0)
     return NodeSetContact(name=name, law=law, a=a, b=b, normal=normal, tangent=tangent,
                           tol=tol, params=params[0], w0=None if w0 is None else w0[0],
-                          stick=tuple(float(x) for x in stick), key=key, b_sector=bs)
+                          stick=tuple(float(x) for x in stick), key=key, b_sector=bs,
+                          patch=number(ctx, c, "patch", f"{key}.patch", positive=True))
