@@ -33,6 +33,7 @@ from ._pack import _Packed, add_timings, pack
 from ._routes import HILL_MAX, MODES_MAX  # noqa: F401 - public here
 from .options import FORMULATIONS, SolverOptions  # noqa: F401 - public here
 from .model import CyclicModel, Excitation, Model
+from ._fold import find_bifurcations
 from ._peak import refine_peaks
 from .results import FRF, FRFPoint
 
@@ -250,6 +251,9 @@ def _run_curve(packed: _Packed, lam_start, lam_end, sink, start, H_start) -> FRF
     run.start(start, H_start)
     complete, message = run.batches()
     out = run.finish(complete, message)
+    # folds located on the curve, stability changes: of the whole curve (a resumed run's
+    # points before the resume too; Bifurcation.index counts them)
+    out.bifurcations = find_bifurcations(packed, run.before + run.points, run.lscale)
     if packed.opts.refine_peak and packed.opts.parameter == "frequency" and run.points:
         # a resumed run: the peak of the whole curve, as the uninterrupted run solves it
         # (Peak.index then counts the points before the resume)

@@ -19,6 +19,7 @@ from ..reduction.rom import FESource, ReductionSpec
 from .fields import Context, DofRef, boolean, dof_ref, file, number, string, table, unknown
 from ..solver import SolverOptions
 from .schema_contacts import parse_contacts, parse_preloads
+from .schema_fold import parse_fold_locus
 from .schema_model import (CyclicSettings, MatrixModel, check_travelling_wave, parse_fe_model,
                            parse_matrix_model, parse_reduction)
 
@@ -237,6 +238,8 @@ class DeckSettings:
     raw: dict = field(default_factory=dict, repr=False)
     modes_auto: object = None
     preloads: tuple = ()
+    #: ``[fold_locus]`` (schema_fold.FoldLocusSettings), None when absent
+    fold_locus: object = None
 
     @property
     def fe(self) -> bool:
@@ -273,7 +276,7 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
     ctx = Context(path)
     unknown(ctx, raw, {"title", "model", "fe_model", "reduction", "damping", "excitation",
                        "contacts", "solver", "frequency", "continuation", "outputs",
-                       "study", "preload"}, "")
+                       "study", "preload", "fold_locus"}, "")
     title = string(ctx, raw, "title", "title", default=path.stem)
 
     # structure: [model] (matrices as they are) or [fe_model] + [reduction]
@@ -310,7 +313,8 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
                         cyclic=cyc, solver=solver, damping=damping, loads=tuple(loads),
                         contacts=tuple(contacts), frequency=frequency,
                         continuation=continuation, outputs=outputs, raw=raw,
-                        modes_auto=modes_auto, preloads=tuple(preloads))
+                        modes_auto=modes_auto, preloads=tuple(preloads),
+                        fold_locus=parse_fold_locus(ctx, raw))
 
 
 def _aliased(ctx, d: dict, table_name: str) -> dict:
