@@ -184,3 +184,31 @@ def test_deck_lists_bifurcations_and_fold_locus(tmp_path, capsys):
         w, _ = closed_form_fold(float(r["omega_rad_s"]), float(list(r.values())[-1]),
                                 F * float(r["level"]))
         assert abs(float(r["omega_rad_s"]) - w) < 1e-9 * w
+
+
+def test_stability_auto_on_where_affordable_and_its_cost_reported():
+    """stability = 'auto': on for a small model (its Hill time reported beside the
+    run's), off with the reason above HILL_AUTO_MAX Hill unknowns or with contact
+    coordinates."""
+    import scipy.sparse as sp
+
+    from frirom._pack import HILL_AUTO_MAX
+    from frirom.model import ContactGroup, Damping, Excitation, Model
+    model, ex = duffing()
+    o = SolverOptions(harmonics=1, samples=16, ds_max=0.3, stability="auto")
+    r = frf(model, ex, 1.0, 2.0, o, outputs=[0])
+    assert r.stability_computed and not r.stable.all()
+    assert 0.0 < r.timings["hill"] <= r.timings["fortran_total"]
+    assert "stability (Hill)" in r.solver_info
+    # a chain of n unit oscillators, the Duffing spring on the first: above the bound
+    n = HILL_AUTO_MAX // (2 * 3) + 1
+    G = sp.csr_matrix(([1.0], ([0], [0])), shape=(1, n))
+    big = Model(sp.identity(n, format="csr"), sp.diags(np.linspace(1.0, 50.0, n)).tocsr(),
+                Damping.rayleigh(0.0, 0.02), [ContactGroup("cubic", G, [[0.0, 0.5]])])
+    F = np.zeros((n, 2), complex)
+    F[0, 1] = 0.1
+    rb = frf(big, Excitation(F), 1.0, 1.05, o, outputs=[0])
+    assert not rb.stability_computed
+    assert "stability: off ('auto':" in rb.solver_info and "Hill unknowns" in rb.solver_info
+    with pytest.raises(Exception, match="stability"):
+        SolverOptions(stability="maybe").check()

@@ -441,7 +441,8 @@ def _save_bifurcations(f, bifs: list) -> None:
     f.attrs["bif_index"] = np.array([b.index for b in bifs], int)
     f.attrs["bif_located"] = np.array([b.located for b in bifs], int)
     f.attrs["bif_t_lam"] = np.array([b.t_lam for b in bifs], float)
-    f.attrs["bif_amp_max"] = np.array([b.amp_max for b in bifs], float).reshape(-1, n_out)
+    f.attrs["bif_amp_max"] = np.array([np.ravel(b.amp_max) for b in bifs],
+                                      float).reshape(len(bifs), n_out)
 
 
 def store_bifurcations(path, bifs: list) -> None:
@@ -455,7 +456,10 @@ def store_bifurcations(path, bifs: list) -> None:
 
 def _load_bifurcations(f, path) -> list:
     from ._fold import Bifurcation
-    kinds = [k.decode() if isinstance(k, bytes) else str(k) for k in f.attrs["bif_kind"]]
+    kinds = [k.decode() if isinstance(k, bytes) else str(k)
+             for k in np.atleast_1d(f.attrs["bif_kind"])]
+    if not kinds:
+        return []
     cols = [np.atleast_1d(f.attrs[f"bif_{k}"]) for k in
             ("omega", "parameter", "index", "located", "t_lam")]
     amp = np.asarray(f.attrs["bif_amp_max"], float).reshape(len(kinds), -1)

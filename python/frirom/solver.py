@@ -200,6 +200,11 @@ class _Continuation:
                               stability_computed=p.stability)
         out.timings = self.timings
         out.solver_info = p.info
+        if p.stability and self.timings:
+            # the cost of stability beside the curve's (Fortran T_HILL, in the total)
+            t_h, t_all = self.timings.get("hill", 0.0), self.timings.get("fortran_total", 0.0)
+            out.solver_info += (f"; stability (Hill) {t_h:.3g} s of the run's {t_all:.3g} s "
+                                f"in Fortran")
         if p.keep is not None and (pts or self.leak_before):
             k = int(np.argmax(out.leak)) if pts else 0
             worst, at = (float(out.leak[k]), pts[k].omega) if pts else (-1.0, 0.0)

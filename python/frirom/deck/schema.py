@@ -59,8 +59,9 @@ class SolverSettings:
     max_iterations : int or None
         Newton iterations per point (None: the solver's default); the deck also accepts
         the solver's name ``max_iter``.
-    stability : bool
-        Hill stability of every point (false with [reduction.cyclic]); default
+    stability : bool or "auto"
+        Hill stability of every point (false with [reduction.cyclic]); "auto": on where
+        affordable, the reason in the run's summary where not; default
         ``SolverOptions.stability``.
     tol_stall : float or None
         A corrector stalling below this residual is accepted (None: the solver's default).
@@ -88,7 +89,7 @@ class SolverSettings:
     tol_residual: float | None
     tol_update: float | None
     max_iterations: int | None
-    stability: bool
+    stability: bool | str
     tol_stall: float | None = None
     history: bool = SOLVER_DEFAULTS.history
     auto_harmonics: bool = False
@@ -355,7 +356,10 @@ def _solver(ctx, sol, cyc) -> SolverSettings:
         tols.append(None if v is None else float(v))
     max_it = number(ctx, sol, "max_iterations", "solver.max_iterations", integer=True,
                     minimum=1)
-    stability = boolean(ctx, sol, "stability", "solver.stability", SOLVER_DEFAULTS.stability)
+    # "auto": on where affordable (frirom._pack.resolve_stability)
+    stability = sol.get("stability", SOLVER_DEFAULTS.stability)
+    if not (isinstance(stability, bool) or stability == "auto"):
+        raise ctx.error("solver.stability", 'true or false (or "auto")', stability)
     stall = number(ctx, sol, "tol_stall", "solver.tol_stall", nonneg=True)
     history = boolean(ctx, sol, "history", "solver.history", SOLVER_DEFAULTS.history)
     kept = _harmonics_kept(ctx, sol.get("harmonics_kept"), H)
