@@ -198,7 +198,7 @@ class FRF:
     slider: np.ndarray | None = None
     #: Fortran time split of the run: aft, assembly, factorization, solve, receptance (s),
     #: evaluations, factorizations, krylov_iterations, double_factorizations (counts),
-    #: fortran_total (s)
+    #: hill (s, Hill's method: the cost of stability), fortran_total (s)
     timings: dict = field(default_factory=dict)
     #: (n_out,) Peak per output solved on the curve by the solver (None: not computed)
     peaks: list | None = None
