@@ -177,7 +177,7 @@ subroutine int_constant(name, value, info, msg)
                           ADVISE_DS_MIN, ADVISE_SAMPLES, N_ISET, N_RSET, COORD_AUTO, COORD_DOFS, &
                           COORD_CONTACT
     use frirom_hbm, only: T_AFT, T_ASM, T_FACT, T_SOLVE, T_REC, N_EVAL, N_FACT, N_KRYLOV, &
-                          N_DOUBLE, N_TIMERS, HILL_DENSE_MAX
+                          N_DOUBLE, N_TIMERS, HILL_DENSE_MAX, T_HILL
     implicit none
     character(len=*), intent(in) :: name
     integer(4), intent(out) :: value
@@ -257,6 +257,8 @@ subroutine int_constant(name, value, info, msg)
         value = N_KRYLOV
     case ('N_DOUBLE')
         value = N_DOUBLE
+    case ('T_HILL')
+        value = T_HILL
     case ('N_TIMERS')
         value = N_TIMERS
     case default

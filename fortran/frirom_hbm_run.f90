@@ -399,6 +399,7 @@ contains
         subroutine store(itn)
             integer(ip), intent(in) :: itn
             integer(ip) :: g, e0
+            real(wp) :: th
             complex(wp), allocatable :: ex(:)
             npts = npts + 1
             ys(:, npts) = y
@@ -419,7 +420,9 @@ contains
             end if
             if (present(hill_re)) then
                 allocate (ex(2*sys%ndof))
+                th = wtime()
                 call hbm_hill(sys, y, lam, ex, hill_re(npts), info, errmsg)
+                sys%timers(T_HILL) = sys%timers(T_HILL) + wtime() - th
                 if (info /= 0) return
             end if
             e0 = 0

@@ -32,7 +32,8 @@ _TIMER_SLOTS = {name: int_constant(slot) - 1 for name, slot in (
     ("aft", "T_AFT"), ("assembly", "T_ASM"), ("factorization", "T_FACT"),
     ("solve", "T_SOLVE"), ("receptance", "T_REC"), ("evaluations", "N_EVAL"),
     ("factorizations", "N_FACT"), ("krylov_iterations", "N_KRYLOV"),
-    ("double_factorizations", "N_DOUBLE"), ("fortran_total", "N_TIMERS"))}
+    ("double_factorizations", "N_DOUBLE"), ("hill", "T_HILL"),
+    ("fortran_total", "N_TIMERS"))}
 TIMER_NAMES = tuple(sorted(_TIMER_SLOTS, key=_TIMER_SLOTS.get))
 
 
@@ -304,6 +305,33 @@ def _split_load(fe: np.ndarray, part: str) -> tuple[np.ndarray, np.ndarray]:
     return fe - fe1, fe1
 
 
+#: stability = "auto" turns Hill's method on up to this many Hill unknowns 2 n_dof (2H+1):
+#: the dense eigen-solve (up to 1 000) and small Arnoldi problems; the paper flange's
+#: ROM_I (26 600 at H = 3) costs ~150 solves per point
+HILL_AUTO_MAX = 2000
+
+
+def resolve_stability(model, opts: SolverOptions) -> tuple[SolverOptions, str]:
+    """opts with stability "auto" made true or false, and why it is off ('' when on, or
+    not "auto"): off for a cyclic sector, a selection, contact coordinates or more than
+    HILL_AUTO_MAX Hill unknowns."""
+    if not isinstance(opts.stability, str):
+        return opts, ""
+    n, H = model.n_dof, opts.harmonics
+    nh = 2 * n * (2 * H + 1)
+    why = ""
+    if isinstance(model, CyclicModel):
+        why = "a cyclic sector (Hill's method is not implemented for it)"
+    elif opts.selection is not None or opts.harmonics_kept is not None:
+        why = "a selection of unknowns (Hill would see only perturbations inside it)"
+    elif opts.coordinates == "contact":
+        why = "contact coordinates (Hill's method needs the contact DoFs)"
+    elif nh > HILL_AUTO_MAX:
+        why = (f"{nh} Hill unknowns, more than {HILL_AUTO_MAX} (set stability = true to "
+               "compute it anyway)")
+    return dataclasses.replace(opts, stability=not why), why
+
+
 def pack(model: Model | CyclicModel, excitation: Excitation, opts: SolverOptions, outputs,
          load_part: str = "dynamic") -> _Packed:
     """Check the inputs and pack them for the Fortran run; outputs: DoF indices (0-based),
@@ -315,6 +343,7 @@ def pack(model: Model | CyclicModel, excitation: Excitation, opts: SolverOptions
     if not isinstance(excitation, Excitation):
         raise ParameterError("excitation: expected a frirom.model.Excitation")
     opts.check()
+    opts, skipped = resolve_stability(model, opts)
     label = "travelling-wave selection"
     if opts.harmonics_kept is not None:
         if isinstance(model, CyclicModel):
@@ -338,6 +367,8 @@ def pack(model: Model | CyclicModel, excitation: Excitation, opts: SolverOptions
         packed.out_map, packed.outputs = P, _map_dofs(P, packed.outputs)
     if opts.selection is not None:
         _select(packed, model, opts.selection, opts.pairs, label)
+    if skipped:
+        packed.info += f"; stability: off ('auto': {skipped})"
     return packed
 
 

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import errno
+import math
 import os
 import re
 import shutil
@@ -324,7 +325,7 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
     """cmd_run once the results folder is locked."""
     from ._resume import deck_fingerprint
     from .plots import plot_frf, plot_states
-    from .results import FRF, FRFWriter
+    from .results import FRF, FRFWriter, store_bifurcations
     from .solver import frf
 
     h5 = out / "frf.h5"
@@ -421,10 +422,16 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
     else:
         elapsed = 0.0
 
+    if result is not None and result.bifurcations is not None:
+        # located on the whole curve (a resumed run's points before it too)
+        store_bifurcations(h5, result.bifurcations)
     full = FRF.load(h5)
     if deck.csv:
         full.save_csv(out / "frf.csv")
     written = [h5] + ([out / "frf.csv"] if deck.csv else [])
+    if deck.csv and full.bifurcations:
+        full.save_bifurcations_csv(out / "bifurcations.csv")
+        written.append(out / "bifurcations.csv")
     if deck.plot and len(full) > 0:
         figures = {"frf.png": plot_frf(full, output_names=deck.output_names,
                                        unit=deck.frequency_unit, title=deck.title + (
@@ -439,6 +446,15 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
             written.append(out / name)
     print(f"frirom: {len(full)} points in {elapsed:.1f} s; wrote "
           + ", ".join(str(p) for p in written))
+    for b in full.bifurcations or []:
+        fb = b.omega / (2 * math.pi) if deck.frequency_unit == "hz" else b.omega
+        unit = "Hz" if deck.frequency_unit == "hz" else "rad/s"
+        print(f"frirom: {b.kind} at {fb:.8g} {unit} ("
+              + ("located on the curve " if b.located else "")
+              + f"between points {b.index - 1} and {b.index})")
+    fl = getattr(deck.settings, "fold_locus", None)
+    if fl is not None:
+        _fold_locus(deck, fl, model, excitation, options, out)
     # a resumed run solved its peaks on the whole curve (the file's points before it too)
     if (args.resume and result is not None and result.peaks is not None and start
             and start.get("before")):
@@ -448,6 +464,28 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
         _print_stop(full, deck, h5)
         return EXIT_STOPPED
     return EXIT_OK
+
+
+def _fold_locus(deck, fl, model, excitation, options, out: Path) -> None:
+    """[fold_locus]: the folds at each level (frirom.bifurcations), OUT/fold_locus.csv."""
+    import csv
+
+    from .bifurcations import fold_locus
+    loc = fold_locus(model, excitation, deck.omega_start, deck.omega_end, fl.levels,
+                     options, outputs=deck.solver_outputs, part=fl.part)
+    path = out / "fold_locus.csv"
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["level", "fold", "f_hz", "omega_rad_s", "located", "complete"]
+                   + [f"{n}_max" for n in deck.output_names])
+        for i, lv in enumerate(loc.levels):
+            for j in range(int(loc.n_folds[i])):
+                w.writerow([repr(float(lv)), j, repr(float(loc.omega[i, j] / (2 * math.pi))),
+                            repr(float(loc.omega[i, j])), int(loc.located[i, j]),
+                            int(loc.complete[i])]
+                           + [repr(float(a)) for a in loc.amp_max[i, j]])
+    print(f"frirom: fold locus ({fl.part} part) at {loc.levels.size} levels, folds per "
+          f"level {loc.n_folds.tolist()}; wrote {path}")
 
 
 def _restore_kept(kept, result) -> bool:

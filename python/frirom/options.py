@@ -57,11 +57,13 @@ class SolverOptions:
         evaluation (no extra one): on small models (the friction beam of
         cases/bench/run.py, 15 unknowns) about 20 % faster, but another path where the
         curve has spurious folds.
-    stability : bool
+    stability : bool or "auto"
         Hill's method at every point: the Floquet exponents in the strip |Im s| <= omega/2
         (and the centred copies of modes above (H + 1/2) omega); a dense eigen-solve of
         size 2 n_dof (2H+1) up to :data:`HILL_MAX`, shift-invert Arnoldi about s = 0 above
-        (strip only).
+        (strip only). "auto": on where affordable (frirom._pack.resolve_stability: at most
+        HILL_AUTO_MAX Hill unknowns, not with a selection, contact coordinates or a cyclic
+        sector), off otherwise, the reason in FRF.solver_info.
     history : bool
         Carry the contact history along the curve: each point starts its sliders where the
         previous point's closed cycles left them. False restarts every point from the
@@ -159,7 +161,7 @@ class SolverOptions:
     max_points: int = DEFAULTS["max_points"]
     parameter: str = "frequency"
     reuse_jacobian: bool = bool(DEFAULTS["reuse_jacobian"])
-    stability: bool = bool(DEFAULTS["stability"])
+    stability: bool | str = bool(DEFAULTS["stability"])
     history: bool = bool(DEFAULTS["history"])
     modes: int | None = None
     batch: int = DEFAULTS["batch"]
@@ -200,12 +202,15 @@ class SolverOptions:
         if self.modes is not None and (self.modes < 1 or self.formulation != "condensed"):
             raise ParameterError("options.modes: a positive number of modes, with "
                                  "formulation 'condensed'")
-        for nm in ("refine_peak", "krylov", "stability", "history", "reuse_jacobian",
-                   "orbits"):
+        if isinstance(self.stability, str) and self.stability != "auto":
+            raise ParameterError(f"options.stability: expected true, false or 'auto', got "
+                                 f"{self.stability!r}")
+        for nm in ("refine_peak", "krylov", "history", "reuse_jacobian", "orbits") + \
+                (("stability",) if not isinstance(self.stability, str) else ()):
             if not isinstance(getattr(self, nm), (bool, np.bool_)):
                 raise ParameterError(f"options.{nm}: expected true or false, got "
                                      f"{getattr(self, nm)!r}")
-        if self.coordinates == "contact" and self.stability:
+        if self.coordinates == "contact" and self.stability is True:
             raise ParameterError("options.coordinates: 'contact' cannot be used with "
                                  "stability (Hill's method needs the contact DoFs)")
         kh = self.harmonics_kept
@@ -216,7 +221,7 @@ class SolverOptions:
             what = ("options.selection: a travelling-wave selection" if self.selection
                     is not None else "options.harmonics_kept: a harmonic selection")
             for bad, why in ((self.formulation != "condensed", "the 'condensed' formulation"),
-                             (self.stability, "stability = false (Hill's method would see "
+                             (self.stability is True, "stability = false (Hill's method would see "
                                               "only perturbations inside the selection)"),
                              (self.krylov, "krylov = false (direct solves)"),
                              (self.coordinates == "contact", "coordinates 'dofs' or 'auto'")):

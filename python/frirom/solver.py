@@ -33,6 +33,7 @@ from ._pack import _Packed, add_timings, pack
 from ._routes import HILL_MAX, MODES_MAX  # noqa: F401 - public here
 from .options import FORMULATIONS, SolverOptions  # noqa: F401 - public here
 from .model import CyclicModel, Excitation, Model
+from ._fold import find_bifurcations
 from ._peak import refine_peaks
 from .results import FRF, FRFPoint
 
@@ -199,6 +200,11 @@ class _Continuation:
                               stability_computed=p.stability)
         out.timings = self.timings
         out.solver_info = p.info
+        if p.stability and self.timings:
+            # the cost of stability beside the curve's (Fortran T_HILL, in the total)
+            t_h, t_all = self.timings.get("hill", 0.0), self.timings.get("fortran_total", 0.0)
+            out.solver_info += (f"; stability (Hill) {t_h:.3g} s of the run's {t_all:.3g} s "
+                                f"in Fortran")
         if p.keep is not None and (pts or self.leak_before):
             k = int(np.argmax(out.leak)) if pts else 0
             worst, at = (float(out.leak[k]), pts[k].omega) if pts else (-1.0, 0.0)
@@ -250,6 +256,9 @@ def _run_curve(packed: _Packed, lam_start, lam_end, sink, start, H_start) -> FRF
     run.start(start, H_start)
     complete, message = run.batches()
     out = run.finish(complete, message)
+    # folds located on the curve, stability changes: of the whole curve (a resumed run's
+    # points before the resume too; Bifurcation.index counts them)
+    out.bifurcations = find_bifurcations(packed, run.before + run.points, run.lscale)
     if packed.opts.refine_peak and packed.opts.parameter == "frequency" and run.points:
         # a resumed run: the peak of the whole curve, as the uninterrupted run solves it
         # (Peak.index then counts the points before the resume)

@@ -21,6 +21,7 @@ from .fields import Context, DofRef, boolean, dof_ref, file, number, string, tab
 from ..solver import SolverOptions
 from .schema_analysis import parse_analysis
 from .schema_contacts import parse_contacts, parse_preloads
+from .schema_fold import parse_fold_locus
 from .schema_model import (CyclicSettings, MatrixModel, check_travelling_wave, parse_fe_model,
                            parse_matrix_model, parse_reduction)
 
@@ -60,8 +61,9 @@ class SolverSettings:
     max_iterations : int or None
         Newton iterations per point (None: the solver's default); the deck also accepts
         the solver's name ``max_iter``.
-    stability : bool
-        Hill stability of every point (false with [reduction.cyclic]); default
+    stability : bool or "auto"
+        Hill stability of every point (false with [reduction.cyclic]); "auto": on where
+        affordable, the reason in the run's summary where not; default
         ``SolverOptions.stability``.
     tol_stall : float or None
         A corrector stalling below this residual is accepted (None: the solver's default).
@@ -89,7 +91,7 @@ class SolverSettings:
     tol_residual: float | None
     tol_update: float | None
     max_iterations: int | None
-    stability: bool
+    stability: bool | str
     tol_stall: float | None = None
     history: bool = SOLVER_DEFAULTS.history
     auto_harmonics: bool = False
@@ -241,6 +243,8 @@ class DeckSettings:
     preloads: tuple = ()
     #: ``[analysis]`` (schema_analysis.AnalysisSettings): a forced response by default
     analysis: object = None
+    #: ``[fold_locus]`` (schema_fold.FoldLocusSettings), None when absent
+    fold_locus: object = None
 
     @property
     def fe(self) -> bool:
@@ -278,7 +282,7 @@ def parse_deck(path, raw: dict | None = None, allow_code=()) -> DeckSettings:
     ctx.allow_code = tuple(allow_code)
     unknown(ctx, raw, {"title", "model", "fe_model", "reduction", "damping", "excitation",
                        "contacts", "solver", "frequency", "continuation", "outputs",
-                       "study", "preload", "analysis"}, "")
+                       "study", "preload", "analysis", "fold_locus"}, "")
     title = string(ctx, raw, "title", "title", default=path.stem)
 
     # structure: [model] (matrices as they are) or [fe_model] + [reduction]
@@ -331,7 +335,7 @@ def parse_deck(path, raw: dict | None = None, allow_code=()) -> DeckSettings:
                         contacts=tuple(contacts), frequency=frequency,
                         continuation=continuation, outputs=outputs, raw=raw,
                         modes_auto=modes_auto, preloads=tuple(preloads),
-                        analysis=analysis)
+                        analysis=analysis, fold_locus=parse_fold_locus(ctx, raw))
 
 
 def _aliased(ctx, d: dict, table_name: str) -> dict:
@@ -372,7 +376,10 @@ def _solver(ctx, sol, cyc) -> SolverSettings:
         tols.append(None if v is None else float(v))
     max_it = number(ctx, sol, "max_iterations", "solver.max_iterations", integer=True,
                     minimum=1)
-    stability = boolean(ctx, sol, "stability", "solver.stability", SOLVER_DEFAULTS.stability)
+    # "auto": on where affordable (frirom._pack.resolve_stability)
+    stability = sol.get("stability", SOLVER_DEFAULTS.stability)
+    if not (isinstance(stability, bool) or stability == "auto"):
+        raise ctx.error("solver.stability", 'true or false (or "auto")', stability)
     stall = number(ctx, sol, "tol_stall", "solver.tol_stall", nonneg=True)
     history = boolean(ctx, sol, "history", "solver.history", SOLVER_DEFAULTS.history)
     kept = _harmonics_kept(ctx, sol.get("harmonics_kept"), H)
