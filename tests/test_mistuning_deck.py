@@ -106,6 +106,11 @@ def test_study_deck_equals_serial_monte_carlo(sector, tmp_path, capsys):
     assert rows[0] == ["sample", "af_stuck", "af_free"] and len(rows) == 5
     assert (tmp_path / "amplification.png").exists()
     assert (tmp_path / "envelope_stuck.png").exists()
+    # a rerun reads every finished sample back: no sample computed, the same statistics
+    assert main(["study", str(deck), "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "stuck 2/4" not in out and "stuck 4/4: amplification mean" in out
+    assert json.loads((tmp_path / "statistics.json").read_text()) == st
 
 
 @pytest.mark.parametrize("mistuning,study,match", [

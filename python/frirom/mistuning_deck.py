@@ -352,14 +352,18 @@ def run_mistuning_study(path, out=None, scheduler=None, workers=None, log=print,
         f"std {std:g}, seed {seed}, scheduler {sched}")
     res = {}
     for state in md.interfaces:
-        def progress(done, total, af, state=state):
+        shown = []
+
+        def progress(done, total, af, state=state, shown=shown):
             if not quiet:
                 log(_partial(state, done, total, af))
+                shown.append(done)
         r = monte_carlo(disk, md.n_samples, std, seed=seed, interfaces=state,
                         out=out / "samples", scheduler=None if sched == "serial" else sched,
                         workers=workers or md.workers, progress=progress)
         res[state] = r
-        log(_partial(state, md.n_samples, md.n_samples, r["af"]) + " (done)")
+        if not shown or shown[-1] != md.n_samples:     # quiet, or resumed with all done
+            log(_partial(state, md.n_samples, md.n_samples, r["af"]))
         plot_envelopes(r["samples"], r["tuned"]).savefig(out / f"envelope_{state}.png",
                                                          dpi=110)
     with open(out / "amplification.csv", "w", newline="") as fh:
