@@ -193,7 +193,14 @@ exit codes:
 
 
 def _study(args) -> int:
+    from .mistuning_deck import is_mistuning_deck, run_mistuning_study
     from .study import run_study
+    if is_mistuning_deck(args.deck):        # [mistuning] + [study] kind = "mistuning"
+        run_mistuning_study(args.deck, args.out, scheduler=args.scheduler,
+                            workers=args.workers, quiet=args.quiet,
+                            trust_deck_scheduler=args.trust_deck_scheduler,
+                            log=lambda s: print(f"frirom: {s}", flush=True))
+        return 0
     tls = {"ca": args.tls_ca, "cert": args.tls_cert, "key": args.tls_key}
     res = run_study(args.deck, args.out, scheduler=args.scheduler, workers=args.workers,
                     quiet=args.quiet, log=lambda s: print(f"frirom: {s}"),
@@ -298,7 +305,11 @@ def cmd_run(args) -> int:
     from ._resume import ResultsLock
     from .auto import resolve_deck
     from .deck import load_deck
+    from .mistuning_deck import is_mistuning_deck, run_mistuning_deck
 
+    if is_mistuning_deck(args.deck):        # [mistuning]: frirom.mistuning_deck
+        run_mistuning_deck(args.deck, args.out, log=lambda s: print(f"frirom: {s}"))
+        return 0
     allow = getattr(args, "allow_code", None)
     deck = load_deck(args.deck, allow_code=allow) if allow else load_deck(args.deck)
     for line in deck.log:
