@@ -84,11 +84,11 @@ def test_brb_linear_limits_against_calculix(brb_case, monkeypatch):
     stuck = chk.stuck / 2 / np.pi
     free = chk.free / 2 / np.pi
     # the two bending modes around the band: normal to the lap (the one of the case) and
-    # in its plane; Craig-Bampton with 20 fixed-interface modes: measured 4e-4
+    # in its plane; Craig-Bampton with 20 fixed-interface modes: measured 3e-5 to 5e-5
     near = stuck[stuck > 50.0][:2]
-    np.testing.assert_allclose(near, elastic[:2], rtol=1e-3)
+    np.testing.assert_allclose(near, elastic[:2], rtol=2e-4)
     f_free = free[free > 50.0][:2]
-    np.testing.assert_allclose(f_free, free_ref[free_ref > 50.0][:2], rtol=1e-3)
+    np.testing.assert_allclose(f_free, free_ref[free_ref > 50.0][:2], rtol=2e-4)
     assert "WARNING" not in "\n".join(chk.notes)
     assert GEOMETRY["lap"] > 0
 

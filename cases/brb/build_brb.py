@@ -4,7 +4,7 @@ CalculiX's own eigenfrequencies (stuck.dat, free.dat), nothing committed.
     python cases/brb/build_brb.py                  # coarse mesh (~3500 nodes, ~1 min)
     python cases/brb/build_brb.py --size fine      # fine mesh (slower)
     frirom modes cases/brb/brb.toml                # linear check: free and stuck limits
-    frirom study cases/brb/brb_levels.toml         # forced response at several levels
+    frirom study cases/brb/brb.toml                # forced response at several levels
 
 The model: cases/models/brb.py. The reference springs of stuck.dat are the deck's kt, kn
 (read from brb.toml), so the stuck limit of the reduced model and CalculiX's tied model
