@@ -74,7 +74,7 @@ def brb_mesh(size=SIZES["coarse"], length=GEOMETRY["length"], width=GEOMETRY["wi
         b1 = occ.addBox(lh - lap, 0, h2, lap, width, h2)
         b2 = occ.addBox(lh, 0, 0, lh - lap, width, height)
         # one conforming mesh over all four blocks; the beams are split afterwards
-        out, _ = occ.fragment([(3, a1), (3, a2)], [(3, b1), (3, b2)])
+        occ.fragment([(3, a1), (3, a2)], [(3, b1), (3, b2)])
         occ.synchronize()
         tags, xyz, elems = generate_tet10(gmsh, size)
         # which volume each element belongs to: its centroid's x and z
