@@ -208,6 +208,7 @@ def test_resume_continues_bit_for_bit():
     assert np.array_equal(both.y, full.y) and np.array_equal(both.amplitude, full.amplitude)
 
 
+@pytest.mark.slow
 def test_deck_run_and_resume(tmp_path):
     """`frirom run` on the bundled nonlinear-mode deck writes backbone.h5/.csv/.png; cut
     by continuation.max_points (exit 3) and resumed with more points, the backbone equals

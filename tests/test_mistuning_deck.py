@@ -90,6 +90,7 @@ def test_run_deck_equals_api(sector, tmp_path, capsys):
     assert "amplification" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_study_deck_equals_serial_monte_carlo(sector, tmp_path, capsys):
     d, folder = sector
     deck = _deck(folder, study='[study]\nkind = "mistuning"\nsamples = 4\n'
