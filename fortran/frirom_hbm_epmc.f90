@@ -7,7 +7,7 @@
 submodule (frirom_epmc) frirom_hbm_epmc
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, &
                              FRIROM_ERR_SINGULAR, FRIROM_ERR_LAPACK, set_status
-    use frirom_lapack, only: dgetrf, dgetrs, dgemm
+    use frirom_lapack, only: dgetrf, dgetrs
     use frirom_csr, only: csr_matvec_add
     use frirom_hbm, only: csr_matrix, contact_assemble, contact_eval, wtime, T_AFT, T_ASM, T_FACT, &
                           T_SOLVE, N_EVAL, N_FACT
@@ -136,7 +136,6 @@ contains
         real(wp) :: a, w, xi, hw, t0, nlin, nfc
         real(wp), allocatable :: rl(:, :), dw(:, :), dx(:, :), yd(:)
         integer(ip) :: nd, nc, nf, h, ca, cb, c
-        integer :: linfo
         info = FRIROM_OK
         if (.not. allocated(this%jd)) then
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: no linear '// &
@@ -235,16 +234,9 @@ contains
             this%jd(nf + 1, 2*nd + 1:3*nd) = 2.0_wp*this%wn*mv(this%m, yh(:, 3))
             this%jd(nf + 2, 2*nd + 1:3*nd) = this%wn*this%pw
         end associate
+        this%timers(T_ASM) = this%timers(T_ASM) + wtime() - t0
         if (.not. this%factor) return
-        call dgetrf(this%n, this%n, this%jd, this%n, this%ipiv, linfo)
-        this%timers(T_FACT) = this%timers(T_FACT) + wtime() - t0
-        this%timers(N_FACT) = this%timers(N_FACT) + 1
-        if (linfo > 0) then
-            call set_status(info, FRIROM_ERR_SINGULAR, errmsg, 'nonlinear mode: dgetrf '// &
-                            'zero pivot (singular Jacobian)')
-        else if (linfo < 0) then
-            call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'dgetrf: illegal argument')
-        end if
+        call epmc_factor(this, info, errmsg)
     end procedure epmc_eval
 
     !> y(:, k) += alpha A x(:, k) for every column k.
@@ -284,6 +276,7 @@ contains
         end do
     end subroutine dense_add
 
+
     module procedure epmc_solve
         real(wp) :: t0
         integer :: linfo
@@ -294,6 +287,22 @@ contains
         if (linfo /= 0) call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'dgetrs: illegal '// &
                                         'argument')
     end procedure epmc_solve
+
+    module procedure epmc_factor
+        real(wp) :: t0
+        integer :: linfo
+        info = FRIROM_OK
+        t0 = wtime()
+        call dgetrf(this%n, this%n, this%jd, this%n, this%ipiv, linfo)
+        this%timers(T_FACT) = this%timers(T_FACT) + wtime() - t0
+        this%timers(N_FACT) = this%timers(N_FACT) + 1
+        if (linfo > 0) then
+            call set_status(info, FRIROM_ERR_SINGULAR, errmsg, 'nonlinear mode: dgetrf '// &
+                            'zero pivot (singular Jacobian)')
+        else if (linfo < 0) then
+            call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'dgetrf: illegal argument')
+        end if
+    end procedure epmc_factor
 
     module procedure epmc_outputs
         integer(ip) :: j

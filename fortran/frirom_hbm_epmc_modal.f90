@@ -6,7 +6,6 @@
 submodule (frirom_epmc) frirom_hbm_epmc_modal
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, &
                              FRIROM_ERR_SINGULAR, FRIROM_ERR_LAPACK, set_status
-    use frirom_lapack, only: dgetrf, dgetrs, dgemm
     use frirom_csr, only: csr_matvec_add
     use frirom_hbm, only: contact_assemble, contact_eval, wtime, T_AFT, T_ASM, T_FACT, T_SOLVE, &
                           N_EVAL, N_FACT
@@ -141,7 +140,6 @@ contains
         integer(ip) :: nnl, nm, nf, h, ca, cb, j
         complex(wp), allocatable :: g(:), gw(:), gx(:), p(:), q(:), z(:), dp(:, :), dz(:, :)
         real(wp), allocatable :: u(:, :), yd(:), jn(:), jw(:, :)
-        integer :: linfo
         info = FRIROM_OK
         if (.not. allocated(this%jd)) then
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: no linear '// &
@@ -231,16 +229,7 @@ contains
         if (.not. jac) return
         this%jd = jw
         if (.not. this%factor) return
-        t0 = wtime()
-        call dgetrf(this%n, this%n, this%jd, this%n, this%ipiv, linfo)
-        this%timers(T_FACT) = this%timers(T_FACT) + wtime() - t0
-        this%timers(N_FACT) = this%timers(N_FACT) + 1
-        if (linfo > 0) then
-            call set_status(info, FRIROM_ERR_SINGULAR, errmsg, 'nonlinear mode: dgetrf '// &
-                            'zero pivot (singular Jacobian)')
-        else if (linfo < 0) then
-            call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'dgetrf: illegal argument')
-        end if
+        call epmc_factor(this, info, errmsg)
     end procedure epmd_eval
 
     !> diag(d) b (rows of b scaled).
@@ -262,16 +251,6 @@ contains
         end do
     end function diag_cscale
 
-    module procedure epmd_solve
-        real(wp) :: t0
-        integer :: linfo
-        info = FRIROM_OK
-        t0 = wtime()
-        call dgetrs('N', this%n, size(b, 2), this%jd, this%n, this%ipiv, b, size(b, 1), linfo)
-        this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
-        if (linfo /= 0) call set_status(info, FRIROM_ERR_LAPACK, errmsg, 'dgetrs: illegal '// &
-                                        'argument')
-    end procedure epmd_solve
 
     module procedure epmd_outputs
         real(wp) :: a, w, xi
