@@ -95,18 +95,7 @@ contains
         rlam = 0.0_wp
         jm = 0.0_wp
         select type (sys => sysc)
-        type is (hbm_epmc)
-            if (size(y) /= sys%n .or. size(r) /= sys%n .or. size(rlam) /= sys%n .or. &
-                any(shape(jm) /= [sys%n, sys%n])) then
-                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'hbm_epmc_jacobian: y, r, '// &
-                                'rlam (n) and jm (n, n) expected')
-                return
-            end if
-            sys%factor = .false.
-            call sys%eval(y, lam, r, rref, .true., rlam, info, errmsg)
-            sys%factor = .true.
-            if (info == 0) jm = sys%jd
-        type is (hbm_epmc_modal)
+        class is (epmc_system)
             if (size(y) /= sys%n .or. size(r) /= sys%n .or. size(rlam) /= sys%n .or. &
                 any(shape(jm) /= [sys%n, sys%n])) then
                 call set_status(info, FRIROM_ERR_SIZE, errmsg, 'hbm_epmc_jacobian: y, r, '// &
@@ -132,22 +121,24 @@ contains
         xp(:, 2:) = a*xp(:, 2:)
     end subroutine physical
 
+    module procedure epmc_unpack
+        info = FRIROM_OK
+        a = 10.0_wp**lam
+        w = this%w0*y(this%nf + 1)
+        xi = this%w0*y(this%nf + 2)
+        if (.not. allocated(this%jd)) call set_status(info, FRIROM_ERR_PARAM, errmsg, &
+            'nonlinear mode: no linear mode set (run_set_nonlinear_mode)')
+    end procedure epmc_unpack
+
     module procedure epmc_eval
         real(wp) :: a, w, xi, hw, t0, nlin, nfc
         real(wp), allocatable :: rl(:, :), dw(:, :), dx(:, :), yd(:)
         integer(ip) :: nd, nc, nf, h, ca, cb, c
-        info = FRIROM_OK
-        if (.not. allocated(this%jd)) then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: no linear '// &
-                            'mode set (run_set_nonlinear_mode)')
-            return
-        end if
+        call epmc_unpack(this, y, lam, a, w, xi, info, errmsg)
+        if (info /= 0) return
         nd = this%ndof
         nc = this%nc
         nf = this%nf
-        a = 10.0_wp**lam
-        w = this%w0*y(nf + 1)
-        xi = this%w0*y(nf + 2)
         call physical(nd, nc, y, a, this%xp)
         this%xd = this%xp
         t0 = wtime()

@@ -140,18 +140,11 @@ contains
         integer(ip) :: nnl, nm, nf, h, ca, cb, j
         complex(wp), allocatable :: g(:), gw(:), gx(:), p(:), q(:), z(:), dp(:, :), dz(:, :)
         real(wp), allocatable :: u(:, :), yd(:), jn(:), jw(:, :)
-        info = FRIROM_OK
-        if (.not. allocated(this%jd)) then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: no linear '// &
-                            'mode set (run_set_nonlinear_mode)')
-            return
-        end if
+        call epmc_unpack(this, y, lam, a, w, xi, info, errmsg)
+        if (info /= 0) return
         nnl = this%nnl
         nm = this%nm
         nf = this%nf
-        a = 10.0_wp**lam
-        w = this%w0*y(nf + 1)
-        xi = this%w0*y(nf + 2)
         call forces(this, y, a, info, errmsg)
         if (info /= 0) return
         t0 = wtime()
@@ -163,8 +156,8 @@ contains
         ! harmonic 0: U_0 - Phi_nl diag(1/w_r^2) (Phi^T fe0 - Phi_nl^T F_0)
         r(1:nnl) = u(:, 1) - matmul(this%phn, (this%qst - matmul(transpose(this%phn), &
                                                                 this%fl(:, 1)))/this%wr**2)
-        jw(1:nnl, 1:nf) = matmul(this%phn, matmul(diag_scale(1.0_wp/this%wr**2, &
-                                      transpose(this%phn)), this%jp(1:nnl, :)))
+        jw(1:nnl, 1:nf) = matmul(this%phn, matmul(spread(1.0_wp/this%wr**2, 2, nnl)* &
+                                      transpose(this%phn), this%jp(1:nnl, :)))
         ! the residual's reference: the size of its terms (unknowns, static load and
         ! contact force responses, each harmonic's receptance term)
         nref = max(norm2(u), norm2(matmul(this%phn, this%qst/this%wr**2)), &
@@ -233,15 +226,6 @@ contains
     end procedure epmd_eval
 
     !> diag(d) b (rows of b scaled).
-    pure function diag_scale(d, b) result(c)
-        real(wp), intent(in) :: d(:), b(:, :)
-        real(wp) :: c(size(b, 1), size(b, 2))
-        integer(ip) :: k
-        do k = 1, size(b, 2)
-            c(:, k) = d*b(:, k)
-        end do
-    end function diag_scale
-
     pure function diag_cscale(d, b) result(c)
         complex(wp), intent(in) :: d(:), b(:, :)
         complex(wp) :: c(size(b, 1), size(b, 2))

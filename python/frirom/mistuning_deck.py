@@ -121,16 +121,8 @@ def parse_mistuning_deck(path) -> MistuningDeck:
             or any(i not in INTERFACES for i in itf)):
         raise ctx.error("study.interfaces", "a non-empty list of distinct names among "
                         "\"friction\", \"stuck\", \"free\"", itf)
-    sched = string(ctx, st, "scheduler", "study.scheduler", default="local")
-    if sched not in ("local", "serial"):
-        from .deck.schema_study import check_address
-        try:
-            check_address(sched)
-        except InputError as e:
-            raise ctx.error("study.scheduler", str(e).split(": expected ", 1)[1],
-                            sched) from None
-    workers = number(ctx, st, "workers", "study.workers", integer=True, minimum=1,
-                     maximum=1024)
+    from .deck.schema_study import scheduler_and_workers
+    sched, workers = scheduler_and_workers(ctx, st)
     if study and "std" not in mis:
         raise ctx.error("mistuning.std", "a standard deviation (and seed) for a [study] of "
                         "kind \"mistuning\": each sample draws its own deviations (the "
