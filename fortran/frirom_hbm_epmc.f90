@@ -19,7 +19,6 @@ contains
 
     module procedure hbm_epmc_set
         real(wp), allocatable :: mphi(:)
-        real(wp) :: mn
         integer(ip) :: nd
         info = FRIROM_OK
         select type (sys => sysc)
@@ -40,17 +39,8 @@ contains
                                 'the linear natural frequency (rad/s > 0) expected')
                 return
             end if
-            allocate (mphi(nd))
-            mphi = 0.0_wp
-            call csr_matvec_add(sys%m, phi, mphi, 1.0_wp)
-            mn = dot_product(phi, mphi)
-            if (.not. (mn > 0.0_wp)) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: phi has '// &
-                                'no mass (phi^T M phi <= 0)')
-                return
-            end if
-            sys%phi = phi/sqrt(mn)
-            mphi = mphi/sqrt(mn)
+            call epmc_normalise(sys, phi, 'phi', sys%phi, mphi, info, errmsg)
+            if (info /= 0) return
             sys%pw = mphi/norm2(mphi)
             sys%w0 = w0
             sys%wn = w0**2*norm2(mphi)
@@ -120,6 +110,22 @@ contains
         xp = reshape(y(1:nd*nc), [nd, nc])
         xp(:, 2:) = a*xp(:, 2:)
     end subroutine physical
+
+    module procedure epmc_normalise
+        real(wp) :: mn
+        info = FRIROM_OK
+        allocate (mphin(size(phi)))
+        mphin = 0.0_wp
+        call csr_matvec_add(this%m, phi, mphin, 1.0_wp)
+        mn = dot_product(phi, mphin)
+        if (.not. (mn > 0.0_wp)) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: '//what// &
+                            ' has no mass (phi^T M phi <= 0)')
+            return
+        end if
+        phin = phi/sqrt(mn)
+        mphin = mphin/sqrt(mn)
+    end procedure epmc_normalise
 
     module procedure epmc_unpack
         info = FRIROM_OK
