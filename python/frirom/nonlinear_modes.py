@@ -87,6 +87,8 @@ class Backbone:
     yscales: np.ndarray = field(default=None, repr=False)
     ds_next: np.ndarray = field(default=None, repr=False)
     sliders: np.ndarray = field(default=None, repr=False)
+    #: |log10 a_end - log10 a_start| of the run: the tangents' scale of log10 a (0: unknown)
+    lscale: float = 0.0
 
     def __len__(self) -> int:
         return int(self.amplitude.size)
@@ -127,6 +129,13 @@ class Backbone:
     def output_amplitude(self, j: int = 0) -> np.ndarray:
         """Amplitude of harmonic 1 at output j (m): hypot(a1, b1)."""
         return np.hypot(self.outputs[:, j, 1], self.outputs[:, j, 2])
+
+    def forced_response(self, load, omega=None, points: int = 400):
+        """The forced response near this mode's resonance under a harmonic-1 load, by
+        single nonlinear mode theory (:func:`frirom.nlm_synthesis.forced_response`): an
+        FRF at the backbone's outputs, in milliseconds."""
+        from .nlm_synthesis import forced_response
+        return forced_response(self, load, omega, points)
 
     def table(self) -> np.ndarray:
         """(n, 5 + n_out) columns: amplitude, frequency (Hz), damping ratio, energy per
@@ -292,6 +301,7 @@ def nonlinear_mode(model: Model, mode: int = 0, amplitudes=(1e-6, 1e-2), start: 
         run.close()
     bb = _backbone(model, packed, phi, w0, mode, start, ys, lams, xos, sts, its, cks, status,
                    message)
+    bb.lscale = abs(np.log10(a1) - np.log10(a0))
     if bb.amplitude.size == 0 and resume is None:
         raise ConvergenceError(f"nonlinear mode: no point converged ({message})")
     return bb

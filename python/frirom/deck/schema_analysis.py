@@ -1,6 +1,9 @@
 """``[analysis]``: what a deck computes. ``kind = "forced_response"`` (the default: the
 FRF over ``[frequency]`` under ``[excitation]``) or ``kind = "nonlinear_mode"`` (the
-backbone of one mode by the extended periodic motion concept, frirom.nonlinear_mode).
+backbone of one mode by the extended periodic motion concept, frirom.nonlinear_mode) or
+``kind = "from_backbone"`` (the forced response over ``[frequency]`` under the harmonic-1
+loads of ``[excitation]`` synthesised from that backbone by single nonlinear mode theory,
+frirom.nlm_synthesis).
 
 A nonlinear-mode deck needs no ``[frequency]``; its ``[excitation]`` may hold static
 loads (harmonic 0, a preload) only.
@@ -12,14 +15,14 @@ from dataclasses import dataclass
 
 from .fields import Context, dof_ref, number, string, unknown
 
-KINDS = ("forced_response", "nonlinear_mode")
+KINDS = ("forced_response", "nonlinear_mode", "from_backbone")
 
 
 @dataclass(frozen=True)
 class AnalysisSettings:
     """``[analysis]``.
 
-    kind : 'forced_response' or 'nonlinear_mode'
+    kind : 'forced_response', 'nonlinear_mode' or 'from_backbone'
     mode : int
         The linear mode the nonlinear mode starts from, 1 = the lowest with a nonzero
         frequency (of the stuck or free structure).
@@ -41,6 +44,10 @@ class AnalysisSettings:
     @property
     def nonlinear_mode(self) -> bool:
         return self.kind == "nonlinear_mode"
+
+    @property
+    def from_backbone(self) -> bool:
+        return self.kind == "from_backbone"
 
 
 def parse_analysis(ctx: Context, raw: dict, fe: bool, labels: bool) -> AnalysisSettings:
