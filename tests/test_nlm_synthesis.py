@@ -188,3 +188,44 @@ def test_breaks_down_with_strong_harmonics():
     assert h3.max() > 1.0
     with pytest.raises(ParameterError, match="turns back"):
         bb.forced_response(F, (90.0, 140.0))
+
+
+@pytest.mark.slow
+def test_deck_from_backbone_and_show_at_a_backbone_point(tmp_path, capsys):
+    """`frirom run` on cases/joint/joint_snmt.toml ([analysis] kind = "from_backbone")
+    writes the backbone and the synthesised FRF (its tip peak against the HBM's of
+    joint.toml: 1.5 % in amplitude, 0.5 % in frequency, as at 2 N above); `frirom show` at
+    a backbone
+    point closes the EPMC's energy balance: the mode's energy per cycle (pi xi omega
+    |x'|_M^2) equals what the damper's hysteresis loop (the AFT march from the stored
+    contact history) and the viscous damping dissipate, to 1e-9."""
+    from frirom.cli import main
+    from frirom.results import FRF
+    src = Path(__file__).parents[1] / "cases" / "joint"
+    for name in ("M.mtx", "K.mtx", "dofs.txt", "joint_snmt.toml", "joint.toml"):
+        (tmp_path / name).write_bytes((src / name).read_bytes())
+    out = tmp_path / "out"
+    assert main(["run", str(tmp_path / "joint_snmt.toml"), "--out", str(out),
+                 "--quiet"]) == 0
+    for f in ("backbone.h5", "backbone.csv", "frf.h5", "frf.csv", "frf.png"):
+        assert (out / f).is_file()
+    s = FRF.load(out / "frf.h5")
+    d, model, opts = joint_setup(0.1)
+    r = frirom.frf(model, d.excitation(), d.omega_start, d.omega_end, opts,
+                   outputs=d.solver_outputs)
+    ea, ew = s.peak(0).amplitude / r.peak(0).amplitude - 1, s.peak(0).omega / r.peak(
+        0).omega - 1
+    print(f"deck: tip peak amplitude {ea:+.2e}, frequency {ew:+.2e}")
+    assert abs(ea) < 1.5e-2 and abs(ew) < 5e-3
+    capsys.readouterr()
+    # show at the backbone point of largest damping (a folder holding only backbone.h5)
+    (out / "frf.h5").unlink()
+    assert main(["show", str(out)]) == 0
+    text = capsys.readouterr().out
+    line = [ln for ln in text.splitlines() if "energy per cycle" in ln][0]
+    mode_j = float(line.split("mode ")[1].split(" J")[0])
+    resid = float(line.split("residual ")[1].split(" J")[0])
+    assert abs(resid) < 1e-9 * mode_j
+    shown = [p for p in out.iterdir() if p.name.startswith("show_a")]
+    assert shown and (shown[0] / "hysteresis.png").is_file()
+    assert main(["show", str(out), "--amplitude", "1.0"]) == 2     # outside the backbone

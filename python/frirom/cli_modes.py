@@ -101,6 +101,7 @@ def synthesise_deck(deck, callback=None):
     """The backbone of a ``kind = "from_backbone"`` deck's [analysis] and the forced
     response over its [frequency] under its harmonic-1 loads synthesised from it
     (frirom.nlm_synthesis): (Backbone, FRF, backbone seconds, synthesis seconds)."""
+    from . import nlm_synthesis  # noqa: F401  (its imports out of the timing)
     from .model import Excitation
     from .nonlinear_modes import nonlinear_mode
     an = deck.settings.analysis
