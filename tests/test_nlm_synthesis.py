@@ -111,19 +111,21 @@ def test_friction_joint_against_hbm(level, tol_a, tol_w):
 
 
 def two_close_modes(split):
-    """Two unit masses on springs 1e4 coupled by a spring `split` * 1e4 / 2 (modes split
-    by ~split relatively), a Jenkins damper on mass 0."""
-    kc = split * 1e4 / 2
+    """Two unit masses on springs 1e4 coupled by a spring `split` * 1.2e4 / 2, a Jenkins
+    damper on each (the stuck modes in phase and in opposition, split by ~split
+    relatively)."""
+    kc = split * 1.2e4 / 2
     K = np.array([[1e4 + kc, -kc], [-kc, 1e4 + kc]])
-    g = ContactGroup(law="jenkins", G=np.array([[1.0, 0.0]]),
-                     params=np.array([[2e3, 0.5, 2.0]]), name="j")
+    g = ContactGroup(law="jenkins", G=np.eye(2), params=np.array([[2e3, 0.5, 2.0]] * 2),
+                     name="j")
     return Model(np.eye(2), K, Damping.modal([0.005, 0.005]), [g])
 
 
 def test_breaks_down_with_two_close_modes():
     """A load on mass 0 excites both modes; the synthesis of mode 1 alone is right when
-    the other mode is far (split 1: peak error < 2 %) and wrong when it is 2 % away (> 10 %:
-    the response is the two modes' sum)."""
+    the other mode is far (split 1: peak amplitude -0.24 %, bound 1 %) and wrong when it
+    is 2 % away (-6.4 %, bound > 5 %: the response is the two modes' sum; 0.5 % away it
+    is -7.6 %)."""
     errs = {}
     for split in (1.0, 0.02):
         model = two_close_modes(split)
@@ -136,8 +138,8 @@ def test_breaks_down_with_two_close_modes():
         errs[split] = peak_errors(s, r)
         print(f"split {split}: peak amplitude {errs[split][0]:+.2e}, frequency "
               f"{errs[split][1]:+.2e}")
-    assert max(map(abs, errs[1.0])) < 2e-2
-    assert abs(errs[0.02][0]) > 0.1
+    assert max(map(abs, errs[1.0])) < 1e-2
+    assert abs(errs[0.02][0]) > 5e-2
 
 
 def test_bad_input_names_the_argument():

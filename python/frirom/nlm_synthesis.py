@@ -74,6 +74,27 @@ def _load_vector(load, n_dof: int) -> np.ndarray:
     return np.asarray(F[:, 1], complex)
 
 
+def _amplitude_sampled(X: np.ndarray) -> np.ndarray:
+    """max_t |x(t)| of harmonics X (..., 2H+1): the largest of 32 (2H+1) samples refined
+    by a parabola through it and its neighbours (to ~1e-6 relatively; a vectorised
+    stand-in for frirom.results.amplitude_max, which solves each row's extrema)."""
+    nc = X.shape[-1]
+    n = 32 * nc
+    tau = 2 * np.pi * np.arange(n) / n
+    h = np.arange(1, (nc - 1) // 2 + 1)
+    B = np.zeros((nc, n))
+    B[0] = 1.0
+    B[1::2], B[2::2] = np.cos(np.outer(h, tau)), np.sin(np.outer(h, tau))
+    y = np.abs(X @ B)                                            # (..., n)
+    k = np.argmax(y, axis=-1)[..., None]
+    y0 = np.take_along_axis(y, (k - 1) % n, -1)[..., 0]
+    y1 = np.take_along_axis(y, k, -1)[..., 0]
+    y2 = np.take_along_axis(y, (k + 1) % n, -1)[..., 0]
+    curv = y0 - 2 * y1 + y2
+    safe = np.where(curv < 0, curv, -1.0)
+    return np.where(curv < 0, y1 - 0.125 * (y2 - y0) ** 2 / safe, y1)
+
+
 def _slopes(bb, order):
     """(n, 2) d omega / d ln a and d xi / d ln a at the backbone's points from the
     continuation's tangents (unknowns scaled by yscale, log10 a by lscale), or None when
@@ -122,8 +143,7 @@ class _Mode:
         self._Y = _INTERP(s, Y, axis=0, extrapolate=False)
         # max_t |x| is that of the mode at a whatever the phase (a shift in time): from the
         # backbone's points, interpolated in log
-        from .results import amplitude_max
-        am = np.maximum(amplitude_max(bb.outputs[order]), 1e-300)
+        am = np.maximum(_amplitude_sampled(bb.outputs[order]), 1e-300)
         self._amp = _INTERP(s, np.log(am), axis=0, extrapolate=False)
         self._static = bool(np.any(bb.outputs[:, :, 0]))
         self._st = (s, frac)
@@ -170,38 +190,33 @@ class _Mode:
 
 def _intervals(mode: _Mode, s: np.ndarray, d: np.ndarray) -> list:
     """[(sa, sb)] where disc >= 0 along the grid s, ends refined to disc = 0."""
-    pos = d >= 0
-    out, i, n = [], 0, s.size
-    while i < n:
-        if not pos[i]:
-            i += 1
-            continue
-        j = i
-        while j + 1 < n and pos[j + 1]:
-            j += 1
+    pos = np.r_[False, d >= 0, False].astype(np.int8)
+    starts = np.flatnonzero(np.diff(pos) == 1)          # first index of each run
+    ends = np.flatnonzero(np.diff(pos) == -1) - 1       # last index of each run
+    n, out = s.size, []
+    for i, j in zip(starts, ends):
         sa = s[i] if i == 0 else brentq(mode.disc, s[i - 1], s[i], xtol=1e-14)
         sb = s[j] if j == n - 1 else brentq(mode.disc, s[j], s[j + 1], xtol=1e-14)
         out.append((sa, sb))
-        i = j + 1
     return out
 
 
 def _window(cs, cw, lo, hi):
     """The curve's points with lo <= Omega <= hi, a point added where it crosses lo or hi
     (linear between the dense points)."""
-    ps, pw = [], []
     inside = (cw >= lo) & (cw <= hi)
-    for i in range(cs.size):
-        if i and inside[i] != inside[i - 1]:
-            for edge in (lo, hi):
-                if (cw[i - 1] - edge) * (cw[i] - edge) < 0:
-                    f = (edge - cw[i - 1]) / (cw[i] - cw[i - 1])
-                    ps.append(cs[i - 1] + f * (cs[i] - cs[i - 1]))
-                    pw.append(edge)
-        if inside[i]:
-            ps.append(cs[i])
-            pw.append(cw[i])
-    return np.asarray(ps), np.asarray(pw)
+    k = np.flatnonzero(inside[1:] != inside[:-1])        # crossings between k and k + 1
+    add_s, add_w, at = [], [], []
+    for i in k:
+        for edge in (lo, hi):
+            if (cw[i] - edge) * (cw[i + 1] - edge) < 0:
+                f = (edge - cw[i]) / (cw[i + 1] - cw[i])
+                add_s.append(cs[i] + f * (cs[i + 1] - cs[i]))
+                add_w.append(edge)
+                at.append(i + 1)
+    cs, cw = np.insert(cs, at, add_s), np.insert(cw, at, add_w)
+    keep = np.insert(inside, at, True)
+    return cs[keep], cw[keep]
 
 
 def forced_response(bb, load, omega=None, points: int = 400):
