@@ -649,7 +649,9 @@ def convergence_table(study: Study, frfs: list, summaries: list) -> list:
     Cost: ``rom_s`` reduction, ``frf_s`` FRF wall time, ``cost_s`` their sum,
     ``memory_mb`` the estimate of :func:`run_member`. ``notes`` lists what failed: the
     curve stopped, a fold only in this model, the error not falling from the previous
-    rung.
+    rung (of the same ``method``: 'hbm', or 'snmt' for a forced response synthesised from
+    a backbone, ``[analysis] kind = "from_backbone"``, whose cost is the backbone's and
+    the synthesis').
     """
     j = study.settings.output
     ref, fref = summaries[-1], frfs[-1]
@@ -665,7 +667,8 @@ def convergence_table(study: Study, frfs: list, summaries: list) -> list:
                             if len(fr) and len(cref) else float("inf")),
                "rom_s": s["rom_seconds"], "frf_s": s["seconds"],
                "memory_mb": s["memory_mb"], "reference": i == len(summaries) - 1,
-               "complete": s["complete"], "notes": []}
+               "complete": s["complete"], "notes": [],
+               "method": s.get("method", "hbm")}
         row["cost_s"] = row["rom_s"] + row["frf_s"]
         row["error"] = max(row["err_amp"], row["err_freq"], row["distance"])
         if s.get("failed"):
@@ -677,7 +680,7 @@ def convergence_table(study: Study, frfs: list, summaries: list) -> list:
         if not np.isfinite(row["error"]):
             row["notes"].append("no peak")
         if rows and not row["reference"] and row["error"] > 1.5 * rows[-1]["error"] \
-                and rows[-1]["error"] > 0:
+                and rows[-1]["error"] > 0 and rows[-1]["method"] == row["method"]:
             row["notes"].append("error rose from the previous rung")
         rows.append(row)
     return rows

@@ -56,9 +56,10 @@ def parse_analysis(ctx: Context, raw: dict, fe: bool, labels: bool) -> AnalysisS
     if not isinstance(an, dict):
         raise ctx.error("analysis", "a table [analysis]", an)
     kind = string(ctx, an, "kind", "analysis.kind", default="forced_response", choices=KINDS)
-    if kind == "forced_response":
-        unknown(ctx, an, {"kind"}, "analysis")
+    if kind == "forced_response" and set(an) <= {"kind"}:
         return AnalysisSettings()
+    # a forced response accepts (and does not use) the nonlinear mode's keys, so that a
+    # study can switch analysis.kind between from_backbone and forced_response
     unknown(ctx, an, {"kind", "mode", "start", "amplitudes", "output"}, "analysis")
     mode = number(ctx, an, "mode", "analysis.mode", default=1, integer=True, minimum=1)
     start = string(ctx, an, "start", "analysis.start", default="stuck",
