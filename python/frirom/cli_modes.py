@@ -154,7 +154,7 @@ def run_synthesis_deck(args, deck, out: Path) -> int:
                       title=f"{deck.title}: nonlinear mode {an.mode}").savefig(
                           out / "backbone.png")
         plot_frf(frf, output_names=names, unit=deck.frequency_unit,
-                 title=f"{deck.title} (single nonlinear mode synthesis)").savefig(
+                 title=deck.title).savefig(
                      out / "frf.png")
         written += [out / "backbone.png", out / "frf.png"]
     print(f"frirom: backbone of {len(bb)} points in {tb:.2f} s, forced response of "
