@@ -219,6 +219,8 @@ def test_deck_from_backbone_and_show_at_a_backbone_point(tmp_path, capsys):
         0).omega - 1
     print(f"deck: tip peak amplitude {ea:+.2e}, frequency {ew:+.2e}")
     assert abs(ea) < 1.5e-2 and abs(ew) < 5e-3
+    assert s.meta["method"] == "snmt"
+    assert main(["show", str(out)]) == 2         # a synthesised curve: no point to solve
     capsys.readouterr()
     # show at the backbone point of largest damping (a folder holding only backbone.h5)
     (out / "frf.h5").unlink()

@@ -153,6 +153,13 @@ def cmd_show(args) -> int:
     if bb is not None and bb.is_file():
         from .show_backbone import cmd_show_backbone
         return cmd_show_backbone(args, bb)
+    if out.is_dir() and (out / "frf.h5").is_file() and (out / "backbone.h5").is_file():
+        from .results import FRF
+        if FRF.load(out / "frf.h5").meta.get("method") == "snmt":
+            raise InputError(f"{out / 'frf.h5'}: synthesised from the nonlinear mode (kind "
+                             f"from_backbone), no solved point to show; show a point of "
+                             f"its backbone: frirom show {out / 'backbone.h5'} "
+                             "[--amplitude A | --point K]")
     if args.amplitude is not None:
         raise InputError(f"--amplitude: {out} holds no backbone.h5 (a nonlinear-mode run)")
     from .show import cmd_show as run

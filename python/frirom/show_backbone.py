@@ -81,6 +81,9 @@ def cmd_show_backbone(args, h5: Path) -> int:
     if not str(path) or not path.is_file():
         raise InputError(f"{h5}: the deck it was made with is not found "
                          f"({path or 'not recorded'}); give it with --deck")
+    for flag, given in (("--along", args.along), ("--phase", args.phase)):
+        if given:
+            raise InputError(f"{flag}: for forced responses only (this is a backbone)")
     if args.at is not None:
         raise InputError("--at: a backbone point is chosen by --amplitude A (modal "
                          "amplitude), --point K or --peak (largest damping ratio)")
