@@ -111,7 +111,8 @@ def _slopes(bb, order):
 
 
 class _Mode:
-    """The backbone as functions of s = ln a (PCHIP; constant outside its range)."""
+    """The backbone as functions of s = ln a (cubic splines, omega and xi Hermite cubics on
+    the continuation's slopes; constant outside its range)."""
 
     def __init__(self, bb, F1):
         if len(bb) < 2:
