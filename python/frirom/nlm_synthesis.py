@@ -14,18 +14,23 @@ psi_h the mode's harmonics per unit modal amplitude (harmonic 1 mass-normalised,
 :class:`frirom.nonlinear_modes.Backbone`). Projected on psi_1, the equations of motion
 under the load f(t) = Re F_1 exp(i Omega t) become the modal equation
 
-    (omega(a)^2 - Omega^2 + 2 i D(a) omega(a) Omega) a exp(i theta) = psi_1(a)^H F_1 = q(a)
+    (omega(a)^2 - Omega^2 + i (Omega c(a) + omega(a) (xi(a) - c(a)))) a exp(i theta)
+        = psi_1(a)^H F_1 = q(a)
 
-with the backbone's frequency omega(a) and damping ratio D(a). Its modulus is a quadratic
-in Omega^2, so every amplitude gives the response frequencies below (-) and above (+) the
-resonance in closed form:
+with the backbone's frequency omega(a) and artificial damping xi(a) = 2 D(a) omega(a),
+split into its viscous part c(a) = psi_1^H C psi_1 (Backbone.xi_viscous), whose force
+grows with the frequency, and the contacts' part xi - c, whose force does not (friction
+and every law here are rate-independent: at H = 1 on one DoF this is the harmonic
+balance equation itself; c = xi gives the textbook 2 D omega Omega). Its modulus,
 
-    Omega^2 = omega^2 (1 - 2 D^2) -/+ sqrt(R^2 - 4 D^2 omega^4 (1 - D^2)),   R = |q| / a.
+    P(Omega) = (omega^2 - Omega^2)^2 + (Omega c + omega (xi - c))^2 = R^2,   R = |q| / a,
 
-The root vanishes at the peak. The curve is the (-) branch up the amplitudes to the peak
-and the (+) branch back down (both branches, folds included); the phase follows from the
-modal equation and gives every harmonic at the outputs. Cost: interpolating the backbone
-and evaluating this formula, milliseconds per curve.
+is a quartic in Omega with one minimum near omega: every amplitude with P_min <= R^2 has a
+response frequency below and one above the resonance (found by bisection on either side
+of the minimum), and P_min = R^2 is the peak. The curve is the lower branch up the
+amplitudes to the peak and the upper branch back down (folds included); the phase follows
+from the modal equation and gives every harmonic at the outputs. Cost: interpolating the
+backbone and evaluating P, milliseconds per curve.
 
 Where it does not hold: a load that also excites another mode near the frequency range
 (several resonances close together, or modal interaction), and motions whose higher
@@ -134,7 +139,9 @@ class _Mode:
         st = bb.states[order]
         frac = st.mean(axis=2) if st.shape[2] else np.zeros((len(a), 0))
         self.n_groups = 1 if st.shape[2] else 0
-        vals = np.column_stack([bb.omega[order], bb.xi[order], q.real, q.imag])
+        cv = (bb.xi_viscous[order] if getattr(bb, "xi_viscous", None) is not None
+              else bb.xi[order])           # not kept: all of xi taken as viscous
+        vals = np.column_stack([bb.omega[order], bb.xi[order], q.real, q.imag, cv])
         self._f = _INTERP(s, vals, axis=0, extrapolate=False)
         slopes = _slopes(bb, order)
         if slopes is not None:      # omega and xi: Hermite cubics on the exact slopes
@@ -153,18 +160,17 @@ class _Mode:
         return np.clip(s, self.s0, self.s1)
 
     def scalars(self, s):
-        """omega, D, |q| at s (arrays)."""
+        """omega, xi, c (viscous part of xi), |q|, arg q at s (arrays)."""
         sc = self._clip(np.asarray(s, float))
         v = self._f(sc)
         wx = self._wx(sc)
-        w, xi = wx[..., 0], wx[..., 1]
-        return w, xi / (2 * w), np.hypot(v[..., 2], v[..., 3]), np.arctan2(v[..., 3],
-                                                                           v[..., 2])
+        return (wx[..., 0], wx[..., 1], v[..., 4], np.hypot(v[..., 2], v[..., 3]),
+                np.arctan2(v[..., 3], v[..., 2]))
 
     def disc(self, s):
-        """R^2 - 4 D^2 omega^4 (1 - D^2): >= 0 where the amplitude a = e^s is reached."""
-        w, D, qa, _ = self.scalars(s)
-        return (qa * np.exp(-np.asarray(s))) ** 2 - 4 * D * D * w ** 4 * (1 - D * D)
+        """R^2 - min P: >= 0 where the amplitude a = e^s is reached."""
+        w, xi, cv, qa, _ = self.scalars(s)
+        return (qa * np.exp(-np.asarray(s))) ** 2 - _p_min(w, xi, cv)[1]
 
     def shapes(self, s):
         return self._Y(self._clip(s))
@@ -187,6 +193,44 @@ class _Mode:
         sk, frac = self._st
         return np.stack([np.interp(s, sk, frac[:, j]) for j in range(frac.shape[1])],
                         axis=-1) if frac.shape[1] else np.zeros((np.size(s), 0))
+
+
+def _modal_term(W, w, xi, cv):
+    """omega^2 - Omega^2 + i (Omega c + omega (xi - c)): the modal equation's factor."""
+    return w * w - W * W + 1j * (W * cv + w * (xi - cv))
+
+
+def _p_min(w, xi, cv):
+    """(Omega_m, P(Omega_m)): the minimum of P = |_modal_term|^2 near omega (Newton)."""
+    g0 = w * (xi - cv)
+    W = np.array(w, float, copy=True)
+    for _ in range(12):
+        dP = -4 * W * (w * w - W * W) + 2 * cv * (cv * W + g0)
+        W = W - dP / (12 * W * W - 4 * w * w + 2 * cv * cv)
+    return W, np.abs(_modal_term(W, w, xi, cv)) ** 2
+
+
+def _branches(w, xi, cv, R):
+    """The frequencies below and above Omega_m where P = R^2 (bisection, 64 halvings);
+    NaN below where P(0) < R^2 (no root under the resonance)."""
+    Wm, _ = _p_min(w, xi, cv)
+
+    def f(W):
+        return np.abs(_modal_term(W, w, xi, cv)) ** 2 - R * R
+
+    out = []
+    for a, b in ((np.zeros_like(Wm), Wm), (Wm, np.sqrt(w * w + 2 * R))):
+        fa = f(a)
+        for _ in range(64):
+            m = 0.5 * (a + b)
+            fm = f(m)
+            left = np.sign(fm) == np.sign(fa)
+            a, fa = np.where(left, m, a), np.where(left, fm, fa)
+            b = np.where(left, b, m)
+        out.append(0.5 * (a + b))
+    lower, upper = out
+    lower[f(np.zeros_like(Wm)) < 0] = np.nan
+    return lower, upper
 
 
 def _intervals(mode: _Mode, s: np.ndarray, d: np.ndarray) -> list:
@@ -262,8 +306,8 @@ def forced_response(bb, load, omega=None, points: int = 400):
     if not (isinstance(points, (int, np.integer)) and points >= 3):
         raise ParameterError("points: an integer >= 3 expected")
     # lowest amplitude needed: the response at the window's ends in the linear limit
-    w, D, qa, _ = mode.scalars(np.array([mode.s0]))
-    a_ends = [qa[0] / abs(w[0] ** 2 - W ** 2 + 2j * D[0] * w[0] * W) for W in (lo, hi)]
+    w, xi, cv, qa, _ = mode.scalars(np.array([mode.s0]))
+    a_ends = [qa[0] / abs(_modal_term(W, w[0], xi[0], cv[0])) for W in (lo, hi)]
     s_lo = min(mode.s0, float(np.log(0.5 * min(a_ends))))
     n = max(_DENSE_MIN, _DENSE_PER * len(bb))
     s = np.linspace(s_lo, mode.s1, n)
@@ -276,17 +320,15 @@ def forced_response(bb, load, omega=None, points: int = 400):
     curve_s, curve_w = [], []
     for sa, sb in _intervals(mode, s, d):
         ss = np.r_[sa, s[(s > sa) & (s < sb)], sb]
-        w, D, _, _ = mode.scalars(ss)
-        root = np.sqrt(np.maximum(mode.disc(ss), 0.0))
-        base = w ** 2 * (1 - 2 * D ** 2)
-        lo_b, hi_b = base - root, base + root
-        # (-) branch up, (+) branch down; they meet at sb (the peak) unless cut there
+        w, xi, cv, qa, _ = mode.scalars(ss)
+        lo_b, hi_b = _branches(w, xi, cv, qa * np.exp(-ss))
+        # lower branch up, upper branch down; they meet at sb (the peak) unless cut there
         met = not (d[-1] > 0 and sb >= mode.s1)
         back = slice(-2, None, -1) if met else slice(None, None, -1)
-        br_s, br_u = np.r_[ss, ss[back]], np.r_[lo_b, hi_b[back]]
-        ok = br_u > 0
+        br_s, br_w = np.r_[ss, ss[back]], np.r_[lo_b, hi_b[back]]
+        ok = np.isfinite(br_w) & (br_w > 0)
         curve_s.append(br_s[ok])
-        curve_w.append(np.sqrt(br_u[ok]))
+        curve_w.append(br_w[ok])
     if not curve_s:
         raise ParameterError("the load reaches no amplitude on the backbone at any frequency")
     cs, cw = np.concatenate(curve_s), np.concatenate(curve_w)
@@ -323,8 +365,8 @@ def _harmonics(mode: _Mode, cs, cw) -> np.ndarray:
     """(m, n_out, nc) harmonics at the outputs of the curve points (ln a, Omega): the
     mode's harmonics at a turned by the phase of the modal equation."""
     a = np.exp(cs)
-    w, D, _, qarg = mode.scalars(cs)
-    theta = qarg - np.angle(w ** 2 - cw ** 2 + 2j * D * w * cw)
+    w, xi, cv, _, qarg = mode.scalars(cs)
+    theta = qarg - np.angle(_modal_term(cw, w, xi, cv))
     Y = mode.shapes(cs)                                          # (m, n_out, nc)
     X = np.empty_like(Y)
     X[:, :, 0] = Y[:, :, 0]
