@@ -212,7 +212,7 @@ _NDIM = {"tangent": 2, "yscale": 1, "ck_scalars": 2, "ck_unknowns": 2, "ck_tange
          "ck_lu": 2}
 #: text attributes of a results file (META_KEYS among them)
 _TEXT = ("parameter_name", "message", "solver_info", "deck_path", "deck_text",
-         "solver_settings", "model_fingerprint", "frirom_version", "auto")
+         "solver_settings", "model_fingerprint", "frirom_version", "auto", "method")
 
 
 def check_results(f, path) -> None:

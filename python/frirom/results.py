@@ -117,9 +117,10 @@ def output_values(X: np.ndarray, amp_max: np.ndarray) -> list:
     return row
 
 
-#: attributes of a result file saying how it was made (FRF.meta)
+#: attributes of a result file saying how it was made (FRF.meta); method: "snmt" for a
+#: forced response synthesised from a nonlinear mode (frirom.nlm_synthesis)
 META_KEYS = ("deck_path", "deck_text", "solver_settings", "model_fingerprint",
-             "frirom_version")
+             "frirom_version", "method")
 
 
 @dataclass

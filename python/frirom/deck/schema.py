@@ -300,7 +300,7 @@ def parse_deck(path, raw: dict | None = None, allow_code=()) -> DeckSettings:
 
     analysis = parse_analysis(ctx, raw, fe, labels)
     nlm = analysis.nonlinear_mode
-    if nlm and cyc is not None:
+    if (nlm or analysis.from_backbone) and cyc is not None:
         raise ctx.error("analysis.kind", "'forced_response' with [reduction.cyclic] (a "
                         "nonlinear mode of a cyclic sector: not yet)", analysis.kind)
     solver = _solver(ctx, table(ctx, raw, "solver"), cyc)
