@@ -155,12 +155,11 @@ def test_brb_forced_response_softens_with_level(brb_case, monkeypatch):
     f_stuck = read_eigenfrequencies(brb_case / "stuck.dat")
     f1 = f_stuck[f_stuck > 50.0][0]
     text = (brb_case / "brb.toml").read_text().split("\n[study]")[0]
-    text = text.replace("harmonics = 3", "harmonics = 1").replace("samples = 32",
-                                                                  "samples = 16")
+    text = text.replace("harmonics = 3", "harmonics = 1\ntol_stall = 2e-6")
     peaks, amps = [], []
-    for level in (0.1, 20.0):
+    for level in (0.0005, 0.3):
         deck = brb_case / f"level{level:g}.toml"
-        deck.write_text(text.replace("amplitude = 10.0", f"amplitude = {level}"))
+        deck.write_text(text.replace("amplitude = 0.1", f"amplitude = {level}"))
         code = main(["run", str(deck), "--out", str(brb_case / deck.stem), "--quiet"])
         r = FRF.load(brb_case / deck.stem / "frf.h5")
         assert code == 0 and r.complete, r.message
@@ -168,26 +167,37 @@ def test_brb_forced_response_softens_with_level(brb_case, monkeypatch):
         assert 0 < i < len(r) - 1
         peaks.append(r.omega[i] / (2 * np.pi))
         amps.append(r.amp_max[i, 0] / level)
-    # linear: on CalculiX's tied first bending mode (the curve's point spacing near the
-    # peak and the CB error, ~1e-3), with the linear stuck receptance (a sparse solve of
-    # the reduced model's K + contact stiffness, no harmonic balance): measured 1e-4
+    # linear (0.0005 N, tip ~0.3 m/s^2): on CalculiX's stuck first bending mode (the
+    # curve's point spacing near the peak and the CB error, ~1e-3), with the linear stuck
+    # receptance (a sparse solve of the reduced model's K + contact stiffness, no
+    # harmonic balance)
     assert peaks[0] == pytest.approx(f1, rel=3e-3)
     from frirom.deck import load_deck
     from frirom.modes import linear_response
-    lin = load_deck(brb_case / "level0.1.toml")
+    lin = load_deck(brb_case / "level0.0005.toml")
     f = np.linspace(f1 * 0.998, f1 * 1.002, 201)
-    r_lin = linear_response(lin, 2 * np.pi * f, stuck=True)[:, 0].max() / 0.1
+    r_lin = linear_response(lin, 2 * np.pi * f, stuck=True)[:, 0].max() / 0.0005
     assert amps[0] == pytest.approx(r_lin, rel=1e-2)
-    assert amps[1] < 0.2 * amps[0]                  # friction damping at 20 N
-    # microslip: clearly softer, but still far above the lower end of the range
-    assert peaks[1] < peaks[0] * 0.995
-    assert peaks[1] > 145.0
+    assert amps[1] < 0.5 * amps[0]                  # friction damping at 0.3 N
+    assert peaks[1] < peaks[0] * 0.995              # microslip softens the joint
+    # phase resonance: the peak of the forced response lies on the backbone (EPMC of
+    # the same deck, H = 1) at the peak's tip acceleration; the load is not the mode's
+    # shape, so only to within the backbone's slope over the peak's width (measured:
+    # 167.32 Hz against 167.03 Hz at 26 m/s^2, 1.7e-3)
+    import run_brb
+    bb, _, _ = run_brb.backbone(brb_case / "brb_mode.toml", harmonics=1,
+                                amplitudes=(5e-8, 1.5e-4), check_start=False)
+    r = FRF.load(brb_case / "level0.3" / "frf.h5")
+    i = int(np.argmax(r.amp_max[:, 0]))
+    acc = r.omega[i] ** 2 * r.amp_max[i, 1]          # OUT:z, the far tip
+    (f_bb, _), = run_brb.at_accelerations(bb, (acc,))
+    assert peaks[1] == pytest.approx(f_bb, rel=5e-3)
 
 
 @pytest.mark.slow
 def test_brb_backbone_from_the_stuck_mode_into_microslip(brb_case, monkeypatch):
     """The EPMC backbone at H = 1 (brb_mode.toml; ~20 s): its low-amplitude end is the
-    stuck first bending mode of CalculiX's full model (the CB error, measured 2e-5) with
+    stuck first bending mode of CalculiX's full model (the CB error, measured 4e-6) with
     the damping ratio of the mass-proportional damping, alpha / (2 omega) (EPMC of a
     linear system: exact to the solver's tolerance); then the joint slips: the frequency
     falls and the damping ratio rises monotonically into microslip."""

@@ -99,7 +99,8 @@ def make(out=HERE, size: str = "coarse", references: bool = True,
     block = deck_block(params)
     for d in decks:
         if write_block(Path(deck_dir) / d, block):
-            log(f"build_brb: {d}: contact groups rewritten (the mesh changed)")
+            log(f"build_brb: {d}: contact groups rewritten (the mesh or the joint's "
+                "parameters changed)")
     if references:
         joined = [(a[g], b[g], kt, kn) for g, (_, kt, kn, _) in zip(groups, params)]
         run_ccx(brb.write_brb_deck(out / "stuck.inp", h, joined=joined, mesh=mesh,
