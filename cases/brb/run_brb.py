@@ -2,8 +2,9 @@
 (cases/brb/build_brb.py), run the first bending mode's nonlinear mode (brb_mode.toml,
 EPMC), and set it beside the published backbone (docs/cases/brb.md).
 
-    python cases/brb/run_brb.py                 # coarse mesh, H = 3 (about a minute)
-    python cases/brb/run_brb.py --mu 0.1 0.3    # the friction coefficient's effect
+    python cases/brb/run_brb.py                 # coarse mesh, H = 3 (1-2 minutes)
+    python cases/brb/run_brb.py --mu 0.1 0.6    # the friction coefficient's effect
+    python cases/brb/run_brb.py --deck brb_cb_mode.toml --out results/brb_cb_mode
 
 Writes results/brb_mode/: backbone.csv, backbone.h5 and backbone.png of the deck's run,
 compare.csv (frequency and damping ratio at the published tip accelerations, every mu)
@@ -99,6 +100,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--mu", type=float, nargs="*", default=[],
                     help="friction coefficients to run besides the deck's")
+    ap.add_argument("--deck", default="brb_mode.toml",
+                    help="the deck next to this script (brb_cb_mode.toml: ROM_I, slow)")
     ap.add_argument("--out", type=Path, default=ROOT / "results" / "brb_mode")
     a = ap.parse_args(argv)
     ensure_built()
@@ -106,7 +109,7 @@ def main(argv=None):
     a.out.mkdir(parents=True, exist_ok=True)
     runs = []
     for mu in [None] + list(a.mu):
-        bb, deck, sec = backbone(mu=mu)
+        bb, deck, sec = backbone(HERE / a.deck, mu=mu)
         m = float(deck.model().contacts[0].params[0, 2]) if mu is None else mu
         print(f"run_brb: mu = {m:g}: {len(bb)} points in {sec:.1f} s, "
               f"{bb.frequency[0]:.3f} -> {bb.frequency[-1]:.3f} Hz"
