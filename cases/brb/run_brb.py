@@ -2,7 +2,7 @@
 (cases/brb/build_brb.py), run the first bending mode's nonlinear mode (brb_mode.toml,
 EPMC), and set it beside the published backbone (docs/cases/brb.md).
 
-    python cases/brb/run_brb.py                 # coarse mesh, H = 3 (1-2 minutes)
+    python cases/brb/run_brb.py                 # coarse mesh, H = 3 (a few minutes)
     python cases/brb/run_brb.py --mu 0.1 0.6    # the friction coefficient's effect
     python cases/brb/run_brb.py --deck brb_cb_mode.toml --out results/brb_cb_mode
 
