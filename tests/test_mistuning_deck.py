@@ -91,10 +91,14 @@ def test_run_deck_equals_api(sector, tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_study_deck_equals_serial_monte_carlo(sector, tmp_path, capsys):
+@pytest.mark.parametrize("scheduler", ["serial", "local"])
+def test_study_deck_equals_serial_monte_carlo(sector, tmp_path, capsys, scheduler):
+    """The deck's study equals monte_carlo run serially; 'local': one LocalCluster of two
+    workers for both interface states."""
     d, folder = sector
     deck = _deck(folder, study='[study]\nkind = "mistuning"\nsamples = 4\n'
-                 'interfaces = ["stuck", "free"]\nscheduler = "serial"\n')
+                 f'interfaces = ["stuck", "free"]\nscheduler = "{scheduler}"\n'
+                 'workers = 2\n')
     assert main(["study", str(deck), "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "stuck 2/4: amplification mean" in out and "free 4/4" in out

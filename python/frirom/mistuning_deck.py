@@ -351,21 +351,31 @@ def run_mistuning_study(path, out=None, scheduler=None, workers=None, log=print,
     log(f"mistuning study: {md.n_samples} samples x {list(md.interfaces)}, {N} blades, "
         f"std {std:g}, seed {seed}, scheduler {sched}")
     res = {}
-    for state in md.interfaces:
-        shown = []
+    cluster = client = None
+    if sched == "local":            # one cluster for every interface state
+        from .mistuning import local_cluster
+        cluster, client, _ = local_cluster(workers or md.workers or 2)
+    try:
+        for state in md.interfaces:
+            shown = []
 
-        def progress(done, total, af, state=state, shown=shown):
-            if not quiet:
-                log(_partial(state, done, total, af))
-                shown.append(done)
-        r = monte_carlo(disk, md.n_samples, std, seed=seed, interfaces=state,
-                        out=out / "samples", scheduler=None if sched == "serial" else sched,
-                        workers=workers or md.workers, progress=progress)
-        res[state] = r
-        if not shown or shown[-1] != md.n_samples:     # quiet, or resumed with all done
-            log(_partial(state, md.n_samples, md.n_samples, r["af"]))
-        plot_envelopes(r["samples"], r["tuned"]).savefig(out / f"envelope_{state}.png",
-                                                         dpi=110)
+            def progress(done, total, af, state=state, shown=shown):
+                if not quiet:
+                    log(_partial(state, done, total, af))
+                    shown.append(done)
+            r = monte_carlo(disk, md.n_samples, std, seed=seed, interfaces=state,
+                            out=out / "samples",
+                            scheduler=None if sched == "serial" else (client or sched),
+                            workers=workers or md.workers, progress=progress)
+            res[state] = r
+            if not shown or shown[-1] != md.n_samples:   # quiet, or resumed with all done
+                log(_partial(state, md.n_samples, md.n_samples, r["af"]))
+            plot_envelopes(r["samples"], r["tuned"]).savefig(out / f"envelope_{state}.png",
+                                                             dpi=110)
+    finally:
+        if client is not None:
+            client.close()
+            cluster.close()
     with open(out / "amplification.csv", "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["sample"] + [f"af_{s}" for s in md.interfaces])
