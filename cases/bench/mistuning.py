@@ -10,8 +10,10 @@ harmonics 0..3.
 
 Measures: the sizes (FE sector and annulus, reduced sector and annulus, contact unknowns),
 the seconds of one tuned and one mistuned FRF with friction, the throughput of the friction
-study in samples per minute serially and on a LocalCluster of two worker processes (and
-its memory per worker), the amplification factor's statistics with friction, stuck and
+study in samples per minute serially and on frirom's LocalCluster of two worker processes
+(frirom.mistuning.local_cluster), back to back, three times (min and median speed-up, the
+load average before each, CPU seconds per sample serially and in a worker, each worker's
+import seconds and memory), the amplification factor's statistics with friction, stuck and
 free; writes cases/bench/results/mistuning.json and the figures
 cases/bench/results/mistuning_*.png (copied into docs/_static by --docs). Last line: seconds
 per mistuned FRF and the Dask speed-up.
