@@ -13,6 +13,9 @@ submodule (frirom_hbm) frirom_hbm_hill
 
     !> Eigenvalues Arnoldi wants per shift at first, at most.
     integer(ip), parameter :: NEV0 = 16, NEV_MAX = 256
+    !> Exponents of least modulus the s = 0 route asks for (a real exponent, the resonant
+    !> mode's folded pair and the nearest copies)
+    integer(ip), parameter :: NEV_S0 = 8
 
     !> The modal Hill problem of a condensed system with real modes (T = P) at a real
     !> shift sg: unknowns q(r + nm (c-1)), slot c of mode r; Q(s) = Lam(s) + E^T Jc E,
@@ -82,6 +85,17 @@ contains
             end if
         end select
         call freq_load(sys, lam, w, s)
+        if (2*n > HILL_DENSE_MAX) then
+            select type (sys)
+            type is (hbm_condensed)
+                if (hill_modal_route(sys) .and. .not. sys%hill_strip) then
+                    ! the exponents nearest 0 through the Newton matrix (frirom_hbm_hill_s0)
+                    call hill_near0(sys, y, lam, w, min(NEV_S0, 2*n - 2), expo, maxre, &
+                                    info, errmsg)
+                    return
+                end if
+            end select
+        end if
         ! contact Jacobians at the solution
         call hbm_contact_forces(sys, y, .true., info, errmsg)
         if (info /= 0) return

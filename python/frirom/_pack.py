@@ -512,10 +512,11 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
                 + (f"{nu} contact coordinates G x" if tcontact else f"{nu} contact DoFs")
                 + f"; {route}")
     if opts.stability:
-        hill = _hill_route(n, H, modes.nmodes if not tcontact else 0, nl.size)
+        hill = _hill_route(n, H, modes.nmodes if not tcontact else 0, nl.size,
+                           strip=opts.stability == "strip")
         if hill == "banded":
             _check_hill_memory(n, H, band.bw)
-        else:
+        elif hill != "near0":
             _check_hill_memory(n, H, 0, modal=(modes.nmodes, nl.size))
         info += "; " + HILL_ROUTES[hill]
     if modes.nmodes and not opts.stability:
