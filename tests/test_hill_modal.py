@@ -118,3 +118,33 @@ def test_truncated_modes_give_the_truncated_models_exponents():
     assert 2 * nm * (2 * H + 1) > HILL_MAX
     assert abs(pm.floquet_max_re - pr.floquet_max_re) < 1e-8 * w, \
         (pm.floquet_max_re, pr.floquet_max_re)
+
+
+def test_near0_in_contact_coordinates_matches_the_banded_path():
+    """Two relative contacts (a Jenkins element between DoFs 0 and 2, a cubic spring
+    between 1 and 3) on the 80-DoF dense model: 2 contact coordinates against 4 contact
+    DoFs, so the s = 0 route (which works in either) leaves the solve on the shorter
+    coordinates; its largest Re s equals the banded Arnoldi path's and the whole strip's
+    (on the contact DoFs), 1e-8 of w."""
+    model, ex = dense_reduced()
+    n = model.n_dof
+    G1 = sp.csr_matrix(([1.0, -1.0], ([0, 0], [0, 2])), shape=(1, n))
+    G2 = sp.csr_matrix(([1.0, -1.0], ([0, 0], [1, 3])), shape=(1, n))
+    model.contacts = [ContactGroup("jenkins", G1, [[2.0, 0.15, 1.0]], name="slider"),
+                      ContactGroup("cubic", G2, [[0.0, 0.3]], name="spring")]
+    from frirom._pack import pack
+    base = dict(harmonics=3, samples=128)
+    o0 = SolverOptions(formulation="condensed", receptances="modes", stability=True, **base)
+    os_ = SolverOptions(formulation="condensed", receptances="modes", stability="strip",
+                        **base)
+    info = pack(model, ex, o0, None).info
+    assert "2 contact coordinates" in info and "s = 0" in info, info
+    assert "4 contact DoFs" in pack(model, ex, os_, None).info
+    for w in (0.9, 1.1):
+        p0 = solve_point(model, ex, w, o0)
+        ps = solve_point(model, ex, w, os_)
+        pb = solve_point(model, ex, w, SolverOptions(formulation="banded", stability=True,
+                                                     **base))
+        assert abs(p0.floquet_max_re - pb.floquet_max_re) < 1e-8 * w, \
+            (p0.floquet_max_re, pb.floquet_max_re)
+        assert abs(ps.floquet_max_re - pb.floquet_max_re) < 1e-8 * w

@@ -238,7 +238,7 @@ def _contact_coords(opts: SolverOptions, nrows: int, nnl: int) -> bool:
     run_contact_coords: 'auto' takes the shorter unless stability or a selection needs
     the DoFs)."""
     code = int_constant("COORD_" + opts.coordinates.upper())
-    return bool(_kernels.contact_coords(code, nrows, nnl, int(opts.stability),
+    return bool(_kernels.contact_coords(code, nrows, nnl, int(bool(opts.stability)),
                                         int(opts.selection is not None)))
 
 
