@@ -63,8 +63,8 @@ class SolverOptions:
         size 2 n_dof (2H+1) up to :data:`HILL_MAX`, shift-invert Arnoldi about s = 0 above
         (strip only). Above HILL_MAX a reduced model (receptances from real modes) gets
         the exponents nearest s = 0 only, through the point solve's own Newton matrix
-        (folds and the resonant mode's pair; docs/theory.md, "Hill's method at the size
-        of a reduced model"); "strip" asks for the whole strip there too (Neimark-Sacker
+        (folds and the resonant mode's pair; docs/theory.md, "Stability: Hill's
+        method"); "strip" asks for the whole strip there too (Neimark-Sacker
         and period doubling of modes far from resonance), at many times the cost.
         "auto": on where affordable (frirom._pack.resolve_stability: at most
         HILL_AUTO_MAX Hill unknowns, not with a selection, contact coordinates or a cyclic
