@@ -148,3 +148,12 @@ def test_near0_in_contact_coordinates_matches_the_banded_path():
         assert abs(p0.floquet_max_re - pb.floquet_max_re) < 1e-8 * w, \
             (p0.floquet_max_re, pb.floquet_max_re)
         assert abs(ps.floquet_max_re - pb.floquet_max_re) < 1e-8 * w
+
+
+def test_stability_strip_is_an_option_and_bad_values_are_named():
+    """'strip' is a valid stability value (the route it picks is checked above); another
+    string is refused naming the values."""
+    from frirom import ParameterError
+    SolverOptions(stability="strip").check()
+    with pytest.raises(ParameterError, match="'strip'"):
+        SolverOptions(stability="full").check()
