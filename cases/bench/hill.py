@@ -19,7 +19,8 @@ the banded one. "F solve" and "F Hill" are the Fortran run's own times (the solv
 without stability, T_HILL with it), free of the Python packing the wall times include.
 Per model the table gives the Hill unknowns, the route, its memory
 (frirom._routes.hill_bytes), seconds per point with and without stability, and
-|max Re s - the banded path's| where that path fits (dense ROM of 80 DoFs). --flange WORK: the paper flange's ROM_II (WORK/rom2.toml, made by
+|max Re s - the banded path's| where that path fits (dense ROM of 80 DoFs).
+--flange WORK: the paper flange's ROM_II (WORK/rom2.toml, made by
 cases/paper_flange/paper_flange.py make --work WORK) and, with --rom1, ROM_I, one point
 each mid-band; the last line is ROM_I's stability cost per point relative to its solve
 and its memory (targets <= 1x, <= 2 GiB). Writes cases/bench/results/hill.json.
