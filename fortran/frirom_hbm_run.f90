@@ -347,8 +347,7 @@ contains
             call sys%accept(y, lam, info, errmsg)
             if (info /= 0) return
             t0 = 0.0_wp
-            ! the curve's orientation (cont_tangent), without a carried contact history:
-            ! with one J gives the stick tangent, not the curve's
+            ! the curve's orientation (cont_tangent), kept by every point after
             orient = 0.0_wp
             call cont_tangent(sys, y, lam, opts, t0, sign(1.0_wp, opts%lam_end - lam), t, &
                               info, errmsg, orient)
@@ -370,7 +369,6 @@ contains
             call cont_tangent(sys, y, lam, o1, t, 1.0_wp, tj, info, errmsg, orient)
             if (info /= 0) return
         end if
-        if (sys%carry) orient = 0.0_wp
         have_fact = .true.
         do while (npts < maxpts)
             if (orient /= 0.0_wp) then

@@ -534,7 +534,8 @@ contains
                 ! degrees on the paper_hooks ROM_II). Predict along the chord (secant).
                 ch(1:n) = (y1 - y)/opts%yscale
                 ch(n + 1) = (lam1 - lam)/opts%lscale
-                if (chord_wins(ch, t1, t, ds, opts)) t1 = ch/norm2(ch)
+                if (chord_wins(ch, t1, t, ds, opts) .and. .not. &
+                    (oriented(orient) .and. ch(n + 1)*t1(n + 1) < 0.0_wp)) t1 = ch/norm2(ch)
             end if
             angle = acos(max(-1.0_wp, min(1.0_wp, dot_product(t, t1))))
             dist = 0.0_wp
@@ -661,6 +662,13 @@ contains
         retraced = dot_product(t1(1:n), (y1 - y)/opts%yscale) + &
                    t1(n + 1)*(lam1 - lam)/opts%lscale < 0.0_wp
     end function retraced
+
+    !> Whether the curve's orientation is known (orient present and nonzero).
+    pure logical function oriented(orient)
+        real(wp), intent(in), optional :: orient
+        oriented = .false.
+        if (present(orient)) oriented = orient /= 0.0_wp
+    end function oriented
 
     !> Whether the chord ch that reached a point (scaled, not unit; ch(n+1) the parameter)
     !> replaces the tangent tj that J gives there (unit, oriented along tprev, the tangent

@@ -1,5 +1,6 @@
 """The continuation keeps the curve's orientation through the folds and contact-state
-corners of cases/joint/joint_liftoff.toml (420-470 Hz, no carried history).
+corners of cases/joint/joint_liftoff.toml (420-470 Hz), with and without the carried
+contact history.
 
 Between 446 and 450 Hz that curve folds several times (lift-off onset: a fold at 449.6 Hz,
 back to about 447.3 Hz, then up the resonance). Oriented by the previous tangent alone,
@@ -7,9 +8,10 @@ the run at H = 8 took a step onto the branch it had just come along, followed it
 left the range through 420 Hz at 4.2e-4 m, against a peak of 1.29e-3 m at 454 Hz
 (N = 256 with chord steps; N = 128 and 1 024 with full Newton). Tangents now keep
 sign(det J) t_lam, the orientation of the bordered Jacobian, and a step against it is
-rejected (frirom_newton: cont_tangent, retraced).
+rejected (frirom_newton: cont_tangent, retraced); the secant rule (chord_wins) may not
+point against the parameter direction of that tangent.
 
-Independent check: fixed-frequency Newton (Run.solve from the linear solution, no
+Independent check: fixed-frequency Newton (solve_point from the neighbouring point, no
 continuation) at frequencies where the response is unique.
 """
 
@@ -38,17 +40,17 @@ def liftoff():
     return build_deck(parse_deck(DECK, raw))
 
 
-def _frf(deck, H, N, reuse):
+def _frf(deck, H, N, reuse, history):
     opts = dataclasses.replace(deck.options(), harmonics=H, samples=N, stability=False,
-                               history=False, reuse_jacobian=reuse)
+                               history=history, reuse_jacobian=reuse)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         return frf(deck.model(), _excitation(deck.F, H), deck.omega_start, deck.omega_end,
                    opts, outputs=deck.solver_outputs), opts
 
 
-def _check(deck, H, N, reuse, solve_at=()):
-    r, opts = _frf(deck, H, N, reuse)
+def _check(deck, H, N, reuse, history, solve_at=()):
+    r, opts = _frf(deck, H, N, reuse, history)
     assert r.complete, (H, N, reuse, r.message)
     hz = r.frequency_hz
     # never back below the first fold once past it (the retraced curve went to 420 Hz)
@@ -65,19 +67,23 @@ def _check(deck, H, N, reuse, solve_at=()):
     return r.peak(0).amplitude
 
 
-@pytest.mark.parametrize("N, reuse", [(256, True), (128, False)],
-                         ids=["N256-chord", "N128-full_newton"])
-def test_liftoff_h8_runs_through_the_folds(liftoff, N, reuse):
-    # the two (N, Jacobian) pairs that turned back before
-    peak = _check(liftoff, 8, N, reuse, solve_at=(430.0, 455.0, 465.0))
+@pytest.mark.parametrize("N, reuse, history", [(256, True, False), (128, False, False),
+                                               (256, False, True)],
+                         ids=["N256-chord", "N128-full_newton", "N256-full_newton-history"])
+def test_liftoff_h8_runs_through_the_folds(liftoff, N, reuse, history):
+    # (N, Jacobian, history) that turned back before (the last one stopped at the fold
+    # near 447.4 Hz, where the secant rule pointed against the orientation, before that
+    # took precedence)
+    peak = _check(liftoff, 8, N, reuse, history, solve_at=(430.0, 455.0, 465.0))
     assert 1.29e-3 < peak < 1.30e-3
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("history", [False, True], ids=["no_history", "history"])
 @pytest.mark.parametrize("reuse", [True, False], ids=["chord", "full_newton"])
 @pytest.mark.parametrize("H", [4, 8])
-def test_liftoff_curve_completes_for_every_sample_count(liftoff, H, reuse):
-    peaks = np.array([_check(liftoff, H, N, reuse) for N in (128, 256, 512, 1024)])
+def test_liftoff_curve_completes_for_every_sample_count(liftoff, H, reuse, history):
+    peaks = np.array([_check(liftoff, H, N, reuse, history) for N in (128, 256, 512, 1024)])
     # one resonance, the same to the aliasing of N (1.29e-3 m near 454 Hz)
     assert np.all(np.abs(peaks / peaks[-1] - 1) < 3e-3), peaks
     assert 1.28e-3 < peaks[-1] < 1.30e-3
