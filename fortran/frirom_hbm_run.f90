@@ -371,7 +371,7 @@ contains
         end if
         have_fact = .true.
         do while (npts < maxpts)
-            if (orient /= 0.0_wp) then
+            if (orient /= 0.0_wp .and. sys%orient) then
                 call cont_run(sys, y, lam, t, ds, lam_lo, o1, yb, lb, tb, ib, n1, finished, &
                               info, errmsg, have_fact, tj, orient)
             else

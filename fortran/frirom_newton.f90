@@ -285,7 +285,7 @@ contains
     !> the corners where contact states switch (it changes only where the curve is
     !> retraced); orient 0 on entry takes it from the tprev orientation here. Leaves the
     !> factorisation of J at this point in the system, for the next corrector.
-    subroutine cont_tangent(sys, y, lam, opts, tprev, sgn, t, info, errmsg, orient)
+    subroutine cont_tangent(sys, y, lam, opts, tprev, sgn, t, info, errmsg, orient, by_det)
         class(nl_system), intent(inout) :: sys
         real(wp), intent(in) :: y(:), lam
         type(cont_options), intent(in) :: opts
@@ -295,6 +295,7 @@ contains
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
         real(wp), intent(inout), optional :: orient  !! +-1 the curve's orientation, 0 unset
+        logical, intent(out), optional :: by_det     !! t oriented by orient
         real(wp), allocatable :: r(:), rlam(:), b(:, :)
         real(wp) :: rref, nrm, dsg
         integer(ip) :: n
@@ -315,6 +316,7 @@ contains
         end if
         t = t/nrm
         dsg = 0.0_wp
+        if (present(by_det)) by_det = .false.
         if (present(orient)) then
             if (n <= DET_MAX_N) call jac_det_sign(sys, dsg, info, errmsg)
             if (info /= 0) return
@@ -322,6 +324,7 @@ contains
         if (dsg /= 0.0_wp .and. orient /= 0.0_wp) then
             ! t(n + 1) > 0 here: the sign that keeps sign(det J) t_lam the curve's
             t = (orient*dsg)*t
+            if (present(by_det)) by_det = .true.
             return
         end if
         if (any(tprev /= 0.0_wp)) then
@@ -333,8 +336,10 @@ contains
     end subroutine cont_tangent
 
     !> Sign of det J (+-1), J as the last eval with jac factorised it: J^-1 by n solves,
-    !> then its LU (for small systems only: n solves and an n^3 LU); 0 if J^-1 is not
-    !> finite or singular.
+    !> then its LU (for small systems only: n solves and an n^3 LU); 0 where it says
+    !> nothing: J^-1 not finite, or J singular to the working precision (pivots of J^-1
+    !> spread by more than 1e10: a direction the equations leave free, e.g. a slider's
+    !> mean position in gross slip, where the sign is rounding).
     subroutine jac_det_sign(sys, dsg, info, errmsg)
         class(nl_system), intent(inout) :: sys
         real(wp), intent(out) :: dsg
@@ -354,6 +359,8 @@ contains
         if (info /= 0 .or. .not. all(abs(x) <= huge(1.0_wp))) return
         call dgetrf(n, n, x, n, ipiv, linfo)
         if (linfo /= 0) return
+        if (maxval(abs([(x(i, i), i=1, n)])) > 1.0e10_wp*minval(abs([(x(i, i), i=1, n)]))) &
+            return
         dsg = 1.0_wp
         do i = 1, n
             if (ipiv(i) /= i) dsg = -dsg
@@ -397,7 +404,7 @@ contains
         real(wp), allocatable :: y1(:), yp(:), t1(:), cy(:), ch(:), tjl(:)
         real(wp) :: lam1, lp, dirn, frac, cl, angle, dist
         integer(ip) :: n, iters
-        logical :: last, turned, retried
+        logical :: last, turned, retried, by_det
         integer(ip) :: nf, effort
         type(cont_options) :: fresh_opts
         character(len=len(errmsg)) :: why
@@ -502,12 +509,12 @@ contains
             ! after a corner the new tangent is oriented along the branch taken (t1)
             if (turned) t = t1
             if (info == 0) call cont_tangent(sys, y1, lam1, opts, t, dirn, t1, info, errmsg, &
-                                             orient)
+                                             orient, by_det)
             if (info /= 0) then
                 have_fact = .false.
                 return
             end if
-            if (.not. last .and. retraced(y, lam, y1, lam1, t1, opts, orient)) then
+            if (.not. last .and. by_det .and. retraced(y, lam, y1, lam1, t1, opts, orient)) then
                 ! the curve retraced: a shorter step (as after a failed corrector)
                 have_fact = .false.
                 if (ds <= opts%ds_min*1.000001_wp) then
@@ -535,7 +542,7 @@ contains
                 ch(1:n) = (y1 - y)/opts%yscale
                 ch(n + 1) = (lam1 - lam)/opts%lscale
                 if (chord_wins(ch, t1, t, ds, opts) .and. .not. &
-                    (oriented(orient) .and. ch(n + 1)*t1(n + 1) < 0.0_wp)) t1 = ch/norm2(ch)
+                    (by_det .and. ch(n + 1)*t1(n + 1) < 0.0_wp)) t1 = ch/norm2(ch)
             end if
             angle = acos(max(-1.0_wp, min(1.0_wp, dot_product(t, t1))))
             dist = 0.0_wp
@@ -594,7 +601,7 @@ contains
         real(wp), allocatable :: yp(:), ch(:), tk(:)
         real(wp) :: lp, dch, ork
         integer(ip) :: n, k, info2
-        logical :: ratchet
+        logical :: ratchet, by_det
         character(len=len(errmsg)) :: msg2
         n = size(y)
         turned = .false.
@@ -633,10 +640,11 @@ contains
                     ! the branch just left, taken backward, is no way past the corner
                     msg2 = ''
                     ork = orient
-                    call cont_tangent(sys, y1, lam1, opts, tc, 1.0_wp, tk, info2, msg2, ork)
+                    call cont_tangent(sys, y1, lam1, opts, tc, 1.0_wp, tk, info2, msg2, ork, &
+                                      by_det)
                     have_fact = .false.
                     if (info2 /= 0) cycle
-                    if (retraced(y, lam, y1, lam1, tk, opts, ork)) cycle
+                    if (by_det .and. retraced(y, lam, y1, lam1, tk, opts, ork)) cycle
                 end if
                 turned = .true.
                 info = FRIROM_OK
@@ -662,13 +670,6 @@ contains
         retraced = dot_product(t1(1:n), (y1 - y)/opts%yscale) + &
                    t1(n + 1)*(lam1 - lam)/opts%lscale < 0.0_wp
     end function retraced
-
-    !> Whether the curve's orientation is known (orient present and nonzero).
-    pure logical function oriented(orient)
-        real(wp), intent(in), optional :: orient
-        oriented = .false.
-        if (present(orient)) oriented = orient /= 0.0_wp
-    end function oriented
 
     !> Whether the chord ch that reached a point (scaled, not unit; ch(n+1) the parameter)
     !> replaces the tangent tj that J gives there (unit, oriented along tprev, the tangent
