@@ -9,9 +9,6 @@ submodule (frirom_run) frirom_run_drive
     use frirom_epmc, only: hbm_epmc_guess
     implicit none
 
-    !> Systems of fewer unknowns take full Newton steps whatever reuse_jacobian says
-    integer(ip), parameter :: FULL_NEWTON_N = 64
-
     !> Where a segment (one hbm_run call) starts and how far it may go.
     type :: seg_start
         integer(ip) :: mode = HBM_START_CONTINUE    !! HBM_START_*
@@ -474,10 +471,7 @@ contains
         o%tol_x = run%s%tol_update
         o%tol_stall = run%s%tol_stall
         o%max_iter = run%s%max_iter
-        ! below FULL_NEWTON_N unknowns every iteration factorises J at its point: an
-        ! evaluation costs about as much as a chord step there, and full Newton needs
-        ! fewer (the friction beam: 894 evaluations against 1 451)
-        o%reuse_jac = run%s%reuse_jacobian /= 0 .and. n >= FULL_NEWTON_N
+        o%reuse_jac = run%s%reuse_jacobian /= 0
         o%yscale = st%yscale
         o%lscale = st%lscale
         o%ds = st%ds
