@@ -91,6 +91,8 @@ def main(argv=None):
                     help="contact pairs at every stride-th lattice point (2: coarse)")
     ap.add_argument("--work", type=Path, default=None,
                     help="folder of the matrices and decks (default: cases/upd itself)")
+    ap.add_argument("--workers", type=int, default=1,
+                    help="members run at once (a local Dask cluster; 1: in this process)")
     a = ap.parse_args(argv)
     from frirom.deck import load_deck
     from frirom.study import run_study
@@ -102,7 +104,9 @@ def main(argv=None):
                 shutil.copy(HERE / name, work / name)
     if not (work / "upd.sti").exists():
         make_upd.make(work, stride=a.stride)
-    res = run_study(work / "upd_design.toml", a.out, scheduler="serial")
+    res = run_study(work / "upd_design.toml", a.out,
+                    scheduler="serial" if a.workers <= 1 else "local",
+                    workers=a.workers if a.workers > 1 else None)
     loads, peaks, ok = [], [], []
     for s in res["summaries"]:
         loads.append(float(next(iter(s["values"].values()))))
