@@ -97,7 +97,7 @@ def plot_design(loads, peaks, limits, opt, ok):
     ax.semilogx(loads[done], peaks[done], "o-", color="C0", label="HBM: peak of TIP_0 x")
     if np.any(stop):
         ax.semilogx(loads[stop], peaks[stop], "x", color="C3", ms=9,
-                    label="curve turned back (the damper lifts off: a fold)")
+                    label="curve turned back at a fold (lift-off): largest before it")
     if np.any(going):
         ax.semilogx(loads[going], peaks[going], "^", color="C4", ms=8,
                     label="curve unfinished: largest so far (a lower bound)")
