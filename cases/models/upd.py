@@ -54,7 +54,8 @@ def _blade(i):
 DAMPER = [(15, 25, 8, 10, 1, 9)]
 #: the damper's retainer, N/m per direction (the whole damper): 1.6e4 N/m puts its
 #: translations on the retainer near 200 Hz (mass 10.0 g), 1/10 of the band; it is
-#: 2.7e-4 of the contacts' stuck tangential stiffness on the full model (90 x 2e6 N/m)
+#: 8.9e-5 of the contacts' stuck tangential stiffness on the full model (90 x 2e6 N/m),
+#: 2.7e-4 on the coarse one (30 pairs)
 RETAINER = 1.6e4
 #: contact patches (x0, x1) at y = 10, z in [1, 9]: left on blade 0, right on blade 1
 PATCHES = {"L": (15, 19, 0), "R": (21, 25, 1)}
