@@ -35,7 +35,7 @@ import warnings
 from pathlib import Path
 
 from . import __version__
-from ._errors import FriromError, InputError
+from ._errors import FriromError, InputError, with_hz
 from ._resume import EXIT_INPUT, EXIT_INTERRUPTED, EXIT_OK, EXIT_STOPPED
 
 
@@ -705,14 +705,6 @@ def _print_peaks(result, deck) -> None:
               f"({p.method})")
 
 
-_RAD_S = re.compile(r"([-+]?\d[\d.]*(?:[eE][-+]?\d+)?) ?rad/s(?! \()")
-
-
-def with_hz(text: str) -> str:
-    """A message's frequencies in rad/s followed by the same in Hz:
-    ``through omega = 2950.3 rad/s`` -> ``... 2950.3 rad/s (469.56 Hz)``."""
-    return _RAD_S.sub(lambda m: f"{m.group(0)} ({float(m.group(1)) / 2 / 3.141592653589793:.6g}"
-                      " Hz)", text)
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
