@@ -9,6 +9,7 @@ submodule (frirom_hbm) frirom_hbm_hill
                              FRIROM_ERR_SINGULAR, FRIROM_ERR_ARPACK, FRIROM_ERR_MODEL, &
                              FRIROM_ERR_PARAM, set_status
     use frirom_banded, only: band_init, band_add, band_factor, band_solve
+    use frirom_arpack, only: znaupd, zneupd
     implicit none
 
     !> Eigenvalues Arnoldi wants per shift at first, at most.
@@ -31,38 +32,6 @@ submodule (frirom_hbm) frirom_hbm_hill
         real(wp), allocatable :: s(:, :)      !! (m, m) LU of S
         integer, allocatable :: ipiv(:)
     end type modal_hill
-
-    interface
-        subroutine znaupd(ido, bmat, n, which, nev, tol, resid, ncv, v, ldv, iparam, ipntr, &
-                          workd, workl, lworkl, rwork, info)
-            import :: wp
-            integer, intent(inout) :: ido
-            character(len=1), intent(in) :: bmat
-            integer, intent(in) :: n, nev, ncv, ldv, lworkl
-            character(len=2), intent(in) :: which
-            real(wp), intent(inout) :: tol
-            complex(wp), intent(inout) :: resid(n), v(ldv, ncv), workd(3*n), workl(lworkl)
-            real(wp), intent(inout) :: rwork(ncv)
-            integer, intent(inout) :: iparam(11), ipntr(14), info
-        end subroutine znaupd
-        subroutine zneupd(rvec, howmny, sel, d, z, ldz, sigma, workev, bmat, n, which, nev, &
-                          tol, resid, ncv, v, ldv, iparam, ipntr, workd, workl, lworkl, &
-                          rwork, info)
-            import :: wp
-            integer, intent(in) :: ldz, n, nev, ncv, ldv, lworkl
-            logical, intent(in) :: rvec
-            character(len=1), intent(in) :: howmny, bmat
-            logical, intent(inout) :: sel(ncv)
-            complex(wp), intent(out) :: d(nev + 1), z(ldz, *)
-            complex(wp), intent(in) :: sigma
-            complex(wp), intent(inout) :: workev(2*ncv)
-            character(len=2), intent(in) :: which
-            real(wp), intent(inout) :: tol
-            complex(wp), intent(inout) :: resid(n), v(ldv, ncv), workd(3*n), workl(lworkl)
-            real(wp), intent(inout) :: rwork(ncv)
-            integer, intent(inout) :: iparam(11), ipntr(14), info
-        end subroutine zneupd
-    end interface
 
 contains
 

@@ -15,41 +15,12 @@
 !> (hbm_system%hill_strip: frirom_hbm_hill's disc_exponents).
 submodule (frirom_hbm:frirom_hbm_factor) frirom_hbm_hill_s0
     use frirom_status, only: FRIROM_ERR_ARPACK, itoa
+    use frirom_arpack, only: dnaupd, dneupd
     implicit none
 
     !> GMRES on the Newton matrix: relative residual, iterations before a second try
     real(wp), parameter :: S0_GMTOL = 1.0e-11_wp
     integer(ip), parameter :: S0_GMIT = 60
-
-    interface
-        subroutine dnaupd(ido, bmat, n, which, nev, tol, resid, ncv, v, ldv, iparam, ipntr, &
-                          workd, workl, lworkl, info)
-            import :: wp
-            integer, intent(inout) :: ido
-            character(len=1), intent(in) :: bmat
-            integer, intent(in) :: n, nev, ncv, ldv, lworkl
-            character(len=2), intent(in) :: which
-            real(wp), intent(inout) :: tol
-            real(wp), intent(inout) :: resid(n), v(ldv, ncv), workd(3*n), workl(lworkl)
-            integer, intent(inout) :: iparam(11), ipntr(14), info
-        end subroutine dnaupd
-        subroutine dneupd(rvec, howmny, sel, dr, di, z, ldz, sigmar, sigmai, workev, bmat, &
-                          n, which, nev, tol, resid, ncv, v, ldv, iparam, ipntr, workd, &
-                          workl, lworkl, info)
-            import :: wp
-            integer, intent(in) :: ldz, n, nev, ncv, ldv, lworkl
-            logical, intent(in) :: rvec
-            character(len=1), intent(in) :: howmny, bmat
-            logical, intent(inout) :: sel(ncv)
-            real(wp), intent(out) :: dr(nev + 1), di(nev + 1), z(ldz, *)
-            real(wp), intent(in) :: sigmar, sigmai
-            real(wp), intent(inout) :: workev(3*ncv)
-            character(len=2), intent(in) :: which
-            real(wp), intent(inout) :: tol
-            real(wp), intent(inout) :: resid(n), v(ldv, ncv), workd(3*n), workl(lworkl)
-            integer, intent(inout) :: iparam(11), ipntr(14), info
-        end subroutine dneupd
-    end interface
 
 contains
 
