@@ -273,6 +273,15 @@ def point_state(frf: FRF, deck, index: int, omega: float) -> PointState:
                       held=held, patch=patch_warnings(model, contacts))
 
 
+def print_contacts(state, top: int, per: str) -> None:
+    """The (at most three) elements that dissipate most, with their states."""
+    for g, e in _chosen(state, None, min(top, 3)):
+        c = state.contacts[g]
+        print(f"frirom: contact {c.name}:{e} dissipates {c.energy[e]:.4g} J per {per} "
+              f"(stick {c.states[e, 0]:.0%}, slip {c.states[e, 1]:.0%}, lift-off "
+              f"{c.states[e, 2]:.0%})")
+
+
 def _chosen(state: PointState, chosen, n_top: int) -> list:
     """[(group index, element)] of the contacts to draw: `chosen` ("name:e" or "e" of the
     first group), else the n_top dissipating most."""
@@ -461,11 +470,7 @@ def cmd_show(args) -> int:
     print(f"frirom: work per period: excitation {b['excitation']:.6g} J = contacts "
           f"{b['contacts']:.6g} J + viscous {b['viscous']:.6g} J (residual "
           f"{b['residual']:.3g} J)")
-    for g, e in _chosen(state, None, min(args.top, 3)):
-        c = state.contacts[g]
-        print(f"frirom: contact {c.name}:{e} dissipates {c.energy[e]:.4g} J per period "
-              f"(stick {c.states[e, 0]:.0%}, slip {c.states[e, 1]:.0%}, lift-off "
-              f"{c.states[e, 2]:.0%})")
+    print_contacts(state, args.top, "period")
     from .held import held_lines
     for line in held_lines(state.held):
         print(f"frirom: {line}")

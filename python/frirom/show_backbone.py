@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ._errors import InputError
-from .show import PointState, _chosen, contact_fields, write_point
+from .show import PointState, contact_fields, print_contacts, write_point
 
 __all__ = ["backbone_point_state", "pick_backbone_point", "cmd_show_backbone"]
 
@@ -107,10 +107,6 @@ def cmd_show_backbone(args, h5: Path) -> int:
     print(f"frirom: energy per cycle: mode {b['excitation']:.6g} J = contacts "
           f"{b['contacts']:.6g} J + viscous {b['viscous']:.6g} J (residual "
           f"{b['residual']:.3g} J)")
-    for g, e in _chosen(state, None, min(args.top, 3)):
-        c = state.contacts[g]
-        print(f"frirom: contact {c.name}:{e} dissipates {c.energy[e]:.4g} J per cycle "
-              f"(stick {c.states[e, 0]:.0%}, slip {c.states[e, 1]:.0%}, lift-off "
-              f"{c.states[e, 2]:.0%})")
+    print_contacts(state, args.top, "cycle")
     print("frirom: wrote " + ", ".join(str(p) for p in written), file=sys.stdout)
     return 0
