@@ -515,17 +515,18 @@ contains
                 return
             end if
             if (.not. last .and. by_det .and. retraced(y, lam, y1, lam1, t1, opts, orient)) then
-                ! the curve retraced: a shorter step (as after a failed corrector)
-                have_fact = .false.
-                if (ds <= opts%ds_min*1.000001_wp) then
-                    call set_status(info, FRIROM_ERR_CONT, errmsg, 'continuation stopped')
-                    write (buf, '(a,es12.5,a,es9.2,a)') ' at parameter ', lam, &
-                        ' with step ', ds, ' at its minimum; every step retraced the curve'
-                    errmsg = trim(errmsg)//trim(buf)
-                    return
+                if (ds > opts%ds_min*1.000001_wp) then
+                    ! the curve retraced: a shorter step (as after a failed corrector)
+                    have_fact = .false.
+                    ds = 0.5_wp*ds
+                    cycle
                 end if
-                ds = 0.5_wp*ds
-                cycle
+                ! still at the minimum step: the determinant's sign is not trusted here (a
+                ! coarse AFT's corner can flip it, e.g. the joint at H = 5, N = 32): the
+                ! point is taken with its tangent along the previous one, as without the
+                ! orientation, which the next point takes up again (orient 0)
+                if (dot_product(t1, t) < 0.0_wp) t1 = -t1
+                orient = 0.0_wp
             end if
             have_fact = .true.
             retried = .false.
