@@ -9,7 +9,7 @@ submodule (frirom_epmc) frirom_hbm_epmc
                              FRIROM_ERR_SINGULAR, FRIROM_ERR_LAPACK, set_status
     use frirom_lapack, only: dgetrf, dgetrs
     use frirom_csr, only: csr_matvec_add
-    use frirom_hbm, only: csr_matrix, contact_assemble, contact_eval, wtime, T_AFT, T_ASM, T_FACT, &
+    use frirom_hbm, only: contact_assemble, contact_eval, wtime, T_AFT, T_ASM, T_FACT, &
                           T_SOLVE, N_EVAL, N_FACT
     implicit none
 
@@ -39,7 +39,7 @@ contains
                                 'the linear natural frequency (rad/s > 0) expected')
                 return
             end if
-            call epmc_normalise(sys, phi, 'phi', sys%phi, mphi, info, errmsg)
+            call epmc_normalise(sys%m, phi, 'phi', sys%phi, mphi, info, errmsg)
             if (info /= 0) return
             sys%pw = mphi/norm2(mphi)
             sys%w0 = w0
@@ -116,7 +116,7 @@ contains
         info = FRIROM_OK
         allocate (mphin(size(phi)))
         mphin = 0.0_wp
-        call csr_matvec_add(this%m, phi, mphin, 1.0_wp)
+        call csr_matvec_add(m, phi, mphin, 1.0_wp)
         mn = dot_product(phi, mphin)
         if (.not. (mn > 0.0_wp)) then
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: '//what// &

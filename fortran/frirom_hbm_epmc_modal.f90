@@ -58,12 +58,12 @@ contains
             do j = 1, nnl
                 sys%colmap(nl(j)) = j
             end do
-            call epmc_normalise(sys, phi0, 'phi', sys%phi0, mp0, info, errmsg)
+            call epmc_normalise(sys%m, phi0, 'phi', sys%phi0, mp0, info, errmsg)
             if (info /= 0) return
             allocate (sys%phn(nnl, nm), sys%pho(size(sys%outdofs), nm), sys%cph(nm), &
                       sys%qst(nm))
             do r = 1, nm
-                call epmc_normalise(sys, phi(:, r), 'mode '//itoa(r), pn, mv, info, errmsg)
+                call epmc_normalise(sys%m, phi(:, r), 'mode '//itoa(r), pn, mv, info, errmsg)
                 if (info /= 0) return
                 sys%phn(:, r) = pn(nl)
                 sys%pho(:, r) = pn(sys%outdofs)

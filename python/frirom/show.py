@@ -128,18 +128,29 @@ def parse_frequency(text: str, unit: str = "hz") -> float:
     return v * 2.0 * np.pi if u == "hz" else v
 
 
+def stored_count(stored, what: str) -> int:
+    """len(stored), an InputError naming ``what`` when it holds no point."""
+    n = len(stored)
+    if n == 0:
+        raise InputError(f"{what} holds no point")
+    return n
+
+
+def stored_index(point: int, n: int) -> int:
+    """--point (negative from the end) as an index into n stored points."""
+    if not -n <= point < n:
+        raise InputError(f"--point: expected an index in {-n}..{n - 1}, got {point}")
+    return point % n
+
+
 def pick_point(frf: FRF, *, at: float | None = None, point: int | None = None,
                peak: bool = False) -> tuple[int, float]:
     """(stored point index, omega rad/s) of one choice: a frequency (the stored point
     nearest in frequency starts the solve; on a folded curve, the first of the nearest
     ones), a point index (negative from the end), or the peak of the first output."""
-    n = len(frf)
-    if n == 0:
-        raise InputError("the result holds no point")
+    n = stored_count(frf, "the result")
     if point is not None:
-        if not -n <= point < n:
-            raise InputError(f"--point: expected an index in {-n}..{n - 1}, got {point}")
-        k = point % n
+        k = stored_index(point, n)
         return k, float(frf.omega[k])
     if peak:
         p = frf.peak(0)

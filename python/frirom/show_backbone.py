@@ -17,7 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from ._errors import InputError
-from .show import PointState, contact_fields, print_contacts, write_point
+from .show import (PointState, contact_fields, print_contacts, stored_count, stored_index,
+                   write_point)
 
 __all__ = ["backbone_point_state", "pick_backbone_point", "cmd_show_backbone"]
 
@@ -27,13 +28,9 @@ def pick_backbone_point(bb, *, amplitude: float | None = None, point: int | None
     """Index of a backbone point: the stored point K (negative from the end), the one
     nearest a modal amplitude (in log), or, neither given, the one of largest damping
     ratio."""
-    n = len(bb)
-    if n == 0:
-        raise InputError("the backbone holds no point")
+    n = stored_count(bb, "the backbone")
     if point is not None:
-        if not -n <= point < n:
-            raise InputError(f"--point: expected an index in {-n}..{n - 1}, got {point}")
-        return point % n
+        return stored_index(point, n)
     if amplitude is not None:
         lo, hi = float(bb.amplitude.min()), float(bb.amplitude.max())
         if not (amplitude > 0 and lo * (1 - 1e-9) <= amplitude <= hi * (1 + 1e-9)):
