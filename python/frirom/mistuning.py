@@ -30,6 +30,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.stats import binom
 
+from ._cluster import local_workers
 from ._errors import InputError, ParameterError
 from .model import Damping
 from .reduction.mistuning import (MistuningSector, deviations, stick_stiffnesses,
@@ -283,11 +284,6 @@ def monte_carlo(disk: MistunedDisk, n_samples: int, std: float, seed: int = 0,
     return {"tuned": tuned, "af": af, "samples": samples, "stats": statistics(af)}
 
 
-#: Environment of LocalCluster workers: one BLAS/OpenMP thread each, so that n workers
-#: use n cores and not n times the machine.
-ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
-
-
 def _warm() -> float:
     """Run on a worker: import what a sample needs (the import itself happens when this
     function is unpickled there); returns the worker's pid for the caller's bookkeeping."""
@@ -311,13 +307,6 @@ def warm_workers(client) -> dict:
     return out
 
 
-#: Dask settings of the LocalCluster workers that :func:`local_cluster` makes (see there).
-QUIET_WORKER = {"distributed.worker.profile.enabled": False,
-                "distributed.admin.tick.interval": "1s",
-                "distributed.admin.system-monitor.interval": "5s",
-                "distributed.worker.memory.monitor-interval": "1s"}
-
-
 def _own_session() -> str:
     """Run on a LocalCluster worker: make it a session of its own (os.setsid)."""
     import os
@@ -334,13 +323,8 @@ def local_cluster(n_workers: int = 2):
     and the cluster (pass the client to :func:`monte_carlo` for several studies). What
     keeps two workers near twice one on a shared machine:
 
-    - one BLAS/OpenMP thread per worker (:data:`ONE_THREAD`);
-    - Dask's statistical profiler off in the workers: it samples the task thread's stack
-      every 10 ms, about 15-30 % more CPU per friction sample (measured: 1.1 CPU s per
-      sample in a worker against 0.9 s serially; 0.94 s with the profiler off); and the
-      workers' event-loop tick, system and memory monitors at 1-5 s instead of 20-500
-      ms (an idle worker: 2.2 % of a core, then 0.26 %, which a loaded machine turns into
-      CPU seconds per sample: the wall time of a sample is several times its CPU time);
+    - the workers of :func:`frirom._cluster.local_workers` (one BLAS thread, glibc's
+      allocator as in a serial run, Dask's profiler and monitors quiet);
     - every worker a session of its own: Linux (``sched_autogroup``) shares the CPU
       between sessions, not processes, and the workers would otherwise share the session
       of the process that started them, so that on a loaded machine two workers got the
@@ -349,11 +333,8 @@ def local_cluster(n_workers: int = 2):
     - frirom imported in each worker before any task, one worker at a time
       (:func:`warm_workers`).
     """
-    import dask
-    from dask.distributed import Client, LocalCluster
-    with dask.config.set(QUIET_WORKER):
-        cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                               dashboard_address=None, env=ONE_THREAD)
+    from dask.distributed import Client
+    cluster = local_workers(n_workers)
     client = Client(cluster)
     try:
         seconds = warm_workers(client)        # first: unpickling imports frirom
