@@ -8,7 +8,6 @@ one load (32 N x the pairs) must build the same contact parameters and loads, to
 round-off."""
 
 import re
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -21,14 +20,11 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture(scope="module")
-def lap(tmp_path_factory):
-    if shutil.which("ccx") is None:
-        pytest.skip("ccx not installed")
-    pytest.importorskip("gmsh")
-    import make_lap_joint
-    from _models import small_lap_joint_deck
-    out = tmp_path_factory.mktemp("lap_preload")
-    make_lap_joint.make(out, size=0.012)
+def lap(lap_joint_mesh, tmp_path_factory):
+    """The session's coarse lap-joint mesh (conftest.py) in a folder of this module's own,
+    and its small CB-only deck."""
+    from _models import copy_job, small_lap_joint_deck
+    out = copy_job(lap_joint_mesh, tmp_path_factory.mktemp("lap_preload"))
     return out, small_lap_joint_deck(None)
 
 

@@ -158,6 +158,17 @@ def brb_mesh(size=SIZES["coarse"], length=GEOMETRY["length"], width=GEOMETRY["wi
     return ids, xyz, elems, sets
 
 
+def _elements(fh, e, etype, elset, rows, card):
+    """An *ELEMENT block of type etype in elset, one element a row of node ids (numbered
+    from e on), then its property card; returns the next free element number."""
+    fh.write(f"*ELEMENT, TYPE={etype}, ELSET={elset}\n")
+    for row in rows:
+        fh.write(", ".join(str(v) for v in (e, *row)) + "\n")
+        e += 1
+    fh.write(card)
+    return e
+
+
 def _springs(fh, first, sets, xyz_of, joined=None):
     """SPRING1 suspension on SUSP (K_SUSP per direction and beam, split over its nodes)
     and, with joined = [(a_nodes, b_nodes, kt, kn), ...], SPRING2 elements joining each
@@ -168,18 +179,12 @@ def _springs(fh, first, sets, xyz_of, joined=None):
     for d in (1, 2, 3):
         for side in (False, True):
             nodes = susp[beam_b == side]
-            fh.write(f"*ELEMENT, TYPE=SPRING1, ELSET=ES{d}{int(side)}\n")
-            for n in nodes:
-                fh.write(f"{e}, {n}\n")
-                e += 1
-            fh.write(f"*SPRING, ELSET=ES{d}{int(side)}\n{d}\n{K_SUSP / len(nodes):.9g}\n")
+            e = _elements(fh, e, "SPRING1", f"ES{d}{int(side)}", [(n,) for n in nodes],
+                          f"*SPRING, ELSET=ES{d}{int(side)}\n{d}\n{K_SUSP / len(nodes):.9g}\n")
     for g, (a_nodes, b_nodes, kt, kn) in enumerate(joined or ()):
         for d, k in ((1, kt), (2, kt), (3, kn)):
-            fh.write(f"*ELEMENT, TYPE=SPRING2, ELSET=EJ{g}_{d}\n")
-            for a, b in zip(a_nodes, b_nodes):
-                fh.write(f"{e}, {a}, {b}\n")
-                e += 1
-            fh.write(f"*SPRING, ELSET=EJ{g}_{d}\n{d},{d}\n{k:.10e}\n")
+            e = _elements(fh, e, "SPRING2", f"EJ{g}_{d}", zip(a_nodes, b_nodes),
+                          f"*SPRING, ELSET=EJ{g}_{d}\n{d},{d}\n{k:.10e}\n")
     return e
 
 
@@ -213,22 +218,16 @@ def _bolts(fh, first, sets, xyz_of):
     m, _ = bolt_hardware()
     e = first
     for j, (nb, na, k) in enumerate(bolt_springs(sets, xyz_of)):
-        fh.write(f"*ELEMENT, TYPE=SPRING2, ELSET=EBOLT{j}\n")
-        for b, a in zip(nb, na):
-            fh.write(f"{e}, {b}, {a}\n")
-            e += 1
-        fh.write(f"*SPRING, ELSET=EBOLT{j}\n3,3\n{k:.10e}\n")
+        e = _elements(fh, e, "SPRING2", f"EBOLT{j}", zip(nb, na),
+                      f"*SPRING, ELSET=EBOLT{j}\n3,3\n{k:.10e}\n")
     for name in ("WASHER_A", "WASHER_B"):
         nodes = np.asarray(sets[name])
         x = xyz_of(nodes)[:, 0]
         which = np.argmin(np.abs(x[:, None] - bolt_centres()[None, :]), axis=1)
         for j in range(len(BOLTS["offsets"])):
             mine = nodes[which == j]
-            fh.write(f"*ELEMENT, TYPE=MASS, ELSET=EM{name[-1]}{j}\n")
-            for n in mine:
-                fh.write(f"{e}, {n}\n")
-                e += 1
-            fh.write(f"*MASS, ELSET=EM{name[-1]}{j}\n{m / 2 / mine.size:.10e}\n")
+            e = _elements(fh, e, "MASS", f"EM{name[-1]}{j}", [(n,) for n in mine],
+                          f"*MASS, ELSET=EM{name[-1]}{j}\n{m / 2 / mine.size:.10e}\n")
     return e
 
 

@@ -220,6 +220,15 @@ def contact_fields(model, x: np.ndarray, slider: np.ndarray, n_samples: int) -> 
     return out
 
 
+def viscous_work(C, x: np.ndarray, omega: float, H: int) -> float:
+    """The energy [J] the viscous damping C dissipates in one period of the real harmonics
+    x (n, 2H+1) at omega [rad/s]: pi omega sum_h h^2 (a_h' C a_h + b_h' C b_h)."""
+    h = np.arange(1, H + 1)
+    a, b = x[:, 1::2], x[:, 2::2]
+    return float(omega * np.pi * np.sum(h**2 * (np.einsum("ih,ih->h", a, C @ a)
+                                                + np.einsum("ih,ih->h", b, C @ b))))
+
+
 def _sector_viscous_work(model: CyclicModel, fe: np.ndarray, contacts: list, omega: float,
                          H: int) -> float:
     """Viscous work per period of a cyclic sector from its modes: harmonic h on nodal
@@ -269,11 +278,7 @@ def point_state(frf: FRF, deck, index: int, omega: float) -> PointState:
         visc = _sector_viscous_work(model, exc.real_harmonic(n, opts.harmonics), contacts,
                                     omega, opts.harmonics)
     else:
-        h = np.arange(1, opts.harmonics + 1)
-        a, b = x[:, 1::2], x[:, 2::2]
-        C = model.C
-        visc = float(omega * np.pi * np.sum(h**2 * (np.einsum("ih,ih->h", a, C @ a)
-                                                    + np.einsum("ih,ih->h", b, C @ b))))
+        visc = viscous_work(model.C, x, omega, opts.harmonics)
     dis = float(sum(c.energy.sum() for c in contacts))
     bal = {"excitation": ext, "contacts": dis, "viscous": visc,
            "residual": ext - dis - visc}

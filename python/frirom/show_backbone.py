@@ -18,7 +18,7 @@ import numpy as np
 
 from ._errors import InputError
 from .show import (PointState, contact_fields, print_contacts, stored_count, stored_index,
-                   write_point)
+                   viscous_work, write_point)
 
 __all__ = ["backbone_point_state", "pick_backbone_point", "cmd_show_backbone"]
 
@@ -52,11 +52,7 @@ def backbone_point_state(bb, deck, index: int) -> PointState:
               else np.zeros(0))
     contacts = contact_fields(model, x, slider, opts.n_samples)
     omega = float(bb.omega[index])
-    h = np.arange(1, bb.H + 1)
-    a, b = x[:, 1::2], x[:, 2::2]
-    C = model.C
-    visc = float(omega * np.pi * np.sum(h ** 2 * (np.einsum("ih,ih->h", a, C @ a)
-                                                  + np.einsum("ih,ih->h", b, C @ b))))
+    visc = viscous_work(model.C, x, omega, bb.H)
     dis = float(sum(c.energy.sum() for c in contacts))
     ext = float(bb.energy[index])
     P = deck.output_map
