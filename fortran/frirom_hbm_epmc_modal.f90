@@ -5,7 +5,8 @@
 !> x = a cos + b sin.
 submodule (frirom_epmc) frirom_hbm_epmc_modal
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, &
-                             FRIROM_ERR_SINGULAR, FRIROM_ERR_LAPACK, set_status, itoa
+                             FRIROM_ERR_SINGULAR, FRIROM_ERR_LAPACK, set_status, itoa, &
+                             failed
     use frirom_csr, only: csr_matvec_add
     use frirom_hbm, only: contact_assemble, contact_eval, wtime, T_AFT, T_ASM, T_FACT, T_SOLVE, &
                           N_EVAL, N_FACT
@@ -42,13 +43,11 @@ contains
                                 'DoF out of range')
                 return
             end if
-            if (.not. (all(wm > 0.0_wp) .and. all(zm >= 0.0_wp) .and. w0 > 0.0_wp .and. &
-                       all(abs(phi) <= huge(1.0_wp)) .and. all(abs(phi0) <= huge(1.0_wp)) &
-                       .and. all(abs(wm) + abs(zm) <= huge(1.0_wp)))) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode (condensed):'// &
-                                ' finite modes, omega > 0 (no rigid-body mode) and zeta >= 0')
-                return
-            end if
+            if (failed(.not. (all(wm > 0.0_wp) .and. all(zm >= 0.0_wp) .and. w0 > 0.0_wp &
+                       .and. all(abs(phi) <= huge(1.0_wp)) .and. all(abs(phi0) <= huge(1.0_wp)) &
+                       .and. all(abs(wm) + abs(zm) <= huge(1.0_wp))), info, FRIROM_ERR_PARAM, &
+                       errmsg, 'nonlinear mode (condensed): finite modes, omega > 0 (no '// &
+                       'rigid-body mode) and zeta >= 0')) return
             sys%nm = nm
             sys%nnl = nnl
             sys%nl = nl

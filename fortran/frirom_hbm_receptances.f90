@@ -6,7 +6,7 @@
 !> of D_h = K + i h w C - (h w)^2 M per harmonic, banded (RCM order) or sparse (MUMPS).
 submodule (frirom_hbm) frirom_hbm_receptances
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, FRIROM_ERR_ALLOC, &
-                             FRIROM_ERR_MODEL, FRIROM_ERR_NONFINITE, set_status
+                             FRIROM_ERR_MODEL, FRIROM_ERR_NONFINITE, set_status, failed
     use frirom_banded, only: zband_init, zband_zero, zband_add, zband_factor, zband_solve
     use frirom_zsparse, only: zsparse_solve
     implicit none
@@ -17,15 +17,11 @@ contains
         integer(ip) :: nm
         info = FRIROM_OK
         nm = size(phi, 2)
-        if (size(phi, 1) /= sysc%ndof .or. size(wm) /= nm .or. size(zm) /= nm .or. nm < 1) then
-            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'modes: phi (ndof, nm), '// &
-                            'omega and zeta (nm)')
-            return
-        end if
-        if (.not. all(abs(phi) <= huge(1.0_wp))) then
-            call set_status(info, FRIROM_ERR_NONFINITE, errmsg, 'modes: phi has NaN or Inf')
-            return
-        end if
+        if (failed(size(phi, 1) /= sysc%ndof .or. size(wm) /= nm .or. size(zm) /= nm .or. &
+                   nm < 1, info, FRIROM_ERR_SIZE, errmsg, 'modes: phi (ndof, nm), omega '// &
+                   'and zeta (nm)')) return
+        if (failed(.not. all(abs(phi) <= huge(1.0_wp)), info, FRIROM_ERR_NONFINITE, errmsg, &
+                   'modes: phi has NaN or Inf')) return
         call modal_store(sysc, nm, spread(wm, 2, sysc%nh + 1), spread(zm, 2, sysc%nh + 1), &
                          info, errmsg, phi=phi)
     end procedure hbm_set_modes
@@ -91,10 +87,8 @@ contains
                     allocate (sys%psi(nr, nm, 0:sys%nh), stat=stat)
                 end if
             end if
-            if (stat /= 0) then
-                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'modes: rows of the modes')
+            if (failed(stat /= 0, info, FRIROM_ERR_ALLOC, errmsg, 'modes: rows of the modes')) &
                 return
-            end if
             sys%wm = wm
             sys%zm = zm
             if (present(phi)) then

@@ -3,7 +3,7 @@
 !> formulation uses (wall clock, frequency and load factor at lam).
 submodule (frirom_hbm) frirom_hbm_run
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, FRIROM_ERR_ALLOC, &
-                             FRIROM_ERR_MODEL, FRIROM_ERR_LAW, set_status
+                             FRIROM_ERR_MODEL, FRIROM_ERR_LAW, set_status, failed
     use frirom_newton, only: newton_correct, cont_tangent, cont_run
     use frirom_aft, only: aft_plan_create, law_ndir, law_npar, law_nslider, law_rest_force, &
                           law_check
@@ -74,11 +74,8 @@ contains
             if (perm(i) < 1 .or. perm(i) > ndof) exit
             sys%iperm(perm(i)) = i
         end do
-        if (any(sys%iperm == 0)) then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'hbm_setup: perm is not a '// &
-                            'permutation of 1..ndof')
-            return
-        end if
+        if (failed(any(sys%iperm == 0), info, FRIROM_ERR_PARAM, errmsg, 'hbm_setup: perm is '// &
+                   'not a permutation of 1..ndof')) return
         sys%fe0 = fe0
         sys%fe1 = fe1
         if (any(outdofs < 1) .or. any(outdofs > ndof)) then
@@ -183,11 +180,9 @@ contains
                 end if
                 npar = law_npar(gr%law)
                 nsl = law_nslider(gr%law)
-                if (ip0 + npar*ne > size(params) .or. iw0 + nsl*ne > size(w0)) then
-                    call set_status(info, FRIROM_ERR_SIZE, errmsg, 'hbm_setup: params or w0 '// &
-                                    'shorter than the groups need')
-                    return
-                end if
+                if (failed(ip0 + npar*ne > size(params) .or. iw0 + nsl*ne > size(w0), info, &
+                           FRIROM_ERR_SIZE, errmsg, 'hbm_setup: params or w0 shorter than '// &
+                           'the groups need')) return
                 gr%ne = ne
                 gr%ndir = nd
                 gr%row0 = row

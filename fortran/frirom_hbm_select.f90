@@ -4,7 +4,7 @@
 !> contact forces, the loads' response and the orbits put off the selection.
 submodule (frirom_hbm:frirom_hbm_condensed) frirom_hbm_select
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_ALLOC, FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, &
-                             set_status
+                             set_status, failed
     implicit none
 
 contains
@@ -109,10 +109,7 @@ contains
                     kpr = pair
                 end if
             end if
-            if (stat /= 0) then
-                call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'selection: Jacobian')
-                return
-            end if
+            if (failed(stat /= 0, info, FRIROM_ERR_ALLOC, errmsg, 'selection: Jacobian')) return
             call move_alloc(kptr, sys%kptr)
             call move_alloc(kpt, sys%kpt)
             call move_alloc(ksel, sys%sel)

@@ -31,7 +31,7 @@ module frirom_run
                                            c_f_pointer
     use frirom_kinds, only: wp, ip
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, FRIROM_ERR_CONT, &
-                             FRIROM_ERR_ALLOC, set_status
+                             FRIROM_ERR_ALLOC, set_status, failed
     use frirom_hbm, only: hbm_system, N_TIMERS
     use frirom_user_law, only: user_law
     implicit none
@@ -450,24 +450,20 @@ contains
     subroutine run_set_sliders(run, w, info, errmsg)
         use frirom_hbm, only: hbm_set_sliders
         type(run_t), intent(inout) :: run
-        real(wp), intent(in) :: w(:)
+        real(wp), intent(in), optional :: w(:)   !! absent: the sliders stay as they are
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
         info = FRIROM_OK
+        if (.not. present(w)) return
         if (.not. run%built) then
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'run_set_sliders: the run is not open')
             return
         end if
         if (run%nw == 0) return
-        if (size(w) /= run%nw) then
-            call set_status(info, FRIROM_ERR_SIZE, errmsg, 'sliders: one value per slider '// &
-                            'of the contact elements expected')
-            return
-        end if
-        if (.not. all(abs(w) <= huge(1.0_wp))) then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'sliders: contains NaN or Inf')
-            return
-        end if
+        if (failed(size(w) /= run%nw, info, FRIROM_ERR_SIZE, errmsg, 'sliders: one value '// &
+                   'per slider of the contact elements expected')) return
+        if (failed(.not. all(abs(w) <= huge(1.0_wp)), info, FRIROM_ERR_PARAM, errmsg, &
+                   'sliders: contains NaN or Inf')) return
         call hbm_set_sliders(run%sys, w)
     end subroutine run_set_sliders
 

@@ -46,10 +46,8 @@ contains
                 return
             end if
         end if
-        if (present(sliders)) then
-            call run_set_sliders(run, sliders, info, errmsg)
-            if (info /= 0) return
-        end if
+        call run_set_sliders(run, sliders, info, errmsg)
+        if (info /= 0) return
         run%lam_start = lam_start
         run%lam_end = lam_end
         run%lscale = abs(lam_end - lam_start)
@@ -365,10 +363,8 @@ contains
             call run_lu_state(run, run%lu_saved)
             run%lu_dirty = .true.
         end if
-        if (present(sliders)) then
-            call run_set_sliders(run, sliders, info, errmsg)
-            if (info /= 0) return
-        end if
+        call run_set_sliders(run, sliders, info, errmsg)
+        if (info /= 0) return
         st%y = y0
         st%lam = lam0
         st%maxpts = 1
@@ -388,16 +384,12 @@ contains
             st%lam_end = lam0 + 0.1_wp*st%lscale
             st%lam_lo = -huge(1.0_wp)
         case (RUN_SOLVE_STEP)
-            if (.not. (present(tan0) .and. present(yscale) .and. present(ds))) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'run_solve: a step needs '// &
-                                'tan0, yscale and ds')
+            if (failed(.not. (present(tan0) .and. present(yscale) .and. present(ds)), info, &
+                       FRIROM_ERR_PARAM, errmsg, 'run_solve: a step needs tan0, yscale and ds')) &
                 return
-            end if
-            if (size(tan0) /= run%ny + 1 .or. .not. (ds > 0.0_wp .and. yscale > 0.0_wp)) then
-                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'run_solve: tan0 (ny + 1), '// &
-                                'ds > 0 and yscale > 0 expected')
-                return
-            end if
+            if (failed(size(tan0) /= run%ny + 1 .or. .not. (ds > 0.0_wp .and. yscale > 0.0_wp), &
+                       info, FRIROM_ERR_SIZE, errmsg, 'run_solve: tan0 (ny + 1), ds > 0 and '// &
+                       'yscale > 0 expected')) return
             st%mode = HBM_START_RESUME
             st%t = tan0
             st%yscale = yscale

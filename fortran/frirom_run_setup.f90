@@ -150,7 +150,6 @@ contains
         run%m%wm = wm
         run%m%zm = zm
         call apply_modes(run, .false., info, errmsg)
-        if (info /= 0) deallocate (run%m%phi, run%m%wm, run%m%zm)
     end procedure run_set_modes
 
     module procedure run_set_modes_harmonic
@@ -164,7 +163,6 @@ contains
         run%m%wh = wh
         run%m%zh = zh
         call apply_modes(run, .true., info, errmsg)
-        if (info /= 0) deallocate (run%m%psi, run%m%wh, run%m%zh)
     end procedure run_set_modes_harmonic
 
     !> An open run and modes of the sizes (bad_size false) and values (good) expected;
@@ -195,7 +193,8 @@ contains
     end function good_modes
 
     !> The system with the model's real (or, harmonic, per-harmonic) modes of run%m: set
-    !> on it, or rebuilt when a selection is set already (the modes come first).
+    !> on it, or rebuilt when a selection is set already (the modes come first); where
+    !> that fails, run%m forgets them again.
     subroutine apply_modes(run, harmonic, info, errmsg)
         type(run_t), intent(inout) :: run
         logical, intent(in) :: harmonic
@@ -207,6 +206,12 @@ contains
             call hbm_set_modes(run%sys, run%m%phi, run%m%wm, run%m%zm, info, errmsg)
         else
             call hbm_set_modes_harmonic(run%sys, run%m%psi, run%m%wh, run%m%zh, info, errmsg)
+        end if
+        if (info == 0) return
+        if (harmonic) then
+            deallocate (run%m%psi, run%m%wh, run%m%zh)
+        else
+            deallocate (run%m%phi, run%m%wm, run%m%zm)
         end if
     end subroutine apply_modes
 

@@ -5,7 +5,7 @@ module frirom_status
     use frirom_kinds, only: ip
     implicit none
     private
-    public :: frirom_status_message, frirom_status_code, set_status, itoa
+    public :: frirom_status_message, frirom_status_code, set_status, failed, itoa
     public :: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, FRIROM_ERR_NONFINITE, &
               FRIROM_ERR_SAMPLES, FRIROM_ERR_ALLOC, FRIROM_ERR_FFTW, FRIROM_ERR_LAPACK, &
               FRIROM_ERR_ARPACK, FRIROM_ERR_NOCONV, FRIROM_ERR_SINGULAR, FRIROM_ERR_LAW, &
@@ -127,6 +127,18 @@ contains
         info = code
         if (present(errmsg)) errmsg = frirom_status_message(code)//': '//detail
     end subroutine set_status
+
+    !> The one form of an argument check: where `bad`, set_status(info, code, errmsg,
+    !> detail) and true, so that `if (failed(...)) return`; else false, info untouched.
+    logical function failed(bad, info, code, errmsg, detail)
+        logical, intent(in) :: bad                          !! the check did not pass
+        integer(ip), intent(inout) :: info
+        integer(ip), intent(in) :: code
+        character(len=*), intent(inout), optional :: errmsg
+        character(len=*), intent(in) :: detail
+        failed = bad
+        if (bad) call set_status(info, code, errmsg, detail)
+    end function failed
 
     !> An integer as text without blanks, for messages (trim the result).
     pure function itoa(i) result(t)
