@@ -375,7 +375,6 @@ contains
         type(run_t), pointer :: r
         integer(ip) :: st
         character(len=512) :: text
-        text = ''
         call get_run(run, 'frirom_run_start', r, st, text)
         if (st == FRIROM_OK) call check_range('frirom_run_start', omega_start, omega_end, st, &
                                               text)
@@ -582,7 +581,6 @@ contains
         character(len=*), intent(inout) :: text
         integer(c_int), intent(in), optional :: count
         character(len=*), intent(in), optional :: name
-        text = ''
         call run_from_handle(transfer(run, 0_c_intptr_t), r, who, st, text)
         if (st /= FRIROM_OK .or. .not. present(count)) return
         if (count < 1) call set_status(st, FRIROM_ERR_SIZE, text, who//': '//name// &

@@ -417,23 +417,19 @@ end subroutine peak_amplitudes
 !> Modal damping C = M Phi diag(2 zeta omega) Phi^T M of the lowest nm modes of dense
 !> real symmetric K, M (n, n) (frirom_damping; lower triangles read); omega (nm) rad/s.
 subroutine modal_damping(n, nm, k, m, zeta, c, omega, info, msg)
-    use frirom_kinds, only: ip
     use frirom_damping, only: frirom_modal_damping => modal_damping
     implicit none
     integer(4), intent(in) :: n, nm
     real(8), intent(in) :: k(n, n), m(n, n), zeta(nm)
     real(8), intent(out) :: c(n, n), omega(nm)
-    integer(4), intent(out) :: info
+    integer(4), intent(out) :: info    !! frirom_damping's status (ip is integer(4))
     character(len=512), intent(out) :: msg
-    integer(ip) :: st
     msg = ''
-    call frirom_modal_damping(k, m, zeta, c, omega, st, msg)
-    info = int(st, 4)
+    call frirom_modal_damping(k, m, zeta, c, omega, info, msg)
 end subroutine modal_damping
 
 !> modal_damping of dense complex Hermitian K, M (n, n): C = M Phi diag(2 zeta omega) Phi^H M.
 subroutine modal_damping_hermitian(n, nm, k, m, zeta, c, omega, info, msg)
-    use frirom_kinds, only: ip
     use frirom_damping, only: frirom_modal_damping => modal_damping
     implicit none
     integer(4), intent(in) :: n, nm
@@ -441,10 +437,8 @@ subroutine modal_damping_hermitian(n, nm, k, m, zeta, c, omega, info, msg)
     real(8), intent(in) :: zeta(nm)
     complex(8), intent(out) :: c(n, n)
     real(8), intent(out) :: omega(nm)
-    integer(4), intent(out) :: info
+    integer(4), intent(out) :: info    !! frirom_damping's status (ip is integer(4))
     character(len=512), intent(out) :: msg
-    integer(ip) :: st
     msg = ''
-    call frirom_modal_damping(k, m, zeta, c, omega, st, msg)
-    info = int(st, 4)
+    call frirom_modal_damping(k, m, zeta, c, omega, info, msg)
 end subroutine modal_damping_hermitian

@@ -20,7 +20,6 @@ subroutine frun_set_nonlinear_mode(handle, ndof, phi, omega0, modal, nm, modes, 
     character(len=512), intent(out) :: msg
     type(run_t), pointer :: r
     integer(ip) :: linfo
-    msg = ''
     ny = 0
     call run_from_handle(handle, r, 'run_set_nonlinear_mode', linfo, msg)
     if (linfo == 0 .and. modal == 1) then
@@ -48,7 +47,6 @@ subroutine frun_mode_jacobian(handle, lam, ny, y, r, rlam, jm, info, msg)
     character(len=512), intent(out) :: msg
     type(run_t), pointer :: rn
     integer(ip) :: linfo
-    msg = ''
     r = 0.0d0
     rlam = 0.0d0
     jm = 0.0d0

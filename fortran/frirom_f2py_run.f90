@@ -40,7 +40,7 @@ subroutine frun_open(formulation, mode, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm,
     integer(4), intent(out) :: ny, nw, netot, info
     character(len=512), intent(out) :: msg
     type(run_t), pointer :: r
-    integer(ip) :: linfo, is(N_ISET)
+    integer(ip) :: linfo
     msg = ''
     handle = 0
     ny = 0
@@ -52,9 +52,8 @@ subroutine frun_open(formulation, mode, nh, nsamp, ndof, nnzk, kp, ki, kx, nnzm,
         info = linfo
         return
     end if
-    is = iset
     allocate (r)
-    call fr_open(r, settings_unpack(is, rset), int(formulation, ip), int(mode, ip), &
+    call fr_open(r, settings_unpack(int(iset, ip), rset), int(formulation, ip), int(mode, ip), &
                  int(nsamp, ip), int(ndof, ip), int(kp, ip), int(ki, ip), kx, int(mp, ip), &
                  int(mi, ip), mx, int(cp, ip), int(ci, ip), cx, int(perm, ip), int(nl, ip), &
                  fe0, fe1, omega_fix, int(ginfo, ip), int(gp, ip), int(gi, ip), gx, params, &
@@ -89,7 +88,6 @@ subroutine frun_set_modes(handle, harmonic, ndof, nmodes, nh1, phi, psi, npsi, w
     character(len=512), intent(out) :: msg
     type(run_t), pointer :: r
     integer(ip) :: linfo
-    msg = ''
     call run_from_handle(handle, r, 'run_set_modes', linfo, msg)
     if (linfo == 0 .and. harmonic == 1) then
         call fr_hmodes(r, psi, wmodes, zmodes, linfo, msg)
@@ -110,7 +108,6 @@ subroutine frun_set_free_bodies(handle, on, info, msg)
     character(len=512), intent(out) :: msg
     type(run_t), pointer :: r
     integer(ip) :: linfo
-    msg = ''
     call run_from_handle(handle, r, 'run_set_free_bodies', linfo, msg)
     if (linfo == 0) call fr_free(r, on == 1, linfo, msg)
     info = linfo
@@ -212,7 +209,6 @@ subroutine frun_lu_state(handle, n, v, info, msg)
     character(len=512), intent(out) :: msg
     type(run_t), pointer :: r
     integer(ip) :: linfo
-    msg = ''
     v = 0.0d0
     call run_from_handle(handle, r, 'run_lu_state', linfo, msg)
     if (linfo == 0) then

@@ -625,8 +625,9 @@ contains
         h = transfer(c_loc(run), h)
     end function run_handle
 
-    !> The run behind a handle of run_handle; a null handle, or one of a closed run,
-    !> gives FRIROM_ERR_PARAM naming `who` and run null.
+    !> The run behind a handle of run_handle, errmsg cleared (the first step of every
+    !> C and f2py entry); a null handle, or one of a closed run, gives FRIROM_ERR_PARAM
+    !> naming `who` and run null.
     subroutine run_from_handle(h, run, who, info, errmsg)
         integer(c_intptr_t), intent(in) :: h
         type(run_t), pointer, intent(out) :: run
@@ -635,6 +636,7 @@ contains
         character(len=*), intent(inout) :: errmsg
         type(c_ptr) :: p
         info = FRIROM_OK
+        errmsg = ''
         nullify (run)
         if (h /= 0) then
             p = transfer(h, p)
