@@ -8,9 +8,11 @@ module frirom_arpack
     private
     public :: dsaupd, dseupd, dnaupd, dneupd, znaupd, zneupd
 
-    interface
-        subroutine dsaupd(ido, bmat, n, which, nev, tol, resid, ncv, v, ldv, iparam, ipntr, &
-                          workd, workl, lworkl, info)
+    !> dsaupd (symmetric Lanczos) and dnaupd (nonsymmetric Arnoldi) share one calling
+    !> sequence, stated once: ipntr holds 14 pointers (dsaupd fills the first 11).
+    abstract interface
+        subroutine real_aupd(ido, bmat, n, which, nev, tol, resid, ncv, v, ldv, iparam, &
+                             ipntr, workd, workl, lworkl, info)
             import :: wp
             integer, intent(inout) :: ido
             character(len=1), intent(in) :: bmat
@@ -18,8 +20,12 @@ module frirom_arpack
             character(len=2), intent(in) :: which
             real(wp), intent(inout) :: tol
             real(wp), intent(inout) :: resid(n), v(ldv, ncv), workd(3*n), workl(lworkl)
-            integer, intent(inout) :: iparam(11), ipntr(11), info
-        end subroutine dsaupd
+            integer, intent(inout) :: iparam(11), ipntr(14), info
+        end subroutine real_aupd
+    end interface
+    procedure(real_aupd) :: dsaupd, dnaupd
+
+    interface
         subroutine dseupd(rvec, howmny, sel, d, z, ldz, sigma, bmat, n, which, nev, tol, &
                           resid, ncv, v, ldv, iparam, ipntr, workd, workl, lworkl, info)
             import :: wp
@@ -63,17 +69,6 @@ module frirom_arpack
             real(wp), intent(inout) :: rwork(ncv)
             integer, intent(inout) :: iparam(11), ipntr(14), info
         end subroutine zneupd
-        subroutine dnaupd(ido, bmat, n, which, nev, tol, resid, ncv, v, ldv, iparam, ipntr, &
-                          workd, workl, lworkl, info)
-            import :: wp
-            integer, intent(inout) :: ido
-            character(len=1), intent(in) :: bmat
-            integer, intent(in) :: n, nev, ncv, ldv, lworkl
-            character(len=2), intent(in) :: which
-            real(wp), intent(inout) :: tol
-            real(wp), intent(inout) :: resid(n), v(ldv, ncv), workd(3*n), workl(lworkl)
-            integer, intent(inout) :: iparam(11), ipntr(14), info
-        end subroutine dnaupd
         subroutine dneupd(rvec, howmny, sel, dr, di, z, ldz, sigmar, sigmai, workev, bmat, &
                           n, which, nev, tol, resid, ncv, v, ldv, iparam, ipntr, workd, &
                           workl, lworkl, info)
