@@ -22,6 +22,14 @@ submodule (frirom_hbm:frirom_hbm_condensed) frirom_hbm_jacobian
         real(wp), allocatable :: gs(:, :, :)     !! (nq, ne, nd) Gd^T on Q, by direction
     end type kept_cols
 
+    !> Blocks of Q's columns (stacked, as in kept_cols) that read the same coefficients of
+    !> J_loc: ca(ib) and cb(ib) (0: none), and direction d's range lo(ib, d):hi(ib, d)
+    !> (hi = 0: none) of block ib.
+    type :: col_blocks
+        integer(ip) :: n = 0
+        integer(ip), allocatable :: ca(:), cb(:), lo(:, :), hi(:, :)
+    end type col_blocks
+
 contains
 
     module procedure cond_jacobian
@@ -454,8 +462,8 @@ contains
         !> two directions, by the mask of those that read a column: d1 only, both, d2 only,
         !> none (each direction's columns are then one range)
         integer(ip), parameter :: ORDER2(0:3) = [3, 0, 2, 1]
-        integer(ip) :: ns, nd, ne, nrg, c, c1, c2, d1, d2, e, s, m1, p, k, a, b
-        real(wp) :: v
+        type(col_blocks) :: bl
+        integer(ip) :: ns, nd, ne, nrg, c, c1, d1, s, p, k
         nd = gr%ndir
         ne = gr%ne
         nrg = ne*nd
@@ -520,26 +528,55 @@ contains
         do c = 1, nc
             pq(kq%qoff(c) + 1:kq%qoff(c + 1)) = kq%py(1:kq%ln(c), c)
         end do
+        ! a block per coefficient, its columns' ranges by direction
+        bl%n = nc
+        bl%ca = [(c, c=1, nc)]
+        bl%cb = spread(0_ip, 1, nc)
+        bl%lo = spread(kq%qoff(1:nc), 2, nd) + kq%lo
+        bl%hi = merge(spread(kq%qoff(1:nc), 2, nd) + kq%hi, 0_ip, kq%hi > 0)
         do c1 = 1, nc
-            m1 = kq%ln(c1)
-            if (m1 == 0) cycle
-            yt = 0.0_wp
-            do d1 = 1, nd
-                do e = 1, ne
-                    do c2 = 1, nc
-                        do d2 = 1, nd
-                            v = gr%jac(c1 + nc*(d1 - 1), c2 + nc*(d2 - 1), e)
-                            if (v == 0.0_wp .or. kq%hi(c2, d2) == 0) cycle
-                            a = kq%qoff(c2) + kq%lo(c2, d2)
-                            b = kq%qoff(c2) + kq%hi(c2, d2)
-                            yt(a:b, e, d1) = yt(a:b, e, d1) + v*kq%gs(a:b, e, d2)
-                        end do
-                    end do
-                end do
-            end do
+            if (kq%ln(c1) == 0) cycle
+            call jloc_gd(gr, nc, c1, bl, kq%gs, kq%gs, yt)
             call rows_into(kq, c1, yt, pq, kt, kc)
         end do
     end subroutine kc_dense_sel
+
+    !> y(:, :, d1) = J_loc Gd on the blocks' columns for coefficient c1's rows (directions
+    !> d1): block ib adds J_loc(c1 d1, ca d2) g1(lo:hi, :, d2) and, where cb > 0,
+    !> J_loc(c1 d1, cb d2) g2(lo:hi, :, d2), element by element, for each direction d2
+    !> that reads it. nc: J_loc's coefficients.
+    subroutine jloc_gd(gr, nc, c1, bl, g1, g2, y)
+        type(contact_group), intent(in) :: gr
+        integer(ip), intent(in) :: nc, c1
+        type(col_blocks), intent(in) :: bl
+        real(wp), intent(in) :: g1(:, :, :), g2(:, :, :)   !! (columns, ne, nd)
+        real(wp), intent(out) :: y(:, :, :)                !! (columns, ne, nd)
+        integer(ip) :: d1, d2, e, ib, a, b
+        real(wp) :: v1, v2
+        y = 0.0_wp
+        do d1 = 1, gr%ndir
+            do e = 1, gr%ne
+                do ib = 1, bl%n
+                    do d2 = 1, gr%ndir
+                        if (bl%hi(ib, d2) == 0) cycle
+                        v1 = gr%jac(c1 + nc*(d1 - 1), bl%ca(ib) + nc*(d2 - 1), e)
+                        v2 = 0.0_wp
+                        if (bl%cb(ib) > 0) v2 = gr%jac(c1 + nc*(d1 - 1), bl%cb(ib) + &
+                                                       nc*(d2 - 1), e)
+                        if (v1 == 0.0_wp .and. v2 == 0.0_wp) cycle
+                        a = bl%lo(ib, d2)
+                        b = bl%hi(ib, d2)
+                        if (bl%cb(ib) > 0) then
+                            y(a:b, e, d1) = y(a:b, e, d1) + v1*g1(a:b, e, d2) + &
+                                            v2*g2(a:b, e, d2)
+                        else
+                            y(a:b, e, d1) = y(a:b, e, d1) + v1*g1(a:b, e, d2)
+                        end if
+                    end do
+                end do
+            end do
+        end do
+    end subroutine jloc_gd
 
     !> kc_dense_sel for a selection's pairs: kc(S1 c1, z) += Gd(:, S1)^T Y_z, Y_z = J_loc
     !> Gd T on T's columns z that touch the group (one or two members in Q, a pair's in
@@ -553,12 +590,10 @@ contains
         integer(ip), intent(in) :: zc(:)         !! (kept) T's column of each kept unknown
         real(wp), intent(in) :: zw(:)            !! (kept) its weight there
         real(wp), intent(inout) :: kc(:, :)
-        integer(ip), allocatable :: zl(:), zm(:, :), zco(:, :), zs(:, :), perm(:), zcs(:), &
-                                    bca(:), bcb(:), blo(:, :), bhi(:, :)
+        integer(ip), allocatable :: zl(:), zm(:, :), zco(:, :), zs(:, :), perm(:), zcs(:)
         real(wp), allocatable :: zwt(:, :), gs1(:, :, :), gs2(:, :, :), yz(:, :, :), kt(:, :)
-        integer(ip) :: nc, nd, ne, nq, nz, nb, c, t, p, i, k, ca, cb, d1, d2, e, c1, m1, a, &
-                       b, ib, iz
-        real(wp) :: v1, v2
+        type(col_blocks) :: bl
+        integer(ip) :: nc, nd, ne, nq, nz, c, t, p, i, k, ca, cb, d2, c1, iz
         nc = size(kq%ln)
         nd = gr%ndir
         ne = gr%ne
@@ -590,9 +625,9 @@ contains
         end do
         ! order: by (ca, cb), then by the first member's reading directions; the blocks
         ! of one (ca, cb) and their ranges per direction (either member read)
-        allocate (perm(nz), bca(2*nc), bcb(2*nc), blo(2*nc, nd), bhi(2*nc, nd))
+        allocate (perm(nz), bl%ca(2*nc), bl%cb(2*nc), bl%lo(2*nc, nd), bl%hi(2*nc, nd))
         k = 0
-        nb = 0
+        bl%n = 0
         do ca = 1, nc
             do cb = 0, nc
                 i = k
@@ -605,17 +640,17 @@ contains
                     end do
                 end do
                 if (k == i) cycle
-                nb = nb + 1
-                bca(nb) = ca
-                bcb(nb) = cb
-                blo(nb, :) = 1
-                bhi(nb, :) = 0
+                bl%n = bl%n + 1
+                bl%ca(bl%n) = ca
+                bl%cb(bl%n) = cb
+                bl%lo(bl%n, :) = 1
+                bl%hi(bl%n, :) = 0
                 do iz = i + 1, k
                     do d2 = 1, nd
                         if (.not. (kq%rd(zs(1, perm(iz)), d2) .or. (cb > 0 .and. &
                                    kq%rd(max(zs(2, perm(iz)), 1_ip), d2)))) cycle
-                        if (bhi(nb, d2) == 0) blo(nb, d2) = iz
-                        bhi(nb, d2) = iz
+                        if (bl%hi(bl%n, d2) == 0) bl%lo(bl%n, d2) = iz
+                        bl%hi(bl%n, d2) = iz
                     end do
                 end do
             end do
@@ -629,27 +664,8 @@ contains
         end do
         zcs(1:nz) = zcs(perm)
         do c1 = 1, nc
-            m1 = kq%ln(c1)
-            if (m1 == 0) cycle
-            yz = 0.0_wp
-            do d1 = 1, nd
-                do e = 1, ne
-                    do ib = 1, nb
-                        do d2 = 1, nd
-                            if (bhi(ib, d2) == 0) cycle
-                            v1 = gr%jac(c1 + nc*(d1 - 1), bca(ib) + nc*(d2 - 1), e)
-                            v2 = 0.0_wp
-                            if (bcb(ib) > 0) v2 = gr%jac(c1 + nc*(d1 - 1), bcb(ib) + &
-                                                         nc*(d2 - 1), e)
-                            if (v1 == 0.0_wp .and. v2 == 0.0_wp) cycle
-                            a = blo(ib, d2)
-                            b = bhi(ib, d2)
-                            yz(a:b, e, d1) = yz(a:b, e, d1) + v1*gs1(a:b, e, d2) + &
-                                             v2*gs2(a:b, e, d2)
-                        end do
-                    end do
-                end do
-            end do
+            if (kq%ln(c1) == 0) cycle
+            call jloc_gd(gr, nc, c1, bl, gs1, gs2, yz)
             call rows_into(kq, c1, yz, zcs(1:nz), kt, kc)
         end do
     end subroutine kc_dense_pairs
