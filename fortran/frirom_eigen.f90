@@ -189,7 +189,7 @@ contains
         integer(ip), intent(in), optional :: maxiter  !! restarts allowed (default 500)
         integer(ip), intent(out), optional :: iterations  !! restarts used
 
-        integer :: ido, iparam(11), ipntr(14), ainfo, lworkl, n, nc, stat, k
+        integer :: ido, iparam(11), ipntr(11), ainfo, lworkl, n, nc, stat, k
         integer(8) :: seed
         real(wp) :: atol
         real(wp), allocatable :: resid(:), v(:, :), workd(:), workl(:), d(:), tmp(:, :)
