@@ -44,11 +44,9 @@ contains
             sys%pw = mphi/norm2(mphi)
             sys%w0 = w0
             sys%wn = w0**2*norm2(mphi)
-            sys%nf = nd*sys%nc
-            sys%n = sys%nf + 2
-            if (allocated(sys%jd)) deallocate (sys%jd, sys%ipiv, sys%jp, sys%xp)
-            allocate (sys%jd(sys%n, sys%n), sys%ipiv(sys%n), sys%jp(sys%nf, sys%nf), &
-                      sys%xp(nd, sys%nc))
+            call epmc_size(sys, nd*sys%nc)
+            if (allocated(sys%xp)) deallocate (sys%xp)
+            allocate (sys%xp(nd, sys%nc))
         class default
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: the run is '// &
                             'not a mode run (mode 3)')
@@ -273,6 +271,13 @@ contains
         end do
     end subroutine dense_add
 
+
+    module procedure epmc_size
+        this%nf = nf
+        this%n = nf + 2
+        if (allocated(this%jd)) deallocate (this%jd, this%ipiv, this%jp)
+        allocate (this%jd(this%n, this%n), this%ipiv(this%n), this%jp(nf, nf))
+    end procedure epmc_size
 
     module procedure epmc_solve
         real(wp) :: t0

@@ -73,10 +73,8 @@ contains
             sys%wr = wm
             sys%zr = zm
             sys%wn = max(norm2(sys%phi0(nl)), tiny(1.0_wp))
-            sys%nf = nnl*sys%nc
-            sys%n = sys%nf + 2
-            allocate (sys%jd(sys%n, sys%n), sys%ipiv(sys%n), sys%jp(sys%nf, sys%nf), &
-                      sys%fl(nnl, sys%nc))
+            call epmc_size(sys, nnl*sys%nc)
+            allocate (sys%fl(nnl, sys%nc))
         class default
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: not a '// &
                             'condensed mode run')
