@@ -1,13 +1,13 @@
 !> bind(c) entry points for contact laws written by the user (declared in frirom.h):
 !> register a law callback with a run, and the code a user-law contact group carries.
 module frirom_capi_laws
-    use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_funptr, c_associated
+    use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_funptr, c_intptr_t, c_associated
     use frirom_kinds, only: ip
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_PARAM, set_status
     use frirom_aft, only: law_user_code
-    use frirom_run, only: run_t, run_set_user_law
+    use frirom_run, only: run_t, run_from_handle, run_set_user_law
     use frirom_user_law, only: user_law
-    use frirom_capi, only: to_c_string, get_run
+    use frirom_capi, only: to_c_string
     implicit none
     private
     public :: frirom_run_set_user_law_c, frirom_law_user_code_c
@@ -25,7 +25,8 @@ contains
         type(run_t), pointer :: r
         integer(ip) :: st
         character(len=512) :: text
-        call get_run(run, 'frirom_run_set_user_law', r, st, text)
+        call run_from_handle(transfer(run, 0_c_intptr_t), r, 'frirom_run_set_user_law', st, &
+                             text)
         if (st == FRIROM_OK .and. .not. c_associated(fn)) call set_status(st, &
             FRIROM_ERR_PARAM, text, 'frirom_run_set_user_law: fn: NULL')
         if (st == FRIROM_OK) call run_set_user_law(r, user_law(fn, ctx), st, text)
