@@ -34,6 +34,14 @@ def _mode_deck(text, nd="3"):
             + "amplitudes = [1.0e-4, 1.0]\n\n" + text[text.index("[continuation]"):])
 
 
+def _is_number(t: str) -> bool:
+    try:
+        float(t)
+    except ValueError:
+        return False
+    return True
+
+
 @pytest.mark.slow
 def test_bladed_sector_mode_deck(tmp_path, capsys):
     """`frirom run` of the mode deck: the backbone of nodal diameter 3 (harmonic 1 on
@@ -41,7 +49,9 @@ def test_bladed_sector_mode_deck(tmp_path, capsys):
     at the stuck sector's eigenfrequency of k = 9 from a direct Hermitian eigen-solve of
     T^H (K + G^T Ks G) T, T^H M T, to 1e-8 (measured 3.6e-10: the modal damping of
     0.2 %, not proportional to the stuck stiffness, moves it by O(zeta^2) of the free
-    modes' mixing); the flange slips at the end (damping ratio above its stuck value)."""
+    modes' mixing); the flange slips at the end (damping ratio above its stuck value);
+    `frirom show` balances the energy per cycle at the damping peak to 1e-8 (measured
+    1.4e-10)."""
     if shutil.which("ccx") is None:
         pytest.skip("ccx (calculix-ccx) not installed")
     from frirom.cli import main
@@ -70,6 +80,13 @@ def test_bladed_sector_mode_deck(tmp_path, capsys):
     assert err < 1e-8
     assert bb.damping_ratio.max() > 1.1 * bb.damping_ratio[0]
     assert bb.states[-1, 1].max() > 0
+    # frirom show at the damping peak: the mode's energy per cycle = the flange's
+    # dissipation + the viscous work (from each harmonic's modal coordinates)
+    assert main(["show", str(tmp_path / "run")]) == 0
+    printed = capsys.readouterr().out
+    line = next(s for s in printed.splitlines() if "energy per cycle: mode" in s)
+    nums = [float(t) for t in line.replace("(", " ").split() if _is_number(t)]
+    assert abs(nums[-1]) < 1e-8 * nums[0], line
     # nodal_diameter below the sectors; a synthesis from a cyclic backbone: not yet
     text = _mode_deck((CASES / "bladed_sector" / "bladed_sector.toml").read_text(), "12")
     p = tmp_path / "bad.toml"

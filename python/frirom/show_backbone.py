@@ -54,9 +54,12 @@ def backbone_point_state(bb, deck, index: int) -> PointState:
     omega = float(bb.omega[index])
     h = np.arange(1, bb.H + 1)
     a, b = x[:, 1::2], x[:, 2::2]
-    C = model.C
-    visc = float(omega * np.pi * np.sum(h ** 2 * (np.einsum("ih,ih->h", a, C @ a)
-                                                  + np.einsum("ih,ih->h", b, C @ b))))
+    if hasattr(model, "n_sectors"):
+        visc = _sector_viscous(model, a - 1j * b, omega)
+    else:
+        C = model.C
+        visc = float(omega * np.pi * np.sum(h ** 2 * (np.einsum("ih,ih->h", a, C @ a)
+                                                      + np.einsum("ih,ih->h", b, C @ b))))
     dis = float(sum(c.energy.sum() for c in contacts))
     ext = float(bb.energy[index])
     P = deck.output_map
@@ -66,6 +69,19 @@ def backbone_point_state(bb, deck, index: int) -> PointState:
                       labels=list(deck.output_names), contacts=contacts,
                       balance={"excitation": ext, "contacts": dis, "viscous": visc,
                                "residual": ext - dis - visc})
+
+
+def _sector_viscous(model, z: np.ndarray, omega: float) -> float:
+    """Viscous work per period of a cyclic sector's mode (sector 0) from its harmonics z
+    (n_dof, H) = a - i b: harmonic h's modal coordinates q in the modes of its nodal
+    diameter (every sector DoF given: least squares, exact), pi omega h^2 sum_r 2 zeta_r
+    w_r |q_r|^2."""
+    work = 0.0
+    for h in range(1, z.shape[1] + 1):
+        m = model.modes_of(model.harmonic_index(h))
+        q = np.linalg.lstsq(m.psi, z[:, h - 1], rcond=None)[0]
+        work += np.pi * omega * h ** 2 * float(np.sum(2 * m.zeta * m.omega * np.abs(q) ** 2))
+    return work
 
 
 def cmd_show_backbone(args, h5: Path) -> int:
