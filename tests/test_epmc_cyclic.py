@@ -211,3 +211,20 @@ def test_bad_input(models):
         nonlinear_mode(cm, 0, (1e-6, 1e-3), "stuck", dataclasses.replace(opts, modes=5))
     with pytest.raises(ParameterError, match="mode: expected"):
         nonlinear_mode(cm, 500, (1e-6, 1e-3), "stuck", opts)
+
+
+def test_large_sector_reports_contact_dofs_and_outputs(models, backbone, monkeypatch):
+    """Above _ALL_OUTPUTS sector coordinates the run reports the contact DoFs and the
+    outputs only: the same backbone, the outputs' harmonics equal, energy NaN."""
+    import frirom.nonlinear_modes_cyclic as nmc
+    cm = models[1]
+    monkeypatch.setattr(nmc, "_ALL_OUTPUTS", 50)
+    out = [7, 100]
+    bb = nonlinear_mode(cm, 0, (1e-6, 1e-1), "stuck", frirom.SolverOptions(**OPTS),
+                        outputs=out)
+    ref = backbone
+    assert bb.harmonics.shape[1] == np.union1d(cm.nonlinear_dofs(), out).size
+    assert np.array_equal(bb.omega, ref.omega) and np.array_equal(bb.xi, ref.xi)
+    assert np.abs(bb.outputs - ref.harmonics[:, out]).max() < 1e-12 * np.abs(
+        ref.harmonics[:, out]).max()
+    assert np.all(np.isnan(bb.energy))

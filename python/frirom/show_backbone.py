@@ -44,6 +44,10 @@ def backbone_point_state(bb, deck, index: int) -> PointState:
     """The PointState of backbone point `index` of the deck's model (no new solve)."""
     model, opts = deck.model(), deck.options()
     n = model.n_dof
+    if bb.harmonics.shape[1] != n and hasattr(model, "n_sectors"):
+        raise InputError(f"the backbone keeps {bb.harmonics.shape[1]} of the sector's {n} "
+                         "coordinates (a cyclic sector above 400 coordinates keeps the "
+                         "contact DoFs and outputs only): frirom show needs every one")
     if bb.harmonics.shape[1] != n:
         raise InputError(f"the backbone has {bb.harmonics.shape[1]} coordinates, the deck's "
                          f"model {n}: not the deck it was made with")
