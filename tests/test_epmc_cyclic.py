@@ -120,9 +120,9 @@ def test_backbone_solves_the_whole_rotor(models, backbone):
 def test_linear_limit_is_the_rotor_eigenfrequency():
     """Undamped, contacts stuck at a = 1e-7: the backbone's first point at the whole
     rotor's stuck eigenfrequency of nodal diameter 2 (a double pair: the two travelling
-    directions) to 1e-10 (measured 2e-14, 4e-14), xi zero to 1e-10 of it (1e-15). (Damped, the linear
-    limit moves off the undamped eigenfrequency by O(zeta^2), 2.3e-7 here with the
-    Rayleigh damping, which is not proportional to the stuck stiffness.)"""
+    directions) to 1e-10 (measured 2e-14, 4e-14), xi zero to 1e-10 of it (1e-15).
+    (Damped, the linear limit moves off the undamped eigenfrequency by O(zeta^2), 2.3e-7
+    here with the Rayleigh damping, which is not proportional to the stuck stiffness.)"""
     r, cm, full = _rotor_models(Damping.rayleigh(0.0, 0.0))
     wf = np.sqrt(sla.eigvalsh((full.K + full.stuck_stiffness()).toarray(),
                               full.M.toarray()))
