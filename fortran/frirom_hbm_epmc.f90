@@ -66,13 +66,7 @@ contains
             y(sys%nf + 1) = 1.0_wp
             y(sys%nf + 2) = dot_product(sys%phi, cphi)/sys%w0
         type is (hbm_epmc_modal)
-            if (.not. allocated(sys%phi0)) return
-            allocate (cphi(sys%ndof))
-            cphi = 0.0_wp
-            call csr_matvec_add(sys%c, sys%phi0, cphi, 1.0_wp)
-            y(sys%nnl + 1:2*sys%nnl) = sys%phi0(sys%nl)
-            y(sys%nf + 1) = 1.0_wp
-            y(sys%nf + 2) = dot_product(sys%phi0, cphi)/sys%w0
+            if (allocated(sys%y0)) y = sys%y0
         end select
     end procedure hbm_epmc_guess
 

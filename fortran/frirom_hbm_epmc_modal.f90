@@ -18,7 +18,7 @@ submodule (frirom_epmc) frirom_hbm_epmc_modal
 contains
 
     module procedure hbm_epmc_modal_set
-        real(wp), allocatable :: mv(:), mp0(:), pn(:)
+        real(wp), allocatable :: mv(:), mp0(:), pn(:), p0(:), cp0(:)
         integer(ip) :: nd, nm, r, nnl, j
         info = FRIROM_OK
         select type (sys => sysc)
@@ -57,24 +57,33 @@ contains
             do j = 1, nnl
                 sys%colmap(nl(j)) = j
             end do
-            call epmc_normalise(sys%m, phi0, 'phi', sys%phi0, mp0, info, errmsg)
+            call epmc_normalise(sys%m, phi0, 'phi', p0, mp0, info, errmsg)
             if (info /= 0) return
-            allocate (sys%phn(nnl, nm), sys%pho(size(sys%outdofs), nm), sys%cph(nm), &
-                      sys%qst(nm))
+            allocate (sys%phn(nnl, nm, 0:0), sys%pho(size(sys%outdofs), nm, 0:0), &
+                      sys%cph(nm), sys%qst(nm))
             do r = 1, nm
                 call epmc_normalise(sys%m, phi(:, r), 'mode '//itoa(r), pn, mv, info, errmsg)
                 if (info /= 0) return
-                sys%phn(:, r) = pn(nl)
-                sys%pho(:, r) = pn(sys%outdofs)
+                sys%phn(:, r, 0) = pn(nl)
+                sys%pho(:, r, 0) = pn(sys%outdofs)
                 sys%cph(r) = dot_product(pn, mp0)
                 sys%qst(r) = dot_product(pn, sys%fe0(:, 1))
             end do
-            if (norm2(sys%cph) > 0.0_wp) sys%cph = sys%cph/norm2(sys%cph)
-            sys%wr = wm
-            sys%zr = zm
-            sys%wn = max(norm2(sys%phi0(nl)), tiny(1.0_wp))
+            if (norm2(abs(sys%cph)) > 0.0_wp) sys%cph = sys%cph/norm2(abs(sys%cph))
+            allocate (sys%wr(nm, 0:0), sys%zr(nm, 0:0))
+            sys%wr(:, 0) = wm
+            sys%zr(:, 0) = zm
+            sys%wn = max(norm2(p0(nl)), tiny(1.0_wp))
             call epmc_size(sys, nnl*sys%nc)
             allocate (sys%fl(nnl, sys%nc))
+            ! the start: the linear mode in harmonic 1's cosine, xi = phi^T C phi
+            allocate (sys%y0(sys%n), cp0(nd))
+            sys%y0 = 0.0_wp
+            cp0 = 0.0_wp
+            call csr_matvec_add(sys%c, p0, cp0, 1.0_wp)
+            sys%y0(nnl + 1:2*nnl) = p0(nl)
+            sys%y0(sys%nf + 1) = 1.0_wp
+            sys%y0(sys%nf + 2) = dot_product(p0, cp0)/w0
         class default
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: not a '// &
                             'condensed mode run')
@@ -118,8 +127,9 @@ contains
 
     module procedure epmd_eval
         real(wp) :: a, w, xi, t0, nref
-        integer(ip) :: nnl, nm, nf, h, ca, cb, j
-        complex(wp), allocatable :: g(:), gw(:), gx(:), p(:), q(:), z(:), dp(:, :), dz(:, :)
+        integer(ip) :: nnl, nm, nf, h, ca, cb, j, hs
+        complex(wp), allocatable :: g(:), gw(:), gx(:), p(:), q(:), z(:), dp(:, :), dz(:, :), &
+                                    dq(:, :)
         real(wp), allocatable :: u(:, :), yd(:), jn(:), jw(:, :)
         call epmc_unpack(this, y, lam, a, w, xi, info, errmsg)
         if (info /= 0) return
@@ -131,56 +141,63 @@ contains
         t0 = wtime()
         u = reshape(y(1:nf), [nnl, this%nc])
         allocate (g(nm), gw(nm), gx(nm), p(nm), q(nm), z(nnl), dp(nm, nf), dz(nnl, nf), &
-                  jn(nf), jw(this%n, this%n))
+                  dq(nm, nf), jn(nf), jw(this%n, this%n))
+        z = (0.0_wp, 0.0_wp)
         ! J is assembled in jw (rlam needs it); jd keeps the LU Newton may still reuse
         jw = 0.0_wp
-        ! harmonic 0: U_0 - Phi_nl diag(1/w_r^2) (Phi^T fe0 - Phi_nl^T F_0)
-        r(1:nnl) = u(:, 1) - matmul(this%phn, (this%qst - matmul(transpose(this%phn), &
-                                                                this%fl(:, 1)))/this%wr**2)
-        jw(1:nnl, 1:nf) = matmul(this%phn, matmul(spread(1.0_wp/this%wr**2, 2, nnl)* &
-                                      transpose(this%phn), this%jp(1:nnl, :)))
-        ! the residual's reference: the size of its terms (unknowns, static load and
-        ! contact force responses, each harmonic's receptance term)
-        nref = max(norm2(u), norm2(matmul(this%phn, this%qst/this%wr**2)), &
-                   norm2(matmul(this%phn, matmul(transpose(this%phn), this%fl(:, 1)) &
-                                /this%wr**2)))
+        ! harmonic 0: U_0 - Re Psi_nl diag(1/w_r^2) (Psi^H fe0 - Psi_nl^H F_0)
+        associate (p0 => this%phn(:, :, 0), w2 => this%wr(:, 0)**2)
+            z = matmul(p0, (this%qst - matmul(conjg(transpose(p0)), &
+                                              cmplx(this%fl(:, 1), 0.0_wp, wp)))/w2)
+            r(1:nnl) = u(:, 1) - real(z)
+            jw(1:nnl, 1:nf) = real(matmul(p0, matmul(spread(1.0_wp/w2, 2, nnl)* &
+                                          conjg(transpose(p0)), this%jp(1:nnl, :))))
+            ! the residual's reference: the size of its terms (unknowns, static load and
+            ! contact force responses, each harmonic's receptance term)
+            nref = max(norm2(u), norm2(abs(matmul(p0, this%qst/w2))), &
+                       norm2(abs(matmul(p0, matmul(conjg(transpose(p0)), &
+                                                   cmplx(this%fl(:, 1), 0.0_wp, wp))/w2))))
+        end associate
         do h = 1, this%nh
             ca = 2*h
             cb = 2*h + 1
-            call modal_g(this%wr, this%zr, h, w, xi, g, gw, gx)
-            p = matmul(transpose(this%phn), cmplx(this%fl(:, ca), -this%fl(:, cb), wp))
-            ! U_h + Phi_nl diag(g) p / a, as (a, b) = (Re z, -Im z)
-            z = matmul(this%phn, g*p)/a
-            nref = max(nref, sqrt(sum(abs(z)**2)))
-            r(nnl*(ca - 1) + 1:nnl*ca) = u(:, ca) + real(z)
-            r(nnl*(cb - 1) + 1:nnl*cb) = u(:, cb) - aimag(z)
-            dp = matmul(transpose(this%phn), cmplx(this%jp(nnl*(ca - 1) + 1:nnl*ca, :), &
-                                                   -this%jp(nnl*(cb - 1) + 1:nnl*cb, :), wp))
-            dz = matmul(this%phn, diag_cscale(g, dp))/a
-            jw(nnl*(ca - 1) + 1:nnl*ca, 1:nf) = real(dz)
-            jw(nnl*(cb - 1) + 1:nnl*cb, 1:nf) = -aimag(dz)
-            z = matmul(this%phn, gw*p)/a
-            jw(nnl*(ca - 1) + 1:nnl*ca, nf + 1) = this%w0*real(z)
-            jw(nnl*(cb - 1) + 1:nnl*cb, nf + 1) = -this%w0*aimag(z)
-            z = matmul(this%phn, gx*p)/a
-            jw(nnl*(ca - 1) + 1:nnl*ca, nf + 2) = this%w0*real(z)
-            jw(nnl*(cb - 1) + 1:nnl*cb, nf + 2) = -this%w0*aimag(z)
+            hs = min(h, ubound(this%phn, 3))
+            call modal_g(this%wr(:, hs), this%zr(:, hs), h, w, xi, g, gw, gx)
+            associate (ph => this%phn(:, :, hs))
+                p = matmul(conjg(transpose(ph)), cmplx(this%fl(:, ca), -this%fl(:, cb), wp))
+                ! U_h + Psi_nl diag(g) p / a, as (a, b) = (Re z, -Im z)
+                z = matmul(ph, g*p)/a
+                nref = max(nref, sqrt(sum(abs(z)**2)))
+                r(nnl*(ca - 1) + 1:nnl*ca) = u(:, ca) + real(z)
+                r(nnl*(cb - 1) + 1:nnl*cb) = u(:, cb) - aimag(z)
+                dp = matmul(conjg(transpose(ph)), &
+                            cmplx(this%jp(nnl*(ca - 1) + 1:nnl*ca, :), &
+                                  -this%jp(nnl*(cb - 1) + 1:nnl*cb, :), wp))
+                dz = matmul(ph, diag_cscale(g, dp))/a
+                jw(nnl*(ca - 1) + 1:nnl*ca, 1:nf) = real(dz)
+                jw(nnl*(cb - 1) + 1:nnl*cb, 1:nf) = -aimag(dz)
+                z = matmul(ph, gw*p)/a
+                jw(nnl*(ca - 1) + 1:nnl*ca, nf + 1) = this%w0*real(z)
+                jw(nnl*(cb - 1) + 1:nnl*cb, nf + 1) = -this%w0*aimag(z)
+                z = matmul(ph, gx*p)/a
+                jw(nnl*(ca - 1) + 1:nnl*ca, nf + 2) = this%w0*real(z)
+                jw(nnl*(cb - 1) + 1:nnl*cb, nf + 2) = -this%w0*aimag(z)
+            end associate
             if (h == 1) then
-                ! modal coordinates of harmonic 1 (unit amplitude): q = -g p / a
+                ! modal coordinates of harmonic 1 (unit amplitude): q = -g p / a; the
+                ! phase Im(c^H q) = 0
                 q = -g*p/a
                 r(nf + 1) = this%wn*(sum(abs(q)**2) - 1.0_wp)
-                r(nf + 2) = -this%wn*dot_product(this%cph, aimag(q))
+                r(nf + 2) = -this%wn*aimag(dot_product(this%cph, q))
                 ! dq/dU = -diag(g) dp / a
-                jn = 2.0_wp*real(matmul(conjg(q), diag_cscale(-g/a, dp)))
+                dq = diag_cscale(-g/a, dp)
+                jn = 2.0_wp*real(matmul(conjg(q), dq))
                 jw(nf + 1, 1:nf) = this%wn*jn
-                jw(nf + 2, 1:nf) = -this%wn*matmul(this%cph, aimag(diag_cscale(-g/a, &
-                                                                                 dp)))
+                jw(nf + 2, 1:nf) = -this%wn*aimag(matmul(conjg(this%cph), dq))
                 jw(nf + 1, nf + 1) = this%w0*this%wn*2.0_wp*real(sum(conjg(q)*(-gw*p/a)))
                 jw(nf + 1, nf + 2) = this%w0*this%wn*2.0_wp*real(sum(conjg(q)*(-gx*p/a)))
-                jw(nf + 2, nf + 1) = -this%w0*this%wn*dot_product(this%cph, &
-                                                                       aimag(-gw*p/a))
-                jw(nf + 2, nf + 2) = -this%w0*this%wn*dot_product(this%cph, &
-                                                                       aimag(-gx*p/a))
+                jw(nf + 2, nf + 1) = -this%w0*this%wn*aimag(dot_product(this%cph, -gw*p/a))
+                jw(nf + 2, nf + 2) = -this%w0*this%wn*aimag(dot_product(this%cph, -gx*p/a))
             end if
         end do
         ! the unknowns of harmonics >= 1 are U / a: their columns times a, then I
@@ -219,7 +236,7 @@ contains
 
     module procedure epmd_outputs
         real(wp) :: a, w, xi
-        integer(ip) :: h, nf
+        integer(ip) :: h, nf, hs
         complex(wp), allocatable :: g(:), gw(:), gx(:), q(:)
         info = FRIROM_OK
         nf = this%nf
@@ -229,14 +246,16 @@ contains
         call forces(this, y, a, info, errmsg)
         if (info /= 0) return
         allocate (g(this%nm), gw(this%nm), gx(this%nm), q(this%nm))
-        xo(:, 1) = matmul(this%pho, (this%qst - matmul(transpose(this%phn), &
-                                                       this%fl(:, 1)))/this%wr**2)
+        q = this%qst - matmul(conjg(transpose(this%phn(:, :, 0))), &
+                              cmplx(this%fl(:, 1), 0.0_wp, wp))
+        xo(:, 1) = real(matmul(this%pho(:, :, 0), q/this%wr(:, 0)**2))
         do h = 1, this%nh
-            call modal_g(this%wr, this%zr, h, w, xi, g, gw, gx)
-            q = -g*matmul(transpose(this%phn), cmplx(this%fl(:, 2*h), -this%fl(:, 2*h + 1), &
-                                                     wp))
-            xo(:, 2*h) = matmul(this%pho, real(q))
-            xo(:, 2*h + 1) = -matmul(this%pho, aimag(q))
+            hs = min(h, ubound(this%phn, 3))
+            call modal_g(this%wr(:, hs), this%zr(:, hs), h, w, xi, g, gw, gx)
+            q = -g*matmul(conjg(transpose(this%phn(:, :, hs))), &
+                          cmplx(this%fl(:, 2*h), -this%fl(:, 2*h + 1), wp))
+            xo(:, 2*h) = real(matmul(this%pho(:, :, hs), q))
+            xo(:, 2*h + 1) = -aimag(matmul(this%pho(:, :, hs), q))
         end do
     end procedure epmd_outputs
 

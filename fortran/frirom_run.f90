@@ -44,6 +44,7 @@ module frirom_run
               run_checkpoint, run_restore, run_contact_coords, open_run, run_lu_size, &
               run_lu_state, run_set_free_bodies, run_set_nonlinear_mode, run_to_mode, &
               run_set_user_law
+    public :: run_set_nonlinear_mode_cyclic
     public :: RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_LOAD, RUN_MODE, &
               RUN_START_COLD, RUN_START_POINT, RUN_START_RESUME, &
               RUN_GOING, RUN_DONE, RUN_MAX_POINTS, RUN_LEFT_RANGE, RUN_FAILED, RUN_STALLED, &
@@ -134,6 +135,10 @@ module frirom_run
         real(wp) :: mode_w0 = 0.0_wp
         !> a condensed mode run: the modes of its receptances (ndof, nm), rad/s, ratios
         real(wp), allocatable :: mode_modes(:, :), mode_wm(:), mode_zm(:)
+        !> a cyclic sector's mode run: the modes per harmonic (ndof, nm, 0:nh), their
+        !> frequencies and ratios (nm, 0:nh), the linear mode's modal coordinates (nm)
+        complex(wp), allocatable :: mode_psi(:, :, :), mode_q0(:)
+        real(wp), allocatable :: mode_wh(:, :), mode_zh(:, :)
         !> the callback of the user laws (run_set_user_law): kept with the model, so that
         !> a rebuilt system and a homotopy's child run evaluate them too
         type(user_law) :: ulaw
@@ -267,6 +272,20 @@ module frirom_run
             character(len=*), intent(inout) :: errmsg
             real(wp), intent(in), optional :: modes(:, :), wm(:), zm(:)
         end subroutine run_set_nonlinear_mode
+
+        !> A condensed mode run of a cyclic sector (frirom_run_modes.f90): the nonlinear
+        !> mode of one nodal diameter k as a travelling wave, harmonic h on the nodal
+        !> diameter of psi(:, :, h) (ndof, nm, 0:nh; complex shapes, the next sector's
+        !> contact DoFs phase-shifted), wh, zh (nm, 0:nh) rad/s and ratios; it starts from
+        !> the linear mode of modal coordinates q0 (nm, in harmonic 1's modes) at omega0.
+        module subroutine run_set_nonlinear_mode_cyclic(run, q0, omega0, psi, wh, zh, info, &
+                                                        errmsg)
+            type(run_t), intent(inout) :: run
+            complex(wp), intent(in) :: q0(:), psi(:, :, 0:)
+            real(wp), intent(in) :: omega0, wh(:, 0:), zh(:, 0:)
+            integer(ip), intent(out) :: info
+            character(len=*), intent(inout) :: errmsg
+        end subroutine run_set_nonlinear_mode_cyclic
 
         !> Make an open run (a frequency or load run, e.g. frf_open's) a nonlinear-mode run
         !> on the same model: mode RUN_MODE, on all DoFs (condensed false) or condensed by

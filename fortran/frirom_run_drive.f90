@@ -72,7 +72,8 @@ contains
         if (present(y0)) run%y = y0
         if (run%m%mode == RUN_MODE) then
             ! a nonlinear mode starts from its linear mode (run_set_nonlinear_mode)
-            if (.not. allocated(run%m%mode_phi) .or. run%s%stability /= 0) then
+            if (.not. (allocated(run%m%mode_phi) .or. allocated(run%m%mode_psi)) .or. &
+                run%s%stability /= 0) then
                 call set_status(info, FRIROM_ERR_PARAM, errmsg, 'run_start: a mode run '// &
                                 'needs run_set_nonlinear_mode first, and stability off')
                 return

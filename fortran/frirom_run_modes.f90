@@ -3,7 +3,7 @@
 !> log10 of the modal amplitude. run_set_nonlinear_mode gives the run the linear mode it
 !> starts from; run_start (cold) then starts from that mode, run_advance continues.
 submodule (frirom_run) frirom_run_modes
-    use frirom_epmc, only: hbm_epmc_set, hbm_epmc_modal_set
+    use frirom_epmc, only: hbm_epmc_set, hbm_epmc_modal_set, hbm_epmc_cyclic_set
     implicit none
 
 contains
@@ -37,6 +37,30 @@ contains
         run%ny = run%sys%n
     end procedure run_set_nonlinear_mode
 
+    module procedure run_set_nonlinear_mode_cyclic
+        info = FRIROM_OK
+        if (.not. open_run(run, 'run_set_nonlinear_mode_cyclic', info, errmsg)) return
+        if (run%m%mode /= RUN_MODE .or. run%m%formulation /= RUN_CONDENSED) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'run_set_nonlinear_mode_cyclic: '// &
+                            'the run was not opened as a condensed mode run (mode 3, '// &
+                            'formulation 1)')
+            return
+        end if
+        call hbm_epmc_cyclic_set(run%sys, q0, omega0, psi, wh, zh, run%m%nl, info, errmsg)
+        if (info /= 0) return
+        if (allocated(run%m%mode_psi)) deallocate (run%m%mode_psi, run%m%mode_q0, &
+                                                   run%m%mode_wh, run%m%mode_zh)
+        allocate (run%m%mode_psi(size(psi, 1), size(psi, 2), 0:ubound(psi, 3)), &
+                  run%m%mode_wh(size(wh, 1), 0:ubound(wh, 2)), &
+                  run%m%mode_zh(size(zh, 1), 0:ubound(zh, 2)))
+        run%m%mode_psi = psi
+        run%m%mode_wh = wh
+        run%m%mode_zh = zh
+        run%m%mode_q0 = q0
+        run%m%mode_w0 = omega0
+        run%ny = run%sys%n
+    end procedure run_set_nonlinear_mode_cyclic
+
     module procedure run_to_mode
         info = FRIROM_OK
         if (.not. open_run(run, 'run_to_mode', info, errmsg)) return
@@ -52,6 +76,8 @@ contains
             if (allocated(m%pair)) deallocate (m%pair)
             if (allocated(m%mode_phi)) deallocate (m%mode_phi)
             if (allocated(m%mode_modes)) deallocate (m%mode_modes, m%mode_wm, m%mode_zm)
+            if (allocated(m%mode_psi)) deallocate (m%mode_psi, m%mode_q0, m%mode_wh, &
+                                                   m%mode_zh)
         end associate
         run%s%stability = 0
         run%s%formulation = int(run%m%formulation, c_int)

@@ -5,6 +5,7 @@ submodule (frirom_run) frirom_run_setup
     use frirom_hbm, only: hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
                           hbm_set_modes_harmonic, hbm_set_selection, hbm_set_orbits
     use frirom_epmc, only: hbm_epmc, hbm_epmc_set, hbm_epmc_modal, hbm_epmc_modal_set
+    use frirom_epmc, only: hbm_epmc_cyclic_set
     use frirom_aft, only: aft_plan_destroy, law_nslider
     implicit none
 
@@ -119,6 +120,9 @@ contains
                                         m%mode_wm, m%mode_zm, m%nl, info, errmsg)
             else if (allocated(m%mode_phi)) then
                 call hbm_epmc_set(run%sys, m%mode_phi, m%mode_w0, info, errmsg)
+            else if (allocated(m%mode_psi)) then
+                call hbm_epmc_cyclic_set(run%sys, m%mode_q0, m%mode_w0, m%mode_psi, &
+                                         m%mode_wh, m%mode_zh, m%nl, info, errmsg)
             end if
             if (info /= 0) return
             run%netot = sum(m%ginfo(2, :))

@@ -80,11 +80,15 @@ def _text(b) -> str:
 class Run:
     """An open Fortran run on a packed model (frirom._pack._Packed)."""
 
-    def __init__(self, packed, omega_fix: float = 0.0, mode_shape=None):
+    def __init__(self, packed, omega_fix: float = 0.0, mode_shape=None, cyclic_mode=None):
         """mode_shape: (phi (n_dof,), omega0 rad/s, modes) opens a nonlinear-mode run
         (EPMC, frirom_run RUN_MODE) starting from that linear mode: on all DoFs when modes
         is None, else condensed to the contact DoFs by modes = (Phi (n_dof, nm), omega
-        (nm,) rad/s, zeta (nm,))."""
+        (nm,) rad/s, zeta (nm,)). cyclic_mode: (q0 (nm,) complex, omega0) opens a cyclic
+        sector's nonlinear-mode run (packed by _pack_sector: its modes per harmonic) from
+        the linear mode of modal coordinates q0 in harmonic 1's modes."""
+        if cyclic_mode is not None:
+            mode_shape = (None, cyclic_mode[1], True)
         modal = mode_shape is not None and mode_shape[2] is not None
         p, o, m = packed, packed.opts, packed.modes
         iset = np.array([_setting(o, n) for n in _INAMES], np.int32)
@@ -120,7 +124,14 @@ class Run:
                 self.handle, self._user_law.address, 0)))
         if getattr(p, "free", False):
             raise_for_status(*self._msg(_kernels.frun_set_free_bodies(self.handle, 1)))
-        if mode_shape is not None:
+        if cyclic_mode is not None:
+            ny, info, msg = _kernels.frun_set_nonlinear_mode_cyclic(
+                self.handle, np.asarray(cyclic_mode[0], complex), float(cyclic_mode[1]),
+                np.asfortranarray(m.psi), np.asfortranarray(m.omega_h),
+                np.asfortranarray(m.zeta_h))
+            raise_for_status(info, _text(msg))
+            self.ny = int(ny)
+        elif mode_shape is not None:
             phi_m, w_m, z_m = (mode_shape[2] if modal else
                                (np.zeros((p.n_dof, 1)), np.ones(1), np.zeros(1)))
             ny, info, msg = _kernels.frun_set_nonlinear_mode(
@@ -134,7 +145,7 @@ class Run:
                 self.handle, 0, np.asfortranarray(m.phi),
                 np.zeros((1, m.nmodes, 1), complex), m.omega[:, None], m.zeta[:, None],
                 nh1=1)))
-        if m.hmodes:
+        if m.hmodes and cyclic_mode is None:
             raise_for_status(*self._msg(_kernels.frun_set_modes(
                 self.handle, 1, np.zeros((p.n_dof, m.hmodes)), np.asfortranarray(m.psi),
                 np.asfortranarray(m.omega_h), np.asfortranarray(m.zeta_h))))

@@ -38,6 +38,8 @@ def save_h5(bb: Backbone, path, attrs: dict | None = None) -> None:
         for name in _SCALARS:
             f.attrs[name] = getattr(bb, name)
         f.attrs["lscale"] = bb.lscale
+        if bb.nodal_diameter is not None:
+            f.attrs["nodal_diameter"] = int(bb.nodal_diameter)
         for k, v in (attrs or {}).items():
             f.attrs[k] = v
     os.replace(tmp, path)
@@ -54,6 +56,8 @@ def load_h5(path) -> tuple[Backbone, dict]:
         raise InputError(f"{path}: cannot be read as a backbone file ({exc})") from None
     kw = {k: attrs.pop(k) for k in _SCALARS}
     kw["lscale"] = float(attrs.pop("lscale", 0.0))
+    if "nodal_diameter" in attrs:
+        kw["nodal_diameter"] = int(attrs.pop("nodal_diameter"))
     for k in ("start", "status", "message"):
         kw[k] = kw[k].decode() if isinstance(kw[k], bytes) else str(kw[k])
     kw["mode"], kw["H"], kw["omega0"] = int(kw["mode"]), int(kw["H"]), float(kw["omega0"])

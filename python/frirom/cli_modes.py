@@ -49,7 +49,11 @@ def run_mode_deck(args, deck, out: Path) -> int:
         shutil.copyfile(deck.path, out / "deck.toml")
     model, options = deck.model(), deck.options()
     static = deck.F[:, 0].real if np.any(deck.F[:, 0]) else None
-    print(f"frirom: nonlinear mode {an.mode} ({an.start} start) of {model.n_dof} "
+    wave = ""
+    if getattr(model, "n_sectors", None):
+        wave = (f" of nodal diameter {model.engine_order} (a travelling wave; sector 0's "
+                "modal amplitude)")
+    print(f"frirom: nonlinear mode {an.mode} ({an.start} start){wave} of {model.n_dof} "
           f"coordinates, {sum(g.n_elem for g in model.contacts)} contact elements, H = "
           f"{deck.harmonics}, modal amplitude {an.amplitudes[0]:g} .. {an.amplitudes[1]:g}")
     attrs = {"deck_fingerprint": fingerprint, "deck_path": str(deck.path.resolve())}

@@ -93,6 +93,10 @@ class Backbone:
     #: per unit modal amplitude), 1/s: xi - xi_viscous is the contacts' share (None: not
     #: kept, files written before it)
     xi_viscous: np.ndarray = field(default=None, repr=False)
+    #: a cyclic sector's mode: the nodal diameter of its harmonic 1 (None: not cyclic);
+    #: amplitude, energy and harmonics are then the sector's (the rotor's amplitude is
+    #: sqrt(N) times it, its energy N times)
+    nodal_diameter: int | None = None
 
     def __len__(self) -> int:
         return int(self.amplitude.size)
@@ -211,7 +215,8 @@ def linear_mode(model: Model, mode: int = 0, start: str = "stuck") -> tuple[np.n
 def nonlinear_mode(model: Model, mode: int = 0, amplitudes=(1e-6, 1e-2), start: str = "stuck",
                    options: SolverOptions | None = None, outputs=None, static=None,
                    max_points: int | None = None, batch: int | None = None,
-                   callback=None, resume: dict | None = None) -> Backbone:
+                   callback=None, resume: dict | None = None,
+                   nodal_diameter: int | None = None) -> Backbone:
     """The backbone of a nonlinear mode by the extended periodic motion concept.
 
     The run object's mode 3 (frirom_run RUN_MODE) from modal amplitude amplitudes[0] to
@@ -219,10 +224,15 @@ def nonlinear_mode(model: Model, mode: int = 0, amplitudes=(1e-6, 1e-2), start: 
 
     Parameters
     ----------
-    model : Model
-        Any contact law and damping; a cyclic sector is not supported yet.
+    model : Model or CyclicModel
+        Any contact law and damping. A cyclic sector (:class:`frirom.model.CyclicModel`):
+        the mode of one nodal diameter as a travelling wave
+        (:mod:`frirom.nonlinear_modes_cyclic`), condensed with each harmonic's receptance
+        from the modes of its own nodal diameter; amplitude, energy and harmonics are
+        sector 0's.
     mode : int
-        Index of the linear mode it starts from, 0 = the lowest with a nonzero frequency.
+        Index of the linear mode it starts from, 0 = the lowest with a nonzero frequency
+        (a cyclic sector: among those of its nodal diameter).
     amplitudes : (float, float)
         Modal amplitudes from and to, sqrt(kg) m.
     start : {'stuck', 'free'}
@@ -247,14 +257,22 @@ def nonlinear_mode(model: Model, mode: int = 0, amplitudes=(1e-6, 1e-2), start: 
         continues from it as the uninterrupted run did, and the Backbone returned holds
         the points after it.
 
+    nodal_diameter : int, optional
+        A cyclic sector's nodal diameter k (default the model's engine_order): harmonic h
+        on nodal diameter sign h k mod N. Not for a Model.
+
     Returns
     -------
     Backbone
     """
     from ._run import GOING, START_COLD, START_RESUME
+    from .model import CyclicModel
 
-    if not isinstance(model, Model):
-        raise ParameterError("model: expected a frirom.Model (a cyclic sector: not yet)")
+    cyclic = isinstance(model, CyclicModel)
+    if not (isinstance(model, Model) or cyclic):
+        raise ParameterError("model: expected a frirom.Model or frirom.model.CyclicModel")
+    if nodal_diameter is not None and not cyclic:
+        raise ParameterError("nodal_diameter: only for a cyclic sector (CyclicModel)")
     a0, a1 = (float(a) for a in amplitudes)
     if not (a0 > 0 and a1 > 0 and a0 != a1 and np.isfinite(a0) and np.isfinite(a1)):
         raise ParameterError("amplitudes: two different positive finite modal amplitudes "
@@ -266,6 +284,9 @@ def nonlinear_mode(model: Model, mode: int = 0, amplitudes=(1e-6, 1e-2), start: 
         raise ParameterError("options.harmonics: a nonlinear mode needs H >= 1")
     condensed = opts.formulation == "condensed" and bool(model.contacts)
     n_modes = opts.modes
+    if cyclic and n_modes:
+        raise ParameterError("options.modes: a cyclic model brings its own modes per nodal "
+                             "diameter (frirom.reduction.cyclic.cyclic_model)")
     # a harmonic selection (harmonics_kept, where SolverOptions has it) is not for modes
     extra = {"harmonics_kept": None} if hasattr(opts, "harmonics_kept") else {}
     opts = dataclasses.replace(opts, formulation="banded", stability=False, modes=None,
@@ -273,8 +294,16 @@ def nonlinear_mode(model: Model, mode: int = 0, amplitudes=(1e-6, 1e-2), start: 
                                krylov=False, receptances="auto", **extra)
     if max_points is not None:
         opts = dataclasses.replace(opts, max_points=int(max_points))
-    packed, run, phi, w0 = _open(model, mode, start, opts, outputs, static,
-                                 condensed=condensed, n_modes=n_modes)
+    if cyclic:
+        from .nonlinear_modes_cyclic import open_cyclic
+        packed, run, make = open_cyclic(model, mode, start, opts, outputs, static,
+                                        nodal_diameter)
+    else:
+        packed, run, phi, w0 = _open(model, mode, start, opts, outputs, static,
+                                     condensed=condensed, n_modes=n_modes)
+
+        def make(*pts):
+            return _backbone(model, packed, phi, w0, mode, start, *pts)
     if resume is None:
         run.start(START_COLD, np.log10(a0), np.log10(a1))
     else:
@@ -301,12 +330,10 @@ def nonlinear_mode(model: Model, mode: int = 0, amplitudes=(1e-6, 1e-2), start: 
             if raise_info:
                 raise ConvergenceError(res.msg)
             if callback is not None:
-                callback(_backbone(model, packed, phi, w0, mode, start, ys, lams, xos,
-                                   sts, its, cks, status, message))
+                callback(make(ys, lams, xos, sts, its, cks, status, message))
     finally:
         run.close()
-    bb = _backbone(model, packed, phi, w0, mode, start, ys, lams, xos, sts, its, cks, status,
-                   message)
+    bb = make(ys, lams, xos, sts, its, cks, status, message)
     bb.lscale = abs(np.log10(a1) - np.log10(a0))
     if bb.amplitude.size == 0 and resume is None:
         raise ConvergenceError(f"nonlinear mode: no point converged ({message})")
@@ -383,7 +410,30 @@ def _status_name(status: int) -> str:
 def _backbone(model, packed, phi, w0, mode, start, ys, lams, xos, sts, its, cks, status,
               message) -> Backbone:
     """A Backbone from the run's points so far."""
-    n, H = model.n_dof, packed.H
+    H = packed.H
+    nc = 2 * H + 1
+
+    def energy_viscous(omega, xi, a, Xp):
+        M = model.M
+        h2 = np.zeros(nc)
+        h2[1::2] = h2[2::2] = np.arange(1, H + 1) ** 2
+        mnorm = np.einsum("pic,pic->pc", Xp, np.stack([M @ Xp[p] for p in range(len(a))])
+                          if len(a) else Xp)
+        energy = np.pi * xi * omega * (mnorm * h2).sum(axis=1)
+        C = model.C
+        xi_visc = (np.einsum("pi,pi->p", Xp[:, :, 1], (C @ Xp[:, :, 1].T).T)
+                   + np.einsum("pi,pi->p", Xp[:, :, 2], (C @ Xp[:, :, 2].T).T)) / np.maximum(
+                       a, 1e-300) ** 2 if len(a) else np.zeros(0)
+        return energy, xi_visc
+    return _backbone_from(packed, w0, mode, start, ys, lams, xos, sts, its, cks, status,
+                          message, n_out=model.n_dof, energy_viscous=energy_viscous)
+
+
+def _backbone_from(packed, w0, mode, start, ys, lams, xos, sts, its, cks, status, message,
+                   n_out, energy_viscous, nodal_diameter=None) -> Backbone:
+    """A Backbone from a mode run's points so far: n_out, the run's outputs per point;
+    energy_viscous(omega, xi, a, Xp) -> (energy per cycle, xi's viscous part)."""
+    n, H = n_out, packed.H
     nc = 2 * H + 1
     ny = packed.mode_ny
     y = np.concatenate(ys, axis=1).T if ys else np.zeros((0, ny))
@@ -391,16 +441,7 @@ def _backbone(model, packed, phi, w0, mode, start, ys, lams, xos, sts, its, cks,
     omega, xi = w0 * y[:, -2], w0 * y[:, -1]
     # the motion's harmonics at every DoF (the run's outputs)
     Xp = (np.concatenate(xos, axis=2).transpose(2, 0, 1) if xos else np.zeros((0, n, nc)))
-    M = model.M
-    h2 = np.zeros(nc)
-    h2[1::2] = h2[2::2] = np.arange(1, H + 1) ** 2
-    mnorm = np.einsum("pic,pic->pc", Xp, np.stack([M @ Xp[p] for p in range(len(a))])
-                      if len(a) else Xp)
-    energy = np.pi * xi * omega * (mnorm * h2).sum(axis=1)
-    C = model.C
-    xi_visc = (np.einsum("pi,pi->p", Xp[:, :, 1], (C @ Xp[:, :, 1].T).T)
-               + np.einsum("pi,pi->p", Xp[:, :, 2], (C @ Xp[:, :, 2].T).T)) / np.maximum(
-                   a, 1e-300) ** 2 if len(a) else np.zeros(0)
+    energy, xi_visc = energy_viscous(omega, xi, a, Xp)
     xo = np.einsum("oj,pjc->poc", packed.select, Xp)
     st = (np.concatenate(sts, axis=2).transpose(2, 0, 1) if sts else np.zeros((0, 3, 0)))
     st = st[:, :, :packed.ne_tot]
@@ -414,4 +455,5 @@ def _backbone(model, packed, phi, w0, mode, start, ys, lams, xos, sts, its, cks,
                     mode=int(mode), start=start, omega0=w0, H=H,
                     status=_status_name(status), message=message,
                     iterations=np.concatenate(its) if its else np.zeros(0, int), y=y,
-                    tans=tans, yscales=ysc, ds_next=dsn, sliders=sl, xi_viscous=xi_visc)
+                    tans=tans, yscales=ysc, ds_next=dsn, sliders=sl, xi_viscous=xi_visc,
+                    nodal_diameter=nodal_diameter)

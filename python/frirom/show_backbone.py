@@ -44,6 +44,10 @@ def backbone_point_state(bb, deck, index: int) -> PointState:
     """The PointState of backbone point `index` of the deck's model (no new solve)."""
     model, opts = deck.model(), deck.options()
     n = model.n_dof
+    if bb.harmonics.shape[1] != n and hasattr(model, "n_sectors"):
+        raise InputError(f"the backbone keeps {bb.harmonics.shape[1]} of the sector's {n} "
+                         "coordinates (a cyclic sector above 400 coordinates keeps the "
+                         "contact DoFs and outputs only): frirom show needs every one")
     if bb.harmonics.shape[1] != n:
         raise InputError(f"the backbone has {bb.harmonics.shape[1]} coordinates, the deck's "
                          f"model {n}: not the deck it was made with")
@@ -52,7 +56,10 @@ def backbone_point_state(bb, deck, index: int) -> PointState:
               else np.zeros(0))
     contacts = contact_fields(model, x, slider, opts.n_samples)
     omega = float(bb.omega[index])
-    visc = viscous_work(model.C, x, omega, bb.H)
+    if hasattr(model, "n_sectors"):
+        visc = _sector_viscous(model, x[:, 1::2] - 1j * x[:, 2::2], omega)
+    else:
+        visc = viscous_work(model.C, x, omega, bb.H)
     dis = float(sum(c.energy.sum() for c in contacts))
     ext = float(bb.energy[index])
     P = deck.output_map
@@ -62,6 +69,19 @@ def backbone_point_state(bb, deck, index: int) -> PointState:
                       labels=list(deck.output_names), contacts=contacts,
                       balance={"excitation": ext, "contacts": dis, "viscous": visc,
                                "residual": ext - dis - visc})
+
+
+def _sector_viscous(model, z: np.ndarray, omega: float) -> float:
+    """Viscous work per period of a cyclic sector's mode (sector 0) from its harmonics z
+    (n_dof, H) = a - i b: harmonic h's modal coordinates q in the modes of its nodal
+    diameter (every sector DoF given: least squares, exact), pi omega h^2 sum_r 2 zeta_r
+    w_r |q_r|^2."""
+    work = 0.0
+    for h in range(1, z.shape[1] + 1):
+        m = model.modes_of(model.harmonic_index(h))
+        q = np.linalg.lstsq(m.psi, z[:, h - 1], rcond=None)[0]
+        work += np.pi * omega * h ** 2 * float(np.sum(2 * m.zeta * m.omega * np.abs(q) ** 2))
+    return work
 
 
 def cmd_show_backbone(args, h5: Path) -> int:

@@ -301,9 +301,19 @@ def parse_deck(path, raw: dict | None = None, allow_code=()) -> DeckSettings:
 
     analysis = parse_analysis(ctx, raw, fe, labels)
     nlm = analysis.nonlinear_mode
-    if (nlm or analysis.from_backbone) and cyc is not None:
-        raise ctx.error("analysis.kind", "'forced_response' with [reduction.cyclic] (a "
-                        "nonlinear mode of a cyclic sector: not yet)", analysis.kind)
+    if analysis.from_backbone and cyc is not None:
+        raise ctx.error("analysis.kind", "'forced_response' or 'nonlinear_mode' with "
+                        "[reduction.cyclic] (a synthesis from a cyclic sector's backbone: "
+                        "not yet)", analysis.kind)
+    if analysis.nodal_diameter is not None:
+        if not (nlm and cyc is not None):
+            raise ctx.error("analysis.nodal_diameter", "only in a nonlinear-mode deck with "
+                            "[reduction.cyclic]", analysis.nodal_diameter)
+        if analysis.nodal_diameter >= cyc.sectors:
+            raise ctx.error("analysis.nodal_diameter", f"an integer 0..{cyc.sectors - 1} "
+                            "(reduction.cyclic.sectors - 1)", analysis.nodal_diameter)
+        # the sector's modes are computed for the nodal diameters of the mode's harmonics
+        cyc = dataclasses.replace(cyc, engine_order=analysis.nodal_diameter)
     solver = _solver(ctx, table(ctx, raw, "solver"), cyc)
     H = solver.harmonics
     damping = _damping(ctx, table(ctx, raw, "damping"), fe)

@@ -33,6 +33,9 @@ class AnalysisSettings:
     output : DofRef or None
         The DoF whose amplitude the backbone figure and table also give (first of
         [outputs] dofs when None; given, it is put first there).
+    nodal_diameter : int or None
+        With [reduction.cyclic]: the nodal diameter k of the mode, a travelling wave
+        (harmonic h on nodal diameter -h k mod N); None: reduction.cyclic.engine_order.
     """
 
     kind: str = "forced_response"
@@ -40,6 +43,7 @@ class AnalysisSettings:
     start: str = "stuck"
     amplitudes: tuple = (1e-6, 1e-2)
     output: object = None
+    nodal_diameter: int | None = None
 
     @property
     def nonlinear_mode(self) -> bool:
@@ -60,7 +64,8 @@ def parse_analysis(ctx: Context, raw: dict, fe: bool, labels: bool) -> AnalysisS
         return AnalysisSettings()
     # a forced response accepts (and does not use) the nonlinear mode's keys, so that a
     # study can switch analysis.kind between from_backbone and forced_response
-    unknown(ctx, an, {"kind", "mode", "start", "amplitudes", "output"}, "analysis")
+    unknown(ctx, an, {"kind", "mode", "start", "amplitudes", "output", "nodal_diameter"},
+            "analysis")
     mode = number(ctx, an, "mode", "analysis.mode", default=1, integer=True, minimum=1)
     start = string(ctx, an, "start", "analysis.start", default="stuck",
                    choices=("stuck", "free"))
@@ -73,5 +78,10 @@ def parse_analysis(ctx: Context, raw: dict, fe: bool, labels: bool) -> AnalysisS
     output = None
     if "output" in an:
         output = dof_ref(ctx, an["output"], "analysis.output", fe, labels)
+    nd = None
+    if "nodal_diameter" in an:
+        nd = int(number(ctx, an, "nodal_diameter", "analysis.nodal_diameter", integer=True,
+                        minimum=0))
     return AnalysisSettings(kind=kind, mode=int(mode), start=start,
-                            amplitudes=(float(amps[0]), float(amps[1])), output=output)
+                            amplitudes=(float(amps[0]), float(amps[1])), output=output,
+                            nodal_diameter=nd)

@@ -1,0 +1,162 @@
+"""Nonlinear modes of a tuned cyclic sector (frirom.model.CyclicModel): the backbone of one
+nodal diameter k, the rotor vibrating as a travelling wave, by the EPMC of
+:mod:`frirom.nonlinear_modes` in the one continuation driver (frirom_run mode 3, the
+condensed system of frirom_hbm_epmc_cyclic.f90).
+
+Sector s moves as sector 0 delayed by s k / N of a period: time harmonic h of that motion
+lives on nodal diameter k_h = sign h k mod N (the model's sign, as for an engine order k),
+so each harmonic's receptance comes from k_h's modes (psi^H M_k psi = I over the sector)
+and a contact to the next sector sees sector 0's motion phase-shifted by exp(i k_h 2 pi /
+N), exactly as in a forced response under engine order k. The unknowns are the contact
+DoFs' harmonics of sector 0, the frequency and the artificial damping; harmonic 1 is
+mass-normalised over the sector (a is the sector's modal amplitude: the whole rotor's is
+sqrt(N) a) and its phase fixed against the linear travelling wave it starts from
+(Im(c^H q_1) = 0, c that wave's modal coordinates).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import scipy.sparse as sp
+
+from ._errors import ParameterError
+from .contact import stuck_stiffness
+from .model import CyclicModel, Excitation
+
+__all__ = ["cyclic_linear_mode", "open_cyclic"]
+
+#: largest sector whose every DoF is an output of the run (energy per cycle, harmonics)
+_ALL_OUTPUTS = 400
+
+
+def _with_diameter(model: CyclicModel, nodal_diameter) -> CyclicModel:
+    """The model with its engine order set to the nodal diameter k of the mode."""
+    if nodal_diameter is None:
+        return model
+    k = nodal_diameter
+    if not (isinstance(k, (int, np.integer)) and 0 <= k < model.n_sectors):
+        raise ParameterError(f"nodal_diameter: expected an integer 0..{model.n_sectors - 1},"
+                             f" got {k!r}")
+    return dataclasses.replace(model, engine_order=int(k))
+
+
+def _contact_shapes(model: CyclicModel, k: int, psi: np.ndarray):
+    """(G_k psi stacked over the groups, stuck stiffness per row): the contacts' relative
+    motion per unit modal coordinate of nodal diameter k's shapes psi (n_dof, nm), the
+    next sector's columns phase-shifted by exp(i k 2 pi / N)."""
+    n = model.n_dof
+    ph = np.exp(2j * np.pi * k / model.n_sectors)
+    rows, ks = [], []
+    for g in model.contacts:
+        G = sp.csr_matrix(g.G)
+        P = G[:, :n] @ psi
+        if G.shape[1] == 2 * n:
+            P = P + ph * (G[:, n:] @ psi)
+        rows.append(np.asarray(P))
+        ks.append(stuck_stiffness(g.law, g.params).ravel())
+    return np.vstack(rows), np.concatenate(ks)
+
+
+def cyclic_linear_mode(model: CyclicModel, mode: int = 0, start: str = "stuck",
+                       nodal_diameter: int | None = None):
+    """The linear travelling wave a cyclic nonlinear mode starts from, in the modal
+    coordinates of harmonic 1's nodal diameter k_1 = sign k mod N: (q0 (nm,) complex,
+    unit norm, omega0 rad/s, k_1). 'free': mode `mode` of k_1 (q0 a unit vector); 'stuck':
+    of diag(omega_r^2) + (G_k Psi)^H Ks (G_k Psi), every contact element a linear spring
+    of its law's stick stiffness (within the model's modes of k_1)."""
+    if not isinstance(model, CyclicModel):
+        raise ParameterError("model: expected a frirom.model.CyclicModel")
+    if start not in ("stuck", "free"):
+        raise ParameterError("start: expected 'stuck' or 'free'")
+    model = _with_diameter(model, nodal_diameter)
+    k1 = model.harmonic_index(1)
+    m = model.modes_of(k1)
+    nm = m.omega.size
+    if not (isinstance(mode, (int, np.integer)) and 0 <= mode < nm):
+        raise ParameterError(f"mode: expected an index 0..{nm - 1} (the modes of nodal "
+                             f"diameter {k1} the model has)")
+    A = np.diag(m.omega.astype(complex) ** 2)
+    if start == "stuck":
+        P, ks = _contact_shapes(model, k1, m.psi)
+        A = A + P.conj().T @ (ks[:, None] * P)
+    lam, V = np.linalg.eigh(0.5 * (A + A.conj().T))
+    q0 = V[:, mode]
+    j = int(np.argmax(np.abs(q0)))
+    q0 = q0 * (abs(q0[j]) / q0[j])          # the largest coordinate real and positive
+    return q0, float(np.sqrt(lam[mode])), k1
+
+
+def open_cyclic(model: CyclicModel, mode, start, opts, outputs=None, static=None,
+                nodal_diameter=None):
+    """The packed sector, a cyclic mode run (frirom._run.Run) on it and the function that
+    makes a Backbone of the run's points: (packed, run, make)."""
+    from ._pack import _output_map, pack
+    from ._run import Run
+    from .nonlinear_modes import _backbone_from
+    model = _with_diameter(model, nodal_diameter)
+    if opts.modes:
+        raise ParameterError("options.modes: a cyclic model brings its own modes per nodal "
+                             "diameter (frirom.reduction.cyclic.cyclic_model)")
+    q0, w0, k1 = cyclic_linear_mode(model, mode, start)
+    n, H = model.n_dof, opts.harmonics
+    F = np.zeros((n, 1))
+    if static is not None:
+        st = np.asarray(static, float).ravel()
+        if st.size != n or not np.all(np.isfinite(st)):
+            raise ParameterError(f"static: {n} finite values expected")
+        F[:, 0] = st
+    out, P = _output_map(outputs, n)
+    # the run reports every sector DoF (up to _ALL_OUTPUTS: the energy per cycle by the
+    # modal coordinates), else the contact DoFs and the outputs asked for
+    run_out = (np.arange(n) if n <= _ALL_OUTPUTS else
+               np.unique(np.r_[model.nonlinear_dofs(),
+                               np.asarray(out if out is not None else [], int)]))
+    if P is not None:
+        if n > _ALL_OUTPUTS:
+            raise ParameterError(f"outputs: a combination matrix needs a sector of at most "
+                                 f"{_ALL_OUTPUTS} DoFs; give DoF indices")
+    else:
+        sel = (np.asarray(out, int) if out is not None
+               else run_out if n <= 100 else model.nonlinear_dofs())
+        P = np.zeros((sel.size, run_out.size))
+        pos = {int(d): i for i, d in enumerate(run_out)}
+        P[np.arange(sel.size), [pos[int(d)] for d in sel]] = 1.0
+        out = sel
+    o = dataclasses.replace(opts, formulation="condensed", modes=None)
+    packed = pack(model, Excitation(F), o, run_out)
+    packed.select = P if P.shape[1] == run_out.size else P[:, run_out]
+    packed.select_dofs = np.asarray(out) if out is not None else np.zeros(0, int)
+    nm = packed.modes.hmodes
+    qp = np.zeros(nm, complex)
+    qp[:q0.size] = q0
+    run = Run(packed, cyclic_mode=(qp, w0))
+    packed.mode_ny = run.ny
+    # each harmonic's modes on the run's outputs: modal coordinates of the reported motion
+    pers = [model.modes_of(model.harmonic_index(h)) for h in range(H + 1)]
+    full = run_out.size == n
+
+    def energy_viscous(omega, xi, a, Xp):
+        """Energy per cycle (per sector) and the viscous part of xi from the modal
+        coordinates of every harmonic (NaN when the run does not report every DoF)."""
+        npt = a.size
+        if not full:
+            return np.full(npt, np.nan), np.full(npt, np.nan)
+        e = np.zeros(npt)
+        for h in range(1, H + 1):
+            psi = pers[h].psi
+            z = Xp[:, :, 2 * h - 1] - 1j * Xp[:, :, 2 * h]        # (npt, n)
+            q = np.linalg.lstsq(psi, z.T, rcond=None)[0]         # (nm, npt)
+            s = (np.abs(q) ** 2).sum(axis=0)
+            e += h ** 2 * s
+            if h == 1:
+                c = 2 * pers[1].zeta * pers[1].omega
+                xv = (c[:, None] * np.abs(q) ** 2).sum(axis=0) / np.maximum(a, 1e-300) ** 2
+        return np.pi * xi * omega * e, xv
+
+    def make(ys, lams, xos, sts, its, cks, status, message):
+        return _backbone_from(packed, w0, mode, start, ys, lams, xos, sts, its, cks, status,
+                              message, n_out=run_out.size, energy_viscous=energy_viscous,
+                              nodal_diameter=k1)
+    return packed, run, make
