@@ -11,7 +11,7 @@ submodule (frirom_epmc) frirom_hbm_epmc_cyclic
 contains
 
     module procedure hbm_epmc_cyclic_set
-        integer(ip) :: nd, nm, nnl, nh, j
+        integer(ip) :: nd, nm, nnl, nh
         complex(wp), allocatable :: u1(:)
         info = FRIROM_OK
         select type (sys => sysc)
@@ -20,11 +20,6 @@ contains
             nm = size(psi, 2)
             nnl = size(nl)
             nh = sys%nh
-            if (nh < 1) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: harmonics '// &
-                                '>= 1 expected')
-                return
-            end if
             if (size(psi, 1) /= nd .or. ubound(psi, 3) /= nh .or. nm < 1 .or. &
                 size(q0) /= nm .or. any(shape(wh) /= [nm, nh + 1]) .or. &
                 any(shape(zh) /= [nm, nh + 1]) .or. nnl < 1) then
@@ -33,11 +28,8 @@ contains
                                 'the contact DoFs expected')
                 return
             end if
-            if (any(nl < 1) .or. any(nl > nd)) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: contact '// &
-                                'DoF out of range')
-                return
-            end if
+            call epmc_modal_base(sys, nm, nl, w0, info, errmsg)
+            if (info /= FRIROM_OK) return
             if (.not. (all(wh > 0.0_wp) .and. all(zh >= 0.0_wp) .and. w0 > 0.0_wp .and. &
                        all(abs(psi) <= huge(1.0_wp)) .and. all(abs(q0) <= huge(1.0_wp)) &
                        .and. all(abs(wh) + abs(zh) <= huge(1.0_wp)) .and. &
@@ -52,16 +44,6 @@ contains
                                 'the linear mode q0 is zero')
                 return
             end if
-            sys%nm = nm
-            sys%nnl = nnl
-            sys%nl = nl
-            sys%w0 = w0
-            if (allocated(sys%colmap)) deallocate (sys%colmap)
-            allocate (sys%colmap(nd))
-            sys%colmap = 0
-            do j = 1, nnl
-                sys%colmap(nl(j)) = j
-            end do
             if (allocated(sys%phn)) deallocate (sys%phn, sys%pho, sys%wr, sys%zr)
             allocate (sys%phn(nnl, nm, 0:nh), sys%pho(size(sys%outdofs), nm, 0:nh), &
                       sys%wr(nm, 0:nh), sys%zr(nm, 0:nh))

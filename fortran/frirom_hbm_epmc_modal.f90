@@ -19,18 +19,13 @@ contains
 
     module procedure hbm_epmc_modal_set
         real(wp), allocatable :: mv(:), mp0(:), pn(:), p0(:), cp0(:)
-        integer(ip) :: nd, nm, r, nnl, j
+        integer(ip) :: nd, nm, r, nnl
         info = FRIROM_OK
         select type (sys => sysc)
         type is (hbm_epmc_modal)
             nd = sys%ndof
             nm = size(phi, 2)
             nnl = size(nl)
-            if (sys%nh < 1) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: harmonics '// &
-                                '>= 1 expected')
-                return
-            end if
             if (size(phi0) /= nd .or. size(phi, 1) /= nd .or. nm < 1 .or. size(wm) /= nm &
                 .or. size(zm) /= nm .or. nnl < 1) then
                 call set_status(info, FRIROM_ERR_SIZE, errmsg, 'nonlinear mode (condensed):'// &
@@ -38,25 +33,13 @@ contains
                                 'contact DoFs expected')
                 return
             end if
-            if (any(nl < 1) .or. any(nl > nd)) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: contact '// &
-                                'DoF out of range')
-                return
-            end if
+            call epmc_modal_base(sys, nm, nl, w0, info, errmsg)
+            if (info /= FRIROM_OK) return
             if (failed(.not. (all(wm > 0.0_wp) .and. all(zm >= 0.0_wp) .and. w0 > 0.0_wp &
                        .and. all(abs(phi) <= huge(1.0_wp)) .and. all(abs(phi0) <= huge(1.0_wp)) &
                        .and. all(abs(wm) + abs(zm) <= huge(1.0_wp))), info, FRIROM_ERR_PARAM, &
                        errmsg, 'nonlinear mode (condensed): finite modes, omega > 0 (no '// &
                        'rigid-body mode) and zeta >= 0')) return
-            sys%nm = nm
-            sys%nnl = nnl
-            sys%nl = nl
-            sys%w0 = w0
-            allocate (sys%colmap(nd))
-            sys%colmap = 0
-            do j = 1, nnl
-                sys%colmap(nl(j)) = j
-            end do
             call epmc_normalise(sys%m, phi0, 'phi', p0, mp0, info, errmsg)
             if (info /= 0) return
             allocate (sys%phn(nnl, nm, 0:0), sys%pho(size(sys%outdofs), nm, 0:0), &
@@ -89,6 +72,26 @@ contains
                             'condensed mode run')
         end select
     end procedure hbm_epmc_modal_set
+
+
+    module procedure epmc_modal_base
+        integer(ip) :: j
+        info = FRIROM_OK
+        if (failed(sys%nh < 1, info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: harmonics '// &
+                   '>= 1 expected')) return
+        if (failed(any(nl < 1) .or. any(nl > sys%ndof), info, FRIROM_ERR_PARAM, errmsg, &
+                   'nonlinear mode: contact DoF out of range')) return
+        sys%nm = nm
+        sys%nnl = size(nl)
+        sys%nl = nl
+        sys%w0 = w0
+        if (allocated(sys%colmap)) deallocate (sys%colmap)
+        allocate (sys%colmap(sys%ndof))
+        sys%colmap = 0
+        do j = 1, size(nl)
+            sys%colmap(nl(j)) = j
+        end do
+    end procedure epmc_modal_base
 
     !> Contact forces fl (nnl, nc) and, into jp, their Jacobian over the physical U.
     subroutine forces(this, y, a, info, errmsg)

@@ -12,6 +12,7 @@ import scipy.sparse as sp
 
 from _lattices import tuned_rotor
 from frirom.model import ContactGroup
+from _rotor import rotor_sector
 from frirom.reduction.cyclic import CyclicSector, axis_rotation
 
 K_SUPPORT = 3e5                   # N/m, springs tying the interface nodes to ground
@@ -36,9 +37,7 @@ def disk(n_sectors: int, ground: bool = True):
     n_s = Ks.shape[0]
     loc = -np.ones(glob.max() + 1, dtype=np.int64)
     loc[glob] = np.arange(glob.size)
-    sector = CyclicSector(n_dof=n_s, n_sectors=N, left=s["node_dofs"][s["left"]],
-                          right=s["node_dofs"][s["right"]], axis=np.array([0.0, 0.0, 1.0]),
-                          origin=np.zeros(3))
+    sector = rotor_sector(r, N)
     n_ring = r["nz"] * 3 * 3
     blade_nodes = [i for i in range(n_ring, owner.size) if owner[i] == 0]
     blade = loc[(3 * np.array(blade_nodes)[:, None] + np.arange(3)).ravel()]

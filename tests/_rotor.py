@@ -10,7 +10,7 @@ import scipy.sparse as sp
 
 from _lattices import tuned_rotor
 from frirom.model import ContactGroup, Damping, Model
-from frirom.reduction.cyclic import axis_rotation
+from frirom.reduction.cyclic import CyclicSector, axis_rotation
 
 N, EO, H = 7, 2, 3
 ALPHA, BETA = 2.0, 2e-6           # Rayleigh damping (1/s, s)
@@ -36,6 +36,15 @@ def rotor():
     own0 = np.repeat(owner[s["nodes"]] == 0, 3)
     Ks = (s["K"] + sp.diags(np.where(own0, sup[glob], 0.0))).tocsr()
     return r, K, Ks, glob
+
+
+def rotor_sector(r, n_sectors: int = N) -> CyclicSector:
+    """The cyclic sector of a ``tuned_rotor`` ``r``: its left and right boundary DoFs, the z
+    axis through the origin."""
+    s = r["sector"]
+    return CyclicSector(n_dof=s["K"].shape[0], n_sectors=n_sectors,
+                        left=s["node_dofs"][s["left"]], right=s["node_dofs"][s["right"]],
+                        axis=np.array([0.0, 0.0, 1.0]), origin=np.zeros(3))
 
 
 def rotor_contacts(r, per_sector_rows):

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from _rotor import (ALPHA, BETA, EO, FORCE, H, N, OPTS, full_model, rotor,
+from _rotor import (ALPHA, BETA, EO, FORCE, H, N, OPTS, full_model, rotor, rotor_sector,
                     sector_contacts)
 from frirom import ParameterError, SizeError
 from frirom.model import ContactGroup, CyclicModel, Damping, Excitation
@@ -33,9 +33,7 @@ def _models(single_index=None):
     r, K, Ks, glob = rotor()
     s = r["sector"]
     n_s = Ks.shape[0]
-    sector = CyclicSector(n_dof=n_s, n_sectors=N, left=s["node_dofs"][s["left"]],
-                          right=s["node_dofs"][s["right"]], axis=np.array([0.0, 0.0, 1.0]),
-                          origin=np.zeros(3))
+    sector = rotor_sector(r, N)
     cm = cyclic_model(sector, Ks, s["M"], sector_contacts(r, glob, n_s), EO, H,
                       damping=Damping.rayleigh(ALPHA, BETA), single_index=single_index)
     full = full_model(r, K)

@@ -23,14 +23,14 @@ import pytest
 import scipy.linalg as sla
 
 import frirom
-from _rotor import ALPHA, BETA, N, full_model, rotor, sector_contacts
+from _rotor import ALPHA, BETA, N, full_model, rotor, rotor_sector, sector_contacts
 from frirom import ParameterError, _kernels
 from frirom._pack import pack
 from frirom._run import Run
 from frirom.model import Damping, Excitation
 from frirom.nonlinear_modes import nonlinear_mode
 from frirom.nonlinear_modes_cyclic import cyclic_linear_mode, open_cyclic
-from frirom.reduction.cyclic import CyclicSector, axis_rotation, cyclic_model
+from frirom.reduction.cyclic import axis_rotation, cyclic_model
 
 H, KND = 3, 2
 OPTS = dict(harmonics=H, samples=16 * N, tol_residual=1e-12, tol_update=1e-12, max_iter=40)
@@ -40,9 +40,7 @@ def _rotor_models(damping):
     r, K, Ks, glob = rotor()
     s = r["sector"]
     n_s = Ks.shape[0]
-    sector = CyclicSector(n_dof=n_s, n_sectors=N, left=s["node_dofs"][s["left"]],
-                          right=s["node_dofs"][s["right"]], axis=np.array([0.0, 0.0, 1.0]),
-                          origin=np.zeros(3))
+    sector = rotor_sector(r, N)
     cm = cyclic_model(sector, Ks, s["M"], sector_contacts(r, glob, n_s), KND, H,
                       damping=damping)
     full = full_model(r, K)
