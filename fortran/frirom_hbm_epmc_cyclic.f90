@@ -5,7 +5,7 @@
 !> phase-shifted by exp(i k_h 2 pi / N), as for a forced response under engine order k);
 !> the residual, its Jacobian and the outputs are hbm_epmc_modal's (frirom_hbm_epmc_modal).
 submodule (frirom_epmc) frirom_hbm_epmc_cyclic
-    use frirom_status, only: FRIROM_OK, FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status
+    use frirom_status, only: FRIROM_OK, FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, set_status, failed
     implicit none
 
 contains
@@ -20,30 +20,20 @@ contains
             nm = size(psi, 2)
             nnl = size(nl)
             nh = sys%nh
-            if (size(psi, 1) /= nd .or. ubound(psi, 3) /= nh .or. nm < 1 .or. &
-                size(q0) /= nm .or. any(shape(wh) /= [nm, nh + 1]) .or. &
-                any(shape(zh) /= [nm, nh + 1]) .or. nnl < 1) then
-                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'nonlinear mode (cyclic): '// &
-                                'psi (ndof, nm, H+1), omega, zeta (nm, H+1), q0 (nm) and '// &
-                                'the contact DoFs expected')
-                return
-            end if
+            if (failed(size(psi, 1) /= nd .or. ubound(psi, 3) /= nh .or. nm < 1 .or. &
+                       size(q0) /= nm .or. any(shape(wh) /= [nm, nh + 1]) .or. &
+                       any(shape(zh) /= [nm, nh + 1]) .or. nnl < 1, info, FRIROM_ERR_SIZE, &
+                       errmsg, 'nonlinear mode (cyclic): psi (ndof, nm, H+1), omega, zeta '// &
+                       '(nm, H+1), q0 (nm) and the contact DoFs expected')) return
             call epmc_modal_base(sys, nm, nl, w0, info, errmsg)
             if (info /= FRIROM_OK) return
-            if (.not. (all(wh > 0.0_wp) .and. all(zh >= 0.0_wp) .and. w0 > 0.0_wp .and. &
-                       all(abs(psi) <= huge(1.0_wp)) .and. all(abs(q0) <= huge(1.0_wp)) &
-                       .and. all(abs(wh) + abs(zh) <= huge(1.0_wp)) .and. &
-                       w0 <= huge(1.0_wp))) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode (cyclic): '// &
-                                'finite modes, omega > 0 (no rigid-body mode), zeta >= 0 '// &
-                                'and omega0 > 0')
-                return
-            end if
-            if (.not. (norm2(abs(q0)) > 0.0_wp)) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode (cyclic): '// &
-                                'the linear mode q0 is zero')
-                return
-            end if
+            if (failed(.not. (all(wh > 0.0_wp) .and. all(zh >= 0.0_wp) .and. w0 > 0.0_wp &
+                       .and. all(abs(psi) <= huge(1.0_wp)) .and. all(abs(q0) <= huge(1.0_wp)) &
+                       .and. all(abs(wh) + abs(zh) <= huge(1.0_wp)) .and. w0 <= huge(1.0_wp)), &
+                       info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode (cyclic): finite '// &
+                       'modes, omega > 0 (no rigid-body mode), zeta >= 0 and omega0 > 0')) return
+            if (failed(.not. (norm2(abs(q0)) > 0.0_wp), info, FRIROM_ERR_PARAM, errmsg, &
+                       'nonlinear mode (cyclic): the linear mode q0 is zero')) return
             if (allocated(sys%phn)) deallocate (sys%phn, sys%pho, sys%wr, sys%zr)
             allocate (sys%phn(nnl, nm, 0:nh), sys%pho(size(sys%outdofs), nm, 0:nh), &
                       sys%wr(nm, 0:nh), sys%zr(nm, 0:nh))

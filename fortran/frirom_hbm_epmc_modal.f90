@@ -26,13 +26,10 @@ contains
             nd = sys%ndof
             nm = size(phi, 2)
             nnl = size(nl)
-            if (size(phi0) /= nd .or. size(phi, 1) /= nd .or. nm < 1 .or. size(wm) /= nm &
-                .or. size(zm) /= nm .or. nnl < 1) then
-                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'nonlinear mode (condensed):'// &
-                                ' phi0 (ndof), modes (ndof, nm), omega, zeta (nm) and the '// &
-                                'contact DoFs expected')
-                return
-            end if
+            if (failed(size(phi0) /= nd .or. size(phi, 1) /= nd .or. nm < 1 .or. &
+                       size(wm) /= nm .or. size(zm) /= nm .or. nnl < 1, info, FRIROM_ERR_SIZE, &
+                       errmsg, 'nonlinear mode (condensed): phi0 (ndof), modes (ndof, nm), '// &
+                       'omega, zeta (nm) and the contact DoFs expected')) return
             call epmc_modal_base(sys, nm, nl, w0, info, errmsg)
             if (info /= FRIROM_OK) return
             if (failed(.not. (all(wm > 0.0_wp) .and. all(zm >= 0.0_wp) .and. w0 > 0.0_wp &
