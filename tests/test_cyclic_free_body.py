@@ -141,6 +141,13 @@ def test_travelling_wave_response_equals_the_whole_rotor(w, n0, f_tip, slip):
     if slip == 0.0:
         assert np.all(pc.state_fractions[:, 0] == 1.0)
     np.testing.assert_allclose(pc.X, pf.X, atol=1e-8 * np.abs(pf.X).max())
+    # what the pin decided is reported as for a Model (frirom show's held lines)
+    from frirom.held import held_directions
+    from frirom.show import contact_fields
+    held = held_directions(cm, contact_fields(cm, pc.X, np.asarray(pc.slider, float),
+                                              o.n_samples))
+    assert [h.group for h in held] == ["own", "next"]
+    assert all(h.tangential.size == (0 if slip == 0.0 else 1) for h in held)
 
 
 def test_static_position_under_the_centrifugal_load():

@@ -14,7 +14,8 @@ far, the change a period, the first harmonic of TIP_0 x and its difference from 
 
 DIR holds the matrices (make_upd.py; --stride 2 for the coarse model the docs use) and
 upd.toml; --frf: a design-curve member's curve at that load, whose point nearest --freq
-starts Newton (needed at the light-load fold).
+starts Newton (needed at the light-load fold); --state FILE.npz keeps the end state after
+every chunk, and the same command with a larger --max-periods goes on from it.
 """
 
 from __future__ import annotations
@@ -55,9 +56,11 @@ def hbm_start(work, load: float, freq_hz: float, H: int, frf_h5=None):
 
 def settle(work, load: float, freq_hz: float, out: Path, H: int = 3, frf_h5=None,
            chunk: int = 20, max_periods: int = 600, tol: float = 1e-3,
-           steps: int = 128) -> dict:
+           steps: int = 128, state_file=None) -> dict:
     """Integrate in chunks of ``chunk`` periods until the change a period is below
-    ``tol``; one line per chunk appended to ``out``. Returns the last line's figures."""
+    ``tol``; one line per chunk appended to ``out``. state_file: an .npz where the end
+    state (x, v, sliders, periods so far) is kept after every chunk, and from which a
+    later call goes on when it exists. Returns the last line's figures."""
     from frirom.timeint import TimeContact, integrate, state_from_harmonics
     d, m, e, p, w = hbm_start(work, load, freq_hz, H, frf_h5)
     x0, v0 = state_from_harmonics(p.X[None], np.array([w]))
@@ -79,11 +82,21 @@ def settle(work, load: float, freq_hz: float, out: Path, H: int = 3, frf_h5=None
                  "max_ti_m  seconds\n")
     state = {"x0": x0, "v0": v0, "w0": w0}
     done, t0, row = 0, time.perf_counter(), {}
+    if state_file is not None and Path(state_file).exists():
+        z = np.load(state_file)
+        state = {"x0": z["x"], "v0": z["v"],
+                 "w0": [z[f"w{i}"] for i in range(len(w0))]}
+        done = int(z["periods"])
+        with open(out, "a") as fh:
+            fh.write(f"# going on from {state_file} after {done} periods\n")
     while done < max_periods:
         ti = integrate(Md, Cd, Kd, tcs, e.F, w, H=H, periods=chunk, min_periods=chunk,
                        tol=0.0, steps_per_period=steps, method="implicit", **state)
         state = ti.restart()
         done += ti.periods
+        if state_file is not None:
+            np.savez(state_file, x=state["x0"], v=state["v0"], periods=done,
+                     **{f"w{i}": w for i, w in enumerate(state["w0"])})
         a_t = float(np.hypot(ti.harmonics[0, o, 1], ti.harmonics[0, o, 2]))
         row = {"load": load, "freq": w / 2 / np.pi, "periods": done,
                "drift": float(ti.drift[0]), "hbm": a_h, "ti": a_t, "rel": a_t / a_h - 1,
@@ -112,10 +125,13 @@ def main(argv=None):
     ap.add_argument("--chunk", type=int, default=20)
     ap.add_argument("--max-periods", type=int, default=600)
     ap.add_argument("--tol", type=float, default=1e-3)
+    ap.add_argument("--state", type=Path, default=None,
+                    help="an .npz keeping the end state after every chunk; a run with "
+                         "the same file goes on from it")
     a = ap.parse_args(argv)
     os.environ.setdefault("FRIROM_CACHE", str(a.work / "cache"))
     print(settle(a.work, a.load, a.freq, a.out, a.harmonics, a.frf, a.chunk,
-                 a.max_periods, a.tol))
+                 a.max_periods, a.tol, state_file=a.state))
 
 
 if __name__ == "__main__":
