@@ -100,3 +100,42 @@ def test_free_body_killed_and_resumed_equals_uninterrupted(form, tmp_path):
     for name in ("omega", "X", "amp_max", "state_fractions", "slider", "iterations"):
         np.testing.assert_array_equal(getattr(got, name), getattr(ref, name), err_msg=name)
     assert rest.peak(0) == full.peak(0)
+
+
+def blade_damper_2d(mu, n0=1.0):
+    """The blade in three directions (x, y on k1, z on 2 k1) and the damper mass held by
+    one normal2d element (u1, u2 tangential, v normal), preloaded by n0 with the
+    balancing harmonic-0 loads: the normal2d route of issue 29's first dead end (its
+    continuation spent 2 000 points between 375.1885 and 375.1890 Hz)."""
+    G = np.hstack([np.eye(3), -np.eye(3)])
+    g = ContactGroup(law="normal2d", G=G, params=np.array([[KT, 2 * KT, mu, n0]]),
+                     name="damper")
+    K = np.diag([K1, K1, 2 * K1, 0.0, 0.0, 0.0])
+    M = np.diag([M1] * 3 + [M2] * 3)
+    return Model(M, K, Damping.rayleigh(ALPHA, 0.0), [g])
+
+
+def exc_2d(n0=1.0):
+    F = np.zeros((6, 2), complex)
+    F[:, 0] = np.hstack([np.eye(3), -np.eye(3)]).T @ np.array([0.0, 0.0, n0])
+    F[0, 1] = F[1, 1] = 0.01
+    return Excitation(F)
+
+
+@pytest.mark.parametrize("form", ["condensed", "banded"])
+def test_normal2d_free_body_stuck_limit_and_gross_slip_sweep(form):
+    """normal2d: stuck (mu large) equals the linear 6-DoF system with kt, kt, 2 kt
+    between the masses (1e-9); in gross slip (mu n0 = 5e-4) the sweep ends in a few
+    hundred points, the damper's tangential mean at the assembled position (the pin)."""
+    opts = SolverOptions(harmonics=3, formulation=form)
+    w = 1.2
+    p = solve_point(blade_damper_2d(100.0), exc_2d(), w, opts)
+    Ks = np.diag([KT, KT, 2 * KT])
+    Kst = np.diag([K1, K1, 2 * K1, 0, 0, 0]) + np.block([[Ks, -Ks], [-Ks, Ks]])
+    Mm = np.diag([M1] * 3 + [M2] * 3)
+    x = np.linalg.solve(Kst - w * w * Mm + 1j * w * ALPHA * Mm, exc_2d().F[:, 1])
+    np.testing.assert_allclose(np.hypot(p.X[:, 1], p.X[:, 2]), np.abs(x), rtol=1e-9,
+                               atol=1e-12)
+    r = frf(blade_damper_2d(5e-4), exc_2d(), 0.5, 1.6, opts)
+    assert r.omega.max() >= 1.6 - 1e-9 and r.omega.size < 400, r.message
+    assert np.abs(r.X[:, 3:5, 0]).max() < 1e-6

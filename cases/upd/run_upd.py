@@ -142,12 +142,6 @@ def main(argv=None):
     if a.plot_only:
         loads, peaks, ok = stored_peaks(work / "upd_design.toml", a.out)
     else:
-        if a.workers > 1:
-            # a member's solve holds the GIL in Fortran for minutes at H = 3: without
-            # this the scheduler takes the silent worker for dead after its 5-minute
-            # heartbeat TTL, restarts it and the member starts over
-            import dask
-            dask.config.set({"distributed.scheduler.worker-ttl": None})
         res = run_study(work / "upd_design.toml", a.out,
                         scheduler="serial" if a.workers <= 1 else "local",
                         workers=a.workers if a.workers > 1 else None)

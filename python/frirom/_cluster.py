@@ -34,6 +34,9 @@ QUIET_WORKER = {"distributed.worker.profile.enabled": False,
                 "distributed.admin.system-monitor.interval": "5s",
                 "distributed.worker.memory.monitor-interval": "1s",
                 "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
+#: Dask settings of the scheduler of frirom's LocalCluster (see :func:`local_workers`):
+#: no heartbeat limit on its workers.
+PATIENT_SCHEDULER = {"distributed.scheduler.worker-ttl": None}
 def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
     """Check that a Dask scheduler answers at a tcp:// ``address`` before a Client is
     made: it must accept the connection and send the length of a handshake-sized first
@@ -112,11 +115,20 @@ def local_workers(n: int):
     - Dask's statistical profiler off: it samples the task thread's stack every 10 ms,
       15-30 % more CPU per friction sample; the workers' event-loop tick, system and
       memory monitors at 1-5 s instead of 20-500 ms (an idle worker: 2.2 % of a core,
-      then 0.26 %).
+      then 0.26 %);
+    - no heartbeat limit (:data:`PATIENT_SCHEDULER`): a member holds its worker's GIL for
+      as long as one call into Fortran takes (a batch of continuation points: minutes on
+      the UPD case at H = 3), the worker's event loop cannot answer meanwhile, and
+      Dask's scheduler took such a worker for dead after ``worker-ttl`` (5 minutes),
+      restarted it and ran the member again, up to KilledWorker. A worker that really
+      dies is still noticed: its nanny sees the process end and the scheduler loses
+      its connection (tests/test_mistuning_cluster.py kills one). A scheduler the user
+      runs keeps its own limit: give it ``distributed.scheduler.worker-ttl`` above the
+      longest member, or null (docs/deck.md, ``[study]``).
     """
     import dask
     from dask.distributed import LocalCluster
-    with dask.config.set(QUIET_WORKER):
+    with dask.config.set({**QUIET_WORKER, **PATIENT_SCHEDULER}):
         return LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                             dashboard_address=None, env=ONE_THREAD)
 

@@ -599,4 +599,7 @@ def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Pa
                    out_f=at[out], stability=False, modes=modes, tcontact=tcontact,
                    info=f"condensed: {nu * (2 * H + 1)} unknowns, {nu} "
                         + ("contact coordinates G x" if tcontact else "contact DoFs")
-                        + "; receptances from each harmonic's nodal-diameter modes")
+                        + "; receptances from each harmonic's nodal-diameter modes"
+                        + ("; a body held only by its contacts: the modes are the stuck "
+                           "sector's" if model.free_bodies() else ""),
+                   free=model.free_bodies())

@@ -456,6 +456,12 @@ class CyclicModel:
     same DoF numbering rotated with the sector: a contact between neighbouring sectors
     such as a shroud or an underplatform damper; its rotation into sector 0's frame is
     part of G). Excitation and outputs are sector 0's DoFs.
+
+    stuck_modes: the modes are those of the stuck structure, K_k + G_k^H Ks G_k (a body
+    held only by its contacts, such as a damper between this sector's platform and the
+    next one's: frirom.reduction.cyclic.sector_free_bodies and sector_modes'
+    ``stuck_contacts``); the solver then takes Ks back off the contact forces and holds
+    the contacts' means as for a :class:`Model` with free bodies (:meth:`free_bodies`).
     """
 
     n_dof: int
@@ -466,6 +472,7 @@ class CyclicModel:
     sign: int = -1
     single_index: int | None = None
     dof_labels: list | None = None
+    stuck_modes: bool = False
 
     def __post_init__(self):
         n, N = int(self.n_dof), int(self.n_sectors)
@@ -494,6 +501,10 @@ class CyclicModel:
         if self.dof_labels is not None and len(self.dof_labels) != n:
             raise SizeError(f"dof_labels: {len(self.dof_labels)} labels for {n} DoFs")
         self.n_dof, self.n_sectors = n, N
+
+    def free_bodies(self) -> bool:
+        """True when the modes are the stuck structure's (``stuck_modes``)."""
+        return bool(self.stuck_modes)
 
     def harmonic_index(self, h: int) -> int:
         """The nodal diameter k_h (0..N-1) time harmonic h lives on."""

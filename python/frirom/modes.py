@@ -327,25 +327,32 @@ def linear_check(deck, n_grid: int | None = None, n_show: int = 2) -> LinearChec
 
 
 def _cyclic(deck, Ks, around, n_show, omega, per, notes):
-    """Cyclic decks: frequencies per harmonic index, FRFs as modal sums of harmonic 1."""
-    from .reduction.cyclic import sector_modes
+    """Cyclic decks: frequencies per harmonic index, FRFs as modal sums of harmonic 1.
+    Stuck: the sector's modes with its contacts stuck (those to the next sector at each
+    index's phase, frirom.reduction.cyclic.sector_stuck_stiffness). With a body held only
+    by its contacts the deck's modes are already the stuck ones; the free frequencies
+    then come from K alone, the zero ones named."""
+    from .reduction.cyclic import _eigvals, sector_modes
     c = deck.cyclic
     model = deck.model()
-    across = [s.name for s in (deck.settings.contacts if deck.settings else ())
-              if getattr(s, "b_sector", 0)]
-    if across:
-        notes.append(f"stuck frequencies not computed: contact(s) {', '.join(across)} "
-                     "join the next sector")
+    K, M = sp.csr_matrix(deck.K), sp.csr_matrix(deck.M)
+    free_body = bool(c.get("free"))
     k1 = model.harmonic_index(1)
     stuck_modes = {}
     for k, m in sorted(c["modes"].items()):
-        st = None
-        if not across:
-            sm = sector_modes(c["sector"], Ks, sp.csr_matrix(deck.M), k, None,
-                              min(max(m.omega.size, 1), deck.n_dof))
-            stuck_modes[k] = sm
-            st = _window(sm.omega, around, n_show)
-        per[k] = (_window(m.omega, around, n_show), st)
+        sm = m if free_body else sector_modes(
+            c["sector"], K, M, k, None, min(max(m.omega.size, 1), deck.n_dof),
+            stuck_contacts=model.contacts)
+        stuck_modes[k] = sm
+        if free_body:
+            Kk, Mk = c["sector"].matrices(K, M, k)
+            lam = _eigvals(Kk, Mk, min(m.omega.size, Kk.shape[0]))
+            fr = np.sqrt(np.clip(lam, 0.0, None))
+            if k == min(c["modes"]):
+                notes += _sector_zero_modes(deck, c["sector"], Kk, Mk, k)
+        else:
+            fr = m.omega
+        per[k] = (_window(fr, around, n_show), _window(sm.omega, around, n_show))
     free, stuck = per.get(k1, (np.zeros(0), None))
     F1 = deck.F[:, 1]
 
@@ -359,11 +366,36 @@ def _cyclic(deck, Ks, around, n_show, omega, per, notes):
         x = (q[None, :] / den) @ psi[deck.outputs, :].T                   # (n_grid, n_out)
         return np.abs(x)
     m1 = model.modes_of(k1)
-    amp_f = modal(m1, m1.zeta)
     s1 = stuck_modes.get(k1)
-    amp_s = modal(s1, np.interp(s1.omega, m1.omega, m1.zeta) if s1 is not None else None)
+    if free_body:               # the deck's modes are the stuck ones; free: not drawn
+        amp_f = np.zeros((omega.size, len(deck.outputs)))
+        amp_s = modal(m1, m1.zeta)
+        notes.append("contacts free: the linear FRF is not drawn (a body held only by "
+                     "its contacts has no free linear response)")
+    else:
+        amp_f = modal(m1, m1.zeta)
+        amp_s = modal(s1, np.interp(s1.omega, m1.omega, m1.zeta) if s1 is not None
+                      else None)
     return free, (stuck if stuck is not None else np.zeros(0)), amp_f, \
         (amp_s if amp_s is not None else np.zeros_like(amp_f))
+
+
+def _sector_zero_modes(deck, sector, Kk, Mk, k: int) -> list:
+    """Notes naming the sector's motions K does not hold at harmonic index k (a body
+    held only by its contacts), as :func:`_zero_modes`."""
+    try:
+        lam, phi = null_motions(sp.csr_matrix(Kk.real) if sector._is_real(k) else Kk,
+                                sp.csr_matrix(Mk.real) if sector._is_real(k) else Mk)
+    except (np.linalg.LinAlgError, ValueError, RuntimeError):
+        return []
+    n = phi.shape[1]
+    if n == 0:
+        return []
+    psi = (sector.projection(k) @ phi).real
+    many = "ies are" if n > 1 else "y is"
+    return [f"contacts free: harmonic index {k}: {n} natural frequenc{many} 0 Hz: a body "
+            "held only by its contacts (solved on the stuck sector's modes)",
+            f"  free motion{'s' if n > 1 else ''}: {_free_body(deck, psi)}"]
 
 
 def _window(w, around, n_show):

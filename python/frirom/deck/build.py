@@ -153,7 +153,8 @@ class Deck:
             return CyclicModel(n_dof=self.n_dof, n_sectors=c["sector"].n_sectors,
                                engine_order=c["engine_order"], modes=c["modes"],
                                contacts=groups, sign=c["sign"],
-                               single_index=c["single_index"], dof_labels=self.dof_labels)
+                               single_index=c["single_index"], dof_labels=self.dof_labels,
+                               stuck_modes=c.get("free", False))
         return Model(self.M, self.K, self.damping_object(), groups,
                      dof_labels=self.dof_labels)
 
@@ -344,7 +345,8 @@ class _Builder:
         onames = [ref.value.text if s.fe else (labels[j] if labels else f"dof{j}")
                   for ref, j in zip(s.outputs.dofs, outputs)]
         if s.cyclic is not None:
-            cyclic = cyclic_modes(s.path, sector, rom, s.cyclic, damping, H, log.append)
+            cyclic = cyclic_modes(s.path, sector, rom, s.cyclic, damping, H, log.append,
+                                  contacts)
         sol = s.solver
         solver = {k: getattr(sol, k) for k in ("tol_residual", "tol_update", "max_iterations",
                                                "tol_stall")

@@ -6,9 +6,10 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from .._errors import InputError
+from .._errors import InputError, SingularMatrixError
 from ..model import Damping
-from ..reduction.cyclic import CyclicSector, cyclic_sector, needed_indices, sector_modes
+from ..reduction.cyclic import (CyclicSector, cyclic_sector, needed_indices, sector_free_bodies,
+                                sector_modes)
 from ..reduction.rom import ReducedModel, ReductionSpec
 from .schema_model import CyclicSettings
 
@@ -53,21 +54,33 @@ def check_sector_contacts(path: Path, rom: ReducedModel, cs: CyclicSector,
 
 
 def cyclic_modes(path: Path, cs: CyclicSector, rom: ReducedModel, cy: CyclicSettings,
-                 damping: dict, H: int, log) -> dict:
+                 damping: dict, H: int, log, contacts=()) -> dict:
     """Modes of every nodal diameter the harmonics 0..H live on (after the cache).
 
-    damping: the Deck's damping dict (rayleigh or modal); log: called with one line.
-    Returns the Deck's ``cyclic`` dict.
+    damping: the Deck's damping dict (rayleigh or modal); log: called with one line;
+    contacts: the deck's ContactGroups on the sector (a body they alone hold, such as a
+    damper between this sector's platform and the next one's, makes the modes the stuck
+    sector's: frirom.reduction.cyclic.sector_free_bodies). Returns the Deck's ``cyclic``
+    dict.
     """
     N, eo, sign = cy.sectors, cy.engine_order, -1
     ks = needed_indices(eo, N, H, sign, cy.single_index)
     damp = (Damping.rayleigh(damping["alpha"], damping["beta"])
             if damping["type"] == "rayleigh" else Damping.modal(damping["zeta"]))
     t0 = time.perf_counter()
+    try:
+        free = sector_free_bodies(cs, rom.K, rom.M, list(contacts), ks)
+    except SingularMatrixError as exc:
+        raise InputError(f"{path}: {_PRE}: {exc}") from None
+    if free:
+        log("cyclic sector: a body held only by its contacts (K alone is singular): the "
+            "modes are the stuck sector's, the contacts' stuck stiffness taken back off "
+            "their forces")
     modes = {}
     for k in ks:
         try:
-            modes[k] = sector_modes(cs, rom.K, rom.M, k, damp, cy.modes, cy.boundary_modes)
+            modes[k] = sector_modes(cs, rom.K, rom.M, k, damp, cy.modes, cy.boundary_modes,
+                                    stuck_contacts=list(contacts) if free else None)
         except InputError as exc:
             msg = str(exc)
             key = ("boundary_modes" if "tran_reduce" in msg else
@@ -90,4 +103,4 @@ def cyclic_modes(path: Path, cs: CyclicSector, rom: ReducedModel, cy: CyclicSett
         + (f" (Tran: {cy.boundary_modes} boundary modes)" if cy.boundary_modes else "")
         + f", {max(nm.values())} modes each, in {dt:.2f} s")
     return {"sector": cs, "modes": modes, "engine_order": eo,
-            "single_index": cy.single_index, "sign": sign, "seconds": dt}
+            "single_index": cy.single_index, "sign": sign, "seconds": dt, "free": free}

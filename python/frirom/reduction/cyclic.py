@@ -37,7 +37,8 @@ from ..model import CyclicModel, Damping, SectorModes
 from .multistage import cylindrical_frame
 
 __all__ = ["CyclicSector", "cyclic_sector", "axis_rotation", "tran_reduce", "sector_modes",
-           "cyclic_model", "needed_indices", "engine_order_loads"]
+           "cyclic_model", "needed_indices", "engine_order_loads", "sector_free_bodies",
+           "sector_stuck_stiffness"]
 
 
 def axis_rotation(angle: float, axis=(0.0, 0.0, 1.0)) -> np.ndarray:
@@ -334,8 +335,62 @@ def _ratios(damping, omega):
                          "damping matrix")
 
 
+def sector_stuck_stiffness(sector: CyclicSector, contacts, k: int) -> sp.csr_matrix:
+    """sum G_k^H Ks G_k over ``contacts`` (n_dof, n_dof), complex: the contacts closed
+    and stuck (frirom.contact.stuck_stiffness) at harmonic index k, where a contact on
+    the next sector (columns n_dof.. of G) reads x_1 = exp(i k alpha) x_0, as the solver
+    does (frirom._pack._pack_sector): G_k = G_0 + exp(i k alpha) G_1."""
+    from ..contact import stuck_stiffness
+    n = sector.n_dof
+    ph = np.exp(1j * k * sector.alpha)
+    out = sp.csr_matrix((n, n), dtype=complex)
+    for g in contacts:
+        G = sp.csr_matrix(g.G)
+        Gk = G[:, :n].astype(complex)
+        if G.shape[1] == 2 * n:
+            Gk = Gk + ph * G[:, n:]
+        ks = np.asarray(stuck_stiffness(g.law, g.params), float).ravel()
+        out = out + Gk.conj().T @ sp.diags(ks) @ Gk
+    return sp.csr_matrix(out)
+
+
+def _definite(A) -> bool:
+    from ..model import _positive_definite
+    A = sp.csr_matrix(A)
+    if np.iscomplexobj(A.data) and np.abs(A.data.imag).max(initial=0.0) > 0:
+        A = _real_form(A)
+    return _positive_definite(sp.csr_matrix(A.real))
+
+
+def sector_free_bodies(sector: CyclicSector, K, M, contacts, indices) -> bool:
+    """True when K alone does not hold the sector at one of the harmonic indices
+    ``indices`` (a body held only by its contacts: an under-platform damper between this
+    sector's platform and the next one's), tested as :meth:`frirom.model.Model.free_bodies`
+    (a Cholesky of K_k - sigma M_k, sigma = 1e-10 max|K| / max|M|). SingularMatrixError
+    when the contacts, stuck, do not hold it either."""
+    K, M = sp.csr_matrix(K), sp.csr_matrix(M)
+    kmax = abs(K).max() if K.nnz else 0.0
+    sigma = 1e-10 * kmax / (abs(M).max() if M.nnz else 1.0)
+    free = False
+    for k in indices:
+        Kk, Mk = sector.matrices(K, M, k)
+        if _definite(Kk - sigma * Mk):
+            continue
+        free = True
+        if not contacts:
+            break
+        T = sector.projection(k)
+        Sk = T.conj().T @ sector_stuck_stiffness(sector, contacts, k) @ T
+        if not _definite(Kk + Sk):
+            raise SingularMatrixError(
+                f"cyclic sector: harmonic index {k} has a rigid-body motion that neither "
+                "K nor the contacts (stuck) hold; constrain the sector")
+    return free and bool(contacts)
+
+
 def sector_modes(sector: CyclicSector, K, M, k: int, damping=None, n_modes=None,
-                 boundary_modes=None, method: str = "auto") -> SectorModes:
+                 boundary_modes=None, method: str = "auto",
+                 stuck_contacts=None) -> SectorModes:
     """Modes of harmonic index k on every DoF of the sector, with their damping ratios.
 
     K, M: the sector's (n_dof, n_dof) real matrices; damping: Damping.rayleigh (ratios
@@ -345,8 +400,20 @@ def sector_modes(sector: CyclicSector, K, M, k: int, damping=None, n_modes=None,
     flexibility); boundary_modes: Tran's interface modes for the cyclic boundary (default
     none: the boundary is kept whole); method: 'dense', 'arpack' or 'auto' (dense up to
     4000 coordinates; ARPACK needs n_modes).
+
+    stuck_contacts: ContactGroup list of a sector with a body held only by its contacts
+    (:func:`sector_free_bodies`): the modes are then those of the stuck structure, K_k +
+    T^H G_k^H Ks G_k T (:func:`sector_stuck_stiffness`), whose stiffness the solver takes
+    back off the contact forces (fortran/frirom_hbm_free.f90); Rayleigh ratios then come
+    from the diagonal of psi^H (alpha M + beta K) psi, K without the contacts (as the
+    modal route of a Model with free bodies).
     """
     Kk, Mk = sector.matrices(K, M, k)
+    K0 = Kk
+    if stuck_contacts:
+        T = sector.projection(k)
+        Sk = T.conj().T @ sector_stuck_stiffness(sector, stuck_contacts, k) @ T
+        Kk = sp.csr_matrix(Kk + (Sk.real if sector._is_real(k) else Sk))
     n = Kk.shape[0]
     R = None
     if boundary_modes is not None:
@@ -381,8 +448,11 @@ def sector_modes(sector: CyclicSector, K, M, k: int, damping=None, n_modes=None,
         phi = R @ phi
     psi = sector.projection(k) @ phi
     omega = np.sqrt(lam)
-    return SectorModes(k=int(k) % sector.n_sectors, psi=psi, omega=omega,
-                       zeta=_ratios(damping, omega))
+    zeta = _ratios(damping, omega)
+    if stuck_contacts and damping is not None and damping.kind == "rayleigh":
+        kr = np.einsum("ir,ir->r", phi.conj(), K0 @ phi).real
+        zeta = (damping.alpha + damping.beta * kr) / (2.0 * omega)
+    return SectorModes(k=int(k) % sector.n_sectors, psi=psi, omega=omega, zeta=zeta)
 
 
 def engine_order_loads(n_dof: int, dofs, eo: int, n_sectors: int, amplitude: complex,
@@ -430,8 +500,11 @@ def cyclic_model(sector: CyclicSector, K, M, contacts, engine_order: int, harmon
     if not (isinstance(harmonics, (int, np.integer)) and harmonics >= 0):
         raise ParameterError(f"harmonics: expected an integer >= 0, got {harmonics!r}")
     N = sector.n_sectors
-    modes = {k: sector_modes(sector, K, M, k, damping, n_modes, boundary_modes)
-             for k in needed_indices(engine_order, N, harmonics, sign, single_index)}
+    ks = needed_indices(engine_order, N, harmonics, sign, single_index)
+    free = sector_free_bodies(sector, K, M, list(contacts), ks)
+    modes = {k: sector_modes(sector, K, M, k, damping, n_modes, boundary_modes,
+                             stuck_contacts=list(contacts) if free else None)
+             for k in ks}
     return CyclicModel(n_dof=sector.n_dof, n_sectors=N, engine_order=int(engine_order),
                        modes=modes, contacts=list(contacts), sign=sign,
-                       single_index=single_index, dof_labels=dof_labels)
+                       single_index=single_index, dof_labels=dof_labels, stuck_modes=free)
