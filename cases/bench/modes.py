@@ -14,11 +14,18 @@ Models: the lumped blade with its friction damper (cases/joint/joint.toml, 5 DoF
 2 N at the tip), and the lap joint (cases/lap_joint/lap_joint.toml: two plates meshed by
 gmsh, CalculiX matrices, Craig-Bampton + GSI, normal1d friction with a bolt preload on
 every node pair; --size the element size, 0.012 m: 65 pairs), skipped without gmsh and
-ccx or with --quick. Backbones from the stuck mode with continuation steps of at most
-0.01 in log10 a (the microslip range resolved: the synthesis interpolates the backbone).
+ccx or with --quick. The Brake-Reuss beam (cases/brb/brb_mode.toml: CB + GSI 60 + 60,
+86 normal2d elements over the lap, H = 3, mu = 0.03; built by cases/brb/build_brb.py when
+gmsh and ccx are there, else skipped; --quick or --no-brb skip it): its backbone from the
+stuck joint to the end of microslip (seconds wall and CPU, points), frequency and damping
+ratio at the published tip accelerations 0.1, 7 and 65 m/s^2 (points landed on them by
+run_brb.exact_at_accelerations, timed apart) against the published backbone (Porter &
+Brake 2023, cases/brb/run_brb.py PUBLISHED), with the deck's own step control. The joint
+and lap joint backbones from the stuck mode with continuation steps of at most 0.01 in
+log10 a (the microslip range resolved: the synthesis interpolates the backbone).
 One core (OPENBLAS_NUM_THREADS=1 is set before numpy loads). Writes
 cases/bench/results/modes.json; the last line gives the seconds per backbone and the
-synthesis's peak error and speed ratio.
+synthesis's peak error and speed ratio, and the BRB's backbone seconds and its three points.
 """
 
 from __future__ import annotations
@@ -59,6 +66,39 @@ def lap_joint_deck(work: Path, size: float) -> Path | None:
         make_lap_joint.make(work, size=size)
     shutil.copy(CASES / "lap_joint" / "lap_joint.toml", work / "lap_joint.toml")
     return work / "lap_joint.toml"
+
+
+def bench_brb() -> dict | None:
+    """The BRB backbone as cases/brb/run_brb.py runs it (None: no gmsh/ccx to build it)."""
+    brb = CASES / "brb"
+    if not (brb / "brb.sti").exists():
+        if shutil.which("ccx") is None:
+            return None
+        try:
+            import gmsh  # noqa: F401
+        except ImportError:
+            return None
+    sys.path.insert(0, str(brb))
+    import run_brb
+    run_brb.ensure_built(log=lambda *a: None)
+    d = load_deck(brb / "brb_mode.toml")
+    t0 = time.perf_counter()
+    model = d.model()                       # the reduction (cached after the first run)
+    t_model = time.perf_counter() - t0
+    c0 = time.process_time()
+    bb, deck, sec = run_brb.backbone(brb / "brb_mode.toml")
+    cpu = time.process_time() - c0
+    t0 = time.perf_counter()
+    at = run_brb.exact_at_accelerations(bb, brb / "brb_mode.toml")
+    t_land = time.perf_counter() - t0
+    pts = [{"acc": acc, "f": float(f), "zeta": float(z), "f_pub": fp, "zeta_pub": zp,
+            "df_rel": float(f / fp - 1), "dzeta": float(z - zp)}
+           for (acc, fp, zp), (f, z) in zip(run_brb.PUBLISHED, at)]
+    return {"model": "BRB", "n_dof": model.n_dof,
+            "n_contact": int(sum(g.n_elem for g in model.contacts)), "H": d.harmonics,
+            "samples": deck.options().samples, "backbone_points": len(bb),
+            "backbone_s": sec, "backbone_cpu_s": cpu, "model_s": t_model, "landing_s": t_land,
+            "backbone_status": bb.status, "published": pts}
 
 
 def in_range_mode(model, lo, hi) -> int:
@@ -109,6 +149,7 @@ def bench(name: str, deck_path: Path, amplitudes, repeat: int) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="the joint only")
+    ap.add_argument("--no-brb", action="store_true", help="skip the Brake-Reuss beam")
     ap.add_argument("--repeat", type=int, default=20)
     ap.add_argument("--work", type=Path, default=None,
                     help="folder for the lap joint's matrices (default: a temporary one)")
@@ -124,8 +165,13 @@ def main(argv=None) -> int:
                 print("lap joint: skipped (needs gmsh and ccx)")
             else:
                 rows.append(bench("lap joint", deck, (1e-8, 3e-4), args.repeat))
+    brb = None
+    if not (args.quick or args.no_brb):
+        brb = bench_brb()
+        if brb is None:
+            print("BRB: skipped (needs gmsh and ccx to build cases/brb)")
     from _results import add
-    add(models=rows)
+    add(models=rows, brb=brb)
     print(f"{'model':>10s}  {'n_dof':>5s}  {'contacts':>8s}  {'H':>2s}  {'bb points':>9s}  "
           f"{'bb s':>6s}  {'SNMT ms':>8s}  {'HBM points':>10s}  {'HBM s':>6s}  "
           f"{'err amp':>9s}  {'err freq':>9s}  {'speed-up':>9s}")
@@ -134,10 +180,30 @@ def main(argv=None) -> int:
               f"{r['backbone_points']:>9d}  {r['backbone_s']:>6.2f}  {r['snmt_ms']:>8.1f}  "
               f"{r['hbm_points']:>10d}  {r['hbm_s']:>6.2f}  {r['err_amp']:>+9.2e}  "
               f"{r['err_freq']:>+9.2e}  {r['speedup']:>8.0f}x")
-    print("; ".join(f"{r['model']}: backbone {r['backbone_s']:.2f} s ({r['backbone_points']} "
-                    f"points), SNMT peak error {100 * r['err_amp']:+.2f} % amplitude, "
-                    f"{100 * r['err_freq']:+.3f} % frequency, {r['speedup']:.0f}x faster than "
-                    f"one HBM FRF" for r in rows))
+    last = [f"{r['model']}: backbone {r['backbone_s']:.2f} s ({r['backbone_points']} "
+            f"points), SNMT peak error {100 * r['err_amp']:+.2f} % amplitude, "
+            f"{100 * r['err_freq']:+.3f} % frequency, {r['speedup']:.0f}x faster than "
+            f"one HBM FRF" for r in rows]
+    if brb is not None:
+        print(f"BRB (CB + GSI, {brb['n_dof']} coordinates, {brb['n_contact']} contact "
+              f"elements, H = {brb['H']}, N = {brb['samples']}): backbone "
+              f"{brb['backbone_s']:.1f} s wall, {brb['backbone_cpu_s']:.1f} s CPU, "
+              f"{brb['backbone_points']} points ({brb['backbone_status']}); reduced model "
+              f"{brb['model_s']:.1f} s; landing on the three accelerations "
+              f"{brb['landing_s']:.1f} s")
+        print(f"{'tip acc.':>8s}  {'f Hz':>9s}  {'published':>9s}  {'df':>8s}  "
+              f"{'zeta %':>7s}  {'published':>9s}  {'dzeta %':>8s}")
+        for p in brb["published"]:
+            print(f"{p['acc']:>8.1f}  {p['f']:>9.3f}  {p['f_pub']:>9.2f}  "
+                  f"{100 * p['df_rel']:>+7.2f}%  {100 * p['zeta']:>7.3f}  "
+                  f"{100 * p['zeta_pub']:>9.3f}  {100 * p['dzeta']:>+8.3f}")
+        last.append(f"BRB: backbone {brb['backbone_s']:.1f} s ({brb['backbone_cpu_s']:.1f} s "
+                    f"CPU, {brb['backbone_points']} points), f/zeta at 0.1/7/65 m/s^2 "
+                    + ", ".join(f"{p['f']:.2f} Hz/{100 * p['zeta']:.3f} %"
+                                for p in brb["published"])
+                    + " (published " + ", ".join(f"{p['f_pub']:.2f}/{100 * p['zeta_pub']:.3f}"
+                                                 for p in brb["published"]) + ")")
+    print("; ".join(last))
     return 0
 
 
