@@ -266,7 +266,7 @@ def hooks_peak(rom, f0):
     with warnings.catch_warnings():
         warnings.simplefilter("error")          # an early stop is a failure here
         res, _ = rom.frf()
-    assert res.complete
+    assert res.complete, res.message
     return ph._peak(res), res
 
 
