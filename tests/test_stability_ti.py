@@ -10,7 +10,7 @@ against Hill's exp(max Re s T).
 
 Measured (these settings, 835-850 Hz): stuck 835.0 Hz Hill 0.9880, time integration
 0.9879 per period; slipping stable 838.6 Hz (stick 0.39, slip 0.15, lift-off 0.45)
-0.9863 / 0.9859; unstable 841.1 Hz 1.0299 / 1.0232.
+0.9863 / 0.9862; unstable 841.1 Hz 1.0299 / 1.0235.
 """
 
 import os

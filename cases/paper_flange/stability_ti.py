@@ -8,13 +8,13 @@ sliders) twice in one batch: started on the HB solution, and started 1 % off it 
 vibration, i.e. the displacements and velocities less their static part, scaled by
 1.01). The difference of the two runs d(t) is the perturbation (the run started on the
 HB point absorbs the truncation of the balance, H harmonics); its size max |d(t)| over a
-period and all DoFs, every 5 periods, gives by a least-squares slope of its logarithm
-over the last half of the integration (after the fast modes' transient and the stuck
+period and all DoFs, every period, gives by a least-squares slope of its logarithm
+over the last half of the integration (60 periods; after the fast modes' transient and the stuck
 sliders' settling) the growth (> 1) or decay (< 1) per period, set against Hill's
 exp(max Re s T), T = 2 pi / omega.
 
     python cases/paper_flange/stability_ti.py --work WORK --frf RUN/frf.h5 \\
-        [--freqs F1 F2 ...] [--periods 100] [--steps 128] [--out results.json]
+        [--freqs F1 F2 ...] [--periods 60] [--steps 128] [--out results.json]
 
 Without --freqs the points are chosen on the curve: the stuck point at the lower end of
 the band, the slipping stable point of largest amplitude and, where Hill flags any, the
@@ -53,19 +53,18 @@ def time_contacts(model, slider):
     return tcs, w0
 
 
-def growth_per_period(model, excitation, X, omega, slider, *, eps=0.01, periods=100,
-                      chunk=5, steps=128) -> dict:
+def growth_per_period(model, excitation, X, omega, slider, *, eps=0.01, periods=60,
+                      steps=128) -> dict:
     """Time integration from the HB point (harmonics X (n, 2H+1) of every DoF at omega,
-    contact history slider) and 1 % off it, in one batch, `chunk` periods per call
-    (continued from the end state). At the end of each chunk the difference of the two
-    runs over its last period d(t) = x_off - x_on gives the deviation max |d| (all DoFs);
-    returns the deviations, their fitted ratio per period over the last half ('ratio'),
-    and the two runs' drift.
+    contact history slider) and 1 % off it, in one batch (one call, every period
+    recorded). Per period the difference of the two runs d(t) = x_off - x_on gives the
+    deviation max |d| (all DoFs); returns the deviations, their fitted ratio per period
+    over the last half ('ratio'), and the two runs' drift.
 
     Why the last half: a friction contact that stays stuck keeps the offset a
     perturbation leaves in its slider, and those offsets settle over tens of periods (the
-    deviation may first grow at a stable point: the coarse flange at 838.7 Hz, for 40
-    periods, then decays at Hill's rate); the first chunks also carry the fast modes'
+    deviation may first grow at a stable point: the coarse flange at 838.7 Hz for 40
+    periods, then decays at Hill's rate); the first periods also carry the fast modes'
     transient."""
     from frirom.timeint import integrate, state_from_harmonics
     dense = [a.toarray() if hasattr(a, "toarray") else np.asarray(a, float)
@@ -76,19 +75,19 @@ def growth_per_period(model, excitation, X, omega, slider, *, eps=0.01, periods=
     vs = np.stack([v0, (1.0 + eps) * v0])
     tcs, w1 = time_contacts(model, slider)
     w0 = [np.concatenate([w, w]) for w in w1]
-    om = np.full(2, float(omega))
-    kw = dict(H=(X.shape[1] - 1) // 2, min_periods=chunk, periods=chunk, tol=0.0,
-              steps_per_period=steps, method="implicit")
-    dev, t0, r = [], time.perf_counter(), None
-    for _ in range(max(periods // chunk, 2)):
-        r = integrate(*dense, tcs, excitation.F, om, x0=xs, v0=vs, w0=w0, **kw)
-        dev.append(float(np.abs(r.samples[1] - r.samples[0]).max()))
-        st = r.restart()
-        xs, vs, w0 = st["x0"], st["v0"], st["w0"]
-    k = chunk * np.arange(1, len(dev) + 1)
+    dev = []
+
+    def record(k, samples):
+        dev.append(float(np.abs(samples[1] - samples[0]).max()))
+
+    t0 = time.perf_counter()
+    r = integrate(*dense, tcs, excitation.F, np.full(2, float(omega)), x0=xs, v0=vs,
+                  w0=w0, H=(X.shape[1] - 1) // 2, min_periods=periods, periods=periods,
+                  tol=0.0, steps_per_period=steps, method="implicit", on_period=record)
+    k = np.arange(1, len(dev) + 1)
     half = slice(len(dev) // 2, None)
     slope = np.polyfit(k[half], np.log(np.maximum(dev, 1e-300))[half], 1)[0]
-    return {"ratio": float(np.exp(slope)), "periods": int(k[-1]), "chunk": chunk,
+    return {"ratio": float(np.exp(slope)), "periods": len(dev),
             "steps": int(r.steps_per_period), "deviation": dev,
             "deviation0": float(eps * np.abs(X[:, 1:]).max()), "drift": r.drift.tolist(),
             "stick_slip_lift": r.state_fractions[0].tolist(),
@@ -155,7 +154,7 @@ def main(argv=None) -> int:
     ap.add_argument("--deck", default="rom1_stability.toml")
     ap.add_argument("--frf", type=Path, required=True, help="the deck's run (frf.h5)")
     ap.add_argument("--freqs", type=float, nargs="*", default=None, help="Hz (nearest points)")
-    ap.add_argument("--periods", type=int, default=100)
+    ap.add_argument("--periods", type=int, default=60)
     ap.add_argument("--steps", type=int, default=128, help="HHT steps per period")
     ap.add_argument("--out", type=Path, default=HERE / "results" / "stability_ti.json")
     a = ap.parse_args(argv)
@@ -165,6 +164,7 @@ def main(argv=None) -> int:
     idx = (pick(curve) if not a.freqs else
            [int(np.argmin(np.abs(f - x))) for x in a.freqs])
     rows = []
+    a.out.parent.mkdir(parents=True, exist_ok=True)
     for i in idx:
         r = check_point(deck, curve, i, periods=a.periods, steps=a.steps)
         rows.append(r)
@@ -173,9 +173,9 @@ def main(argv=None) -> int:
               f"{r['max_re']:+.4g} 1/s -> {r['hill_ratio']:.5f} per period; time "
               f"integration {r['ti_ratio']:.5f} per period ({r['ti']['seconds']:.0f} s); "
               f"{'agree' if r['agree'] else 'DISAGREE'}", flush=True)
-    a.out.parent.mkdir(parents=True, exist_ok=True)
-    a.out.write_text(json.dumps({"deck": str(a.work / a.deck), "frf": str(a.frf),
-                                 "n_dof": int(deck.model().n_dof), "rows": rows}, indent=1))
+        a.out.write_text(json.dumps({"deck": str(a.work / a.deck), "frf": str(a.frf),
+                                     "n_dof": int(deck.model().n_dof), "rows": rows},
+                                    indent=1))
     print(f"wrote {a.out}")
     return 0 if all(r["agree"] for r in rows) else 1
 
