@@ -157,3 +157,29 @@ def test_stability_strip_is_an_option_and_bad_values_are_named():
     SolverOptions(stability="strip").check()
     with pytest.raises(ParameterError, match="'strip'"):
         SolverOptions(stability="full").check()
+
+
+def test_stability_auto_takes_the_s0_route_on_a_reduced_model():
+    """stability = 'auto' above HILL_AUTO_MAX Hill unknowns (issue 30 item 4): on a model
+    whose receptances come from real modes it runs the s = 0 route (a few solves per
+    point) and flags exactly the saddle branch the 1-DoF dense path flags; with receptances
+    by factorisation (no s = 0 route) it is off and the summary says why."""
+    from test_stability import OPTS, duffing_plus_oscillators
+
+    from frirom._pack import HILL_AUTO_MAX
+    from frirom.solver import frf
+    small = frf(*duffing_plus_oscillators(0), 1.0, 2.0, SolverOptions(**OPTS), outputs=[0])
+    model, ex = duffing_plus_oscillators(150, zeta_e=0.2)
+    assert 2 * model.n_dof * (2 * OPTS["harmonics"] + 1) > HILL_AUTO_MAX
+    auto = dict(OPTS, stability="auto")
+    big = frf(model, ex, 1.0, 2.0, SolverOptions(receptances="modes", **auto), outputs=[0])
+    assert big.complete and big.stability_computed
+    assert "Arnoldi at s = 0" in big.solver_info and "stability (Hill)" in big.solver_info
+    assert len(big) == len(small)
+    np.testing.assert_array_equal(big.stable, small.stable)
+    assert not big.stable.all()
+    off = frf(model, ex, 1.0, 1.05, SolverOptions(receptances="factorization", **auto),
+              outputs=[0])
+    assert not off.stability_computed
+    assert "stability: off ('auto':" in off.solver_info
+    assert "not from real modes" in off.solver_info

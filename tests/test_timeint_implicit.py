@@ -283,3 +283,22 @@ def test_tangent_of_pattern_matches_finite_differences(law):
         du[..., d] = h
         fd = (_forces(law, p, u + du, w)[0] - _forces(law, p, u - du, w)[0]) / (2 * h)
         assert np.allclose(D[..., :, d], fd, rtol=1e-6, atol=1e-6 * 2.0)
+
+
+@pytest.mark.parametrize("method", ["explicit", "implicit"])
+def test_on_period_records_every_period_as_a_restart_would(method):
+    """integrate(on_period=...) hands over each period's samples: the k-th equals the last
+    period of a run of k periods (the same steps), for a batch of two frequencies, one of
+    them twice (the implicit scheme then shares its operators between the two)."""
+    con = [TimeContact("jenkins", np.array([[1.0]]), J_PAR)]
+    F = np.array([[0.0, 0.3]], complex)
+    om = np.array([1.05, 1.05, 1.2])
+    seen = []
+    kw = dict(H=3, min_periods=3, tol=0.0, steps_per_period=64, method=method)
+    r = integrate(J_M, J_C, J_K, con, F, om, periods=3, **kw,
+                  on_period=lambda k, s: seen.append((k, s.copy())))
+    assert [k for k, _ in seen] == [1, 2, 3]
+    np.testing.assert_array_equal(seen[-1][1], r.samples)
+    r2 = integrate(J_M, J_C, J_K, con, F, om, periods=2, **dict(kw, min_periods=2))
+    np.testing.assert_array_equal(seen[1][1], r2.samples)
+    np.testing.assert_array_equal(r.samples[0], r.samples[1])

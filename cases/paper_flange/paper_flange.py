@@ -56,6 +56,10 @@ QUICK = flange.FlangeSpec(sectors=6, z_per_sector=2, n_modes=10, coarse=True, kt
 F0_PAPER = (1.0, 10.0, 30.0, 100.0, 300.0)      # N per blade: full stick .. strong slip
 F0_QUICK = (1.0, 30.0, 300.0)
 F0_DECK = 20.0                                  # the F0 of rom*.toml
+#: rom1_stability.toml: ROM_I with Hill stability on, at an F0 whose curve leans over folds
+STABILITY_DECK, F0_STABILITY = "rom1_stability.toml", 30.0
+NO_STABILITY = "false     # the paper's comparison needs no Hill stability (it costs time)"
+STABILITY = "true      # Hill at every point (on a reduced model: the exponents nearest 0)"
 BETA_ZETA = 0.002                               # stiffness damping: zeta at the stuck EO mode
 TARGET_AMP, TARGET_FREQ = 0.01, 0.001           # the paper's "perfect match"
 ROMS = {
@@ -128,7 +132,7 @@ phase = {clock:.6f}
 [solver]
 harmonics = {h}
 samples = {samples}
-stability = false     # the paper's comparison needs no Hill stability (it costs time)
+stability = {stability}
 
 [frequency]
 start = {f1:.4f}
@@ -153,7 +157,8 @@ def _samples(spec) -> int:
     return int(step * int(np.ceil(64 / step)))
 
 
-def deck_text(spec, rom: str, f0: float, sets: dict, band, beta: float) -> str:
+def deck_text(spec, rom: str, f0: float, sets: dict, band, beta: float,
+              stability: bool = False) -> str:
     label, ms = ROMS[rom]
     return DECK.format(
         label=label, f0=f0, modes=2 * spec.n_modes, rom=CACHE_OF.get(rom, rom),
@@ -162,7 +167,8 @@ def deck_text(spec, rom: str, f0: float, sets: dict, band, beta: float) -> str:
         dofs1=json.dumps([f"{n}:z" for n in sets["ACTIVE1"]]),
         dofs2=json.dumps([f"{n}:z" for n in sets["ACTIVE2"]]),
         clock=-np.degrees(spec.clocking), h=H, samples=_samples(spec), f1=band[0],
-        f2=band[1], out1=sets["ACTIVE1"][0], out2=sets["ACTIVE2"][0])
+        f2=band[1], out1=sets["ACTIVE1"][0], out2=sets["ACTIVE2"][0],
+        stability=STABILITY if stability else NO_STABILITY)
 
 
 def deck_name(rom: str, f0: float | None = None) -> str:
@@ -237,12 +243,16 @@ def make(work: Path, quick: bool, log=print) -> dict:
 
 
 def _write_decks(work, spec, quick, sets, band, beta, missing_only=False) -> None:
-    """rom*.toml (F0_DECK) and rom*_F0_<F0>.toml of every ROM."""
+    """rom*.toml (F0_DECK), rom*_F0_<F0>.toml of every ROM, and rom1_stability.toml (ROM_I
+    at F0_STABILITY with Hill stability on, the same reduced model and cache)."""
     for rom in ROMS:
         for f0, name in [(F0_DECK, deck_name(rom))] + [(f, deck_name(rom, f))
                                                         for f in family_of(quick)]:
             if not (missing_only and (work / name).exists()):
                 (work / name).write_text(deck_text(spec, rom, f0, sets, band, beta))
+    if not (missing_only and (work / STABILITY_DECK).exists()):
+        (work / STABILITY_DECK).write_text(
+            deck_text(spec, "rom1", F0_STABILITY, sets, band, beta, stability=True))
 
 
 # --------------------------------------------------------------------------------------------

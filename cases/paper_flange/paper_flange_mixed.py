@@ -183,7 +183,7 @@ def deck_text(m: Mixed, rom: str, sets: dict, band, beta: float, indices=None) -
         dofs1=json.dumps([f"{n}:z" for n in sets["ACTIVE1"]]),
         dofs2=json.dumps([f"{n}:z" for n in sets["ACTIVE2"]]),
         clock=-np.degrees(s.clocking), h=H, samples=_samples(m), f1=band[0], f2=band[1],
-        out1=sets["ACTIVE1"][0], out2=sets["ACTIVE2"][0])
+        out1=sets["ACTIVE1"][0], out2=sets["ACTIVE2"][0], stability=pf.NO_STABILITY)
 
 
 def stage1_frequencies(d, sets: dict) -> tuple[float, float]:

@@ -314,7 +314,9 @@ HILL_AUTO_MAX = 2000
 def resolve_stability(model, opts: SolverOptions) -> tuple[SolverOptions, str]:
     """opts with stability "auto" made true or false, and why it is off ('' when on, or
     not "auto"): off for a cyclic sector, a selection, contact coordinates or more than
-    HILL_AUTO_MAX Hill unknowns."""
+    HILL_AUTO_MAX Hill unknowns. Above HILL_AUTO_MAX a condensed Model with contacts keeps
+    "auto": _pack_model turns it on when the receptances come from real modes (the s = 0
+    route through the Newton matrix, a few solves' cost), else off (_auto_near0)."""
     if opts.stability != "auto":
         return opts, ""
     n, H = model.n_dof, opts.harmonics
@@ -326,10 +328,26 @@ def resolve_stability(model, opts: SolverOptions) -> tuple[SolverOptions, str]:
         why = "a selection of unknowns (Hill would see only perturbations inside it)"
     elif opts.coordinates == "contact":
         why = "contact coordinates (Hill's method needs the contact DoFs)"
+    elif (nh > HILL_AUTO_MAX and opts.formulation == "condensed"
+          and model.nonlinear_dofs().size):
+        return opts, ""                 # decided with the receptance route (_auto_near0)
     elif nh > HILL_AUTO_MAX:
         why = (f"{nh} Hill unknowns, more than {HILL_AUTO_MAX} (set stability = true to "
                "compute it anyway)")
     return dataclasses.replace(opts, stability=not why), why
+
+
+def _auto_near0(opts: SolverOptions, n: int, nmodes: int, nnl: int) -> tuple[SolverOptions,
+                                                                              str]:
+    """stability "auto" above HILL_AUTO_MAX (resolve_stability left it): on when Hill
+    takes the s = 0 route (receptances from real modes: a reduced model), else off and
+    why ('' when on)."""
+    H = opts.harmonics
+    if _hill_route(n, H, nmodes, nnl) == "near0":
+        return dataclasses.replace(opts, stability=True), ""
+    return dataclasses.replace(opts, stability=False), (
+        f"{2 * n * (2 * H + 1)} Hill unknowns, more than {HILL_AUTO_MAX}, and receptances "
+        "not from real modes (no s = 0 route; set stability = true to compute it anyway)")
 
 
 def pack(model: Model | CyclicModel, excitation: Excitation, opts: SolverOptions, outputs,
@@ -507,6 +525,9 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
             rmodel = copy.copy(model)
             rmodel.K = sp.csr_matrix(model.K + model.stuck_stiffness())
         modes, route, sparse = _receptance_route(rmodel, opts, H, band)
+        if opts.stability == "auto":
+            opts, why = _auto_near0(opts, n, modes.nmodes, nl.size)
+            note += f"; stability: off ('auto': {why})" if why else ""
         # Hill's route at s = 0 (the Newton matrix) works in either coordinates: then
         # stability does not hold the unknowns on the contact DoFs
         near0 = opts.stability and _hill_route(

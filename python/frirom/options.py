@@ -66,8 +66,9 @@ class SolverOptions:
         method"); "strip" asks for the whole strip there too (Neimark-Sacker
         and period doubling of modes far from resonance), at many times the cost.
         "auto": on where affordable (frirom._pack.resolve_stability: at most
-        HILL_AUTO_MAX Hill unknowns, not with a selection, contact coordinates or a cyclic
-        sector), off otherwise, the reason in FRF.solver_info.
+        HILL_AUTO_MAX Hill unknowns, or above that a reduced model's s = 0 route; not
+        with a selection, contact coordinates or a cyclic sector), off otherwise, the
+        reason in FRF.solver_info.
     history : bool
         Carry the contact history along the curve: each point starts its sliders where the
         previous point's closed cycles left them. False restarts every point from the

@@ -212,7 +212,8 @@ def _as_dense(A, name):
 def integrate(M, C, K, contacts, F, omega, *, H: int = 5, periods: int = 200,
               min_periods: int = 5, steps_per_period: int = 512,
               max_phase_step: float = 0.5, tol: float = 1e-7, x0=None, v0=None,
-              w0=None, method: str = "auto", alpha: float = -0.05) -> TimeResult:
+              w0=None, method: str = "auto", alpha: float = -0.05,
+              on_period=None) -> TimeResult:
     """Integrate to a periodic steady state at each forcing frequency of ``omega``.
 
     M, C, K: (n, n); contacts: list of :class:`TimeContact`; F: complex (n, H_F+1) with
@@ -229,7 +230,9 @@ def integrate(M, C, K, contacts, F, omega, *, H: int = 5, periods: int = 200,
     :mod:`frirom.timeint_implicit`: ``steps_per_period`` steps whatever the model's highest
     mode; ``max_phase_step`` is not used) or ``"auto"`` (explicit unless it needs more
     than AUTO_IMPLICIT times ``steps_per_period`` steps: see there). alpha: the HHT parameter in [-1/3, 0] (implicit
-    only; 0 is Newmark's average acceleration). Both are second order: the frequency of a
+    only; 0 is Newmark's average acceleration). on_period(k, samples): called after each
+    period k = 1, 2, ... with its samples (nb, N, n_dof) (a record of every period, e.g. a
+    perturbation's growth, without restarting). Both are second order: the frequency of a
     resolved mode is shifted by ~(2 pi / N)^2 / 24 (explicit) or ~(2 pi / N)^2 / 12
     (implicit) relatively, N = steps per period.
     """
@@ -264,7 +267,8 @@ def integrate(M, C, K, contacts, F, omega, *, H: int = 5, periods: int = 200,
     if method == "implicit":
         return _run_implicit(M, C, K, contacts, F, omega, H=H, periods=periods,
                              min_periods=min_periods, steps_per_period=steps_per_period,
-                             tol=tol, x0=x0, v0=v0, w0=w0, alpha=alpha)
+                             tol=tol, x0=x0, v0=v0, w0=w0, alpha=alpha,
+                             on_period=on_period)
 
     N = max(int(steps_per_period), need, 4 * H + 4)
     N += N % 2
@@ -323,6 +327,8 @@ def integrate(M, C, K, contacts, F, omega, *, H: int = 5, periods: int = 200,
             stack[:, sl_p] = x_prev
             x_prev, x = x, np.matmul(stack[:, None, :], ET)[:, 0]
         n_done = period + 1
+        if on_period is not None:
+            on_period(n_done, last)
         drift, done = period_change(last, prev, n_done >= min_periods, tol)
         if done:
             break
@@ -362,7 +368,7 @@ def _result(omega, H, last, drift, n_done, N, states, x, x_prev, v, w,
 
 
 def _run_implicit(M, C, K, contacts, F, omega, *, H, periods, min_periods,
-                  steps_per_period, tol, x0, v0, w0, alpha) -> TimeResult:
+                  steps_per_period, tol, x0, v0, w0, alpha, on_period=None) -> TimeResult:
     """integrate(..., method="implicit"): see :mod:`frirom.timeint_implicit`."""
     n, nb = M.shape[0], omega.size
     N = max(int(steps_per_period), 4 * H + 4)
@@ -372,5 +378,5 @@ def _run_implicit(M, C, K, contacts, F, omega, *, H, periods, min_periods,
     last, drift, n_done, states, x, x_prev, v, w = integrate_implicit(
         M, C, K, contacts, _external(F), omega, N=N, alpha=alpha, periods=periods,
         min_periods=min_periods, tol=tol, x0=x, v0=v,
-        w_start=_start_sliders(contacts, w0, nb))
+        w_start=_start_sliders(contacts, w0, nb), on_period=on_period)
     return _result(omega, H, last, drift, n_done, N, states, x, x_prev, v, w, "implicit")

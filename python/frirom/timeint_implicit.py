@@ -123,13 +123,14 @@ def _forces_and_tangent(law: str, p: list, u: np.ndarray, w: np.ndarray):
 
 def integrate_implicit(M, C, K, contacts, fe_at, omega, *, N: int, alpha: float,
                        periods: int, min_periods: int, tol: float, x0, v0, w_start,
-                       newton_tol: float = 1e-12, max_newton: int = 50):
+                       newton_tol: float = 1e-12, max_newton: int = 50, on_period=None):
     """The HHT-alpha march behind ``integrate(..., method="implicit")``.
 
     M, C, K: (n, n) dense; contacts: list of TimeContact; fe_at(tau) -> (len(tau), n) the
     external force at phases tau; omega (nb,) rad/s; N steps per period; x0, v0 (nb, n);
-    w_start: list of (nb, n_elem, n_slider). Returns (samples (nb, N, n), drift (nb,),
-    periods done, states per group (N, nb, n_elem), x, x_prev, v, w list).
+    w_start: list of (nb, n_elem, n_slider); on_period(k, samples): called after each
+    period k = 1, 2, ... with its samples (nb, N, n). Returns (samples (nb, N, n), drift
+    (nb,), periods done, states per group (N, nb, n_elem), x, x_prev, v, w list).
     """
     beta, gamma = hht_coefficients(alpha)
     n = M.shape[0]
@@ -153,6 +154,9 @@ def integrate_implicit(M, C, K, contacts, fe_at, omega, *, N: int, alpha: float,
     P = np.empty((nb, 3 * n, n))
     Kinv = np.empty((nb, n, n))
     for i, h in enumerate(dt):
+        if i and h == dt[i - 1]:        # a batch at one frequency: the same operators
+            Kinv[i], P[i] = Kinv[i - 1], P[i - 1]
+            continue
         Keff = M / (beta * h * h) + c1 * gamma / (beta * h) * C + c1 * K
         lu = scipy.linalg.lu_factor(Keff)
         Kinv[i] = scipy.linalg.lu_solve(lu, np.eye(n))
@@ -273,6 +277,8 @@ def integrate_implicit(M, C, K, contacts, fe_at, omega, *, N: int, alpha: float,
             a = a_new
             x_prev, x = x, x_new
         n_done = period + 1
+        if on_period is not None:
+            on_period(n_done, last)
         drift, done = period_change(last, prev, n_done >= min_periods, tol)
         if done:
             break
