@@ -161,6 +161,54 @@ levels = [0.5, 1.0]
 
 
 @pytest.mark.slow
+def liftoff_pair():
+    """Two unit masses (tangential x, normal y) on unit springs held by one preloaded
+    normal1d contact (kt = kn = 1, mu = 0.5, n0 = 1), 1 % stiffness-proportional damping,
+    both pushed at 0.1 cos(w t): the contact sticks, slips and lifts off within a period
+    at the resonance, and lift-off softens it (sqrt 2 stuck, 1 open), so the curve folds
+    back where it jumps down."""
+    import scipy.sparse as sp
+    from frirom.model import ContactGroup, Damping, Excitation, Model
+    g = ContactGroup("normal1d", sp.csr_matrix(np.eye(2)), [[1.0, 1.0, 0.5, 1.0]], name="n")
+    return (Model(np.eye(2), np.eye(2), Damping.rayleigh(0.0, 0.01), [g]),
+            Excitation(np.array([[0.0, 0.1], [0.0, 0.1]], complex)))
+
+
+def test_friction_fold_locus_against_dense_sweeps():
+    """The fold locus of a friction contact with lift-off (H = 3, stick, slip and lift-off
+    in a period) against dense sweeps (steps 25x smaller, no fold location): at each level
+    the located jump-down fold is the dense curve's largest frequency to 1e-6 (its
+    frequency is an extremum along the curve: the dense points miss it by O(step^2)); at
+    the levels between (0.75, 1.5) the dense curves fold between their neighbours' folds,
+    so the locus is continuous and monotone (it falls with the level as lift-off grows)."""
+    import dataclasses
+    from frirom.bifurcations import fold_locus, scaled_excitation
+    model, ex = liftoff_pair()
+    opts = SolverOptions(harmonics=3, samples=256, formulation="condensed", ds_max=0.1,
+                         stability=False)
+    levels = [0.5, 1.0, 2.0]
+    loc = fold_locus(model, ex, 0.9, 1.6, levels, opts, outputs=[1])
+    assert loc.complete.all()
+    top = np.nanmax(loc.omega, axis=1)                  # the jump-down fold per level
+    assert all(loc.located[i, np.nanargmax(loc.omega[i])] for i in range(len(levels)))
+    assert np.all(np.diff(top) < 0)
+    dense = dataclasses.replace(opts, ds_max=0.004, ds=0.004)
+
+    def dense_fold(level):
+        r = frf(model, scaled_excitation(ex, level, "dynamic"), 1.0, 1.45, dense,
+                outputs=[1])
+        w = r.omega
+        k = int(np.argmax(np.diff(w) < 0))              # the first step back
+        assert k > 0, level
+        return w[k]
+
+    for lv, w_fold in zip(levels, top):
+        assert abs(dense_fold(lv) / w_fold - 1) < 1e-6, lv
+    for lv, (hi, lo) in zip([0.75, 1.5], [(top[0], top[1]), (top[1], top[2])]):
+        w = dense_fold(lv)
+        assert lo < w < hi, (lv, lo, w, hi)
+
+
 def test_deck_lists_bifurcations_and_fold_locus(tmp_path, capsys):
     """The CLI: folds printed and kept in frf.h5, [fold_locus] written (9 s loaded)."""
     from frirom.cli import main
