@@ -23,7 +23,9 @@ Per model the table gives the Hill unknowns, the route, its memory
 --flange WORK: the paper flange's ROM_II (WORK/rom2.toml, made by
 cases/paper_flange/paper_flange.py make --work WORK) and, with --rom1, ROM_I, one point
 each mid-band; the last line is ROM_I's stability cost per point relative to its solve
-and its memory (targets <= 1x, <= 2 GiB). Writes cases/bench/results/hill.json.
+and its memory (targets <= 1x, <= 2 GiB): the process's peak resident memory
+while that row's model is built and solved (reset per row). Writes
+cases/bench/results/hill.json.
 
 Models: the Duffing oscillator plus n uncoupled linear oscillators (sparse), a chain of n
 masses with a cubic spring (banded), and the tet10 cantilever of
@@ -143,6 +145,28 @@ def numpy_dense(m):
     return t1 - t, time.perf_counter() - t1
 
 
+def _reset_peak() -> None:
+    """Set this process's peak resident memory (VmHWM) back to its present size (Linux:
+    5 written to /proc/self/clear_refs), so that each row reports its own peak and not
+    the largest of the rows before it; elsewhere the peak stays cumulative."""
+    try:
+        Path("/proc/self/clear_refs").write_text("5")
+    except OSError:
+        pass
+
+
+def _peak_bytes() -> int:
+    """Peak resident memory [bytes] since the last :func:`_reset_peak` (VmHWM), or the
+    process's whole-life peak where /proc is not there."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="small sizes only")
@@ -178,6 +202,7 @@ def main(argv=None):
           f"{'solve s':>8} {'Hill s':>8} {'Hill/solve':>10} {'F solve':>8} {'F Hill':>8} "
           f"{'max Re':>10} {'|dRe|':>9}")
     for name, n, H in cases:
+        _reset_peak()                  # each row's own peak, the model's build included
         ref = None
         rep = a.repeat
         if name == "duffing+osc":
@@ -216,7 +241,7 @@ def main(argv=None):
                    memory_bytes=int(mem), solve_s=t0, hill_s=t1 - t0,
                    hill_per_solve=(t1 - t0) / t0, solve_fortran_s=f0, hill_fortran_s=fh,
                    hill_per_solve_fortran=fh / f0,
-                   peak_rss_bytes=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
+                   peak_rss_bytes=_peak_bytes(),
                    max_re=p.floquet_max_re,
                    stable=bool(p.stable), abs_diff_re_banded=d_re, omega=w)
         rows.append(row)
