@@ -98,14 +98,20 @@ def closed_form_fold_count(f_amp, w_lo, w_hi):
     return n
 
 
-def test_duffing_fold_locus_against_the_closed_form():
+def complete_locus(model_ex, span, levels, H, N, ds_max, output):
+    """(fold_locus over ``span`` (rad/s) at ``levels``, its options), every level's run
+    complete (condensed, no stability)."""
     from frirom.bifurcations import fold_locus
-    model, ex = duffing()
-    opts = SolverOptions(harmonics=1, samples=16, formulation="condensed", ds_max=0.3,
+    opts = SolverOptions(harmonics=H, samples=N, formulation="condensed", ds_max=ds_max,
                          stability=False)
+    loc = fold_locus(*model_ex, *span, levels, opts, outputs=[output])
+    assert loc.complete.all(), loc.messages
+    return loc, opts
+
+
+def test_duffing_fold_locus_against_the_closed_form():
     levels = [0.05, 0.5, 1.5]
-    loc = fold_locus(model, ex, 0.5, 3.0, levels, opts, outputs=[0])
-    assert loc.complete.all()
+    loc, _ = complete_locus(duffing(), (0.5, 3.0), levels, 1, 16, 0.3, 0)
     for i, lv in enumerate(levels):
         assert loc.n_folds[i] == closed_form_fold_count(F * lv, 0.5, 3.0), lv
         for j in range(loc.n_folds[i]):
@@ -182,13 +188,10 @@ def test_friction_fold_locus_against_dense_sweeps():
     the levels between (0.75, 1.5) the dense curves fold between their neighbours' folds,
     so the locus is continuous and monotone (it falls with the level as lift-off grows)."""
     import dataclasses
-    from frirom.bifurcations import fold_locus, scaled_excitation
+    from frirom.bifurcations import scaled_excitation
     model, ex = liftoff_pair()
-    opts = SolverOptions(harmonics=3, samples=256, formulation="condensed", ds_max=0.1,
-                         stability=False)
     levels = [0.5, 1.0, 2.0]
-    loc = fold_locus(model, ex, 0.9, 1.6, levels, opts, outputs=[1])
-    assert loc.complete.all()
+    loc, opts = complete_locus((model, ex), (0.9, 1.6), levels, 3, 256, 0.1, 1)
     top = np.nanmax(loc.omega, axis=1)                  # the jump-down fold per level
     assert all(loc.located[i, np.nanargmax(loc.omega[i])] for i in range(len(levels)))
     assert np.all(np.diff(top) < 0)

@@ -21,7 +21,6 @@ every chunk, and the same command with a larger --max-periods goes on from it.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import os
 import sys
 import time
@@ -33,27 +32,6 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 
-def hbm_start(work, load: float, freq_hz: float, H: int, frf_h5=None):
-    """(deck, model, excitation, point, omega) of the HBM solution verify_upd.ti_check
-    starts from."""
-    from frirom.results import FRF
-    from frirom.solver import solve_point
-    from verify_upd import at_load
-    d, m, e = at_load(work, load)
-    w = 2 * np.pi * freq_hz
-    o = dataclasses.replace(d.options(), harmonics=H, stability=False)
-    start, h0 = None, None
-    if frf_h5 is not None:
-        r = FRF.load(frf_h5)
-        i = int(np.argmin(abs(r.omega - w)))
-        w = float(r.omega[i])
-        start = {"unknowns": r.unknowns[i], "slider": r.slider[i]}
-        h0 = int(r.harmonics)
-    p = solve_point(m, e, w, o, outputs=np.arange(m.n_dof), start=start,
-                    start_harmonics=h0)
-    return d, m, e, p, w
-
-
 def settle(work, load: float, freq_hz: float, out: Path, H: int = 3, frf_h5=None,
            chunk: int = 20, max_periods: int = 600, tol: float = 1e-3,
            steps: int = 128, state_file=None) -> dict:
@@ -61,15 +39,9 @@ def settle(work, load: float, freq_hz: float, out: Path, H: int = 3, frf_h5=None
     ``tol``; one line per chunk appended to ``out``. state_file: an .npz where the end
     state (x, v, sliders, periods so far) is kept after every chunk, and from which a
     later call goes on when it exists. Returns the last line's figures."""
-    from frirom.timeint import TimeContact, integrate, state_from_harmonics
-    d, m, e, p, w = hbm_start(work, load, freq_hz, H, frf_h5)
-    x0, v0 = state_from_harmonics(p.X[None], np.array([w]))
-    tcs, w0, off = [], [], 0
-    for g in m.contacts:
-        nsl = g.w0.shape[1] if np.ndim(g.w0) == 2 else 2
-        tcs.append(TimeContact(g.law, g.G.toarray(), g.params))
-        w0.append(np.asarray(p.slider[off:off + g.n_elem * nsl]).reshape(1, g.n_elem, nsl))
-        off += g.n_elem * nsl
+    from frirom.timeint import integrate
+    from verify_upd import hbm_start
+    d, m, e, p, w, (x0, v0, tcs, w0) = hbm_start(work, load, freq_hz, H, frf_h5)
     Md, Cd, Kd = m.M.toarray(), m.C.toarray(), m.K.toarray()
     o = d.outputs[0]
     a_h = float(np.hypot(p.X[o, 1], p.X[o, 2]))

@@ -137,18 +137,16 @@ def bounce_ratio(work, d, X, omega: float, load: float) -> float:
     return omega ** 2 * y / (load / DAMPER_MASS)
 
 
-def ti_check(work, load: float, freq_hz: float, H: int = 3, periods: int = 40,
-             steps: int = 128, frf_h5=None) -> dict:
-    """HBM (H harmonics) at one load and frequency against time integration started
-    from it; amplitudes of the first output (TIP_0 x): first harmonic and max |x(t)|.
-    frf_h5: a curve of that load (a design-curve member's frf.h5); Newton then starts
-    from its point nearest freq_hz (its unknowns and contact history), at that point's
-    frequency: in gross slip near resonance Newton from the linear solution fails."""
+def hbm_start(work, load: float, freq_hz: float, H: int, frf_h5=None):
+    """(deck, model, excitation, point, omega, (x0, v0, contacts, sliders)): the HBM
+    solution (H harmonics) at one load and frequency and the time integration's start
+    from it (ti_check, ti_settle.py); with ``frf_h5`` Newton starts from that curve's
+    point nearest freq_hz, at its frequency."""
     from frirom.results import FRF
     from frirom.solver import solve_point
-    from frirom.timeint import TimeContact, integrate, state_from_harmonics
+    from frirom.timeint import TimeContact, state_from_harmonics
     d, m, e = at_load(work, load)
-    n, w = m.n_dof, 2 * np.pi * freq_hz
+    w = 2 * np.pi * freq_hz
     o = dataclasses.replace(d.options(), harmonics=H, stability=False)
     start, h0 = None, None
     if frf_h5 is not None:
@@ -157,8 +155,8 @@ def ti_check(work, load: float, freq_hz: float, H: int = 3, periods: int = 40,
         w = float(r.omega[i])
         start = {"unknowns": r.unknowns[i], "slider": r.slider[i]}
         h0 = int(r.harmonics)
-    p = solve_point(m, e, w, o, outputs=np.arange(n), start=start, start_harmonics=h0)
-    freq_hz = w / 2 / np.pi
+    p = solve_point(m, e, w, o, outputs=np.arange(m.n_dof), start=start,
+                    start_harmonics=h0)
     x0, v0 = state_from_harmonics(p.X[None], np.array([w]))
     tcs, w0, off = [], [], 0
     for g in m.contacts:
@@ -166,6 +164,19 @@ def ti_check(work, load: float, freq_hz: float, H: int = 3, periods: int = 40,
         tcs.append(TimeContact(g.law, g.G.toarray(), g.params))
         w0.append(np.asarray(p.slider[off:off + g.n_elem * nsl]).reshape(1, g.n_elem, nsl))
         off += g.n_elem * nsl
+    return d, m, e, p, w, (x0, v0, tcs, w0)
+
+
+def ti_check(work, load: float, freq_hz: float, H: int = 3, periods: int = 40,
+             steps: int = 128, frf_h5=None) -> dict:
+    """HBM (H harmonics) at one load and frequency against time integration started
+    from it; amplitudes of the first output (TIP_0 x): first harmonic and max |x(t)|.
+    frf_h5: a curve of that load (a design-curve member's frf.h5); Newton then starts
+    from its point nearest freq_hz (its unknowns and contact history), at that point's
+    frequency: in gross slip near resonance Newton from the linear solution fails."""
+    from frirom.timeint import integrate
+    d, m, e, p, w, (x0, v0, tcs, w0) = hbm_start(work, load, freq_hz, H, frf_h5)
+    freq_hz = w / 2 / np.pi
     ti = integrate(m.M.toarray(), m.C.toarray(), m.K.toarray(), tcs, e.F, w, H=H,
                    periods=periods, min_periods=periods, x0=x0, v0=v0, w0=w0, tol=0.0,
                    steps_per_period=steps, method="implicit")
