@@ -316,8 +316,8 @@ def test_contact_patch_key(deckdir):
 @pytest.mark.parametrize("form", ["condensed", "banded"])
 def test_deck_without_contacts_gives_its_linear_response(deckdir, form):
     """Issue 29 item 5: [[contacts]] is optional in docs/deck.md; a deck without it gave
-    "hbm_continue: ny or netot does not match the model" in either formulation. Now it
-    solves, and equals the dense linear solve (K - w^2 M + i w C) x = F to 1e-8 (the
+    "ny or netot does not match the model" (from the old f2py driver) in either
+    formulation. Now it solves, and equals the dense linear solve (K - w^2 M + i w C) x = F to 1e-8 (the
     continuation's Newton tolerance) at every point."""
     from frirom.solver import frf
     text = BASE.split("[[contacts]]")[0] + "[solver]" + BASE.split("[solver]")[1]

@@ -78,7 +78,7 @@ def test_cli_error_gives_frequencies_in_hz(monkeypatch, capsys):
     from frirom._errors import ConvergenceError
 
     def cmd(args):
-        raise ConvergenceError("hbm_continue: step below ds_min at omega = 2950.3 rad/s")
+        raise ConvergenceError("continuation: step below ds_min at omega = 2950.3 rad/s")
     monkeypatch.setattr(frirom.cli, "cmd_show", cmd)
     assert main(["show", "somewhere"]) == 2
     err = capsys.readouterr().err.strip()
