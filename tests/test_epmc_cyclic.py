@@ -142,7 +142,7 @@ def test_jacobian_against_central_differences(models, backbone):
     cm = models[1]
     bb = backbone
     opts = dataclasses.replace(frirom.SolverOptions(**OPTS), stability=False)
-    _, run, _ = open_cyclic(cm, 0, "stuck", opts)
+    _, run, _, _ = open_cyclic(cm, 0, "stuck", opts)
 
     def res(yy, ll):
         r, rl, J, info, msg = _kernels.frun_mode_jacobian(run.handle, ll, yy)

@@ -296,8 +296,11 @@ def nonlinear_mode(model: Model, mode: int = 0, amplitudes=(1e-6, 1e-2), start: 
         opts = dataclasses.replace(opts, max_points=int(max_points))
     if cyclic:
         from .nonlinear_modes_cyclic import open_cyclic
-        packed, run, make = open_cyclic(model, mode, start, opts, outputs, static,
-                                        nodal_diameter)
+        packed, run, w0, kw = open_cyclic(model, mode, start, opts, outputs, static,
+                                          nodal_diameter)
+
+        def make(*pts):
+            return _backbone_from(packed, w0, mode, start, *pts, **kw)
     else:
         packed, run, phi, w0 = _open(model, mode, start, opts, outputs, static,
                                      condensed=condensed, n_modes=n_modes)

@@ -90,11 +90,12 @@ def cyclic_linear_mode(model: CyclicModel, mode: int = 0, start: str = "stuck",
 
 def open_cyclic(model: CyclicModel, mode, start, opts, outputs=None, static=None,
                 nodal_diameter=None):
-    """The packed sector, a cyclic mode run (frirom._run.Run) on it and the function that
-    makes a Backbone of the run's points: (packed, run, make)."""
+    """The packed sector, a cyclic mode run (frirom._run.Run) on it, the linear mode's
+    frequency w0 and the rest that a Backbone of the run's points needs
+    (frirom.nonlinear_modes._backbone_from's keywords n_out, energy_viscous,
+    nodal_diameter): (packed, run, w0, keywords)."""
     from ._pack import _output_map, pack
     from ._run import Run
-    from .nonlinear_modes import _backbone_from
     model = _with_diameter(model, nodal_diameter)
     if opts.modes:
         raise ParameterError("options.modes: a cyclic model brings its own modes per nodal "
@@ -155,8 +156,5 @@ def open_cyclic(model: CyclicModel, mode, start, opts, outputs=None, static=None
                 xv = (c[:, None] * np.abs(q) ** 2).sum(axis=0) / np.maximum(a, 1e-300) ** 2
         return np.pi * xi * omega * e, xv
 
-    def make(ys, lams, xos, sts, its, cks, status, message):
-        return _backbone_from(packed, w0, mode, start, ys, lams, xos, sts, its, cks, status,
-                              message, n_out=run_out.size, energy_viscous=energy_viscous,
-                              nodal_diameter=k1)
-    return packed, run, make
+    return packed, run, w0, {"n_out": run_out.size, "energy_viscous": energy_viscous,
+                             "nodal_diameter": k1}
