@@ -131,3 +131,25 @@ def test_normal2d_in_one_plane_equals_normal1d():
     assert r1.state_fractions[:, 0, 1:].sum(axis=1).max() > 0.2     # slips / lifts off
     assert np.allclose(r1.samples, r2.samples, rtol=0, atol=1e-12)
     assert np.allclose(r1.state_fractions, r2.state_fractions)
+
+
+@pytest.mark.parametrize("method", ["explicit", "implicit"])
+def test_no_period_gives_the_start_state_and_no_samples(method):
+    """periods = 0 (frirom.floquet asks for the start state this way): x and v are the
+    start (v to O(dt) in the explicit march), and the samples, harmonics and contact states are NaN, not the unwritten
+    buffers (their garbage gave overflow warnings in the FFT, and numbers)."""
+    import warnings
+    G = np.array([[1.0]])
+    jen = TimeContact("jenkins", G, [[2.0, 1.0, 1e6]])
+    F = np.zeros((1, 2), complex)
+    F[0, 1] = 0.5
+    x0, v0 = np.array([[0.1]]), np.array([[-0.2]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        r = integrate(np.eye(1), 0.01 * np.eye(1), np.eye(1), [jen], F, np.array([1.1]),
+                      H=3, periods=0, min_periods=0, x0=x0, v0=v0, method=method)
+    assert r.periods == 0
+    # the explicit march keeps x and x_prev: its v is their difference, within O(dt)
+    assert np.allclose(r.x, x0) and np.allclose(r.v, v0, rtol=1e-2)
+    for a in (r.samples, r.harmonics, r.amp_max, r.state_fractions):
+        assert np.isnan(a).all()

@@ -359,6 +359,16 @@ def _result(omega, H, last, drift, n_done, N, states, x, x_prev, v, w,
             method="explicit") -> TimeResult:
     """TimeResult of the last period ``last`` (nb, N, n) and the states per group."""
     nb = omega.size
+    if n_done == 0:
+        # no period run (periods = 0: only the start state x, v, w is wanted): the
+        # sample and state buffers were never written, so nothing is read from them
+        n = last.shape[-1]
+        last = np.full_like(last, np.nan)
+        return TimeResult(omega=omega, harmonics=np.full((nb, n, 2 * H + 1), np.nan),
+                          amp_max=np.full((nb, n), np.nan), samples=last, drift=drift,
+                          periods=0, steps_per_period=N,
+                          state_fractions=np.full((nb, len(states), 3), np.nan),
+                          x=x, x_prev=x_prev, v=v, w=w, method=method)
     fractions = (np.stack([np.stack([(st == j).mean(axis=(0, 2)) for j in range(3)], -1)
                            for st in states], axis=1) if states else np.zeros((nb, 0, 3)))
     return TimeResult(omega=omega, harmonics=harmonics_from_samples(last, H),
