@@ -37,6 +37,8 @@ QUIET_WORKER = {"distributed.worker.profile.enabled": False,
 #: Dask settings of the scheduler of frirom's LocalCluster (see :func:`local_workers`):
 #: no heartbeat limit on its workers.
 PATIENT_SCHEDULER = {"distributed.scheduler.worker-ttl": None}
+
+
 def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
     """Check that a Dask scheduler answers at a tcp:// ``address`` before a Client is
     made: it must accept the connection and send the length of a handshake-sized first

@@ -612,6 +612,7 @@ def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Pa
     empty = _csr(sp.csr_matrix((nr, nr)))
     tcontact = _contact_coords(o, G.shape[0], cols.size)
     nu = G.shape[0] if tcontact else cols.size
+    free = model.free_bodies()
     return _Packed(opts=o, H=H, n_dof=nr, fe0=fe0_r, fe1=fe1_r,
                    K=empty, M=empty, C=empty, perm=np.arange(1, nr + 1, dtype=np.int32),
                    nl=at[cols], G=_csr(G), ginfo=c.ginfo, params=c.params, w0=c.w0,
@@ -622,5 +623,5 @@ def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Pa
                         + ("contact coordinates G x" if tcontact else "contact DoFs")
                         + "; receptances from each harmonic's nodal-diameter modes"
                         + ("; a body held only by its contacts: the modes are the stuck "
-                           "sector's" if model.free_bodies() else ""),
-                   free=model.free_bodies())
+                           "sector's" if free else ""),
+                   free=free)

@@ -19,11 +19,10 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-import scipy.sparse as sp
 
 from ._errors import ParameterError
-from .contact import stuck_stiffness
 from .model import CyclicModel, Excitation
+from .reduction.cyclic import contact_rows
 
 __all__ = ["cyclic_linear_mode", "open_cyclic"]
 
@@ -40,23 +39,6 @@ def _with_diameter(model: CyclicModel, nodal_diameter) -> CyclicModel:
         raise ParameterError(f"nodal_diameter: expected an integer 0..{model.n_sectors - 1},"
                              f" got {k!r}")
     return dataclasses.replace(model, engine_order=int(k))
-
-
-def _contact_shapes(model: CyclicModel, k: int, psi: np.ndarray):
-    """(G_k psi stacked over the groups, stuck stiffness per row): the contacts' relative
-    motion per unit modal coordinate of nodal diameter k's shapes psi (n_dof, nm), the
-    next sector's columns phase-shifted by exp(i k 2 pi / N)."""
-    n = model.n_dof
-    ph = np.exp(2j * np.pi * k / model.n_sectors)
-    rows, ks = [], []
-    for g in model.contacts:
-        G = sp.csr_matrix(g.G)
-        P = G[:, :n] @ psi
-        if G.shape[1] == 2 * n:
-            P = P + ph * (G[:, n:] @ psi)
-        rows.append(np.asarray(P))
-        ks.append(stuck_stiffness(g.law, g.params).ravel())
-    return np.vstack(rows), np.concatenate(ks)
 
 
 def cyclic_linear_mode(model: CyclicModel, mode: int = 0, start: str = "stuck",
@@ -79,7 +61,8 @@ def cyclic_linear_mode(model: CyclicModel, mode: int = 0, start: str = "stuck",
                              f"diameter {k1} the model has)")
     A = np.diag(m.omega.astype(complex) ** 2)
     if start == "stuck":
-        P, ks = _contact_shapes(model, k1, m.psi)
+        Gk, ks = contact_rows(model.n_dof, model.n_sectors, model.contacts, k1)
+        P = Gk @ m.psi
         A = A + P.conj().T @ (ks[:, None] * P)
     lam, V = np.linalg.eigh(0.5 * (A + A.conj().T))
     q0 = V[:, mode]

@@ -38,7 +38,7 @@ from .multistage import cylindrical_frame
 
 __all__ = ["CyclicSector", "cyclic_sector", "axis_rotation", "tran_reduce", "sector_modes",
            "cyclic_model", "needed_indices", "engine_order_loads", "sector_free_bodies",
-           "sector_stuck_stiffness"]
+           "sector_stuck_stiffness", "contact_rows"]
 
 
 def axis_rotation(angle: float, axis=(0.0, 0.0, 1.0)) -> np.ndarray:
@@ -335,23 +335,33 @@ def _ratios(damping, omega):
                          "damping matrix")
 
 
-def sector_stuck_stiffness(sector: CyclicSector, contacts, k: int) -> sp.csr_matrix:
-    """sum G_k^H Ks G_k over ``contacts`` (n_dof, n_dof), complex: the contacts closed
-    and stuck (frirom.contact.stuck_stiffness) at harmonic index k, where a contact on
-    the next sector (columns n_dof.. of G) reads x_1 = exp(i k alpha) x_0, as the solver
-    does (frirom._pack._pack_sector): G_k = G_0 + exp(i k alpha) G_1."""
+def contact_rows(n_dof: int, n_sectors: int, contacts, k: int):
+    """(G_k (n_rows, n_dof) complex CSR, Ks (n_rows,)): the contacts' rows at harmonic index
+    k, stacked over the groups, where a contact on the next sector (columns n_dof.. of G)
+    reads x_1 = exp(i k alpha) x_0, alpha = 2 pi / n_sectors, as the solver does
+    (frirom._pack._pack_sector): G_k = G_0 + exp(i k alpha) G_1; and each row's stuck
+    stiffness (frirom.contact.stuck_stiffness)."""
     from ..contact import stuck_stiffness
-    n = sector.n_dof
-    ph = np.exp(1j * k * sector.alpha)
-    out = sp.csr_matrix((n, n), dtype=complex)
+    n = int(n_dof)
+    ph = np.exp(2j * np.pi * k / n_sectors)
+    rows, ks = [], []
     for g in contacts:
         G = sp.csr_matrix(g.G)
         Gk = G[:, :n].astype(complex)
         if G.shape[1] == 2 * n:
             Gk = Gk + ph * G[:, n:]
-        ks = np.asarray(stuck_stiffness(g.law, g.params), float).ravel()
-        out = out + Gk.conj().T @ sp.diags(ks) @ Gk
-    return sp.csr_matrix(out)
+        rows.append(Gk)
+        ks.append(np.asarray(stuck_stiffness(g.law, g.params), float).ravel())
+    if not rows:
+        return sp.csr_matrix((0, n), dtype=complex), np.zeros(0)
+    return sp.csr_matrix(sp.vstack(rows)), np.concatenate(ks)
+
+
+def sector_stuck_stiffness(sector: CyclicSector, contacts, k: int) -> sp.csr_matrix:
+    """sum G_k^H Ks G_k over ``contacts`` (n_dof, n_dof), complex: the contacts closed
+    and stuck at harmonic index k (:func:`contact_rows`)."""
+    Gk, ks = contact_rows(sector.n_dof, sector.n_sectors, contacts, k)
+    return sp.csr_matrix(Gk.conj().T @ sp.diags(ks) @ Gk)
 
 
 def _definite(A) -> bool:
