@@ -92,7 +92,7 @@ module frirom_aft
     type :: aft_plan
         type(fourier_plan) :: fp
         integer(ip), allocatable :: state(:, :)      !! (nbatch, N) contact state per sample
-        real(wp), allocatable :: tangent(:, :, :)    !! (nbatch, 6, N) 2-D slip tangents
+        real(wp), allocatable :: tangent(:, :, :)    !! (nbatch, 12, N) 2-D slip tangents
         real(wp), allocatable :: follow(:, :, :)     !! (nbatch, N, 2) u the sliders follow
                                                      !! (frirom_contact recontact_follow)
         real(wp), allocatable :: par(:, :)           !! (nbatch, 4) parameters of the batch
@@ -405,7 +405,7 @@ contains
         if (info /= FRIROM_OK) return
         nb = plan%fp%nbatch
         nc = plan%fp%ncoef
-        allocate (plan%state(nb, nsamp), plan%tangent(nb, 6, nsamp), plan%par(nb, 4), &
+        allocate (plan%state(nb, nsamp), plan%tangent(nb, 12, nsamp), plan%par(nb, 4), &
                   plan%follow(nb, nsamp, 2))
         allocate (plan%w(nb, 2), plan%wstart(nb, 2), plan%scale(nb), plan%closed_at(nb))
         allocate (plan%anchor(nb), plan%anchor_state(nb), plan%anchor_dtv(nb), &

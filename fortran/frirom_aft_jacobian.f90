@@ -290,7 +290,7 @@ contains
         integer(ip), allocatable :: st(:, :), st_keep(:)
         real(wp), allocatable :: w(:, :), f(:, :, :), tg(:, :, :), tg_keep(:, :)
         n = plan%fp%nsamp
-        allocate (st(1, n), w(1, 2), f(1, n, 3), tg(1, 6, n))
+        allocate (st(1, n), w(1, 2), f(1, n, 3), tg(1, 12, n))
         st_keep = plan%state(j, :)
         tg_keep = plan%tangent(j, :, :)
         w(1, :) = w0j(1:2)
@@ -310,8 +310,8 @@ contains
     end subroutine settle2d
 
     !> One period of the 2-D slider tangent recursion (see friction2d_march):
-    !> stick: d f = kt (dU_k - dw), dw kept; slip: d f = A_k (dU_k - dw) + b_k dV_k,
-    !> dw = dU_k - d f / kt; lift-off: d f = 0, dw = dU_k; a closed sample after an open
+    !> stick: d f = kt (dU_k - dw), dw kept; slip: d f = G_k (dU_{k-1} - dw) +
+    !> A_k (dU_k - dU_{k-1}) + b_k dV_k + c_k dV_{k-1}, dw = dU_k - d f / kt; lift-off: d f = 0, dw = dU_k; a closed sample after an open
     !> one first puts the slider at the re-contact point (recontact). The same-sample
     !> stick part is in the Toeplitz blocks already; here only the terms in dw and the
     !> slip samples.
@@ -342,14 +342,19 @@ contains
                 if (open_seg .and. accumulate) call flush_stick(gsum)
                 open_seg = .false.
                 if (st(k) == STATE_SLIP) then
+                    ! G (du_{k-1} - dw) + A (du_k - du_{k-1}) + b dv_k + c dv_{k-1}
+                    ! (friction2d_march); after an open sample A = G and c = 0
                     dft(1, :) = -(tg(1, k)*dw(1, :) + tg(3, k)*dw(2, :))
                     dft(2, :) = -(tg(2, k)*dw(1, :) + tg(4, k)*dw(2, :))
-                    dft(1, 1:nc) = dft(1, 1:nc) + tg(1, k)*bas(k, :)
-                    dft(2, 1:nc) = dft(2, 1:nc) + tg(2, k)*bas(k, :)
-                    dft(1, nc + 1:2*nc) = dft(1, nc + 1:2*nc) + tg(3, k)*bas(k, :)
-                    dft(2, nc + 1:2*nc) = dft(2, nc + 1:2*nc) + tg(4, k)*bas(k, :)
-                    dft(1, 2*nc + 1:3*nc) = dft(1, 2*nc + 1:3*nc) + tg(5, k)*bas(k, :)
-                    dft(2, 2*nc + 1:3*nc) = dft(2, 2*nc + 1:3*nc) + tg(6, k)*bas(k, :)
+                    do i = 1, 2
+                        do c = 1, 2
+                            dft(i, (c - 1)*nc + 1:c*nc) = dft(i, (c - 1)*nc + 1:c*nc) &
+                                + tg(6 + i + 2*(c - 1), k)*bas(k, :) &
+                                + (tg(i + 2*(c - 1), k) - tg(6 + i + 2*(c - 1), k))*bas(kp, :)
+                        end do
+                        dft(i, 2*nc + 1:3*nc) = dft(i, 2*nc + 1:3*nc) + tg(4 + i, k)*bas(k, :) &
+                                                + tg(10 + i, k)*bas(kp, :)
+                    end do
                     if (accumulate) then
                         pk = wgt*bas(k, :)
                         do i = 1, 2

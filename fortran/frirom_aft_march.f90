@@ -218,7 +218,7 @@ contains
 
     !> Derivative m(2, 2) of the end-of-period 2-D slider of element j of the batch with
     !> respect to its start, from the states and slip tangents of the period just
-    !> marched: the product over the samples of A_k/kt at slip, I at stick, 0 at
+    !> marched: the product over the samples of G_k/kt at slip, I at stick, 0 at
     !> lift-off. opened: the period has a lift-off sample.
     pure subroutine slider_map(plan, j, kt, m, opened)
         type(aft_plan), intent(in) :: plan
