@@ -34,8 +34,9 @@
 !> the march locates lift-off and re-contact between samples (frirom_contact), so the
 !> force harmonics of the 1-D laws converge like O(N^-2) in every regime; the default N
 !> is chosen from measurements in the Python package (frirom.harmonics.default_samples).
-!> Use N >= 4H+1 for the cubic law to be exact. The 2-D law's radial return is first
-!> order on curved slip paths (energy error ~ 1/N relative under circular motion).
+!> Use N >= 4H+1 for the cubic law to be exact. The 2-D law moves its slider exactly along
+!> the interpolated path between samples (frirom_contact slip2d_step), so it converges
+!> like O(N^-2) too, curved slip paths and lift-off included.
 !>
 !> Layout: this parent module holds the law table, the plan and the interfaces; the work
 !> is in submodules by job: frirom_aft_eval (the two entry points and the checks of their
@@ -115,6 +116,8 @@ module frirom_aft
         logical, allocatable :: accelerated(:)       !! (nbatch) a step was accepted
         integer(ip), allocatable :: hold(:)          !! (nbatch) plain periods before a step
         real(wp), allocatable :: damp(:)             !! (nbatch) fraction of the step taken
+        real(wp), allocatable :: damp_cap(:)         !! (nbatch) largest fraction since a
+                                                     !! rejected step
     end type aft_plan
 
     ! The two entry points are generic names over separate module procedures: gfortran 12
@@ -414,7 +417,7 @@ contains
                   plan%jt(0:2*nharm, 6))
         allocate (plan%wplain(nb, 2), plan%res_base(nb), &
                   plan%res_last(nb), plan%stepped(nb), plan%accelerated(nb), plan%hold(nb), &
-                  plan%damp(nb))
+                  plan%damp(nb), plan%damp_cap(nb))
     end subroutine aft_plan_create
 
     !> Release the plans and work arrays (a destroyed or never created plan is fine).
@@ -429,6 +432,6 @@ contains
         if (allocated(plan%dw)) deallocate (plan%dw, plan%dw0, plan%dft, plan%jw, plan%jt)
         if (allocated(plan%wplain)) deallocate (plan%wplain, plan%res_base, plan%res_last, &
                                                 plan%stepped, plan%accelerated, plan%hold, &
-                                                plan%damp)
+                                                plan%damp, plan%damp_cap)
     end subroutine aft_plan_destroy
 end module frirom_aft

@@ -230,6 +230,8 @@ contains
         real(wp), intent(out) :: n1(2), dn(2, 6)
         !> |z0|^2 within this of r0^2: z0 on the limit (the previous sample slipped)
         real(wp), parameter :: ON_LIMIT = 1.0e-12_wp
+        !> relative slip rate at the onset below which the interval is taken as stuck
+        real(wp), parameter :: GRAZE = 1.0e-8_wp
         real(wp) :: dr, g0, b, a, disc, theta, y(2), rho, na(2), ra, lam, s, e(2), c
         real(wp) :: el, phi, phia, phi1, sx, q, p, d, nvec(2), eye(2, 2)
         real(wp) :: gth(6), dy(2, 6), dna(2, 6), dra(6), de(2, 6), ds(6), dc(6), dl(6)
@@ -268,7 +270,9 @@ contains
         na = y/rho
         ra = r0 + theta*dr
         lam = dot_product(na, du) - dr
-        if (lam <= 0.0_wp) return     ! touches the limit without crossing it
+        ! touches the limit without crossing it; grazing (lam ~ 0) slips by O(lam^2) while
+        ! d theta ~ 1/lam: taken as stick below GRAZE
+        if (lam <= GRAZE*(norm2(du) + abs(dr))) return
         slip = .true.
         ! derivatives with respect to (z0, du, r0, r1)
         gth = 0.0_wp
