@@ -98,6 +98,10 @@ int frirom_frf(int n, int nk, const int *kr, const int *kc, const double *kv,
  *   frirom_run_set_selection  a travelling-wave selection keep (nnl, H+1) of the contact
  *                        DoFs' harmonics (1 = kept), its direction pair (nnl, H+1) or
  *                        NULL, orbits = 1: AFT on one element per orbit (optional)
+ *   frirom_run_set_free_bodies  on = 1: a body held only by its contacts (K singular):
+ *                        the contacts' stuck stiffness moved into the linear part and a
+ *                        pin of FREE_PIN = 1e-2 of it on each contact's mean (the Python
+ *                        Model.free_bodies() case; docs/cases/upd.md) (optional)
  *   frirom_run_start     from omega_start to omega_end (rad/s): solves the first point
  *   frirom_run_advance   up to k more points into omega (k+1), xo (nout, 2H+1, k+1), amp
  *                        (nout, k+1) and y (ny, k+1) or NULL; status: 0 going, 1 done
@@ -130,6 +134,7 @@ int frirom_run_set_modes(frirom_run *run, int nmodes, const double *phi,
                          const double *omega, const double *zeta, char *msg, int msglen);
 int frirom_run_set_selection(frirom_run *run, int nnl, const int *keep, const int *pair,
                              int orbits, char *msg, int msglen);
+int frirom_run_set_free_bodies(frirom_run *run, int on, char *msg, int msglen);
 int frirom_run_start(frirom_run *run, double omega_start, double omega_end, char *msg,
                      int msglen);
 int frirom_run_advance(frirom_run *run, int k, int *npts, double *omega, double *xo,
@@ -139,6 +144,50 @@ int frirom_run_solve_at(frirom_run *run, double omega, const double *y0, double 
 int frirom_run_checkpoint(const frirom_run *run, int nck, double *ck, char *msg, int msglen);
 int frirom_run_restore(frirom_run *run, int nck, const double *ck, char *msg, int msglen);
 int frirom_run_close(frirom_run **run);
+
+/* Nonlinear modes by the extended periodic motion concept (EPMC, Krack 2015) on the same
+ * run object: the backbone of one mode, its frequency and damping against its amplitude.
+ *
+ *   frirom_run_set_nonlinear_mode  makes an open run a mode run starting from the linear
+ *                        mode phi (n) at omega0 (rad/s; mass-normalised here): on all
+ *                        DoFs (nmodes = 0), or condensed to the contact DoFs by nmodes
+ *                        real modes (n, nmodes) of the free structure with omega (rad/s)
+ *                        and zeta (the artificial damping changes their damping term)
+ *   frirom_run_start_mode  from modal amplitude a_start to a_end (> 0, log steps; harmonic
+ *                        1 mass-normalised): solves the first point
+ *   frirom_run_advance_mode  up to k more points into amplitude, omega (rad/s), xi (the
+ *                        artificial damping, 1/s; damping ratio xi / (2 omega)) (k+1 each)
+ *                        and xo (nout, 2H+1, k+1) the output harmonics; status as
+ *                        frirom_run_advance
+ *
+ * frirom_run_checkpoint, _restore, _sizes and _close work on a mode run as on any run. */
+int frirom_run_set_nonlinear_mode(frirom_run *run, const double *phi, double omega0,
+                                  int nmodes, const double *modes, const double *omega,
+                                  const double *zeta, char *msg, int msglen);
+int frirom_run_start_mode(frirom_run *run, double a_start, double a_end, char *msg,
+                          int msglen);
+int frirom_run_advance_mode(frirom_run *run, int k, int *npts, double *amplitude,
+                            double *omega, double *xi, double *xo, int *status, char *msg,
+                            int msglen);
+
+/* Contact laws written by the user (docs/tutorials/user_laws.md). A contact group whose
+ * ginfo law code is frirom_law_user_code(ndir, npar, nslider) (negative; 0 when a size is
+ * out of range: 1 <= ndir <= 7, 0 <= npar <= 255, 0 <= nslider <= 1e6) is evaluated by the
+ * function registered with frirom_run_set_user_law, in every formulation. The function
+ * marches one period of the group's ne elements: u (ne, ndir, nsamp) relative
+ * displacements, params (ne, npar), w (ne, nslider) the state at the period's start in
+ * and at its end out, f (ne, ndir, nsamp) the forces against u; column-major, element
+ * fastest. It returns 0, or a nonzero code the run reports as a law error. ctx is
+ * passed back untouched; group is the contact group, 1-based. frirom closes the cycle
+ * (repeats the period until w returns to its start), takes the force harmonics, and builds
+ * the Jacobian by central differences (2 ndir (2H+1) closed periods). The run keeps the
+ * pointers only: keep ctx alive until frirom_run_close. */
+typedef int (*frirom_user_law_fn)(void *ctx, int group, int ne, int ndir, int nsamp,
+                                  int npar, int nslider, const double *u,
+                                  const double *params, double *w, double *f);
+int frirom_law_user_code(int ndir, int npar, int nslider);
+int frirom_run_set_user_law(frirom_run *run, frirom_user_law_fn fn, void *ctx, char *msg,
+                            int msglen);
 
 #ifdef __cplusplus
 }

@@ -53,7 +53,7 @@ module frirom_aft
     public :: LAW_JENKINS, LAW_NORMAL1D, LAW_NORMAL2D, LAW_CUBIC, LAW_IWAN4, LAW_IWAN, LAW_CODES
     public :: IWAN4_BINS, IWAN_MAX
     public :: law_info, law_check, law_ndir, law_npar, law_nslider, law_rest_force, &
-              law_stuck_stiffness
+              law_stuck_stiffness, law_user_code
     public :: iwan_sliders
 
     ! The contact-law table: the one source of the codes and sizes (the Python package
@@ -288,9 +288,14 @@ contains
         integer(ip), intent(out) :: npar                  !! parameters per element
         integer(ip), intent(out) :: nslider               !! slider components
         character(len=*), intent(out), optional :: name  !! e.g. 'jenkins'
-        ndir = law_ndir(law)
-        npar = law_npar(law)
-        nslider = law_nslider(law)
+        ndir = 0
+        npar = 0
+        nslider = 0
+        if (known(law)) then            ! the table only (a user law's code: zeros)
+            ndir = law_ndir(law)
+            npar = law_npar(law)
+            nslider = law_nslider(law)
+        end if
         if (present(name)) then
             name = ''
             if (known(law)) name = LAW_NAMES(law)
@@ -299,13 +304,19 @@ contains
 
     !> FRIROM_OK for a law code of the table, else FRIROM_ERR_LAW with a message listing
     !> the laws: 'law 9 (expected 1 jenkins, 2 normal1d, ...)'.
-    pure subroutine law_check(law, info, errmsg)
+    !> user: also accept a user law's code (law_user_code; the solver evaluates those
+    !> through the run's callback, frirom_user_law).
+    pure subroutine law_check(law, info, errmsg, user)
         integer(ip), intent(in) :: law                     !! the code to check
         integer(ip), intent(out) :: info
         character(len=*), intent(inout), optional :: errmsg
+        logical, intent(in), optional :: user
         character(len=200) :: buf
         info = FRIROM_OK
         if (any(LAW_CODES == law)) return
+        if (present(user)) then
+            if (user .and. law < 0 .and. law_ndir(law) >= 1) return
+        end if
         write (buf, '(a,i0,a,a,a)') 'law ', law, ' (expected ', law_list(), ')'
         call set_status(info, FRIROM_ERR_LAW, errmsg, trim(buf))
     end subroutine law_check
@@ -359,11 +370,23 @@ contains
         if (law == LAW_NORMAL1D .or. law == LAW_NORMAL2D) f(size(f)) = max(p(4), 0.0_wp)
     end subroutine law_rest_force
 
+    !> The code of a user law (frirom_user_law): negative, carrying its sizes,
+    !> -(ndir + 8 (npar + 256 nslider)) with 1 <= ndir <= 7, 0 <= npar <= 255,
+    !> 0 <= nslider <= 1e6 (0 when out of range).
+    pure integer(ip) function law_user_code(ndir, npar, nslider)
+        integer(ip), intent(in) :: ndir, npar, nslider
+        law_user_code = 0
+        if (ndir < 1 .or. ndir > 7 .or. npar < 0 .or. npar > 255 .or. nslider < 0 .or. &
+            nslider > 1000000) return
+        law_user_code = -(ndir + 8*(npar + 256*nslider))
+    end function law_user_code
+
     !> Number of directions of a law (0 for an unknown code).
     pure integer(ip) function law_ndir(law)
         integer(ip), intent(in) :: law
         law_ndir = 0
         if (known(law)) law_ndir = NDIR_OF(law)
+        if (law < 0) law_ndir = mod(-law, 8)
     end function law_ndir
 
     !> Number of parameters per element of a law (0 for an unknown code).
@@ -371,6 +394,7 @@ contains
         integer(ip), intent(in) :: law
         law_npar = 0
         if (known(law)) law_npar = NPAR_OF(law)
+        if (law < 0) law_npar = mod(-law/8, 256)
     end function law_npar
 
     !> Number of slider components of a law (0 for an unknown code).
@@ -378,6 +402,7 @@ contains
         integer(ip), intent(in) :: law
         law_nslider = 0
         if (known(law)) law_nslider = NSLIDER_OF(law)
+        if (law < 0) law_nslider = -law/2048
     end function law_nslider
 
     pure logical function known(law)

@@ -10,7 +10,7 @@ module frirom_capi
     use frirom_run, only: run_t, run_points, run_handle, run_from_handle, run_start, &
                           run_advance, run_solve, run_close, run_set_modes, run_set_selection, &
                           run_checkpoint, run_restore, run_checkpoint_size, RUN_START_COLD, &
-                          RUN_SOLVE_FIXED
+                          RUN_SOLVE_FIXED, run_set_free_bodies
     implicit none
     private
     !> The largest frequency a C caller may give (rad/s), as decks (frirom MAX_OMEGA): the
@@ -20,7 +20,9 @@ module frirom_capi
     public :: frirom_run_open_c, frirom_run_sizes_c, frirom_run_set_modes_c, &
               frirom_run_set_selection_c, frirom_run_start_c, frirom_run_advance_c, &
               frirom_run_solve_at_c, frirom_run_checkpoint_c, frirom_run_restore_c, &
-              frirom_run_close_c
+              frirom_run_close_c, frirom_run_set_free_bodies_c
+    !> for frirom_capi_modes (the nonlinear-mode entry points)
+    public :: to_c_string, get_run
 
 contains
 
@@ -313,6 +315,23 @@ contains
         call to_c_string(text, msg, msglen)
         info = int(st, c_int)
     end function frirom_run_set_modes_c
+
+    !> int frirom_run_set_free_bodies(frirom_run *run, int on, char *msg, int msglen)
+    function frirom_run_set_free_bodies_c(run, on, msg, msglen) result(info) &
+        bind(c, name='frirom_run_set_free_bodies')
+        type(c_ptr), value :: run, msg
+        integer(c_int), value :: on, msglen
+        integer(c_int) :: info
+        type(run_t), pointer :: r
+        integer(ip) :: st
+        character(len=512) :: text
+        call get_run(run, 'frirom_run_set_free_bodies', r, st, text)
+        if (st == FRIROM_OK .and. on /= 0 .and. on /= 1) call set_status(st, &
+            FRIROM_ERR_PARAM, text, 'frirom_run_set_free_bodies: on: expected 0 or 1')
+        if (st == FRIROM_OK) call run_set_free_bodies(r, on == 1, st, text)
+        call to_c_string(text, msg, msglen)
+        info = int(st, c_int)
+    end function frirom_run_set_free_bodies_c
 
     !> int frirom_run_set_selection(frirom_run *run, int nnl, const int *keep,
     !>                              const int *pair, int orbits, char *msg, int msglen)
@@ -671,7 +690,7 @@ contains
         np = 0
         nsl = 0
         do g = 1, ngroup
-            call law_check(int(ginfo(3*g - 2), ip), st, text)
+            call law_check(int(ginfo(3*g - 2), ip), st, text, user=.true.)
             if (st /= FRIROM_OK) then
                 text = who//': ginfo: '//trim(text)
                 return
@@ -726,6 +745,10 @@ contains
                 ne = ginfo(3*g - 1)
                 nd = law_ndir(law)
                 npl = law_npar(law)
+                if (law < 0) then           ! a user law: its own checks, at evaluation
+                    p0 = p0 + npl*ne
+                    cycle
+                end if
                 allocate (x(1, nd, ne), f(1, nd, ne), w(max(law_nslider(law), 1_ip), ne))
                 x = 0.0_wp
                 w = 0.0_wp

@@ -170,14 +170,14 @@ end subroutine default_samples
 subroutine int_constant(name, value, info, msg)
     use frirom_kinds, only: ip
     use frirom_status, only: FRIROM_ERR_PARAM, frirom_status_code, set_status
-    use frirom_run, only: RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_LOAD, &
+    use frirom_run, only: RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_LOAD, RUN_MODE, &
                           RUN_START_COLD, RUN_START_POINT, RUN_START_RESUME, RUN_GOING, &
                           RUN_DONE, RUN_MAX_POINTS, RUN_LEFT_RANGE, RUN_FAILED, RUN_STALLED, &
                           RUN_SOLVE_FIXED, RUN_SOLVE_STEP, ADVISE_TOL_STALL, ADVISE_MAX_ITER, &
                           ADVISE_DS_MIN, ADVISE_SAMPLES, N_ISET, N_RSET, COORD_AUTO, COORD_DOFS, &
                           COORD_CONTACT
     use frirom_hbm, only: T_AFT, T_ASM, T_FACT, T_SOLVE, T_REC, N_EVAL, N_FACT, N_KRYLOV, &
-                          N_DOUBLE, N_TIMERS, HILL_DENSE_MAX
+                          N_DOUBLE, N_TIMERS, HILL_DENSE_MAX, T_HILL
     implicit none
     character(len=*), intent(in) :: name
     integer(4), intent(out) :: value
@@ -195,6 +195,8 @@ subroutine int_constant(name, value, info, msg)
         value = RUN_FREQUENCY
     case ('RUN_LOAD')
         value = RUN_LOAD
+    case ('RUN_MODE')
+        value = RUN_MODE
     case ('RUN_START_COLD')
         value = RUN_START_COLD
     case ('RUN_START_POINT')
@@ -255,6 +257,8 @@ subroutine int_constant(name, value, info, msg)
         value = N_KRYLOV
     case ('N_DOUBLE')
         value = N_DOUBLE
+    case ('T_HILL')
+        value = T_HILL
     case ('N_TIMERS')
         value = N_TIMERS
     case default

@@ -5,6 +5,7 @@ submodule (frirom_hbm) frirom_hbm_contacts
                              set_status
     use frirom_banded, only: band_add
     use frirom_aft, only: aft_eval, law_nslider
+    use frirom_user_law, only: user_aft
     implicit none
 
 contains
@@ -58,7 +59,22 @@ contains
                         end do
                     end do
                 end if
-                if (upd) then
+                if (gr%law < 0) then            ! a user law: through the run's callback
+                    gr%states = 0.0_wp
+                    if (upd) then
+                        wnew = gr%w0
+                        call user_aft(cs%ulaw, g, plan%fp%nsamp, law_nslider(gr%law), gr%x, &
+                                      gr%params, gr%w0, gr%f, info, errmsg, slider=wnew)
+                        if (info == 0) gr%w0 = wnew
+                        deallocate (wnew)
+                    else if (jac) then
+                        call user_aft(cs%ulaw, g, plan%fp%nsamp, law_nslider(gr%law), gr%x, &
+                                      gr%params, gr%w0, gr%f, info, errmsg, jac=gr%jac)
+                    else
+                        call user_aft(cs%ulaw, g, plan%fp%nsamp, law_nslider(gr%law), gr%x, &
+                                      gr%params, gr%w0, gr%f, info, errmsg)
+                    end if
+                else if (upd) then
                     allocate (wnew, mold=gr%w0)
                     wnew = gr%w0
                     call aft_eval(plan, gr%law, gr%x, gr%params, gr%w0, gr%f, info, errmsg, &

@@ -5,7 +5,8 @@ submodule (frirom_hbm) frirom_hbm_run
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, FRIROM_ERR_ALLOC, &
                              FRIROM_ERR_MODEL, FRIROM_ERR_LAW, set_status
     use frirom_newton, only: newton_correct, cont_tangent, cont_run
-    use frirom_aft, only: aft_plan_create, law_ndir, law_npar, law_nslider, law_rest_force
+    use frirom_aft, only: aft_plan_create, law_ndir, law_npar, law_nslider, law_rest_force, &
+                          law_check
     implicit none
 
 contains
@@ -173,10 +174,8 @@ contains
                 gr%law = ginfo(1, g)
                 ne = ginfo(2, g)
                 nd = ginfo(3, g)
-                if (gr%law < 1 .or. gr%law > 4) then
-                    call set_status(info, FRIROM_ERR_LAW, errmsg, 'hbm_setup: contact group law')
-                    return
-                end if
+                call law_check(gr%law, info, errmsg, user=.true.)
+                if (info /= 0) return
                 if (nd /= law_ndir(gr%law) .or. ne < 1) then
                     call set_status(info, FRIROM_ERR_SIZE, errmsg, 'hbm_setup: contact group '// &
                                     'directions do not match its law, or no element')
@@ -400,6 +399,7 @@ contains
         subroutine store(itn)
             integer(ip), intent(in) :: itn
             integer(ip) :: g, e0
+            real(wp) :: th
             complex(wp), allocatable :: ex(:)
             npts = npts + 1
             ys(:, npts) = y
@@ -420,7 +420,9 @@ contains
             end if
             if (present(hill_re)) then
                 allocate (ex(2*sys%ndof))
+                th = wtime()
                 call hbm_hill(sys, y, lam, ex, hill_re(npts), info, errmsg)
+                sys%timers(T_HILL) = sys%timers(T_HILL) + wtime() - th
                 if (info /= 0) return
             end if
             e0 = 0

@@ -33,6 +33,7 @@ module frirom_run
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, FRIROM_ERR_CONT, &
                              FRIROM_ERR_ALLOC, set_status
     use frirom_hbm, only: hbm_system, N_TIMERS
+    use frirom_user_law, only: user_law
     implicit none
     private
     public :: run_t, run_model, run_settings, run_points
@@ -41,8 +42,9 @@ module frirom_run
               run_advice, run_sizes, run_default_samples, settings_pack, settings_unpack, &
               run_settings_names, run_handle, run_from_handle, run_checkpoint_size, &
               run_checkpoint, run_restore, run_contact_coords, open_run, run_lu_size, &
-              run_lu_state, run_set_free_bodies
-    public :: RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_LOAD, &
+              run_lu_state, run_set_free_bodies, run_set_nonlinear_mode, run_to_mode, &
+              run_set_user_law
+    public :: RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_LOAD, RUN_MODE, &
               RUN_START_COLD, RUN_START_POINT, RUN_START_RESUME, &
               RUN_GOING, RUN_DONE, RUN_MAX_POINTS, RUN_LEFT_RANGE, RUN_FAILED, RUN_STALLED, &
               STALL_POINTS, STALL_PROGRESS, &
@@ -55,6 +57,9 @@ module frirom_run
     integer(ip), parameter :: RUN_CONDENSED = 1, RUN_BANDED = 2
     !> The parameter: the frequency (rad/s), or a load factor at a fixed frequency.
     integer(ip), parameter :: RUN_FREQUENCY = 1, RUN_LOAD = 2
+    !> A nonlinear mode (EPMC, frirom_hbm_epmc): lam = log10 of the modal amplitude, the
+    !> frequency and the artificial damping among the unknowns (run_set_nonlinear_mode).
+    integer(ip), parameter :: RUN_MODE = 3
     !> How run_start begins: from nothing (Newton from the linear solution, then the
     !> homotopy start); from a point solved at its parameter first; from a point with
     !> its tangent (a checkpoint when its step is given).
@@ -124,6 +129,14 @@ module frirom_run
         real(wp) :: orbtol = 1.0e-9_wp
         !> bodies held only by their contacts (run_set_free_bodies)
         logical :: free = .false.
+        !> a mode run (RUN_MODE): the linear mode it starts from and its frequency (rad/s)
+        real(wp), allocatable :: mode_phi(:)
+        real(wp) :: mode_w0 = 0.0_wp
+        !> a condensed mode run: the modes of its receptances (ndof, nm), rad/s, ratios
+        real(wp), allocatable :: mode_modes(:, :), mode_wm(:), mode_zm(:)
+        !> the callback of the user laws (run_set_user_law): kept with the model, so that
+        !> a rebuilt system and a homotopy's child run evaluate them too
+        type(user_law) :: ulaw
     end type run_model
 
     !> Points of a run (run_advance, run_solve), in the full layout of the unknowns.
@@ -241,6 +254,31 @@ module frirom_run
             character(len=*), intent(inout) :: errmsg
         end subroutine run_set_modes_harmonic
 
+        !> A mode run (opened with mode RUN_MODE): the linear mode phi (ndof; stuck or
+        !> free, the caller's choice) and its natural frequency omega0 (rad/s) the
+        !> nonlinear mode starts from (frirom_run_modes.f90). Needed before run_start.
+        !> A condensed run (formulation RUN_CONDENSED) needs the modes of its receptances:
+        !> modes (ndof, nm), their frequencies wm (rad/s) and damping ratios zm.
+        module subroutine run_set_nonlinear_mode(run, phi, omega0, info, errmsg, modes, wm, &
+                                                 zm)
+            type(run_t), intent(inout) :: run
+            real(wp), intent(in) :: phi(:), omega0
+            integer(ip), intent(out) :: info
+            character(len=*), intent(inout) :: errmsg
+            real(wp), intent(in), optional :: modes(:, :), wm(:), zm(:)
+        end subroutine run_set_nonlinear_mode
+
+        !> Make an open run (a frequency or load run, e.g. frf_open's) a nonlinear-mode run
+        !> on the same model: mode RUN_MODE, on all DoFs (condensed false) or condensed by
+        !> modes (run_set_nonlinear_mode then gives them); receptance modes, a selection,
+        !> Krylov, sparse LU and Hill's method are dropped. The run is built again.
+        module subroutine run_to_mode(run, condensed, info, errmsg)
+            type(run_t), intent(inout) :: run
+            logical, intent(in) :: condensed
+            integer(ip), intent(out) :: info
+            character(len=*), intent(inout) :: errmsg
+        end subroutine run_to_mode
+
         !> Bodies held only by their contacts (on): the contacts' stuck stiffness moved
         !> into the linear part and taken back off the contact forces, each contact's mean
         !> relative displacement held by a weak spring (frirom_hbm_free); rebuilds the
@@ -251,6 +289,18 @@ module frirom_run
             integer(ip), intent(out) :: info
             character(len=*), intent(inout) :: errmsg
         end subroutine run_set_free_bodies
+
+        !> The function (and its context, passed back untouched) that evaluates the
+        !> contact groups whose law is a user law (frirom_user_law user_law_fn; a negative
+        !> law code, frirom_aft law_user_code), in every formulation. The run keeps only
+        !> the pointers: the caller keeps the function and its context alive until
+        !> run_close.
+        module subroutine run_set_user_law(run, ulaw, info, errmsg)
+            type(run_t), intent(inout) :: run
+            type(user_law), intent(in) :: ulaw
+            integer(ip), intent(out) :: info
+            character(len=*), intent(inout) :: errmsg
+        end subroutine run_set_user_law
 
         !> A travelling-wave selection keep (nnl, H+1) of the condensed unknowns; with
         !> pair (nnl, H+1) its direction; with orbits, Newton's evaluations on one element

@@ -6,6 +6,7 @@ submodule (frirom_run) frirom_run_drive
     use frirom_newton, only: cont_options, YSCALE_RELATIVE
     use frirom_hbm, only: hbm_lu_forget, hbm_lu_rebuild, hbm_run, hbm_sel_expand, hbm_sel_reduce, &
                           HBM_START_CONTINUE, HBM_START_RESUME, HBM_START_SOLVE_ONLY
+    use frirom_epmc, only: hbm_epmc_guess
     implicit none
 
     !> Where a segment (one hbm_run call) starts and how far it may go.
@@ -71,6 +72,16 @@ contains
         run%lam = lam_start
         if (present(lam0)) run%lam = lam0
         if (present(y0)) run%y = y0
+        if (run%m%mode == RUN_MODE) then
+            ! a nonlinear mode starts from its linear mode (run_set_nonlinear_mode)
+            if (.not. allocated(run%m%mode_phi) .or. run%s%stability /= 0) then
+                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'run_start: a mode run '// &
+                                'needs run_set_nonlinear_mode first, and stability off')
+                return
+            end if
+            if (kind == RUN_START_COLD .or. .not. present(y0)) &
+                call hbm_epmc_guess(run%sys, run%y)
+        end if
         ! a run starts as one on a system just built: nothing of an earlier use is held
         call hbm_lu_forget(run%sys)
         run%lu_dirty = .false.

@@ -4,6 +4,7 @@
 submodule (frirom_run) frirom_run_setup
     use frirom_hbm, only: hbm_condensed, hbm_full, hbm_setup, hbm_set_modes, &
                           hbm_set_modes_harmonic, hbm_set_selection, hbm_set_orbits
+    use frirom_epmc, only: hbm_epmc, hbm_epmc_set, hbm_epmc_modal, hbm_epmc_modal_set
     use frirom_aft, only: aft_plan_destroy, law_nslider
     implicit none
 
@@ -17,9 +18,12 @@ contains
         if (formulation /= RUN_CONDENSED .and. formulation /= RUN_BANDED) then
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'formulation: expected 1 '// &
                             '(condensed) or 2 (banded)')
-        else if (mode /= RUN_FREQUENCY .and. mode /= RUN_LOAD) then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'mode: expected 1 (frequency) '// &
-                            'or 2 (load)')
+        else if (mode /= RUN_FREQUENCY .and. mode /= RUN_LOAD .and. mode /= RUN_MODE) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'mode: expected 1 (frequency), '// &
+                            '2 (load) or 3 (nonlinear mode)')
+        else if (mode == RUN_MODE .and. (krylov == 1 .or. sparse)) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'mode 3 (nonlinear mode): '// &
+                            'dense solves only (krylov and sparse off)')
         else if (ndof < 1) then
             call set_status(info, FRIROM_ERR_PARAM, errmsg, 'ndof: expected at least 1 DoF')
         else if (nsamp < 0) then
@@ -86,21 +90,34 @@ contains
         end if
         run%built = .false.
         associate (m => run%m)
-            if (m%formulation == RUN_CONDENSED) then
+            if (m%mode == RUN_MODE .and. m%formulation == RUN_CONDENSED) then
+                allocate (hbm_epmc_modal :: run%sys)
+            else if (m%mode == RUN_MODE) then
+                allocate (hbm_epmc :: run%sys)
+            else if (m%formulation == RUN_CONDENSED) then
                 allocate (hbm_condensed :: run%sys)
             else
                 allocate (hbm_full :: run%sys)
             end if
             call hbm_setup(run%sys, m%nh, m%nsamp, m%ndof, m%kp, m%ki, m%kx, m%mp, m%mi, &
-                           m%mx, m%cp, m%ci, m%cx, m%perm, m%nl, m%fe0, m%fe1, m%mode, &
+                           m%mx, m%cp, m%ci, m%cx, m%perm, m%nl, m%fe0, m%fe1, &
+                           merge(RUN_FREQUENCY, m%mode, m%mode == RUN_MODE), &
                            m%omega_fix, m%ginfo, m%gp, m%gi, m%gx, m%params, m%w0, &
                            m%outdofs, info, errmsg, contact_coords=m%tcontact, &
                            krylov=m%krylov, sparse_lu=m%sparse, free_bodies=m%free)
             if (info /= 0) return
+            run%sys%cs%ulaw = m%ulaw
             if (allocated(m%phi)) call hbm_set_modes(run%sys, m%phi, m%wm, m%zm, info, errmsg)
             if (info /= 0) return
             if (allocated(m%psi)) call hbm_set_modes_harmonic(run%sys, m%psi, m%wh, m%zh, &
                                                               info, errmsg)
+            if (info /= 0) return
+            if (allocated(m%mode_modes)) then
+                call hbm_epmc_modal_set(run%sys, m%mode_phi, m%mode_w0, m%mode_modes, &
+                                        m%mode_wm, m%mode_zm, m%nl, info, errmsg)
+            else if (allocated(m%mode_phi)) then
+                call hbm_epmc_set(run%sys, m%mode_phi, m%mode_w0, info, errmsg)
+            end if
             if (info /= 0) return
             run%netot = sum(m%ginfo(2, :))
             if (allocated(m%keep)) call apply_selection(run, info, errmsg)
@@ -197,6 +214,13 @@ contains
         run%m%free = on
         call run_build(run, info, errmsg)
     end procedure run_set_free_bodies
+
+    module procedure run_set_user_law
+        info = FRIROM_OK
+        if (.not. open_run(run, 'run_set_user_law', info, errmsg)) return
+        run%m%ulaw = ulaw
+        if (allocated(run%sys)) run%sys%cs%ulaw = ulaw
+    end procedure run_set_user_law
 
     module procedure run_set_selection
         info = FRIROM_OK

@@ -107,6 +107,49 @@ int main(void) {
             return 1;
         }
     }
+    {   /* a body held only by its contacts (issue 29): a blade (m 1 on k 1, forced 0.01)
+         * and a damper (m 0.3, no stiffness) tied by one Jenkins element that never slips
+         * (kt 2, mu fn0 100): K is singular and the solve fails until
+         * frirom_run_set_free_bodies; then the stuck 2-DoF closed form to 1e-9 */
+        const int kr[] = {0}, mr[] = {0, 1}, ginfo[] = {FRIROM_LAW_JENKINS, 1, 1};
+        const int gr[] = {0, 0}, gc[] = {0, 1}, out[] = {0, 1};
+        const double kv[] = {1.0}, mv[] = {1.0, 0.3}, gv[] = {1.0, -1.0};
+        const double p[3] = {2.0, 1.0, 100.0}, fe[6] = {0, 0, 0.01, 0, 0, 0};
+        const double w = 1.0, al = 0.02;
+        double xo[6], amp[2];
+        struct frirom_settings s;
+        frirom_run *run = NULL;
+        frirom_settings_default(&s);
+        s.harmonics = 1;
+        if (frirom_run_open(&run, 2, 1, kr, kr, kv, 2, mr, mr, mv, 0, NULL, NULL, NULL, al,
+                            0.0, 0, NULL, 1, ginfo, 2, gr, gc, gv, 3, p, 0, NULL, fe, 2, out,
+                            &s, 0, msg, 256)) {
+            fprintf(stderr, "free body open: %s\n", msg);
+            return 1;
+        }
+        if (frirom_run_solve_at(run, w, NULL, NULL, xo, amp, msg, 256) == 0) {
+            fprintf(stderr, "free body solved without frirom_run_set_free_bodies\n");
+            return 1;
+        }
+        REFUSED("free bodies on = 2", frirom_run_set_free_bodies(run, 2, msg, 256),
+                "expected 0 or 1")
+        if (frirom_run_set_free_bodies(run, 1, msg, 256) ||
+            frirom_run_solve_at(run, w, NULL, NULL, xo, amp, msg, 256)) {
+            fprintf(stderr, "free body: %s\n", msg);
+            return 1;
+        }
+        /* D x = [F, 0]: x0 = F D22 / det, with D11 = 1 + 2 - w^2 + i w al, D22 = 2 -
+         * 0.3 w^2 + 0.3 i w al, D12 = -2 */
+        double d11r = 3.0 - w * w, d11i = w * al, d22r = 2.0 - 0.3 * w * w, d22i = 0.3 * w * al;
+        double detr = d11r * d22r - d11i * d22i - 4.0, deti = d11r * d22i + d11i * d22r;
+        double ref = 0.01 * hypot(d22r, d22i) / hypot(detr, deti);
+        double got = hypot(xo[2], xo[4]);     /* xo (nout = 2, 3): a1 of DoF 0 at [2] */
+        if (fabs(got / ref - 1.0) > 1e-9) {
+            fprintf(stderr, "free body: amplitude %.15g, closed form %.15g\n", got, ref);
+            return 1;
+        }
+        frirom_run_close(&run);
+    }
     puts("test_capi: ok");
     return 0;
 }

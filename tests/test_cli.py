@@ -31,6 +31,7 @@ def deck(tmp_path):
     return tmp_path / "joint.toml"
 
 
+@pytest.mark.slow
 def test_run_writes_results(deck, tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["run", str(deck), "--out", str(out), "--quiet"]) == 0

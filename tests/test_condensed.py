@@ -173,6 +173,7 @@ def test_general_damping_keeps_the_factorisation(models):
     assert n == model.n_dof
 
 
+@pytest.mark.slow
 def test_krylov_solves_agree_with_direct_ones(models):
     """GMRES on the current J preconditioned by an older LU (forced on here; by default
     from 1000 unknowns): the same points to TOL, along an FRF through slip, with fewer

@@ -301,3 +301,36 @@ def test_deck_defaults_are_the_solvers_and_documented(deckdir):
             assert got == str(want).lower(), key
         else:
             assert float(got) == float(want), key
+
+
+def test_contact_patch_key(deckdir):
+    """[[contacts]] patch (issue 29 item 1): the patch extent reaches the model's group;
+    without it none (not checked); a non-positive one is refused by key path."""
+    d = load_deck(write(deckdir, _with(BASE, "[contacts]", ["patch = 9e-3"])))
+    assert d.model().contacts[0].patch == 9e-3
+    assert load_deck(write(deckdir, BASE)).model().contacts[0].patch is None
+    with pytest.raises(InputError, match=r"contacts\[0\]\.patch"):
+        load_deck(write(deckdir, _with(BASE, "[contacts]", ["patch = -1.0"])))
+
+
+@pytest.mark.parametrize("form", ["condensed", "banded"])
+def test_deck_without_contacts_gives_its_linear_response(deckdir, form):
+    """Issue 29 item 5: [[contacts]] is optional in docs/deck.md; a deck without it gave
+    "hbm_continue: ny or netot does not match the model" in either formulation. Now it
+    solves, and equals the dense linear solve (K - w^2 M + i w C) x = F to 1e-8 (the
+    continuation's Newton tolerance) at every point."""
+    from frirom.solver import frf
+    text = BASE.split("[[contacts]]")[0] + "[solver]" + BASE.split("[solver]")[1]
+    text = text.replace('formulation = "condensed"', f'formulation = "{form}"')
+    text = text.replace("stability = true", "stability = false")
+    d = load_deck(write(deckdir, text))
+    model, exc = d.model(), d.excitation()
+    assert not model.contacts
+    r = frf(model, exc, d.omega_start, d.omega_end, d.options(), outputs=d.outputs)
+    assert r.complete and len(r) > 10
+    K, M, C = (np.asarray(a.toarray()) for a in (model.K, model.M, model.C))
+    for k in range(0, len(r), 5):
+        w = r.omega[k]
+        x = np.linalg.solve(K - w**2 * M + 1j * w * C, exc.F[:, 1])[d.outputs]
+        ref = np.c_[x.real, -x.imag]
+        assert np.abs(r.X[k][:, 1:3] - ref).max() <= 1e-8 * np.abs(x).max()

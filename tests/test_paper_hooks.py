@@ -119,6 +119,7 @@ def test_normal2d_hooks_rom2_matches_rom1_with_the_lug_tied(tied):
     assert f2 == pytest.approx(f1, rel=0.001)
 
 
+@pytest.mark.slow
 def test_rom1_first_point_does_not_depend_on_the_stuck_lug_preload(hooks_case):
     """The lug stays stuck, so its preload P only adds a constant force that its static
     load balances: ROM_I's first point (f0 = 300 N, hooks slipping) is the same for

@@ -128,6 +128,7 @@ def test_parallel_faces_share_one_pressure(lap, tmp_path, monkeypatch):
                                atol=1e-12 * np.abs(one.F[:, 0]).max())
 
 
+@pytest.mark.slow
 def test_hand_written_preload_with_flipped_normal_is_warned(lap, tmp_path, monkeypatch):
     # no [[preload]]: n0 = 32 N and the +-32 N loads by hand, the normal flipped; the
     # loads then push against the preload's balance (factor -1): a warning names the key

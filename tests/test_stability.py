@@ -219,6 +219,7 @@ def test_jenkins_stable_points_against_reference_and_time_integration():
 
 
 
+@pytest.mark.slow
 def test_arnoldi_on_friction_matches_the_strip_of_the_reference():
     """72 stiff masses: 2 n_dof (2H+1) = 1022 > HILL_MAX, the Arnoldi path. Its largest
     Re s is that of the reference's strip (1e-8 of w). It does not compute modes above

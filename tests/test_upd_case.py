@@ -45,3 +45,11 @@ def test_upd_linear_limits_against_calculix(tmp_path, monkeypatch):
             "direction, 3 rotations or deformations; PLAT_0, PLAT_1, TIP_0, TIP_1 still"
             in text), text
     assert "WARNING" not in text            # stuck, the contacts hold the damper
+    # the contact patch as meshed (frirom.held's default): cases/models/upd.py's lattice,
+    # h = 2 mm: patches x0..x1 = 4 cells along the tangent x, z 1..9 = 8 cells along z
+    from upd import DAMPER, PATCHES
+    h = 0.002
+    for c, side in zip(deck.model().contacts, "LR"):
+        x0, x1, _ = PATCHES[side]
+        ext = [(x1 - x0) * h, (DAMPER[0][5] - DAMPER[0][4]) * h]
+        np.testing.assert_allclose(c.patch, ext, rtol=1e-9)

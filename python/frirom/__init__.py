@@ -36,6 +36,7 @@ _LAZY = {
     "Excitation": ".model", "CyclicModel": ".model",
     "SolverOptions": ".solver", "frf": ".solver", "solve_point": ".solver",
     "load_curve": ".solver",
+    "nonlinear_mode": ".nonlinear_modes", "Backbone": ".nonlinear_modes",
     "FRF": ".results", "FRFPoint": ".results", "Peak": ".results",
     "load_deck": ".deck", "parse_deck": ".deck", "build_deck": ".deck", "Deck": ".deck",
     "FEModel": ".io", "read_calculix": ".io", "read_matrix_market": ".io",

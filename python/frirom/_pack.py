@@ -32,7 +32,8 @@ _TIMER_SLOTS = {name: int_constant(slot) - 1 for name, slot in (
     ("aft", "T_AFT"), ("assembly", "T_ASM"), ("factorization", "T_FACT"),
     ("solve", "T_SOLVE"), ("receptance", "T_REC"), ("evaluations", "N_EVAL"),
     ("factorizations", "N_FACT"), ("krylov_iterations", "N_KRYLOV"),
-    ("double_factorizations", "N_DOUBLE"), ("fortran_total", "N_TIMERS"))}
+    ("double_factorizations", "N_DOUBLE"), ("hill", "T_HILL"),
+    ("fortran_total", "N_TIMERS"))}
 TIMER_NAMES = tuple(sorted(_TIMER_SLOTS, key=_TIMER_SLOTS.get))
 
 
@@ -64,13 +65,14 @@ class _Contacts(NamedTuple):
     nw: int                  # sliders in all
     names: list[str]
     sizes: list[int]         # n_elem per group
+    laws: tuple = ()         # the law of each group (names; user laws: frirom.laws.USER_LAWS)
 
 
 def _pack_contacts(groups, ncol: int) -> _Contacts:
     names, sizes = [g.name for g in groups], [g.n_elem for g in groups]
     if not groups:
         return _Contacts(sp.csr_matrix((0, ncol)), np.zeros((3, 0), np.int32, order="F"),
-                         np.zeros(1), np.zeros(1), 0, names, sizes)
+                         np.zeros(1), np.zeros(1), 0, names, sizes, ())
     ginfo = np.array([[LAWS[g.law].code, g.n_elem, g.n_dir] for g in groups],
                      dtype=np.int32).T.copy(order="F")
     params = np.concatenate([g.params.ravel() for g in groups])
@@ -80,7 +82,7 @@ def _pack_contacts(groups, ncol: int) -> _Contacts:
                    else sp.hstack([g.G, sp.csr_matrix((g.G.shape[0], ncol - g.G.shape[1]))])
                    for g in groups]).tocsr()
     return _Contacts(G, ginfo, params, np.concatenate(w0) if nw else np.zeros(1), nw,
-                     names, sizes)
+                     names, sizes, tuple(g.law for g in groups))
 
 
 def _output_map(outputs, n: int):
@@ -165,6 +167,7 @@ class _Packed:
     #: (nnl, H+1) bool: the travelling-wave selection over the nonlinear DoFs nl
     #: (SolverOptions.selection), None: every unknown
     keep: np.ndarray | None = None
+    sel_label: str = "travelling-wave selection"   # or "harmonic selection" (the leak's text)
     #: (nnl, H+1) int32: SolverOptions.pairs over nl (s (position in nl + 1)), None: none
     pair: np.ndarray | None = None
     #: SolverOptions.orbits as the run found them: (elements the AFT runs on, largest
@@ -172,6 +175,8 @@ class _Packed:
     orbits: tuple | None = None
     #: the frequency of a load continuation, rad/s (0 for frequency)
     omega_fix: float = 0.0
+    #: the law of each contact group (user laws evaluated through the run's callback)
+    group_laws: tuple = ()
     orbit_tol: float = ORBIT_TOL
     #: a body held only by its contacts: the run moves their stuck stiffness into K
     #: (frirom_hbm_free); the modes of the receptance route are K + G^T Ks G's
@@ -300,6 +305,33 @@ def _split_load(fe: np.ndarray, part: str) -> tuple[np.ndarray, np.ndarray]:
     return fe - fe1, fe1
 
 
+#: stability = "auto" turns Hill's method on up to this many Hill unknowns 2 n_dof (2H+1):
+#: the dense eigen-solve (up to 1 000) and small Arnoldi problems; the paper flange's
+#: ROM_I (26 600 at H = 3) costs ~150 solves per point
+HILL_AUTO_MAX = 2000
+
+
+def resolve_stability(model, opts: SolverOptions) -> tuple[SolverOptions, str]:
+    """opts with stability "auto" made true or false, and why it is off ('' when on, or
+    not "auto"): off for a cyclic sector, a selection, contact coordinates or more than
+    HILL_AUTO_MAX Hill unknowns."""
+    if not isinstance(opts.stability, str):
+        return opts, ""
+    n, H = model.n_dof, opts.harmonics
+    nh = 2 * n * (2 * H + 1)
+    why = ""
+    if isinstance(model, CyclicModel):
+        why = "a cyclic sector (Hill's method is not implemented for it)"
+    elif opts.selection is not None or opts.harmonics_kept is not None:
+        why = "a selection of unknowns (Hill would see only perturbations inside it)"
+    elif opts.coordinates == "contact":
+        why = "contact coordinates (Hill's method needs the contact DoFs)"
+    elif nh > HILL_AUTO_MAX:
+        why = (f"{nh} Hill unknowns, more than {HILL_AUTO_MAX} (set stability = true to "
+               "compute it anyway)")
+    return dataclasses.replace(opts, stability=not why), why
+
+
 def pack(model: Model | CyclicModel, excitation: Excitation, opts: SolverOptions, outputs,
          load_part: str = "dynamic") -> _Packed:
     """Check the inputs and pack them for the Fortran run; outputs: DoF indices (0-based),
@@ -311,6 +343,14 @@ def pack(model: Model | CyclicModel, excitation: Excitation, opts: SolverOptions
     if not isinstance(excitation, Excitation):
         raise ParameterError("excitation: expected a frirom.model.Excitation")
     opts.check()
+    opts, skipped = resolve_stability(model, opts)
+    label = "travelling-wave selection"
+    if opts.harmonics_kept is not None:
+        if isinstance(model, CyclicModel):
+            raise ParameterError("options.harmonics_kept: not for a cyclic sector (its "
+                                 "harmonics already live on their own nodal diameters)")
+        opts = dataclasses.replace(opts, selection=harmonic_selection(model, opts))
+        label = "harmonic selection"
     fe = excitation.real_harmonic(model.n_dof, opts.harmonics)
     if load_part not in ("static", "dynamic"):
         raise ParameterError("load_part: expected 'static' or 'dynamic'")
@@ -326,11 +366,54 @@ def pack(model: Model | CyclicModel, excitation: Excitation, opts: SolverOptions
     if P is not None:
         packed.out_map, packed.outputs = P, _map_dofs(P, packed.outputs)
     if opts.selection is not None:
-        _select(packed, model, opts.selection, opts.pairs)
+        _select(packed, model, opts.selection, opts.pairs, label)
+    if skipped:
+        packed.info += f"; stability: off ('auto': {skipped})"
     return packed
 
 
-def _select(packed: _Packed, model, selection, pairs=None) -> None:
+def harmonic_selection(model: Model, opts: SolverOptions) -> np.ndarray:
+    """SolverOptions.harmonics_kept as a selection (n_dof, H+1) bool, combined with
+    SolverOptions.selection when both are given."""
+    from .options import kept_harmonics
+    H, n, spec = opts.harmonics, model.n_dof, opts.harmonics_kept
+    sel = (np.ones((n, H + 1), bool) if opts.selection is None
+           else np.asarray(opts.selection, bool))
+    if sel.shape != (n, H + 1):
+        raise SizeError(f"options.selection: expected (n_dof, H+1) = ({n}, {H + 1}), got "
+                        f"{sel.shape}")
+    if isinstance(spec, np.ndarray) and spec.dtype == bool:
+        if spec.shape != (n, H + 1):
+            raise SizeError(f"options.harmonics_kept: a mask must be (n_dof, H+1) = ({n}, "
+                            f"{H + 1}), got {spec.shape}")
+        return sel & spec
+    if not isinstance(spec, dict):
+        return sel & kept_harmonics(spec, H, "options.harmonics_kept")[None, :]
+    names = [g.name for g in model.contacts]
+    per = {}
+    for key, s in spec.items():
+        if isinstance(key, str):
+            if key not in names:
+                raise ParameterError(f"options.harmonics_kept: no contact group named "
+                                     f"{key!r} (groups: {names})")
+            idx = names.index(key)
+        elif isinstance(key, (int, np.integer)) and 0 <= key < len(names):
+            idx = int(key)
+        else:
+            raise ParameterError(f"options.harmonics_kept: {key!r} is neither a contact "
+                                 f"group's name nor its index 0..{len(names) - 1}")
+        per[idx] = kept_harmonics(s, H, f"options.harmonics_kept[{key!r}]")
+    keep = np.zeros((n, H + 1), bool)
+    touched = np.zeros(n, bool)
+    for idx, g in enumerate(model.contacts):
+        dofs = np.unique(sp.csr_matrix(g.G).indices)
+        keep[dofs] |= per.get(idx, np.ones(H + 1, bool))
+        touched[dofs] = True
+    return sel & np.where(touched[:, None], keep, True)
+
+
+def _select(packed: _Packed, model, selection, pairs=None,
+            label: str = "travelling-wave selection") -> None:
     """Check SolverOptions.selection against the packed model and set packed.keep: the
     rows of the nonlinear DoFs; loads on them outside the selection are refused (a
     travelling wave of the selection's engine order has none)."""
@@ -356,8 +439,9 @@ def _select(packed: _Packed, model, selection, pairs=None) -> None:
                     f"{int(packed.nl[np.argmax(off)])} at harmonic {h}, outside the "
                     "selection (not a travelling wave of the selection's engine order)")
     packed.keep = keep
+    packed.sel_label = label
     n = kept_unknowns(keep)
-    packed.info += f"; travelling-wave selection: {n} of {packed.ny} unknowns"
+    packed.info += f"; {label}: {n} of {packed.ny} unknowns"
     if pairs is not None:
         packed.pair = _pairs_on_nl(packed, pairs)
         packed.info += f", {n - 2 * int(np.count_nonzero(packed.pair))} in one direction"
@@ -446,7 +530,8 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
     return _Packed(opts=opts, H=H, n_dof=n, fe0=fe0, fe1=fe1,
                    K=K, M=M, C=C, perm=perm, nl=nl,
                    G=_csr(c.G), ginfo=c.ginfo, params=c.params, w0=c.w0, nw=c.nw,
-                   group_names=c.names, group_sizes=c.sizes, outputs=out, out_f=out,
+                   group_names=c.names, group_sizes=c.sizes, group_laws=c.laws,
+                   outputs=out, out_f=out,
                    stability=bool(opts.stability), modes=modes, tcontact=tcontact, sparse=sparse,
                    info=info + note, free=free)
 
@@ -500,7 +585,8 @@ def _pack_sector(model: CyclicModel, o: SolverOptions, fe0, fe1, outputs) -> _Pa
     return _Packed(opts=o, H=H, n_dof=nr, fe0=fe0_r, fe1=fe1_r,
                    K=empty, M=empty, C=empty, perm=np.arange(1, nr + 1, dtype=np.int32),
                    nl=at[cols], G=_csr(G), ginfo=c.ginfo, params=c.params, w0=c.w0,
-                   nw=c.nw, group_names=c.names, group_sizes=c.sizes, outputs=out,
+                   nw=c.nw, group_names=c.names, group_sizes=c.sizes, group_laws=c.laws,
+                   outputs=out,
                    out_f=at[out], stability=False, modes=modes, tcontact=tcontact,
                    info=f"condensed: {nu * (2 * H + 1)} unknowns, {nu} "
                         + ("contact coordinates G x" if tcontact else "contact DoFs")

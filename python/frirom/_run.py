@@ -16,7 +16,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import _kernels
-from ._errors import SizeError, int_constant, raise_for_status
+from ._errors import ParameterError, SizeError, int_constant, raise_for_status
 
 #: run_start kinds, stop reasons, solve kinds and advice bits (frirom_run RUN_*, ADVISE_*)
 START_COLD, START_POINT, START_RESUME = (int_constant(f"RUN_START_{k}")
@@ -80,16 +80,23 @@ def _text(b) -> str:
 class Run:
     """An open Fortran run on a packed model (frirom._pack._Packed)."""
 
-    def __init__(self, packed, omega_fix: float = 0.0):
+    def __init__(self, packed, omega_fix: float = 0.0, mode_shape=None):
+        """mode_shape: (phi (n_dof,), omega0 rad/s, modes) opens a nonlinear-mode run
+        (EPMC, frirom_run RUN_MODE) starting from that linear mode: on all DoFs when modes
+        is None, else condensed to the contact DoFs by modes = (Phi (n_dof, nm), omega
+        (nm,) rad/s, zeta (nm,))."""
+        modal = mode_shape is not None and mode_shape[2] is not None
         p, o, m = packed, packed.opts, packed.modes
         iset = np.array([_setting(o, n) for n in _INAMES], np.int32)
         rset = np.array([_setting(o, n) for n in _RNAMES], float)
         nl = (p.nl + 1).astype(np.int32) if p.nl.size else np.ones(1, np.int32)
         (kp, ki, kx), (mp, mi, mx), (cp, ci, cx), (gp, gi, gx) = p.K, p.M, p.C, p.G
         h, ny, nw, netot, info, msg = _kernels.frun_open(
-            formulation=int_constant("RUN_CONDENSED" if o.formulation == "condensed"
+            formulation=int_constant("RUN_CONDENSED" if (o.formulation == "condensed"
+                                                         if mode_shape is None else modal)
                                      else "RUN_BANDED"),
-            mode=int_constant("RUN_FREQUENCY" if o.parameter == "frequency" else "RUN_LOAD"),
+            mode=int_constant("RUN_MODE" if mode_shape is not None else
+                              "RUN_FREQUENCY" if o.parameter == "frequency" else "RUN_LOAD"),
             nh=p.H, nsamp=o.n_samples, ndof=p.n_dof, kp=kp, ki=ki, kx=kx, mp=mp, mi=mi,
             mx=mx, cp=cp, ci=ci, cx=cx, perm=p.perm, nl=nl, nnl=p.nl.size or 1,
             fe0=np.asfortranarray(p.fe0), fe1=np.asfortranarray(p.fe1), omega_fix=omega_fix,
@@ -102,8 +109,26 @@ class Run:
         self.ny, self.nw, self.netot = int(ny), int(nw), int(netot)
         self.nout, self.nc = p.out_f.size, 2 * p.H + 1
         self.orbits = None
+        if np.any(p.ginfo[0] < 0):
+            if p.keep is not None and p.pair is not None and o.orbits:
+                raise ParameterError("orbits: the AFT on one element per orbit takes the "
+                                     "built-in laws only; a contact group has a user law "
+                                     "(set orbits = false)")
+            from .laws import solver_callback
+            self._user_law = solver_callback(p.group_laws)   # kept alive with the run
+            raise_for_status(*self._msg(_kernels.frun_set_user_law(
+                self.handle, self._user_law.address, 0)))
         if getattr(p, "free", False):
             raise_for_status(*self._msg(_kernels.frun_set_free_bodies(self.handle, 1)))
+        if mode_shape is not None:
+            phi_m, w_m, z_m = (mode_shape[2] if modal else
+                               (np.zeros((p.n_dof, 1)), np.ones(1), np.zeros(1)))
+            ny, info, msg = _kernels.frun_set_nonlinear_mode(
+                self.handle, np.asarray(mode_shape[0], float), float(mode_shape[1]),
+                int(modal), np.asfortranarray(phi_m, dtype=float), np.asarray(w_m, float),
+                np.asarray(z_m, float))
+            raise_for_status(info, _text(msg))
+            self.ny = int(ny)
         if m.nmodes:
             raise_for_status(*self._msg(_kernels.frun_set_modes(
                 self.handle, 0, np.asfortranarray(m.phi),

@@ -141,6 +141,8 @@ class AutoChoice:
     met_modes: bool = True
     modes_tolerance: float = 0.0
     mode_lines: list = field(default_factory=list)
+    #: ``harmonics_kept = "auto"``: the selection chosen (frirom.auto_kept.KeptChoice)
+    kept: object = None
 
     def modes_text(self) -> str:
         """``"free = 20, stick = 20"``: the chosen interface-mode counts."""
@@ -175,6 +177,8 @@ class AutoChoice:
                              + ")")
         if parts:
             out.append("; ".join(parts) + f", tolerance {self.tolerance:g}")
+        if self.kept is not None:
+            out.append(self.kept.summary())
         return "; ".join(out)
 
     def title(self) -> str:
@@ -188,6 +192,10 @@ class AutoChoice:
         if self.modes:
             out.append(f"auto: modes {self.modes_text()} for {self.modes_tolerance:g}"
                        + ("" if self.met_modes else " - NOT within it: the largest"))
+        if self.kept is not None and self.kept.selection is not None:
+            u = self.kept.unknowns
+            out.append(f"auto: {u[0]} of {u[1]} unknowns" + (" - RESTORED: all"
+                                                             if self.kept.restored else ""))
         if text:
             out.append(f"auto: {text} for {self.tolerance:g}" + (
                 f" - {' and '.join(bad)} estimate NOT within it: the maximum" if bad
@@ -207,7 +215,10 @@ class AutoChoice:
                 out.append(f"auto: {name} estimate (relative change of the amplitudes at "
                            f"{'H+2' if name == 'H' else '2N'}): "
                            + ", ".join(f"{k}: {e:.2e}" for k, e in est))
-        out.append(f"auto: {self.summary()} ({self.seconds:.1f} s)")
+        if self.kept is None or self.h_estimates or self.n_estimates or self.modes:
+            out.append(f"auto: {self.summary()} ({self.seconds:.1f} s)")
+        elif self.kept is not None:
+            out += self.kept.lines()
         out += [f"auto: WARNING: {n}" for n in self.notes]
         return out
 
@@ -434,7 +445,8 @@ def _rung_peaks(deck, H, opts, window, full):
 def _same_options(a, b) -> bool:
     """Two SolverOptions that compute the same curve (no travelling-wave selection: its
     arrays are not compared)."""
-    if a.selection is not None or b.selection is not None:
+    if a.selection is not None or b.selection is not None or \
+            isinstance(a.harmonics_kept, np.ndarray) or isinstance(b.harmonics_kept, np.ndarray):
         return False
     return all(getattr(a, f.name) == getattr(b, f.name) for f in dataclasses.fields(a))
 
@@ -563,17 +575,19 @@ def resolve_deck(deck, log=print):
     sol = getattr(deck.settings, "solver", None)
     modes = getattr(deck.settings, "modes_auto", None)
     hn = sol is not None and (sol.auto_harmonics or sol.auto_samples)
-    if modes is None and not hn:
+    kept = sol is not None and getattr(sol, "harmonics_kept", None) == "auto"
+    if modes is None and not hn and not kept:
         deck.auto = None
         return deck
     mc = None
     if modes is not None:
         deck, mc = choose_modes(deck, log)
     if not hn:
-        for line in mc.lines()[len(mc.mode_lines) - 1:]:
-            log(line)
+        if mc is not None:
+            for line in mc.lines()[len(mc.mode_lines) - 1:]:
+                log(line)
         deck.auto = mc
-        return deck
+        return _resolve_kept(deck, sol, log) if kept else deck
     opts = deck.options()
     if sol.auto_samples:
         opts = dataclasses.replace(opts, samples=None)
@@ -593,4 +607,21 @@ def resolve_deck(deck, log=print):
     F = _excitation(deck.F, H).F
     new = dataclasses.replace(deck, harmonics=H, samples=ch.samples, F=F)
     new.auto, new.auto_response = ch, None
-    return new
+    return _resolve_kept(new, sol, log) if kept else new
+
+
+def _resolve_kept(deck, sol, log):
+    """``harmonics_kept = "auto"``: the selection chosen by frirom.auto_kept on the
+    deck's H and N (``deck.kept_auto``), its lines logged and kept in ``deck.auto``."""
+    from .auto_kept import choose_kept
+    opts = deck.options()
+    kc = choose_kept(deck.model(), deck.F, deck.omega_start, deck.omega_end, opts,
+                     deck.solver_outputs, tolerance=sol.tolerance_auto)
+    for line in kc.lines():
+        log(line)
+    if deck.auto is None:
+        deck.auto = AutoChoice(harmonics=deck.harmonics, samples=deck.samples,
+                               tolerance=sol.tolerance_auto)
+    deck.auto.kept = kc
+    deck.kept_auto = kc.selection
+    return deck

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import errno
+import math
 import os
 import re
 import shutil
@@ -80,6 +81,10 @@ def _add_run(sub) -> None:
                    "it names changed, except frequency.end and continuation.max_points, "
                    "which may extend the run (each deck's own folder with several decks)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--allow-code", action="append", default=[], metavar="MODULE",
+                   help="let the decks' contact laws 'MODULE:function' import MODULE (a "
+                   "deck that names code runs code: never without this, or an installed "
+                   "entry point in the group frirom.laws; docs/security.md)")
     p.set_defaults(func=cmd_run_decks)
 
 
@@ -188,7 +193,14 @@ exit codes:
 
 
 def _study(args) -> int:
+    from .mistuning_deck import is_mistuning_deck, run_mistuning_study
     from .study import run_study
+    if is_mistuning_deck(args.deck):        # [mistuning] + [study] kind = "mistuning"
+        run_mistuning_study(args.deck, args.out, scheduler=args.scheduler,
+                            workers=args.workers, quiet=args.quiet,
+                            trust_deck_scheduler=args.trust_deck_scheduler,
+                            log=lambda s: print(f"frirom: {s}", flush=True))
+        return 0
     tls = {"ca": args.tls_ca, "cert": args.tls_cert, "key": args.tls_key}
     res = run_study(args.deck, args.out, scheduler=args.scheduler, workers=args.workers,
                     quiet=args.quiet, log=lambda s: print(f"frirom: {s}"),
@@ -210,6 +222,9 @@ def _add_modes(sub) -> None:
     p.add_argument("deck", type=Path, help="the TOML deck (see docs/deck.md)")
     p.add_argument("--out", type=Path, default=None,
                    help="output folder (default: results/<deck name>)")
+    p.add_argument("--allow-code", action="append", default=[], metavar="MODULE",
+                   help="let the deck's contact laws 'MODULE:function' import MODULE "
+                   "(as frirom run --allow-code)")
     p.set_defaults(func=_modes)
 
 
@@ -221,7 +236,8 @@ def _modes(args) -> int:
     from .deck import load_deck
     from .modes import linear_check
     from .plots import plot_frf
-    deck = load_deck(args.deck)
+    allow = getattr(args, "allow_code", None)
+    deck = load_deck(args.deck, allow_code=allow) if allow else load_deck(args.deck)
     for line in deck.log:
         print(f"frirom: {line}")
     check = linear_check(deck)
@@ -289,11 +305,18 @@ def cmd_run(args) -> int:
     from ._resume import ResultsLock
     from .auto import resolve_deck
     from .deck import load_deck
+    from .mistuning_deck import is_mistuning_deck, run_mistuning_deck
 
-    deck = load_deck(args.deck)
+    if is_mistuning_deck(args.deck):        # [mistuning]: frirom.mistuning_deck
+        run_mistuning_deck(args.deck, args.out, log=lambda s: print(f"frirom: {s}"))
+        return 0
+    allow = getattr(args, "allow_code", None)
+    deck = load_deck(args.deck, allow_code=allow) if allow else load_deck(args.deck)
     for line in deck.log:
         print(f"frirom: {line}")
-    linear = _linear_lines(deck)
+    analysis = getattr(deck.settings, "analysis", None)
+    mode_deck = analysis is not None and analysis.nonlinear_mode
+    linear = None if mode_deck else _linear_lines(deck)
     deck = resolve_deck(deck, lambda s: print(f"frirom: {s}"))
     out = args.out if args.out is not None else Path("results") / deck.path.stem
     if out.exists() and not out.is_dir():
@@ -301,6 +324,9 @@ def cmd_run(args) -> int:
     out.mkdir(parents=True, exist_ok=True)
     lock = ResultsLock(out)     # before anything in out is opened or replaced
     try:
+        if mode_deck:
+            from .cli_modes import run_mode_deck
+            return run_mode_deck(args, deck, out)
         return _run_locked(args, deck, out, linear)
     finally:
         lock.release()
@@ -310,7 +336,7 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
     """cmd_run once the results folder is locked."""
     from ._resume import deck_fingerprint
     from .plots import plot_frf, plot_states
-    from .results import FRF, FRFWriter
+    from .results import FRF, FRFWriter, store_bifurcations
     from .solver import frf
 
     h5 = out / "frf.h5"
@@ -320,6 +346,12 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
     if not done:
         shutil.copyfile(deck.path, out / "deck.toml")
 
+    kept = getattr(deck.auto, "kept", None) if deck.auto is not None else None
+    if kept is not None and kept.selection is not None and args.resume and \
+            _stored_restored(h5):
+        # the stored run had given the selection up: it goes on with every harmonic
+        kept.restored = "(the stored run's: its leak had grown)"
+        deck.kept_auto = None
     model, excitation, options = deck.model(), deck.excitation(), deck.options()
     print(f"frirom: {model.n_dof} coordinates, {len(model.nonlinear_dofs())} in contact, "
           f"{sum(g.n_elem for g in model.contacts)} contact elements, H = {deck.harmonics}")
@@ -373,6 +405,23 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
             raise
         progress.close()
         writer.close(complete=result.complete, message=result.message)
+        if kept is not None and reuse is None and _restore_kept(kept, result):
+            # harmonics_kept = "auto": the selection leaked along the curve beyond what
+            # the probes saw: the whole curve again with every harmonic, the file replaced
+            print(f"frirom: auto: the harmonic selection's {kept.restored}: the curve is "
+                  "run again with every harmonic", file=sys.stderr)
+            deck.kept_auto = None
+            options = deck.options()
+            writer = FRFWriter(h5, deck.outputs, names, deck.harmonics, append=False,
+                               attrs={"deck_fingerprint": fingerprint,
+                                      "omega_range": [deck.omega_start, deck.omega_end],
+                                      "auto": "\n".join(deck.auto.lines())},
+                               output_labels=deck.output_names, meta=deck.result_meta())
+            progress = _Progress(deck, args.quiet)
+            result = frf(model, excitation, deck.omega_start, deck.omega_end, options,
+                         outputs=deck.solver_outputs, sink=sink)
+            progress.close()
+            writer.close(complete=result.complete, message=result.message)
         elapsed = time.perf_counter() - t0
         if deck.auto is not None:
             result.solver_info += f"; {deck.auto.summary()}"
@@ -384,10 +433,16 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
     else:
         elapsed = 0.0
 
+    if result is not None and result.bifurcations is not None:
+        # located on the whole curve (a resumed run's points before it too)
+        store_bifurcations(h5, result.bifurcations)
     full = FRF.load(h5)
     if deck.csv:
         full.save_csv(out / "frf.csv")
     written = [h5] + ([out / "frf.csv"] if deck.csv else [])
+    if deck.csv and full.bifurcations:
+        full.save_bifurcations_csv(out / "bifurcations.csv")
+        written.append(out / "bifurcations.csv")
     if deck.plot and len(full) > 0:
         figures = {"frf.png": plot_frf(full, output_names=deck.output_names,
                                        unit=deck.frequency_unit, title=deck.title + (
@@ -402,6 +457,15 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
             written.append(out / name)
     print(f"frirom: {len(full)} points in {elapsed:.1f} s; wrote "
           + ", ".join(str(p) for p in written))
+    for b in full.bifurcations or []:
+        fb = b.omega / (2 * math.pi) if deck.frequency_unit == "hz" else b.omega
+        unit = "Hz" if deck.frequency_unit == "hz" else "rad/s"
+        print(f"frirom: {b.kind} at {fb:.8g} {unit} ("
+              + ("located on the curve " if b.located else "")
+              + f"between points {b.index - 1} and {b.index})")
+    fl = getattr(deck.settings, "fold_locus", None)
+    if fl is not None:
+        _fold_locus(deck, fl, model, excitation, options, out)
     # a resumed run solved its peaks on the whole curve (the file's points before it too)
     if (args.resume and result is not None and result.peaks is not None and start
             and start.get("before")):
@@ -411,6 +475,46 @@ def _run_locked(args, deck, out: Path, linear=None) -> int:
         _print_stop(full, deck, h5)
         return EXIT_STOPPED
     return EXIT_OK
+
+
+def _fold_locus(deck, fl, model, excitation, options, out: Path) -> None:
+    """[fold_locus]: the folds at each level (frirom.bifurcations), OUT/fold_locus.csv."""
+    import csv
+
+    from .bifurcations import fold_locus
+    loc = fold_locus(model, excitation, deck.omega_start, deck.omega_end, fl.levels,
+                     options, outputs=deck.solver_outputs, part=fl.part)
+    path = out / "fold_locus.csv"
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["level", "fold", "f_hz", "omega_rad_s", "located", "complete"]
+                   + [f"{n}_max" for n in deck.output_names])
+        for i, lv in enumerate(loc.levels):
+            for j in range(int(loc.n_folds[i])):
+                w.writerow([repr(float(lv)), j, repr(float(loc.omega[i, j] / (2 * math.pi))),
+                            repr(float(loc.omega[i, j])), int(loc.located[i, j]),
+                            int(loc.complete[i])]
+                           + [repr(float(a)) for a in loc.amp_max[i, j]])
+    print(f"frirom: fold locus ({fl.part} part) at {loc.levels.size} levels, folds per "
+          f"level {loc.n_folds.tolist()}; wrote {path}")
+
+
+def _restore_kept(kept, result) -> bool:
+    from .auto_kept import restore
+    return restore(kept, result)
+
+
+def _stored_restored(h5: Path) -> bool:
+    """Whether a stored run gave its automatic harmonic selection up (frirom.auto_kept
+    restore): its 'auto' lines say so."""
+    import h5py
+    try:
+        with h5py.File(h5, "r") as f:
+            text = f.attrs.get("auto", "")
+    except (OSError, KeyError):
+        return False
+    text = text.decode() if isinstance(text, bytes) else str(text)
+    return "RESTORED every harmonic" in text
 
 
 def _resume_start(h5: Path, deck, fingerprint: str):

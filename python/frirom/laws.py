@@ -27,7 +27,11 @@ Jacobian d(force harmonics)/d(displacement harmonics):
   max(amplitude of the element's displacement, 1e-12 m) (per element), and the
   perturbed AFT is closed again from the closed cycle's state. Cost: 2 n_dir (2H+1) AFTs;
   accuracy O(h^2) where the forces are smooth in x and O(h) at a contact event within
-  h of a sample (about 1e-8 relative).
+  h of a sample (about 1e-8 relative). Where one side is flat (a one-sided difference
+  below 1e-3 of the other: an element stuck at its friction limit, slipping on one side)
+  the flat side is taken, the slipping side the built-in analytical Jacobians take, so
+  that Newton converges on the kink (the central mean would halve the error per
+  iteration). The solver's user laws use the same scheme (frirom_user_law).
 
 Code from a deck. A deck may name a law ``"package.module:function"`` (a function returning
 a :class:`UserLaw`, or a :class:`UserLaw` object). A deck that names code runs code, so
@@ -61,6 +65,9 @@ class UserLaw:
     n_slider: int
     force: Callable
     jacobian: Callable | None = None
+    #: address of a C function of the solver's signature (:data:`SOLVER_LAW`) the solver
+    #: calls directly, without Python, when every user-law group of a run has it
+    native: int | None = None
 
     def __post_init__(self):
         if not callable(self.force):
@@ -162,8 +169,20 @@ def aft(law: UserLaw, x, params, n_samples: int | None = None, w0=None,
             dx[:, j // nc, j % nc] = step
             fp, _, _ = _close(law, (x + dx) @ E.T, p, wc, scale, tol, max_periods)
             fm, _, _ = _close(law, (x - dx) @ E.T, p, wc, scale, tol, max_periods)
-            jac[:, :, j] = ((fp - fm) @ Ep.T).reshape(ne, nd * nc) / (2.0 * step[:, None])
+            dp = ((fp @ Ep.T) - fh).reshape(ne, nd * nc) / step[:, None]
+            dm = (fh - (fm @ Ep.T)).reshape(ne, nd * nc) / step[:, None]
+            jac[:, :, j] = _kink_column(dp, dm)
     return UserAftResult(forces=fh, jacobian=jac, periods=periods, slider=wc)
+
+
+def _kink_column(dp, dm, kink: float = 1e-3):
+    """Jacobian columns (ne, m) from the one-sided differences: central, or where one
+    side is flat (below ``kink`` of the other: an element at its friction limit, stuck
+    on one side) the flat side (slipping, as the built-in analytical Jacobians)."""
+    np_, nm = np.linalg.norm(dp, axis=1), np.linalg.norm(dm, axis=1)
+    smooth = np.minimum(np_, nm) > kink * np.maximum(np_, nm)
+    side = np.where((np_ <= nm)[:, None], dp, dm)
+    return np.where(smooth[:, None], 0.5 * (dp + dm), side)
 
 
 def _params(law: UserLaw, params, ne: int) -> np.ndarray:
@@ -197,10 +216,14 @@ C_LAW = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_int, ctypes.c_int, ctypes.c_int,
 
 
 def c_law(name: str, library: str, symbol: str, directions, parameters,
-          n_slider: int) -> UserLaw:
+          n_slider: int, solver_symbol: str | None = None) -> UserLaw:
     """A :class:`UserLaw` whose period march is the C function ``symbol`` of the shared
-    library ``library`` (signature :data:`C_LAW`)."""
+    library ``library`` (signature :data:`C_LAW`); with ``solver_symbol``, the function of
+    the solver's signature (:data:`SOLVER_LAW`) the solver then calls directly."""
     lib = ctypes.CDLL(library)
+    native = None
+    if solver_symbol is not None:
+        native = ctypes.cast(getattr(lib, solver_symbol), ctypes.c_void_p).value
     fn = getattr(lib, symbol)
     fn.restype = ctypes.c_int
     fn.argtypes = C_LAW._argtypes_
@@ -219,7 +242,93 @@ def c_law(name: str, library: str, symbol: str, directions, parameters,
             raise ParameterError(f"C law {name!r} ({symbol} in {library}) returned {rc}")
         return ff, wf
 
-    return UserLaw(name, directions, parameters, int(n_slider), force)
+    law = UserLaw(name, directions, parameters, int(n_slider), force, native=native)
+    object.__setattr__(law, "_library", lib)        # the library lives as long as the law
+    return law
+
+
+# --- user laws in the solver -----------------------------------------------------------
+
+#: The solver's law callback (frirom_user_law user_law_fn, frirom.h frirom_user_law_fn):
+#: int law(void *ctx, int group, int ne, int ndir, int nsamp, int npar, int nslider,
+#: const double *u, const double *params, double *w, double *f), column-major arrays
+#: u, f (ne, ndir, N), params (ne, npar), w (ne, nslider): the :data:`C_LAW` march with
+#: the context and the 1-based contact group in front.
+SOLVER_LAW = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, *([ctypes.c_int] * 6),
+                              *([ctypes.POINTER(ctypes.c_double)] * 4))
+
+#: User laws by name, as contact groups name them (:func:`register`); their entries in
+#: :data:`frirom.contact.LAWS` carry the negative code the solver evaluates through
+#: the run's callback.
+USER_LAWS: dict[str, UserLaw] = {}
+
+
+def register(law: UserLaw) -> str:
+    """Make ``law`` usable as a contact group's law (by its name) and return the name.
+
+    The law table :data:`frirom.contact.LAWS` gets an entry with the law's directions,
+    parameters and slider size and a negative code (frirom_aft law_user_code); the solver
+    evaluates such groups through the run's callback (:func:`solver_callback`). A name
+    registered again names the latest law from then on (runs opened before keep theirs).
+    """
+    from . import _kernels
+    from .contact import LAWS, Law
+    if not isinstance(law, UserLaw):
+        raise ParameterError(f"register: expected a frirom.laws.UserLaw, got {type(law)}")
+    old = LAWS.get(law.name)
+    if old is not None and old.code > 0:
+        raise ParameterError(f"user law {law.name!r}: the name is a built-in law's")
+    code = int(_kernels.law_user_code(law.n_dir, len(law.parameters), law.n_slider))
+    if code == 0:
+        raise ParameterError(f"user law {law.name!r}: the solver takes 1..7 directions, "
+                             f"<= 255 parameters and <= 1e6 slider components")
+    LAWS[law.name] = Law(law.name, code, law.directions, law.parameters, law.n_slider)
+    USER_LAWS[law.name] = law
+    return law.name
+
+
+class _SolverCallback:
+    """The ctypes function a run evaluates its user-law groups with; ``address`` goes to
+    the run (frun_set_user_law), the object must live as long as the run."""
+
+    def __init__(self, group_laws):
+        self.laws = [USER_LAWS.get(name) for name in group_laws]
+        self.error: BaseException | None = None
+        native = {law.native for law in self.laws if law is not None}
+        if len(native) == 1 and None not in native:      # C all the way: no Python
+            self._keep = [law for law in self.laws if law is not None]
+            self.address = native.pop()
+            return
+        self._fn = SOLVER_LAW(self._call)
+        self.address = ctypes.cast(self._fn, ctypes.c_void_p).value
+
+    def _call(self, ctx, group, ne, nd, n, npar, nsl, u, p, w, f):
+        try:
+            law = self.laws[group - 1]
+            def arr(ptr, shape):
+                size = int(np.prod(shape))
+                a = np.ctypeslib.as_array(ptr, shape=(max(size, 1),))[:size]
+                return a.reshape(shape, order="F")
+            ua, pa, wa, fa = arr(u, (ne, nd, n)), arr(p, (ne, npar)), arr(w, (ne, nsl)), \
+                arr(f, (ne, nd, n))
+            fo, wo = _call(law, ua, pa, wa.copy())
+            fa[...] = fo
+            wa[...] = wo
+            return 0
+        except Exception as exc:        # the run reports the law's failure (code 1)
+            import warnings
+            self.error = exc
+            name = getattr(self.laws[group - 1], "name", "?") if 0 < group <= len(self.laws) \
+                else "?"
+            warnings.warn(f"user law {name!r} (contact group {group}) raised "
+                          f"{type(exc).__name__}: {exc}", RuntimeWarning, stacklevel=1)
+            return 1
+
+
+def solver_callback(group_laws) -> _SolverCallback:
+    """The callback a run registers for the contact groups whose laws are user laws
+    (``group_laws``: each group's law name, in the run's group order)."""
+    return _SolverCallback(group_laws)
 
 
 # --- laws named from a deck -------------------------------------------------------------

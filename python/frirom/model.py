@@ -215,7 +215,8 @@ class ContactGroup:
     G: (n_elem*n_dir, n_dof) sparse; row e*n_dir + d gives local relative displacement d of
     element e from the model's coordinates. params: (n_elem, n_par) in the law's order
     (see :data:`frirom.contact.LAWS`). w0: (n_elem, n_slider) initial slider positions or
-    None (zeros).
+    None (zeros). patch: the contact patch's extent [m] along the tangents (one number, or
+    one per tangential direction) for :func:`frirom.held.patch_warnings`; None: unknown.
     """
 
     law: str
@@ -223,8 +224,12 @@ class ContactGroup:
     params: np.ndarray
     w0: np.ndarray | None = None
     name: str = "contact"
+    patch: object = None
 
     def __post_init__(self):
+        from .laws import UserLaw, register
+        if isinstance(self.law, UserLaw):
+            self.law = register(self.law)
         if self.law not in LAWS:
             raise ParameterError(f"contact {self.name!r}: law {self.law!r} unknown; expected "
                                  f"one of {sorted(LAWS)}")

@@ -26,7 +26,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from .contact import LAWS
+from .contact import LAWS, stuck_stiffness as law_stuck_stiffness
 from .model import describe_motion, null_motions
 from .results import amplitude_max
 
@@ -103,8 +103,21 @@ def stuck_stiffness(contacts, n_dof: int) -> sp.csr_matrix:
     for c in contacts:
         law = LAWS[c.law]
         names = law.parameters
-        cols = [names.index(p) for p in _STICK[c.law]]
-        k = np.asarray(c.params, float)[:, cols].ravel()            # (n_elem*n_dir,)
+        if c.law in _STICK:
+            cols = [names.index(p) for p in _STICK[c.law]]
+            k = np.asarray(c.params, float)[:, cols].ravel()        # (n_elem*n_dir,)
+        elif law.code > 0:                                          # iwan4, iwan
+            k = law_stuck_stiffness(c.law, c.params).ravel()
+        else:
+            # a user law: its parameters named kt (tangents) and kn (the last direction,
+            # when it has one), else none
+            p = np.asarray(c.params, float)
+            k = np.zeros((p.shape[0], law.n_dir))
+            if "kt" in names:
+                k[:, :] = p[:, [names.index("kt")]]
+            if "kn" in names and law.n_dir > 1:
+                k[:, -1] = p[:, names.index("kn")]
+            k = k.ravel()
         G = sp.csr_matrix(c.G)
         Ks = Ks + (G.T @ sp.diags(k) @ G)
     return Ks.tocsr()

@@ -57,11 +57,13 @@ class SolverOptions:
         evaluation (no extra one): on small models (the friction beam of
         cases/bench/run.py, 15 unknowns) about 20 % faster, but another path where the
         curve has spurious folds.
-    stability : bool
+    stability : bool or "auto"
         Hill's method at every point: the Floquet exponents in the strip |Im s| <= omega/2
         (and the centred copies of modes above (H + 1/2) omega); a dense eigen-solve of
         size 2 n_dof (2H+1) up to :data:`HILL_MAX`, shift-invert Arnoldi about s = 0 above
-        (strip only).
+        (strip only). "auto": on where affordable (frirom._pack.resolve_stability: at most
+        HILL_AUTO_MAX Hill unknowns, not with a selection, contact coordinates or a cyclic
+        sector), off otherwise, the reason in FRF.solver_info.
     history : bool
         Carry the contact history along the curve: each point starts its sliders where the
         previous point's closed cycles left them. False restarts every point from the
@@ -117,6 +119,22 @@ class SolverOptions:
         (:func:`frirom.reduction.multistage.travelling_wave_pairs`); 0: no pair. Exact
         when the selection is, for one travelling direction; the leak then also counts
         the other direction.
+    harmonics_kept : str, sequence of int, dict or None
+        Harmonic selection: the harmonics the nonlinear DoFs are solved for, the others held
+        at zero and their equations dropped (Galerkin on the kept harmonics; outputs are
+        the linear response to the contact forces on the kept harmonics). ``"odd"``
+        (1, 3, 5, ...: a symmetric nonlinearity under a harmonic load, e.g. Duffing or a
+        friction contact without preload, has no even harmonics), ``"even"``, or a list
+        such as ``[0, 1, 2, 3, 5]``; or a dict from contact group (name or 0-based index)
+        to such a spec, for the DoFs of that group only (a DoF in several groups keeps what
+        any of them keeps; DoFs of groups not named keep every harmonic); or a bool mask
+        (n_dof, H+1) per DoF and harmonic (what :func:`frirom.auto_kept.choose_kept`
+        gives). The linear part
+        is exact at every harmonic (receptances); what the selection neglects is reported
+        per point as its leak (``FRFPoint.leak``, the contact forces on the dropped
+        harmonics over those on the kept ones), with a warning above :data:`LEAK_TOL`. A
+        load on a dropped harmonic of a nonlinear DoF is refused. Same requirements as
+        ``selection`` (with which it combines: both must keep a harmonic).
     orbits : bool
         With ``pairs``: Newton's evaluations run the contact law (AFT) on one contact
         element per orbit, the elements whose motion on the wave is another's turned in
@@ -143,7 +161,7 @@ class SolverOptions:
     max_points: int = DEFAULTS["max_points"]
     parameter: str = "frequency"
     reuse_jacobian: bool = bool(DEFAULTS["reuse_jacobian"])
-    stability: bool = bool(DEFAULTS["stability"])
+    stability: bool | str = bool(DEFAULTS["stability"])
     history: bool = bool(DEFAULTS["history"])
     modes: int | None = None
     batch: int = DEFAULTS["batch"]
@@ -154,6 +172,7 @@ class SolverOptions:
     selection: np.ndarray | None = field(default=None, repr=False)
     pairs: np.ndarray | None = field(default=None, repr=False)
     orbits: bool = True
+    harmonics_kept: object = field(default=None, repr=False)
 
     def check(self) -> None:
         """Raise ParameterError naming the first invalid field."""
@@ -183,23 +202,31 @@ class SolverOptions:
         if self.modes is not None and (self.modes < 1 or self.formulation != "condensed"):
             raise ParameterError("options.modes: a positive number of modes, with "
                                  "formulation 'condensed'")
-        for nm in ("refine_peak", "krylov", "stability", "history", "reuse_jacobian",
-                   "orbits"):
+        if isinstance(self.stability, str) and self.stability != "auto":
+            raise ParameterError(f"options.stability: expected true, false or 'auto', got "
+                                 f"{self.stability!r}")
+        for nm in ("refine_peak", "krylov", "history", "reuse_jacobian", "orbits") + \
+                (("stability",) if not isinstance(self.stability, str) else ()):
             if not isinstance(getattr(self, nm), (bool, np.bool_)):
                 raise ParameterError(f"options.{nm}: expected true or false, got "
                                      f"{getattr(self, nm)!r}")
-        if self.coordinates == "contact" and self.stability:
+        if self.coordinates == "contact" and self.stability is True:
             raise ParameterError("options.coordinates: 'contact' cannot be used with "
                                  "stability (Hill's method needs the contact DoFs)")
-        if self.selection is not None:
+        kh = self.harmonics_kept
+        if kh is not None and not (isinstance(kh, np.ndarray) and kh.dtype == bool):
+            for spec in (kh.values() if isinstance(kh, dict) else [kh]):
+                kept_harmonics(spec, self.harmonics, "options.harmonics_kept")
+        if self.selection is not None or self.harmonics_kept is not None:
+            what = ("options.selection: a travelling-wave selection" if self.selection
+                    is not None else "options.harmonics_kept: a harmonic selection")
             for bad, why in ((self.formulation != "condensed", "the 'condensed' formulation"),
-                             (self.stability, "stability = false (Hill's method would see "
+                             (self.stability is True, "stability = false (Hill's method would see "
                                               "only perturbations inside the selection)"),
                              (self.krylov, "krylov = false (direct solves)"),
                              (self.coordinates == "contact", "coordinates 'dofs' or 'auto'")):
                 if bad:
-                    raise ParameterError(f"options.selection: a travelling-wave selection "
-                                         f"needs {why}")
+                    raise ParameterError(f"{what} needs {why}")
         if self.pairs is not None and self.selection is None:
             raise ParameterError("options.pairs: needs options.selection")
         for nm, allowed in (("coordinates", ("auto", "dofs", "contact")),
@@ -213,3 +240,28 @@ class SolverOptions:
         """AFT time samples per period actually used: `samples`, else the measured default
         :func:`frirom.harmonics.default_samples` (1e-4 relative on a friction resonance)."""
         return self.samples or default_samples(self.harmonics)
+
+
+def kept_harmonics(spec, H: int, where: str = "harmonics_kept") -> np.ndarray:
+    """The harmonics 0..H a selection spec keeps (SolverOptions.harmonics_kept): 'odd',
+    'even' or a list of distinct integers in 0..H; (H+1,) bool. ParameterError naming
+    ``where`` otherwise."""
+    keep = np.zeros(H + 1, dtype=bool)
+    if isinstance(spec, str):
+        if spec not in ("odd", "even"):
+            raise ParameterError(f"{where}: expected 'odd', 'even' or a list of harmonics "
+                                 f"in 0..{H}, got {spec!r}")
+        keep[(1 if spec == "odd" else 0)::2] = True
+    else:
+        try:
+            hs = [int(h) for h in spec]
+            ok = all(float(h) == float(g) for h, g in zip(hs, spec))
+        except (TypeError, ValueError):
+            ok = False
+        if not ok or not hs or len(set(hs)) != len(hs) or min(hs) < 0 or max(hs) > H:
+            raise ParameterError(f"{where}: expected 'odd', 'even' or a list of distinct "
+                                 f"harmonics in 0..{H} (harmonics = {H}), got {spec!r}")
+        keep[hs] = True
+    if not keep.any():
+        raise ParameterError(f"{where}: {spec!r} keeps no harmonic of 0..{H}")
+    return keep

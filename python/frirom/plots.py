@@ -149,9 +149,19 @@ def plot_frf(frf, *, output_names=None, unit: str = "hz", title: str | None = No
     if f.size and amp.size:
         top = int(np.argmax(np.nanmax(amp, axis=0)))
         marks = fold_marks(f, amp[:, top], fold)
+        # where the folds were located on the curve (FRF.bifurcations), mark them there
+        bifs = getattr(frf, "bifurcations", None) or []
+        at = {b.index: b for b in bifs if b.kind == "fold" and b.located}
         if marks.size:
-            ax.plot(f[marks], amp[marks, top], "o", mfc="none", mec="k", ms=6, mew=1.0,
-                    zorder=5, label="fold")
+            fx = [frequency_axis(np.array([at[i].omega]), unit)[0][0] if i in at else f[i]
+                  for i in marks]
+            fy = [np.ravel(at[i].amp_max)[top] if i in at else amp[i, top] for i in marks]
+            ax.plot(fx, fy, "o", mfc="none", mec="k", ms=6, mew=1.0, zorder=5, label="fold")
+        ns = [b for b in bifs if b.kind == "ns_or_pd"]
+        if ns:
+            ax.plot(frequency_axis(np.array([b.omega for b in ns]), unit)[0],
+                    [np.ravel(b.amp_max)[top] for b in ns], "x", color="k", ms=7, mew=1.2,
+                    zorder=5, label="stability change (NS or PD)")
     for kind, ls in (("free", ":"), ("stuck", "-.")):
         if kind in refs:
             wl, al = refs[kind]

@@ -198,7 +198,7 @@ class FRF:
     slider: np.ndarray | None = None
     #: Fortran time split of the run: aft, assembly, factorization, solve, receptance (s),
     #: evaluations, factorizations, krylov_iterations, double_factorizations (counts),
-    #: fortran_total (s)
+    #: hill (s, Hill's method: the cost of stability), fortran_total (s)
     timings: dict = field(default_factory=dict)
     #: (n_out,) Peak per output solved on the curve by the solver (None: not computed)
     peaks: list | None = None
@@ -217,6 +217,9 @@ class FRF:
     #: (n_pts,) FRFPoint.leak of each point (None without a travelling-wave selection; NaN
     #: for points a resumed run's file held from before the leak was kept)
     leak: np.ndarray | None = None
+    #: bifurcations of the curve (frirom._fold.Bifurcation: folds located on it, stability
+    #: changes away from folds); None when not searched
+    bifurcations: list | None = None
 
     @property
     def labels(self) -> list:
@@ -328,6 +331,8 @@ class FRF:
                 f.create_dataset("peak_amplitude", data=[p.amplitude for p in self.peaks])
                 f.create_dataset("peak_index", data=[p.index for p in self.peaks])
                 f.attrs["peak_method"] = np.array([p.method for p in self.peaks], dtype="S")
+            if self.bifurcations is not None:
+                _save_bifurcations(f, self.bifurcations)
             f.attrs["group_names"] = np.array(self.group_names, dtype="S")
             f.attrs["parameter_name"] = self.parameter_name
             f.attrs["complete"] = self.complete
@@ -364,6 +369,19 @@ class FRF:
                 row += [f"{self.leak[i]:.3g}"] if self.leak is not None else []
                 w.writerow(row)
 
+    def save_bifurcations_csv(self, path) -> None:
+        """One row per bifurcation (FRF.bifurcations): kind, frequency (Hz, rad/s), the
+        parameter, the point after it, whether it was located on the curve, the parameter
+        part of the tangent there (0 at a fold), then each output's max over the period."""
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["kind", "f_hz", "omega_rad_s", "parameter", "index",
+                        "located", "t_lam"] + [f"{lab}_max" for lab in self.labels])
+            for b in self.bifurcations or []:
+                w.writerow([b.kind, repr(b.omega / (2.0 * np.pi)), repr(b.omega),
+                            repr(b.parameter), b.index, int(b.located), f"{b.t_lam:.3g}"]
+                           + [repr(float(a)) for a in b.amp_max])
+
     @classmethod
     def load(cls, path) -> "FRF":
         """Read a file written by save_h5 or by FRFWriter."""
@@ -396,6 +414,8 @@ class FRF:
                 kw["peaks"] = [Peak(float(w), float(a), int(i), m.decode()) for w, a, i, m in
                                zip(f["peak_omega"], f["peak_amplitude"], f["peak_index"],
                                    f.attrs["peak_method"])]
+            if "bif_kind" in f.attrs:
+                kw["bifurcations"] = _load_bifurcations(f, path)
             if "unknowns" in f and f["unknowns"].shape[0] == kw["omega"].shape[0]:
                 kw["unknowns"] = f["unknowns"][...]
             kw["output_labels"] = _h5check.attr_texts(f, path, "output_labels")
@@ -410,6 +430,43 @@ class FRF:
                        stability_computed=_h5check.attr_bool(f, path, "stability_computed",
                                                              False),
                        solver_info=txt("solver_info", ""))
+
+
+def _save_bifurcations(f, bifs: list) -> None:
+    """FRF.bifurcations as attributes of an open HDF5 file (bif_*)."""
+    n_out = f["amp_max"].shape[1] if f["amp_max"].ndim == 2 else 1
+    f.attrs["bif_kind"] = np.array([b.kind for b in bifs], dtype="S")
+    f.attrs["bif_omega"] = np.array([b.omega for b in bifs], float)
+    f.attrs["bif_parameter"] = np.array([b.parameter for b in bifs], float)
+    f.attrs["bif_index"] = np.array([b.index for b in bifs], int)
+    f.attrs["bif_located"] = np.array([b.located for b in bifs], int)
+    f.attrs["bif_t_lam"] = np.array([b.t_lam for b in bifs], float)
+    f.attrs["bif_amp_max"] = np.array([np.ravel(b.amp_max) for b in bifs],
+                                      float).reshape(len(bifs), n_out)
+
+
+def store_bifurcations(path, bifs: list) -> None:
+    """Add FRF.bifurcations to a closed result file (an FRFWriter's, after its run):
+    the bif_* attributes, the file sealed again."""
+    import h5py
+    with h5py.File(path, "a") as f:
+        _save_bifurcations(f, bifs)
+        _h5check.seal(f)
+
+
+def _load_bifurcations(f, path) -> list:
+    from ._fold import Bifurcation
+    kinds = [k.decode() if isinstance(k, bytes) else str(k)
+             for k in np.atleast_1d(f.attrs["bif_kind"])]
+    if not kinds:
+        return []
+    cols = [np.atleast_1d(f.attrs[f"bif_{k}"]) for k in
+            ("omega", "parameter", "index", "located", "t_lam")]
+    amp = np.asarray(f.attrs["bif_amp_max"], float).reshape(len(kinds), -1)
+    if any(c.shape[0] != len(kinds) for c in cols):
+        raise InputError(f"{path}: the stored bifurcations (bif_*) disagree in size")
+    return [Bifurcation(k, float(w), float(p), amp[i], int(j), bool(loc), float(t))
+            for i, (k, w, p, j, loc, t) in enumerate(zip(kinds, *cols))]
 
 
 #: File attribute of an FRFWriter file: [points committed, points up to the last

@@ -74,6 +74,8 @@ class PointState:
     contacts: ContactField per group; balance: {'excitation', 'contacts', 'viscous'} work
     per period [J] (for a cyclic sector per sector, the viscous part from the modes of
     each harmonic's nodal diameter) and 'residual' = excitation - contacts - viscous.
+    held: frirom.held.Held per group, what the free-body pin decided ([]: no free body);
+    patch: warnings of pairs sliding beyond their contact patch (frirom.held).
     """
 
     omega: float
@@ -83,6 +85,8 @@ class PointState:
     labels: list
     contacts: list
     balance: dict = field(default_factory=dict)
+    held: list = field(default_factory=list)
+    patch: list = field(default_factory=list)
 
     @property
     def frequency_hz(self) -> float:
@@ -262,8 +266,11 @@ def point_state(frf: FRF, deck, index: int, omega: float) -> PointState:
     dis = float(sum(c.energy.sum() for c in contacts))
     bal = {"excitation": ext, "contacts": dis, "viscous": visc,
            "residual": ext - dis - visc}
+    from .held import held_directions, patch_warnings
+    held = held_directions(model, contacts) if hasattr(model, "free_bodies") else []
     return PointState(omega=float(omega), index=int(index), x=x, outputs=P @ x,
-                      labels=list(deck.output_names), contacts=contacts, balance=bal)
+                      labels=list(deck.output_names), contacts=contacts, balance=bal,
+                      held=held, patch=patch_warnings(model, contacts))
 
 
 def _chosen(state: PointState, chosen, n_top: int) -> list:
@@ -459,5 +466,10 @@ def cmd_show(args) -> int:
         print(f"frirom: contact {c.name}:{e} dissipates {c.energy[e]:.4g} J per period "
               f"(stick {c.states[e, 0]:.0%}, slip {c.states[e, 1]:.0%}, lift-off "
               f"{c.states[e, 2]:.0%})")
+    from .held import held_lines
+    for line in held_lines(state.held):
+        print(f"frirom: {line}")
+    for line in state.patch:
+        print(f"frirom: warning: {line}", file=sys.stderr)
     print("frirom: wrote " + ", ".join(str(p) for p in written))
     return 0

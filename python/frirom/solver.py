@@ -33,6 +33,7 @@ from ._pack import _Packed, add_timings, pack
 from ._routes import HILL_MAX, MODES_MAX  # noqa: F401 - public here
 from .options import FORMULATIONS, SolverOptions  # noqa: F401 - public here
 from .model import CyclicModel, Excitation, Model
+from ._fold import find_bifurcations
 from ._peak import refine_peaks
 from .results import FRF, FRFPoint
 
@@ -47,16 +48,26 @@ from .results import FRF, FRFPoint
 LEAK_TOL = 1e-6
 
 
-def warn_leak(leak: float, omega: float, stacklevel: int, what: str = "") -> None:
-    """Warn (RuntimeWarning) when a travelling-wave selection's leak (FRFPoint.leak) is
-    above LEAK_TOL; omega: rad/s, where; stacklevel: 1 = the caller of warn_leak, 2 = its
-    caller, and so on; what: names the point when it is not one of the run's."""
-    if leak > LEAK_TOL:
-        warnings.warn(f"frirom: the travelling-wave selection leaks: contact forces off "
-                      f"the selection reach {leak:.2g} of those on it at "
-                      f"{omega / 2 / np.pi:.6g} Hz{f' ({what})' if what else ''} (tolerance "
-                      f"{LEAK_TOL:g}); the rotor, its "
-                      "contacts, its load or the contact history carried from point "
+def warn_leak(leak: float, omega: float, stacklevel: int, what: str = "",
+              label: str = "travelling-wave selection") -> None:
+    """Warn (RuntimeWarning) when a selection's leak (FRFPoint.leak) is above LEAK_TOL;
+    omega: rad/s, where; stacklevel: 1 = the caller of warn_leak, 2 = its caller, and so
+    on; what: names the point when it is not one of the run's; label: the kind of
+    selection (_Packed.sel_label)."""
+    if leak <= LEAK_TOL:
+        return
+    where = (f"contact forces off the selection reach {leak:.2g} of those on it at "
+             f"{omega / 2 / np.pi:.6g} Hz{f' ({what})' if what else ''} (tolerance "
+             f"{LEAK_TOL:g})")
+    if label == "harmonic selection":
+        warnings.warn(f"frirom: the harmonic selection leaks: {where}; the dropped "
+                      "harmonics carry that much of the contact forces there, and the "
+                      "selected solution is not the full one (keep more harmonics, or "
+                      "solve without options.harmonics_kept to see how far)",
+                      RuntimeWarning, stacklevel=stacklevel + 1)
+    else:
+        warnings.warn(f"frirom: the travelling-wave selection leaks: {where}; the rotor, "
+                      "its contacts, its load or the contact history carried from point "
                       "to point (sliders frozen at different phases) are not a "
                       "travelling wave there, and the selected solution is not the "
                       "full one (solve without the selection to see how far)",
@@ -189,13 +200,18 @@ class _Continuation:
                               stability_computed=p.stability)
         out.timings = self.timings
         out.solver_info = p.info
+        if p.stability and self.timings:
+            # the cost of stability beside the curve's (Fortran T_HILL, in the total)
+            t_h, t_all = self.timings.get("hill", 0.0), self.timings.get("fortran_total", 0.0)
+            out.solver_info += (f"; stability (Hill) {t_h:.3g} s of the run's {t_all:.3g} s "
+                                f"in Fortran")
         if p.keep is not None and (pts or self.leak_before):
             k = int(np.argmax(out.leak)) if pts else 0
             worst, at = (float(out.leak[k]), pts[k].omega) if pts else (-1.0, 0.0)
             if self.leak_before is not None and self.leak_before[0] > worst:
                 worst, at = self.leak_before      # a point stored before the resume
             out.solver_info += f"; leak max {worst:.1e}"
-            warn_leak(worst, at, stacklevel=4)
+            warn_leak(worst, at, stacklevel=4, label=p.sel_label)
         return out
 
 
@@ -240,6 +256,9 @@ def _run_curve(packed: _Packed, lam_start, lam_end, sink, start, H_start) -> FRF
     run.start(start, H_start)
     complete, message = run.batches()
     out = run.finish(complete, message)
+    # folds located on the curve, stability changes: of the whole curve (a resumed run's
+    # points before the resume too; Bifurcation.index counts them)
+    out.bifurcations = find_bifurcations(packed, run.before + run.points, run.lscale)
     if packed.opts.refine_peak and packed.opts.parameter == "frequency" and run.points:
         # a resumed run: the peak of the whole curve, as the uninterrupted run solves it
         # (Peak.index then counts the points before the resume)
@@ -248,7 +267,7 @@ def _run_curve(packed: _Packed, lam_start, lam_end, sink, start, H_start) -> FRF
             k = int(np.argmax([q.leak for q in solved])) if solved else -1
             if k >= 0:
                 warn_leak(solved[k].leak, solved[k].omega, stacklevel=3,
-                          what="a peak solved between points")
+                          what="a peak solved between points", label=packed.sel_label)
     return out
 
 
@@ -378,7 +397,7 @@ def solve_point(model: Model | CyclicModel, excitation: Excitation, omega: float
     raise_for_status(res.info, res.msg)
     pt = packed.points(res, time.perf_counter() - t0)[0]
     if pt.leak is not None:
-        warn_leak(pt.leak, pt.omega, stacklevel=2)
+        warn_leak(pt.leak, pt.omega, stacklevel=2, label=packed.sel_label)
     pt.output_dofs = packed.outputs
     pt.timings = {}
     add_timings(pt.timings, res.timings)

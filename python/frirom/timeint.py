@@ -92,6 +92,9 @@ class TimeContact:
             raise InputError(f"timeint: unknown contact law {self.law!r}; expected one of "
                              f"{sorted(LAWS)}")
         law = LAWS[self.law]
+        if law.code < 0:
+            raise InputError(f"timeint: contact {self.name!r}: law {self.law!r} is a user "
+                             f"law; time integration takes the built-in laws only")
         ndir, npar, nsl = law.n_dir, len(law.parameters), law.n_slider
         G = self.G.toarray() if hasattr(self.G, "toarray") else np.asarray(self.G, float)
         params = np.atleast_2d(np.asarray(self.params, float))

@@ -38,7 +38,8 @@ __all__ = ["Deck", "ContactSpec", "DeckSettings", "load_deck", "parse_deck", "bu
            "engine_order_loads", "read_matrix", "MATRIX_FORMATS"]
 
 
-def load_deck(path) -> Deck:
+def load_deck(path, allow_code=()) -> Deck:
     """Read, check and build a deck file; raises :class:`frirom.InputError` on any bad
-    field."""
-    return build_deck(parse_deck(path))
+    field. ``allow_code``: modules a contact law ``"module:function"`` may import
+    (the CLI's ``--allow-code``; :func:`frirom.laws.load_law`)."""
+    return build_deck(parse_deck(path, allow_code=allow_code))

@@ -46,6 +46,8 @@ class ContactSpec:
         Law parameters (SI units).
     w0 : ndarray, (n_elem, n_slider), or None
         Initial slider positions [m].
+    patch : float, ndarray (n_tangential,) or None
+        The contact patch's extent along the tangents [m] (frirom.held.patch_warnings).
     """
 
     name: str
@@ -53,6 +55,7 @@ class ContactSpec:
     G: sp.csr_matrix
     params: np.ndarray
     w0: np.ndarray | None
+    patch: object = None
 
 
 @dataclass
@@ -90,6 +93,9 @@ class Deck:
     #: (n_out, n_dof) with [fe_model]: x_out = output_map @ x, the rows of the reduction
     #: basis T of the FE DoFs named in [outputs] (sector 0's with [reduction.cyclic])
     output_map: np.ndarray | None = None
+    #: with ``harmonics_kept = "auto"``: the chosen selection (n_dof, H+1) bool (None:
+    #: every harmonic), set by frirom.auto.resolve_deck
+    kept_auto: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def n_dof(self) -> int:
@@ -140,8 +146,8 @@ class Deck:
 
     def model(self):
         """The solver's Model, or its CyclicModel with [reduction.cyclic]."""
-        groups = [ContactGroup(law=c.law, G=c.G, params=c.params, w0=c.w0, name=c.name)
-                  for c in self.contacts]
+        groups = [ContactGroup(law=c.law, G=c.G, params=c.params, w0=c.w0, name=c.name,
+                               patch=c.patch) for c in self.contacts]
         if self.cyclic is not None:
             c = self.cyclic
             return CyclicModel(n_dof=self.n_dof, n_sectors=c["sector"].n_sectors,
@@ -178,8 +184,9 @@ class Deck:
               "formulation": self.formulation}
         for key, name in (("tol_residual", "tol_residual"), ("tol_update", "tol_update"),
                           ("max_iterations", "max_iter"), ("stability", "stability"),
-                          ("tol_stall", "tol_stall"), ("history", "history")):
-            if key in self.solver:
+                          ("tol_stall", "tol_stall"), ("history", "history"),
+                          ("harmonics_kept", "harmonics_kept")):
+            if key in self.solver and self.solver[key] != "auto":
                 kw[name] = self.solver[key]
         for key, name in (("step", "ds"), ("min_step", "ds_min"), ("max_step", "ds_max"),
                           ("max_points", "max_points")):
@@ -189,6 +196,8 @@ class Deck:
         if red is not None and red.travelling_wave:
             kw["selection"] = self.travelling_wave_selection()
             kw["pairs"] = self.travelling_wave_pairs()
+        if self.kept_auto is not None:
+            kw["harmonics_kept"] = np.asarray(self.kept_auto, bool)
         opts = SolverOptions(**kw)
         if opts.ds_min > opts.ds_max or not opts.ds_min <= opts.ds <= opts.ds_max:
             # keep the user's steps consistent with the solver's defaults for the others
@@ -324,7 +333,8 @@ class _Builder:
             log.append(self.add_preload(F, contacts, pl))
         if s.fe:
             log.extend(self.normal_warnings(F, contacts))
-        if not np.any(F[:, 1:]):
+        mode_deck = s.analysis is not None and s.analysis.nonlinear_mode
+        if not np.any(F[:, 1:]) and not mode_deck:
             raise ctx.error("excitation", "at least one load on a harmonic >= 1 "
                             "([[excitation.load]] or [[excitation.engine_order]])")
         outputs = [self.coordinate(ref) for ref in s.outputs.dofs]
@@ -341,11 +351,15 @@ class _Builder:
                   if getattr(sol, k) is not None}
         solver["stability"] = sol.stability
         solver["history"] = sol.history
+        if sol.harmonics_kept is not None:
+            solver["harmonics_kept"] = sol.harmonics_kept
         cont = {k: v for k, v in vars(s.continuation).items() if v is not None}
         return Deck(path=s.path, title=s.title, M=M, K=K, damping=damping, F=F,
                     contacts=contacts, harmonics=H, samples=sol.samples,
-                    formulation=sol.formulation, omega_start=s.frequency.omega_start,
-                    omega_end=s.frequency.omega_end, frequency_unit=s.frequency.unit,
+                    formulation=sol.formulation,
+                    omega_start=s.frequency.omega_start if s.frequency else 0.0,
+                    omega_end=s.frequency.omega_end if s.frequency else 0.0,
+                    frequency_unit=s.frequency.unit if s.frequency else "hz",
                     continuation=cont, solver=solver, outputs=outputs, output_names=onames,
                     dof_labels=labels if not s.fe else list(rom.labels),
                     plot=s.outputs.plot, csv=s.outputs.csv, raw=s.raw, reduced=rom, log=log,
@@ -429,7 +443,8 @@ class _Builder:
                             cols.append(b[j])
                             vals.append(-D[d, j])
         G = sp.csr_matrix((vals, (rows, cols)), shape=(len(c.elements) * ndir, self.n))
-        return ContactSpec(name=c.name, law=c.law, G=G, params=c.params, w0=c.w0)
+        return ContactSpec(name=c.name, law=c.law, G=G, params=c.params, w0=c.w0,
+                           patch=c.patch)
 
     # ---- [fe_model]: node sets of the reduced model ----
     def reduced_contact(self, c) -> ContactSpec:
@@ -437,7 +452,20 @@ class _Builder:
         G = self.rom.contact_matrix(c.name)
         ne = self.rom.pairs[c.name].n_elem
         return ContactSpec(name=c.name, law=c.law, G=G, params=np.tile(c.params, (ne, 1)),
-                           w0=None if c.w0 is None else np.tile(c.w0, (ne, 1)))
+                           w0=None if c.w0 is None else np.tile(c.w0, (ne, 1)),
+                           patch=c.patch if c.patch is not None else self._patch(c))
+
+    def _patch(self, c):
+        """Side a's node set's extent [m] along each tangent of the pairs' first frame
+        (the contact patch as meshed); None where the nodes' coordinates are not kept."""
+        try:
+            xyz = self.rom.coordinates(self.rom.node_sets[c.a.upper()])
+            frame = np.asarray(self.rom.pairs[c.name].frames, float)[0]
+        except (InputError, KeyError, IndexError, AttributeError):
+            return None
+        dirs = LAWS[c.law].directions
+        t = frame[[d for d, nm in enumerate(dirs) if nm != "v"]]
+        return np.ptp(xyz @ t.T, axis=0)
 
     def add_preload(self, F, contacts: list, pl) -> str:
         """A ``[[preload]]``: the normal preload n0 of each pair of its contacts and the

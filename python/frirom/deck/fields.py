@@ -29,6 +29,8 @@ class Context:
     def __init__(self, path: Path):
         self.path = path
         self.base = path.parent
+        #: modules a contact law 'module:function' may import (--allow-code)
+        self.allow_code: tuple = ()
 
     def error(self, key: str, expected: str, got=None) -> InputError:
         """``InputError("<deck>: <key>: expected <expected>[, got <got>]")``."""

@@ -8,6 +8,7 @@ in ``model.dof_labels``, a node of a node set) is checked by :mod:`frirom.deck.b
 from __future__ import annotations
 
 import math
+import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -18,7 +19,9 @@ from ..io._common import read_text
 from ..reduction.rom import FESource, ReductionSpec
 from .fields import Context, DofRef, boolean, dof_ref, file, number, string, table, unknown
 from ..solver import SolverOptions
+from .schema_analysis import parse_analysis
 from .schema_contacts import parse_contacts, parse_preloads
+from .schema_fold import parse_fold_locus
 from .schema_model import (CyclicSettings, MatrixModel, check_travelling_wave, parse_fe_model,
                            parse_matrix_model, parse_reduction)
 
@@ -58,8 +61,9 @@ class SolverSettings:
     max_iterations : int or None
         Newton iterations per point (None: the solver's default); the deck also accepts
         the solver's name ``max_iter``.
-    stability : bool
-        Hill stability of every point (false with [reduction.cyclic]); default
+    stability : bool or "auto"
+        Hill stability of every point (false with [reduction.cyclic]); "auto": on where
+        affordable, the reason in the run's summary where not; default
         ``SolverOptions.stability``.
     tol_stall : float or None
         A corrector stalling below this residual is accepted (None: the solver's default).
@@ -73,6 +77,12 @@ class SolverSettings:
         Relative error on the response amplitude that the chosen H and N must meet.
     max_harmonics, max_samples : int
         The largest H and N the choice may use.
+    harmonics_kept : str, list, dict or None
+        Harmonic selection (``SolverOptions.harmonics_kept``): ``"odd"``, ``"even"``, a list
+        of harmonics, or a table from contact group name to such a spec; ``"auto"``:
+        chosen per unknown before the run (:mod:`frirom.auto_kept`, to
+        ``tolerance_auto``); stability is then off (Hill's method would see only the kept
+        harmonics).
     """
 
     harmonics: int
@@ -81,7 +91,7 @@ class SolverSettings:
     tol_residual: float | None
     tol_update: float | None
     max_iterations: int | None
-    stability: bool
+    stability: bool | str
     tol_stall: float | None = None
     history: bool = SOLVER_DEFAULTS.history
     auto_harmonics: bool = False
@@ -89,6 +99,7 @@ class SolverSettings:
     tolerance_auto: float = 1e-3
     max_harmonics: int = 15
     max_samples: int = 4096
+    harmonics_kept: object = None
 
 
 @dataclass(frozen=True)
@@ -230,6 +241,10 @@ class DeckSettings:
     raw: dict = field(default_factory=dict, repr=False)
     modes_auto: object = None
     preloads: tuple = ()
+    #: ``[analysis]`` (schema_analysis.AnalysisSettings): a forced response by default
+    analysis: object = None
+    #: ``[fold_locus]`` (schema_fold.FoldLocusSettings), None when absent
+    fold_locus: object = None
 
     @property
     def fe(self) -> bool:
@@ -253,20 +268,21 @@ def read_toml(path: Path) -> dict:
         raise InputError(f"{path}: not valid TOML: {exc}") from None
 
 
-def parse_deck(path, raw: dict | None = None) -> DeckSettings:
+def parse_deck(path, raw: dict | None = None, allow_code=()) -> DeckSettings:
     """Read and check a deck file; raises :class:`frirom.InputError` on any bad field.
 
     ``raw``: the deck's TOML as a dict, used instead of reading ``path`` (a study member:
     the deck with some keys replaced, :mod:`frirom.study`); relative file names stay
     relative to ``path``. A ``[study]`` table is checked by :func:`frirom.study.parse_study`
-    and ignored here.
+    and ignored here. ``allow_code``: modules a user contact law may import (load_deck).
     """
     path = Path(path)
     raw = read_toml(path) if raw is None else raw
     ctx = Context(path)
+    ctx.allow_code = tuple(allow_code)
     unknown(ctx, raw, {"title", "model", "fe_model", "reduction", "damping", "excitation",
                        "contacts", "solver", "frequency", "continuation", "outputs",
-                       "study", "preload"}, "")
+                       "study", "preload", "analysis", "fold_locus"}, "")
     title = string(ctx, raw, "title", "title", default=path.stem)
 
     # structure: [model] (matrices as they are) or [fe_model] + [reduction]
@@ -282,22 +298,44 @@ def parse_deck(path, raw: dict | None = None) -> DeckSettings:
     fe = model is None
     labels = not fe and model.dof_labels is not None
 
+    analysis = parse_analysis(ctx, raw, fe, labels)
+    nlm = analysis.nonlinear_mode
+    if nlm and cyc is not None:
+        raise ctx.error("analysis.kind", "'forced_response' with [reduction.cyclic] (a "
+                        "nonlinear mode of a cyclic sector: not yet)", analysis.kind)
     solver = _solver(ctx, table(ctx, raw, "solver"), cyc)
     H = solver.harmonics
     damping = _damping(ctx, table(ctx, raw, "damping"), fe)
-    loads = _excitation(ctx, table(ctx, raw, "excitation"), H, fe, labels, cyc)
+    loads = _excitation(ctx, table(ctx, raw, "excitation", required=not nlm), H, fe, labels,
+                        cyc)
+    if nlm:
+        for ld in loads:
+            if ld.harmonic != 0:
+                raise ctx.error("excitation.load", "static loads only (harmonic = 0) in a "
+                                "nonlinear-mode deck ([analysis] kind = "
+                                "\"nonlinear_mode\")", ld.harmonic)
     preloads = parse_preloads(ctx, raw, fe)
     contacts = parse_contacts(ctx, raw, fe, labels, cyc, preloads)
-    frequency = _frequency(ctx, table(ctx, raw, "frequency"))
+    frequency = (None if nlm and "frequency" not in raw else
+                 _frequency(ctx, table(ctx, raw, "frequency")))
     continuation = _continuation(ctx, table(ctx, raw, "continuation", required=False))
     outputs = _outputs(ctx, table(ctx, raw, "outputs"), fe, labels)
+    if analysis.output is not None:
+        outputs = dataclasses.replace(outputs, dofs=(analysis.output,) + outputs.dofs)
     if spec is not None and spec.travelling_wave:
         check_travelling_wave(ctx, raw, solver)
+    if isinstance(solver.harmonics_kept, dict):
+        names = [c.name for c in contacts]
+        for name in solver.harmonics_kept:
+            if name not in names:
+                raise ctx.error(f"solver.harmonics_kept.{name}", f"a contact group's name "
+                                f"(groups: {names})", name)
     return DeckSettings(path=path, title=title, model=model, fe_model=source, reduction=spec,
                         cyclic=cyc, solver=solver, damping=damping, loads=tuple(loads),
                         contacts=tuple(contacts), frequency=frequency,
                         continuation=continuation, outputs=outputs, raw=raw,
-                        modes_auto=modes_auto, preloads=tuple(preloads))
+                        modes_auto=modes_auto, preloads=tuple(preloads),
+                        analysis=analysis, fold_locus=parse_fold_locus(ctx, raw))
 
 
 def _aliased(ctx, d: dict, table_name: str) -> dict:
@@ -317,7 +355,7 @@ def _solver(ctx, sol, cyc) -> SolverSettings:
     unknown(ctx, sol, {"harmonics", "samples", "formulation", "tol_residual",
                        "tol_update", "max_iterations", "stability", "tolerance_auto",
                        "max_harmonics", "max_samples", "tol_stall", "history",
-                       *ALIASES["solver"]}, "solver")
+                       "harmonics_kept", *ALIASES["solver"]}, "solver")
     sol = _aliased(ctx, sol, "solver")
     auto = _auto(ctx, sol, cyc)
     H = auto["max_harmonics"] if auto["auto_harmonics"] else number(
@@ -338,9 +376,25 @@ def _solver(ctx, sol, cyc) -> SolverSettings:
         tols.append(None if v is None else float(v))
     max_it = number(ctx, sol, "max_iterations", "solver.max_iterations", integer=True,
                     minimum=1)
-    stability = boolean(ctx, sol, "stability", "solver.stability", SOLVER_DEFAULTS.stability)
+    # "auto": on where affordable (frirom._pack.resolve_stability)
+    stability = sol.get("stability", SOLVER_DEFAULTS.stability)
+    if not (isinstance(stability, bool) or stability == "auto"):
+        raise ctx.error("solver.stability", 'true or false (or "auto")', stability)
     stall = number(ctx, sol, "tol_stall", "solver.tol_stall", nonneg=True)
     history = boolean(ctx, sol, "history", "solver.history", SOLVER_DEFAULTS.history)
+    kept = _harmonics_kept(ctx, sol.get("harmonics_kept"), H)
+    if kept is not None:
+        if cyc is not None:
+            raise ctx.error("solver.harmonics_kept", "no harmonic selection with "
+                            "[reduction.cyclic] (a sector's harmonics live on their own nodal "
+                            "diameters)", sol["harmonics_kept"])
+        if form != "condensed":
+            raise ctx.error("solver.formulation", "'condensed' with solver.harmonics_kept",
+                            form)
+        if sol.get("stability") is True:
+            raise ctx.error("solver.stability", "false with solver.harmonics_kept (Hill's "
+                            "method would see only the kept harmonics)", True)
+        stability = False
     if cyc is not None:
         if form != "condensed":
             raise ctx.error("solver.formulation", "'condensed' with [reduction.cyclic] "
@@ -352,7 +406,32 @@ def _solver(ctx, sol, cyc) -> SolverSettings:
     return SolverSettings(harmonics=H, samples=N, formulation=form, tol_residual=tols[0],
                           tol_update=tols[1], max_iterations=max_it, stability=stability,
                           tol_stall=None if stall is None else float(stall), history=history,
-                          **auto)
+                          harmonics_kept=kept, **auto)
+
+
+def _harmonics_kept(ctx, kept, H: int):
+    """``solver.harmonics_kept``: "odd", "even", a list of harmonics in 0..H, or a table
+    from contact group name to one of those; checked, None when absent."""
+    from ..options import kept_harmonics
+    from .._errors import ParameterError
+    if kept is None or kept == "auto":
+        return kept
+    expected = (f"'auto', 'odd', 'even' or a list of distinct harmonics in 0..{H} "
+                f"(harmonics = {H})")
+    items = kept.items() if isinstance(kept, dict) else [(None, kept)]
+    if isinstance(kept, dict) and not kept:
+        raise ctx.error("solver.harmonics_kept", "a table naming at least one contact group",
+                        kept)
+    for name, spec in items:
+        key = "solver.harmonics_kept" + ("" if name is None else f".{name}")
+        if isinstance(spec, (bool, dict)):
+            raise ctx.error(key, expected, spec)
+        try:
+            kept_harmonics(spec, H, key)
+        except ParameterError:
+            raise ctx.error(key, expected, spec) from None
+    return dict(kept) if isinstance(kept, dict) else (list(kept) if isinstance(kept, list)
+                                                      else kept)
 
 
 def _auto(ctx, sol, cyc) -> dict:
@@ -363,9 +442,13 @@ def _auto(ctx, sol, cyc) -> dict:
             raise ctx.error(f"solver.{k}", 'an integer or "auto"', sol[k])
     on = out["auto_harmonics"] or out["auto_samples"]
     given = [k for k in ("tolerance_auto", "max_harmonics", "max_samples") if k in sol]
+    kept = sol.get("harmonics_kept") == "auto"
+    if kept and given == ["tolerance_auto"]:
+        given = []              # harmonics_kept = "auto" reads the tolerance too
     if given and not on:
-        raise ctx.error(f"solver.{given[0]}", 'harmonics = "auto" or samples = "auto" '
-                        "(it only bounds that choice)", sol[given[0]])
+        raise ctx.error(f"solver.{given[0]}", 'harmonics = "auto", samples = "auto" or '
+                        'harmonics_kept = "auto" (it only bounds that choice)',
+                        sol[given[0]])
     if on and cyc is not None:
         key = "harmonics" if out["auto_harmonics"] else "samples"
         raise ctx.error(f"solver.{key}", "an integer with [reduction.cyclic] (\"auto\" is "

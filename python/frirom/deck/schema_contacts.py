@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._errors import InputError
 from ..contact import LAWS
 from .fields import Context, dof_ref, finite, number, per_element, string, unknown, vector
 from .schema_model import CyclicSettings
@@ -47,6 +48,9 @@ class DofContact:
         Law parameters in the order of ``LAWS[law].parameters`` (SI units).
     w0 : ndarray, (n_elem, n_slider), or None
         Initial slider positions [m] (None: zeros).
+    patch : float or None
+        The contact patch's extent along the tangents [m] (key ``patch``): a relative
+        tangential displacement beyond it is warned about (frirom.held).
     """
 
     name: str
@@ -54,6 +58,7 @@ class DofContact:
     elements: tuple
     params: np.ndarray
     w0: np.ndarray | None
+    patch: float | None = None
 
 
 @dataclass(frozen=True)
@@ -80,6 +85,9 @@ class NodeSetContact:
         Key path of the table (``contacts[0]``).
     b_sector : int
         0: side b in sector 0; 1: side b in the next sector (cyclic).
+    patch : float or None
+        The contact patch's extent along the tangents [m] (key ``patch``; None: side a's
+        node set's extent along each tangent, frirom.deck.build).
     """
 
     name: str
@@ -94,6 +102,7 @@ class NodeSetContact:
     stick: tuple
     key: str
     b_sector: int = 0
+    patch: float | None = None
 
 
 @dataclass(frozen=True)
@@ -191,12 +200,16 @@ def parse_contacts(ctx: Context, raw: dict, fe: bool, labels: bool,
 def _contact(ctx, c, key, fe, labels, cyclic, derived=frozenset()):
     if not isinstance(c, dict):
         raise ctx.error(key, "a table [[contacts]]", c)
-    law = string(ctx, c, "law", f"{key}.law", required=True, choices=tuple(LAWS))
+    law = _user_law(ctx, c, key)
+    if law is None:
+        law = string(ctx, c, "law", f"{key}.law", required=True,
+                     choices=tuple(k for k, v in LAWS.items() if v.code > 0))
     if fe:
         return _node_set_contact(ctx, c, key, law, cyclic, derived)
     dirs, pnames = LAWS[law].directions, LAWS[law].parameters
     ndir = len(dirs)
-    unknown(ctx, c, {"name", "law", "elements", "directions", "w0"} | set(pnames), key)
+    unknown(ctx, c, {"name", "law", "elements", "directions", "w0", "patch"} | set(pnames),
+            key)
     name = string(ctx, c, "name", f"{key}.name", default=key)
     els = c.get("elements")
     if not isinstance(els, list) or not els:
@@ -223,7 +236,8 @@ def _contact(ctx, c, key, fe, labels, cyclic, derived=frozenset()):
         elements.append(ContactElement(a=a, b=b, frame=_frame(ctx, frame, fk, len(a), dirs),
                                        key=ek))
     params, w0 = _law_parameters(ctx, c, key, law, len(els))
-    return DofContact(name=name, law=law, elements=tuple(elements), params=params, w0=w0)
+    return DofContact(name=name, law=law, elements=tuple(elements), params=params, w0=w0,
+                      patch=number(ctx, c, "patch", f"{key}.patch", positive=True))
 
 
 def _side(ctx, v, key, labels, allow_ground):
@@ -268,6 +282,22 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v if abs(nrm - 1.0) <= 4.0 * np.finfo(float).eps else v / nrm
 
 
+def _user_law(ctx, c, key):
+    """The name of the user law a contact's ``law = "module:function"`` names (loaded
+    and registered: frirom.laws.load_law, register), None for a built-in law's name."""
+    from ..laws import load_law, register
+    v = c.get("law")
+    if not (isinstance(v, str) and ":" in v):
+        return None
+    try:
+        return register(load_law(v, allowed=ctx.allow_code, where=f"{key}.law"))
+    except ImportError as exc:
+        raise ctx.error(f"{key}.law", "an importable 'module:function'", f"{v} ({exc})") \
+            from None
+    except InputError as exc:
+        raise InputError(f"{ctx.path}: {exc}") from None
+
+
 def _law_parameters(ctx, c, key, law, ne, derived=()):
     """(params (ne, n_par), w0 (ne, n_slider) or None) of a contact table; the parameters
     in ``derived`` come from elsewhere (a [[preload]]: 0 here) and must not be given."""
@@ -298,7 +328,7 @@ def _node_set_contact(ctx, c, key, law, cyclic, derived=frozenset()):
     """A [[contacts]] table of a reduced model: node sets a, b, a normal."""
     pnames = LAWS[law].parameters
     unknown(ctx, c, {"name", "law", "a", "b", "b_sector", "normal", "tangent", "tol",
-                     "w0"} | set(pnames), key)
+                     "w0", "patch"} | set(pnames), key)
     name = string(ctx, c, "name", f"{key}.name", default=f"contacts{key[9:-1]}")
     a = string(ctx, c, "a", f"{key}.a", required=True)
     b = string(ctx, c, "b", f"{key}.b", default="ground")
@@ -330,4 +360,5 @@ def _node_set_contact(ctx, c, key, law, cyclic, derived=frozenset()):
     stick = (params[0, 0], params[0, 1] if "kn" in pnames else 0.0)
     return NodeSetContact(name=name, law=law, a=a, b=b, normal=normal, tangent=tangent,
                           tol=tol, params=params[0], w0=None if w0 is None else w0[0],
-                          stick=tuple(float(x) for x in stick), key=key, b_sector=bs)
+                          stick=tuple(float(x) for x in stick), key=key, b_sector=bs,
+                          patch=number(ctx, c, "patch", f"{key}.patch", positive=True))

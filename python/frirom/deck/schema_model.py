@@ -243,7 +243,7 @@ def check_travelling_wave(ctx: Context, raw: dict, solver) -> int:
     if solver.auto_harmonics:
         raise ctx.error("solver.harmonics", f"an integer with {key} = true (the selection "
                         "is built for one H; choose H with a run without it)", "auto")
-    if solver.stability:
+    if solver.stability is True:
         raise ctx.error("solver.stability", f"false with {key} = true (Hill's method "
                         "would see only perturbations inside the travelling wave); set "
                         "[solver] stability = false", True)
