@@ -21,7 +21,11 @@
 !> marching can contract its mismatch as little as 0.99 a period (the onset of partial
 !> slip); its march takes Newton steps on the slider fixed point between periods, with
 !> the 2x2 derivative of the period map from the slip tangents (frirom_aft_march), and
-!> the Jacobian then solves the closed cycle's slider tangent directly.
+!> the Jacobian then solves the closed cycle's slider tangent directly. Where one period
+!> determines the slider along a direction only weakly (det(I - M) < DET_ISOLATED: stuck,
+!> or barely slipping to and fro along one line) the slider is history, as a stuck 1-D
+!> slider is: marched plainly from w0 until it drifts by less than DRIFT a period, and
+!> differentiated as marched.
 !>
 !> Cost per element: O(N) marching per period (usually 2 periods from a cold slider, about
 !> 5 for the 2-D law near the onset of partial slip),
@@ -85,8 +89,17 @@ module frirom_aft
     !> A closed 2-D cycle is an isolated fixed point of the period map when
     !> det(I - dw_end/dw_start) >= this (stuck all cycle: 0; touching the friction limit
     !> with a slip of the order of the closure tolerance: ~1e-12; onset of partial slip at
-    !> 0.991 a period: ~1e-2).
-    real(wp), parameter :: DET_ISOLATED = 1.0e-6_wp
+    !> 0.991 a period: ~1e-2). Below it the slider is determined along one direction by
+    !> less than this a period (a hook element of the paper mesh that barely slips to and
+    !> fro along one line: 2.3e-6): like a stuck slider, it is history, carried from w0.
+    !> (The fixed point's tangent is amplified by up to 1/det: with 1e-4 here the paper
+    !> hooks' ROM_II at f0 = 300 N turned back at 131.2 Hz, with 1e-2 it runs through.)
+    real(wp), parameter :: DET_ISOLATED = 1.0e-2_wp
+    !> A cycle that is not isolated closes once its slider moves less than DRIFT times the
+    !> displacement scale a period (its weak direction drifts by that, the force by kt
+    !> times it: a relative error of DRIFT), where an exact closure to tol would take
+    !> ~1/det periods.
+    real(wp), parameter :: DRIFT = 1.0e-7_wp
 
     !> Everything one caller needs to evaluate contact forces at H harmonics and N samples:
     !> FFTW plans, buffers and per-batch work arrays. Owned by the caller (one per thread).

@@ -224,34 +224,31 @@ contains
     !> Jacobian of the 2-D element. The slip direction depends on the whole history, so
     !> the slider tangent dw (2 x 3(2H+1)) is propagated through the period from the
     !> closed cycle's own tangent, solved directly when that cycle is an isolated fixed
-    !> point (fixed_point2d). Otherwise (stuck all cycle, or only touching the friction
-    !> limit, where the recursion does not contract) the slider depends on the path: the
-    !> propagation starts from the tangent the settling periods leave (marched again from
-    !> w0) and is repeated until it closes (or max_periods), then once more accumulating.
+    !> point (fixed_point2d). Otherwise (stuck all cycle, or determined along a direction
+    !> by less than DET_ISOLATED a period) the slider is history: the propagation starts
+    !> from the tangent the settling periods leave (marched again from w0), so that the
+    !> Jacobian is that of the forces as marched (tol, max_periods: unused, kept for the
+    !> laws' common interface).
     subroutine jac_friction2d(plan, j, kt, w0j, tol, max_periods, jac)
         type(aft_plan), intent(inout) :: plan
         integer(ip), intent(in) :: j, max_periods
         real(wp), intent(in) :: kt, tol
         real(wp), intent(in) :: w0j(:)        !! (2) the element's initial slider
         real(wp), intent(inout) :: jac(:, :)  !! (3 nc, 3 nc)
-        integer(ip) :: nc, pass
+        integer(ip) :: nc
         nc = plan%fp%ncoef
         call jac_diagonal(plan, j, 4_ip, jac, 0_ip, 0_ip)       ! d f1/du1, stick
         call jac_diagonal(plan, j, 4_ip, jac, nc, nc)           ! d f2/du2, stick
         call jac_diagonal(plan, j, 5_ip, jac, 2*nc, 2*nc)       ! d fn/dv, contact
         if (fixed_point2d(plan, j, kt, jac)) return
+        ! not isolated: the forces are those of the closed_at-th period marched plainly
+        ! from w0 (frirom_aft_march), differentiated as such (the settling periods give
+        ! the slider tangent at the start of the last one); a stepped cycle kept where the
+        ! plain march does not close starts from its own slider, held
         plan%dw = 0.0_wp
-        if (plan%closed_at(j) > 1 .and. any(plan%w(j, 1:2) /= w0j(1:2))) &
+        if (plan%closed_at(j) > 1 .and. .not. plan%accelerated(j)) &
             call settle2d(plan, j, kt, w0j, jac)
-        if (all(plan%state(j, :) == STATE_STICK)) then
-            if (any(plan%dw /= 0.0_wp)) call propagate2d(plan, j, kt, .true., jac)
-            return
-        end if
-        do pass = 1, max_periods
-            plan%dw0 = plan%dw
-            call propagate2d(plan, j, kt, .false., jac)
-            if (maxval(abs(plan%dw - plan%dw0)) <= tol*max(1.0_wp, maxval(abs(plan%dw)))) exit
-        end do
+        if (all(plan%state(j, :) == STATE_STICK) .and. all(plan%dw == 0.0_wp)) return
         call propagate2d(plan, j, kt, .true., jac)
     end subroutine jac_friction2d
 

@@ -150,11 +150,15 @@ contains
     !> marching would be, HOLD plain periods follow, and the fraction of the step taken
     !> halves and stays at most that for the rest of the march (damp_cap: near a cycle
     !> that only touches the limit, doubling it again after each kept step was rejected
-    !> every other time; a recorded hook element closed in 73 periods instead of 250). A cycle is closed only by a plain
-    !> or kept period. A slipping cycle with I - M regular is the isolated fixed point
-    !> plain marching tends to; one that sticks, or only touches the friction limit, is one
-    !> of a set (the sliders that stick all cycle and its border), reached at a point that
-    !> depends on the path: march_closed then marches the element again without steps
+    !> every other time; a recorded hook element closed in 73 periods instead of 250). A
+    !> cycle is closed only by a plain or kept period. A cycle that sticks, or whose
+    !> slider one period determines along some direction by less than DET_ISOLATED (it
+    !> barely slips to and fro along one line) is one of a set or nearly so: its slider is
+    !> history, like a stuck 1-D slider's, so it is marched plainly from w0 and closes once
+    !> it drifts by less than DRIFT a period (a step ~1/det long would make the forces
+    !> hypersensitive: a hook element of the paper mesh, det 2.3e-6, took 175 periods of
+    !> steps and did not close after a change of 1e-5 in its motion). Only one that drifts
+    !> faster still takes steps; if it ends not isolated it is marched again without them
     !> (march_plain2d).
     subroutine settle_step2d(plan, j, nper, tolj)
         type(aft_plan), intent(inout) :: plan
@@ -188,13 +192,26 @@ contains
                 plan%closed_at(j) = nper
                 return
             end if
+            call slider_fixed_point(plan, j, a, det, isolated, opened)
+            if (.not. isolated) then
+                ! the slider is history along its weak direction: closed once it drifts by
+                ! less than DRIFT a period; a step towards a fixed point ~1/det away only
+                ! as a last resort, where the drift stays above that (see above)
+                if (res <= max(tolj, DRIFT*plan%scale(j))) then
+                    plan%closed_at(j) = nper
+                    return
+                end if
+                if (abs(det) < DET_MIN) then
+                    plan%res_last(j) = res
+                    return
+                end if
+            end if
             if (nper > 1) try = try .or. res > SLOW*plan%res_last(j)
             try = try .and. plan%hold(j) == 0
             plan%hold(j) = max(plan%hold(j) - 1, 0_ip)
             plan%res_last(j) = res
             if (.not. try) return
-            call slider_fixed_point(plan, j, a, det, isolated, opened)
-            if (opened .or. abs(det) < DET_MIN) return
+            if (opened) return
             g = w - ws
             plan%wplain(j, :) = w
             plan%res_base(j) = res
@@ -258,6 +275,8 @@ contains
         real(wp), intent(in) :: w0j(:)    !! (2) initial slider, m
         real(wp), intent(in) :: tol
         integer(ip) :: nper
+        real(wp) :: res, lim, a(2, 2), det
+        logical :: isolated, opened
         integer(ip), allocatable :: st_keep(:)
         real(wp), allocatable :: f_keep(:, :), tg_keep(:, :), w_keep(:), ws_keep(:)
         st_keep = plan%state(j, :)
@@ -275,7 +294,11 @@ contains
                                       plan%w(j:j, 1:2), rout(j:j, :, 1), rout(j:j, :, 2), &
                                       rout(j:j, :, 3), plan%state(j:j, :), &
                                       plan%tangent(j:j, :, :))
-                if (maxval(abs(plan%w(j, 1:2) - plan%wstart(j, 1:2))) <= tol*plan%scale(j)) then
+                res = maxval(abs(plan%w(j, 1:2) - plan%wstart(j, 1:2)))
+                call slider_fixed_point(plan, j, a, det, isolated, opened)
+                lim = tol*plan%scale(j)
+                if (.not. isolated) lim = max(lim, DRIFT*plan%scale(j))   ! as settle_step2d
+                if (res <= lim) then
                     plan%closed_at(j) = nper
                     plan%accelerated(j) = .false.
                     return

@@ -113,3 +113,41 @@ def test_liftoff_against_time_integration_return_map(case):
     assert res.states[0, 2] > 0.2 and res.states[0, 1] > 0.1      # opens and slips
     assert max(errs[n] for n in (256, 512, 1024)) < 2.5e-4, errs
     assert errs[64] > 4 * errs[128], errs
+
+
+# A hook element of the coarse paper_hooks ROM_I (normal2d, lug tied, f0 = 1 000 N, H = 1,
+# N = 128) at 181.3 Hz, where the sweep used to stop: it barely slips to and fro along
+# one line (2 samples of 128), so one period determines its slider across that line by
+# det(I - M) ~ 2e-6 only.
+HOOK_U = np.array([[-1.0223724642420776e-08, 8.50266726267175e-08, 1.2114879431511006e-07],
+                   [1.2170700444755202e-07, -3.0823911853791423e-09, 1.8627560731344652e-09],
+                   [-3.3747671383828007e-09, 4.819793335700922e-10, -6.007980169753861e-10]])
+HOOK_P = [55555600.0, 111111000.0, 0.3, 27.77777777777778]
+HOOK_W0 = [-1.0088930426122499e-08, 1.216946519734509e-07]
+
+
+def test_nearly_undetermined_slider_is_history_and_its_jacobian_is_the_march_s():
+    """The hook element above from the slider its previous point left: its slider across
+    the line of slip is history (like a stuck one), so the march closes once it drifts by
+    less than 1e-7 of the motion a period instead of stepping ~1/det towards a far fixed
+    point (which took 175 periods, and a change of 1e-12 m in one harmonic then did not
+    close in 200). Checks: it closes within 3 periods, so does every +-1e-12 m change of
+    a harmonic, and the Jacobian equals central differences of the forces with the same
+    w0 at h = 1e-14 m (a step within which no sample changes state) to 1e-7 of its
+    largest entry (seen 1.6e-9)."""
+    x = HOOK_U[None]
+    w0 = np.array([HOOK_W0])
+    res = contact.aft("normal2d", x, HOOK_P, 128, w0=w0)
+    assert res.periods[0] <= 3 and 0 < res.states[0, 1] < 0.05
+    J = res.jacobian[0]
+    h, fd = 1e-14, np.zeros_like(J)
+    for c in range(x.size):
+        f = []
+        for s in (h, -h, 1e-12, -1e-12):
+            xp = x.copy()
+            xp.reshape(-1)[c] += s
+            r = contact.aft("normal2d", xp, HOOK_P, 128, w0=w0, jacobian=False)
+            assert r.periods[0] <= 3, (c, s, r.periods)
+            f.append(r.forces[0].reshape(-1))
+        fd[:, c] = (f[0] - f[1]) / (2 * h)
+    assert np.abs(J - fd).max() <= 1e-7 * np.abs(J).max(), np.abs(J - fd).max()
