@@ -99,7 +99,7 @@ module frirom_aft
     !> displacement scale a period (its weak direction drifts by that, the force by kt
     !> times it: a relative error of DRIFT), where an exact closure to tol would take
     !> ~1/det periods.
-    real(wp), parameter :: DRIFT = 1.0e-7_wp
+    real(wp), parameter :: DRIFT = 1.0e-8_wp
 
     !> Everything one caller needs to evaluate contact forces at H harmonics and N samples:
     !> FFTW plans, buffers and per-batch work arrays. Owned by the caller (one per thread).
