@@ -39,7 +39,8 @@ struct frirom_settings {
     int batch;            /* points per segment of frirom_frf (a checkpoint after each) */
     int reuse_jacobian;   /* 1: keep a factorisation while Newton contracts */
     int history;          /* 1: carry the contact sliders along the curve */
-    int stability;        /* 1: Hill's method at every point */
+    int stability;        /* 1: Hill's method at every point; 2: the same,
+                             whole strip on reduced models (else nearest 0) */
     double tol_residual;  /* Newton's relative residual test */
     double tol_update;    /* ... and update test */
     double tol_stall;     /* a corrector stalled below this after max_iter is accepted */

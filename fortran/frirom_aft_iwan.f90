@@ -65,11 +65,11 @@ contains
     end procedure iwan_sliders
 
     module procedure iwan_forces
-        integer(ip) :: ne, nc, ns, e0, mc, ie, s, n, q
-        real(wp) :: ks(NSLIDER_OF(law)), fss(NSLIDER_OF(law)), ktot
+        integer(ip) :: ne, nc, ns, e0, mc, ie, n, q
+        real(wp) :: ktot
         integer(ip), allocatable :: owner(:), slot(:), per(:)
         real(wp), allocatable :: xs(:, :, :), ps(:, :), ws(:, :), fsub(:, :, :), &
-                                 jsub(:, :, :), st(:, :), wout(:, :), kw(:)
+                                 jsub(:, :, :), st(:, :), wout(:, :)
         logical :: want_jac
 
         info = FRIROM_OK
@@ -77,30 +77,14 @@ contains
         nc = size(x, 1)
         ns = NSLIDER_OF(law)
         want_jac = present(jac)
-        allocate (owner(CHUNK*ns), slot(CHUNK*ns), per(CHUNK*ns), kw(CHUNK*ns))
+        allocate (owner(CHUNK*ns), slot(CHUNK*ns), per(CHUNK*ns))
         allocate (xs(nc, 1, CHUNK*ns), ps(3, CHUNK*ns), ws(1, CHUNK*ns), &
                   fsub(nc, 1, CHUNK*ns), st(3, CHUNK*ns), wout(1, CHUNK*ns))
         if (want_jac) allocate (jsub(nc, nc, CHUNK*ns))
-        if (present(slider)) slider(1:ns, :) = 0.0_wp
         do e0 = 1, ne, CHUNK
             mc = min(CHUNK, ne - e0 + 1)
-            n = 0
-            do ie = e0, e0 + mc - 1
-                call iwan_sliders(law, params(:, ie), ks, fss)
-                do s = 1, ns
-                    if (ks(s) <= 0.0_wp) then
-                        if (present(slider)) slider(s, ie) = w0(s, ie)
-                        cycle
-                    end if
-                    n = n + 1
-                    owner(n) = ie
-                    slot(n) = s
-                    xs(:, 1, n) = x(:, 1, ie)
-                    ps(:, n) = [ks(s), 1.0_wp, fss(s)]
-                    ws(1, n) = w0(s, ie)
-                    kw(n) = ks(s)
-                end do
-            end do
+            if (present(slider)) slider(1:ns, e0:e0 + mc - 1) = w0(1:ns, e0:e0 + mc - 1)
+            call gather(law, x, params, w0, e0, mc, n, owner, slot, xs, ps, ws)
             if (want_jac) then
                 call aft_forces(plan, LAW_JENKINS, xs(:, :, 1:n), ps(:, 1:n), ws(:, 1:n), &
                                 fsub(:, :, 1:n), info, errmsg, jac=jsub(:, :, 1:n), &
@@ -123,7 +107,7 @@ contains
                 if (want_jac) jac(:, :, ie) = jac(:, :, ie) + jsub(:, :, q)
                 if (present(periods)) periods(ie) = max(periods(ie), per(q))
                 ! state fractions weighted by the sliders' stiffness
-                if (present(states)) states(:, ie) = states(:, ie) + kw(q)*st(:, q)
+                if (present(states)) states(:, ie) = states(:, ie) + ps(1, q)*st(:, q)
                 if (present(slider)) slider(slot(q), ie) = wout(1, q)
             end do
             if (present(states)) then
@@ -137,9 +121,8 @@ contains
     end procedure iwan_forces
 
     module procedure iwan_histories
-        integer(ip) :: ne, nc, ns, nsamp, e0, mc, ie, s, n, q
-        real(wp) :: ks(NSLIDER_OF(law)), fss(NSLIDER_OF(law))
-        integer(ip), allocatable :: owner(:)
+        integer(ip) :: ne, nc, ns, nsamp, e0, mc, ie, n, q
+        integer(ip), allocatable :: owner(:), slot(:)
         real(wp), allocatable :: xs(:, :, :), ps(:, :), ws(:, :), xts(:, :, :), fts(:, :, :)
 
         info = FRIROM_OK
@@ -147,22 +130,11 @@ contains
         nc = size(x, 1)
         ns = NSLIDER_OF(law)
         nsamp = size(xt, 1)
-        allocate (owner(CHUNK*ns), xs(nc, 1, CHUNK*ns), ps(3, CHUNK*ns), ws(1, CHUNK*ns), &
-                  xts(nsamp, 1, CHUNK*ns), fts(nsamp, 1, CHUNK*ns))
+        allocate (owner(CHUNK*ns), slot(CHUNK*ns), xs(nc, 1, CHUNK*ns), ps(3, CHUNK*ns), &
+                  ws(1, CHUNK*ns), xts(nsamp, 1, CHUNK*ns), fts(nsamp, 1, CHUNK*ns))
         do e0 = 1, ne, CHUNK
             mc = min(CHUNK, ne - e0 + 1)
-            n = 0
-            do ie = e0, e0 + mc - 1
-                call iwan_sliders(law, params(:, ie), ks, fss)
-                do s = 1, ns
-                    if (ks(s) <= 0.0_wp) cycle
-                    n = n + 1
-                    owner(n) = ie
-                    xs(:, 1, n) = x(:, 1, ie)
-                    ps(:, n) = [ks(s), 1.0_wp, fss(s)]
-                    ws(1, n) = w0(s, ie)
-                end do
-            end do
+            call gather(law, x, params, w0, e0, mc, n, owner, slot, xs, ps, ws)
             call aft_histories(plan, LAW_JENKINS, xs(:, :, 1:n), ps(:, 1:n), ws(:, 1:n), &
                                xts(:, :, 1:n), fts(:, :, 1:n), info, errmsg, tol=tol, &
                                max_periods=max_periods, index_base=index_base)
@@ -175,4 +147,30 @@ contains
             end do
         end do
     end procedure iwan_histories
+
+    !> The sliders with stiffness > 0 of elements e0 .. e0 + mc - 1 as n Jenkins elements:
+    !> their element (owner) and slider (slot), displacement xs, parameters ps = [k_s, 1,
+    !> fs_s] (mu 1, the slip force as the normal load) and start positions ws.
+    subroutine gather(law, x, params, w0, e0, mc, n, owner, slot, xs, ps, ws)
+        integer(ip), intent(in) :: law, e0, mc
+        real(wp), intent(in) :: x(:, :, :), params(:, :), w0(:, :)
+        integer(ip), intent(out) :: n
+        integer(ip), intent(inout) :: owner(:), slot(:)
+        real(wp), intent(inout) :: xs(:, :, :), ps(:, :), ws(:, :)
+        real(wp) :: ks(NSLIDER_OF(law)), fss(NSLIDER_OF(law))
+        integer(ip) :: ie, s
+        n = 0
+        do ie = e0, e0 + mc - 1
+            call iwan_sliders(law, params(:, ie), ks, fss)
+            do s = 1, size(ks)
+                if (ks(s) <= 0.0_wp) cycle
+                n = n + 1
+                owner(n) = ie
+                slot(n) = s
+                xs(:, 1, n) = x(:, 1, ie)
+                ps(:, n) = [ks(s), 1.0_wp, fss(s)]
+                ws(1, n) = w0(s, ie)
+            end do
+        end do
+    end subroutine gather
 end submodule frirom_aft_iwan

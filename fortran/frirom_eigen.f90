@@ -16,6 +16,7 @@ module frirom_eigen
     use frirom_status, only: set_status, FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, &
                              FRIROM_ERR_NONFINITE, FRIROM_ERR_ALLOC, FRIROM_ERR_ARPACK, &
                              FRIROM_ERR_NOCONV, FRIROM_ERR_SINGULAR, FRIROM_ERR_FACTOR
+    use frirom_arpack, only: dsaupd, dseupd
     implicit none
     private
     public :: eigen_work, eigen_factor, eigen_solve, eigen_modes, eigen_destroy, csr_symv
@@ -30,34 +31,6 @@ module frirom_eigen
         integer(ip) :: n = 0                 !! order of the matrix
         real(wp) :: sigma = 0.0_wp           !! shift of the factored matrix
     end type eigen_work
-
-    interface
-        subroutine dsaupd(ido, bmat, n, which, nev, tol, resid, ncv, v, ldv, iparam, ipntr, &
-                          workd, workl, lworkl, info)
-            import :: wp
-            integer, intent(inout) :: ido
-            character(len=1), intent(in) :: bmat
-            integer, intent(in) :: n, nev, ncv, ldv, lworkl
-            character(len=2), intent(in) :: which
-            real(wp), intent(inout) :: tol
-            real(wp), intent(inout) :: resid(n), v(ldv, ncv), workd(3*n), workl(lworkl)
-            integer, intent(inout) :: iparam(11), ipntr(11), info
-        end subroutine dsaupd
-        subroutine dseupd(rvec, howmny, sel, d, z, ldz, sigma, bmat, n, which, nev, tol, &
-                          resid, ncv, v, ldv, iparam, ipntr, workd, workl, lworkl, info)
-            import :: wp
-            integer, intent(in) :: ldz, n, nev, ncv, ldv, lworkl
-            logical, intent(in) :: rvec
-            character(len=1), intent(in) :: howmny, bmat
-            logical, intent(inout) :: sel(ncv)
-            real(wp), intent(out) :: d(nev), z(ldz, *)
-            real(wp), intent(in) :: sigma
-            character(len=2), intent(in) :: which
-            real(wp), intent(inout) :: tol
-            real(wp), intent(inout) :: resid(n), v(ldv, ncv), workd(2*n), workl(lworkl)
-            integer, intent(inout) :: iparam(11), ipntr(11), info
-        end subroutine dseupd
-    end interface
 
 contains
 

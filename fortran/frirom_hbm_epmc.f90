@@ -9,7 +9,7 @@ submodule (frirom_epmc) frirom_hbm_epmc
                              FRIROM_ERR_SINGULAR, FRIROM_ERR_LAPACK, set_status
     use frirom_lapack, only: dgetrf, dgetrs
     use frirom_csr, only: csr_matvec_add
-    use frirom_hbm, only: csr_matrix, contact_assemble, contact_eval, wtime, T_AFT, T_ASM, T_FACT, &
+    use frirom_hbm, only: contact_assemble, contact_eval, wtime, T_AFT, T_ASM, T_FACT, &
                           T_SOLVE, N_EVAL, N_FACT
     implicit none
 
@@ -19,7 +19,6 @@ contains
 
     module procedure hbm_epmc_set
         real(wp), allocatable :: mphi(:)
-        real(wp) :: mn
         integer(ip) :: nd
         info = FRIROM_OK
         select type (sys => sysc)
@@ -40,17 +39,8 @@ contains
                                 'the linear natural frequency (rad/s > 0) expected')
                 return
             end if
-            allocate (mphi(nd))
-            mphi = 0.0_wp
-            call csr_matvec_add(sys%m, phi, mphi, 1.0_wp)
-            mn = dot_product(phi, mphi)
-            if (.not. (mn > 0.0_wp)) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: phi has '// &
-                                'no mass (phi^T M phi <= 0)')
-                return
-            end if
-            sys%phi = phi/sqrt(mn)
-            mphi = mphi/sqrt(mn)
+            call epmc_normalise(sys%m, phi, 'phi', sys%phi, mphi, info, errmsg)
+            if (info /= 0) return
             sys%pw = mphi/norm2(mphi)
             sys%w0 = w0
             sys%wn = w0**2*norm2(mphi)
@@ -95,18 +85,7 @@ contains
         rlam = 0.0_wp
         jm = 0.0_wp
         select type (sys => sysc)
-        type is (hbm_epmc)
-            if (size(y) /= sys%n .or. size(r) /= sys%n .or. size(rlam) /= sys%n .or. &
-                any(shape(jm) /= [sys%n, sys%n])) then
-                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'hbm_epmc_jacobian: y, r, '// &
-                                'rlam (n) and jm (n, n) expected')
-                return
-            end if
-            sys%factor = .false.
-            call sys%eval(y, lam, r, rref, .true., rlam, info, errmsg)
-            sys%factor = .true.
-            if (info == 0) jm = sys%jd
-        type is (hbm_epmc_modal)
+        class is (epmc_system)
             if (size(y) /= sys%n .or. size(r) /= sys%n .or. size(rlam) /= sys%n .or. &
                 any(shape(jm) /= [sys%n, sys%n])) then
                 call set_status(info, FRIROM_ERR_SIZE, errmsg, 'hbm_epmc_jacobian: y, r, '// &
@@ -132,22 +111,40 @@ contains
         xp(:, 2:) = a*xp(:, 2:)
     end subroutine physical
 
+    module procedure epmc_normalise
+        real(wp) :: mn
+        info = FRIROM_OK
+        allocate (mphin(size(phi)))
+        mphin = 0.0_wp
+        call csr_matvec_add(m, phi, mphin, 1.0_wp)
+        mn = dot_product(phi, mphin)
+        if (.not. (mn > 0.0_wp)) then
+            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: '//what// &
+                            ' has no mass (phi^T M phi <= 0)')
+            return
+        end if
+        phin = phi/sqrt(mn)
+        mphin = mphin/sqrt(mn)
+    end procedure epmc_normalise
+
+    module procedure epmc_unpack
+        info = FRIROM_OK
+        a = 10.0_wp**lam
+        w = this%w0*y(this%nf + 1)
+        xi = this%w0*y(this%nf + 2)
+        if (.not. allocated(this%jd)) call set_status(info, FRIROM_ERR_PARAM, errmsg, &
+            'nonlinear mode: no linear mode set (run_set_nonlinear_mode)')
+    end procedure epmc_unpack
+
     module procedure epmc_eval
         real(wp) :: a, w, xi, hw, t0, nlin, nfc
         real(wp), allocatable :: rl(:, :), dw(:, :), dx(:, :), yd(:)
         integer(ip) :: nd, nc, nf, h, ca, cb, c
-        info = FRIROM_OK
-        if (.not. allocated(this%jd)) then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: no linear '// &
-                            'mode set (run_set_nonlinear_mode)')
-            return
-        end if
+        call epmc_unpack(this, y, lam, a, w, xi, info, errmsg)
+        if (info /= 0) return
         nd = this%ndof
         nc = this%nc
         nf = this%nf
-        a = 10.0_wp**lam
-        w = this%w0*y(nf + 1)
-        xi = this%w0*y(nf + 2)
         call physical(nd, nc, y, a, this%xp)
         this%xd = this%xp
         t0 = wtime()

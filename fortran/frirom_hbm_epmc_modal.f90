@@ -5,7 +5,7 @@
 !> x = a cos + b sin.
 submodule (frirom_epmc) frirom_hbm_epmc_modal
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_PARAM, FRIROM_ERR_SIZE, &
-                             FRIROM_ERR_SINGULAR, FRIROM_ERR_LAPACK, set_status
+                             FRIROM_ERR_SINGULAR, FRIROM_ERR_LAPACK, set_status, itoa
     use frirom_csr, only: csr_matvec_add
     use frirom_hbm, only: contact_assemble, contact_eval, wtime, T_AFT, T_ASM, T_FACT, T_SOLVE, &
                           N_EVAL, N_FACT
@@ -17,8 +17,7 @@ submodule (frirom_epmc) frirom_hbm_epmc_modal
 contains
 
     module procedure hbm_epmc_modal_set
-        real(wp), allocatable :: mv(:), mp0(:)
-        real(wp) :: mn
+        real(wp), allocatable :: mv(:), mp0(:), pn(:)
         integer(ip) :: nd, nm, r, nnl, j
         info = FRIROM_OK
         select type (sys => sysc)
@@ -59,32 +58,17 @@ contains
             do j = 1, nnl
                 sys%colmap(nl(j)) = j
             end do
-            allocate (mv(nd), mp0(nd))
-            mp0 = 0.0_wp
-            call csr_matvec_add(sys%m, phi0, mp0, 1.0_wp)
-            mn = dot_product(phi0, mp0)
-            if (.not. (mn > 0.0_wp)) then
-                call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: phi has '// &
-                                'no mass (phi^T M phi <= 0)')
-                return
-            end if
-            sys%phi0 = phi0/sqrt(mn)
-            mp0 = mp0/sqrt(mn)
+            call epmc_normalise(sys%m, phi0, 'phi', sys%phi0, mp0, info, errmsg)
+            if (info /= 0) return
             allocate (sys%phn(nnl, nm), sys%pho(size(sys%outdofs), nm), sys%cph(nm), &
                       sys%qst(nm))
             do r = 1, nm
-                mv = 0.0_wp
-                call csr_matvec_add(sys%m, phi(:, r), mv, 1.0_wp)
-                mn = dot_product(phi(:, r), mv)
-                if (.not. (mn > 0.0_wp)) then
-                    call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: a '// &
-                                    'mode without mass')
-                    return
-                end if
-                sys%phn(:, r) = phi(nl, r)/sqrt(mn)
-                sys%pho(:, r) = phi(sys%outdofs, r)/sqrt(mn)
-                sys%cph(r) = dot_product(phi(:, r), mp0)/sqrt(mn)
-                sys%qst(r) = dot_product(phi(:, r), sys%fe0(:, 1))/sqrt(mn)
+                call epmc_normalise(sys%m, phi(:, r), 'mode '//itoa(r), pn, mv, info, errmsg)
+                if (info /= 0) return
+                sys%phn(:, r) = pn(nl)
+                sys%pho(:, r) = pn(sys%outdofs)
+                sys%cph(r) = dot_product(pn, mp0)
+                sys%qst(r) = dot_product(pn, sys%fe0(:, 1))
             end do
             if (norm2(sys%cph) > 0.0_wp) sys%cph = sys%cph/norm2(sys%cph)
             sys%wr = wm
@@ -140,18 +124,11 @@ contains
         integer(ip) :: nnl, nm, nf, h, ca, cb, j
         complex(wp), allocatable :: g(:), gw(:), gx(:), p(:), q(:), z(:), dp(:, :), dz(:, :)
         real(wp), allocatable :: u(:, :), yd(:), jn(:), jw(:, :)
-        info = FRIROM_OK
-        if (.not. allocated(this%jd)) then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, 'nonlinear mode: no linear '// &
-                            'mode set (run_set_nonlinear_mode)')
-            return
-        end if
+        call epmc_unpack(this, y, lam, a, w, xi, info, errmsg)
+        if (info /= 0) return
         nnl = this%nnl
         nm = this%nm
         nf = this%nf
-        a = 10.0_wp**lam
-        w = this%w0*y(nf + 1)
-        xi = this%w0*y(nf + 2)
         call forces(this, y, a, info, errmsg)
         if (info /= 0) return
         t0 = wtime()
@@ -163,8 +140,8 @@ contains
         ! harmonic 0: U_0 - Phi_nl diag(1/w_r^2) (Phi^T fe0 - Phi_nl^T F_0)
         r(1:nnl) = u(:, 1) - matmul(this%phn, (this%qst - matmul(transpose(this%phn), &
                                                                 this%fl(:, 1)))/this%wr**2)
-        jw(1:nnl, 1:nf) = matmul(this%phn, matmul(diag_scale(1.0_wp/this%wr**2, &
-                                      transpose(this%phn)), this%jp(1:nnl, :)))
+        jw(1:nnl, 1:nf) = matmul(this%phn, matmul(spread(1.0_wp/this%wr**2, 2, nnl)* &
+                                      transpose(this%phn), this%jp(1:nnl, :)))
         ! the residual's reference: the size of its terms (unknowns, static load and
         ! contact force responses, each harmonic's receptance term)
         nref = max(norm2(u), norm2(matmul(this%phn, this%qst/this%wr**2)), &
@@ -233,15 +210,6 @@ contains
     end procedure epmd_eval
 
     !> diag(d) b (rows of b scaled).
-    pure function diag_scale(d, b) result(c)
-        real(wp), intent(in) :: d(:), b(:, :)
-        real(wp) :: c(size(b, 1), size(b, 2))
-        integer(ip) :: k
-        do k = 1, size(b, 2)
-            c(:, k) = d*b(:, k)
-        end do
-    end function diag_scale
-
     pure function diag_cscale(d, b) result(c)
         complex(wp), intent(in) :: d(:), b(:, :)
         complex(wp) :: c(size(b, 1), size(b, 2))

@@ -23,8 +23,11 @@ submodule (frirom_hbm:frirom_hbm_condensed) frirom_hbm_factor
     !> once the iterations since the last LU reach that, or when one solve needs more
     !> than a third of it (at least GN_MINIT); always when an LU is worth less than
     !> GN_WORTH_MIN iterations (a few hundred unknowns: LUs are cheap and each Newton
-    !> path stays the one of the LUs). Deterministic: sizes and counts only.
-    real(wp), parameter :: GN_TOL = 1.0e-8_wp, LU_SPEEDUP = 10.0_wp, GN_WORTH_MIN = 12.0_wp
+    !> path stays the one of the LUs). Deterministic: sizes and counts only. GN_TOL is
+    !> an inexact Newton step's: Newton's own residual test decides convergence, and 1e-4
+    !> took 1/3 fewer GMRES iterations than 1e-8 with no more evaluations on the
+    !> large_interface scaling FRFs.
+    real(wp), parameter :: GN_TOL = 1.0e-4_wp, LU_SPEEDUP = 10.0_wp, GN_WORTH_MIN = 12.0_wp
     integer(ip), parameter :: GN_MINIT = 4
     !> GMRES iterations on a fresh single-precision LU before J is factorised in double
     integer(ip), parameter :: GS_MAXIT = 12
@@ -140,8 +143,7 @@ contains
         end if
         if (this%held%single .and. .not. this%lu_fresh) then
             ! a chord step (Jacobian reused) with the LU of an older J, as a double one
-            call wb_prepare(this)
-            call lu_apply(this, b)
+            call chord_apply(this, b)
             this%timers(T_SOLVE) = this%timers(T_SOLVE) + wtime() - t0
             return
         else if (this%held%single) then
@@ -454,6 +456,26 @@ contains
             call held_lu_apply(sys%held, sys%jm, w, sys%wj)
         end if
     end subroutine lu_apply
+
+    !> A chord step's w := M^-1 w with the LU held, its Woodbury correction taken at the
+    !> frequency of the last evaluation (w_cache: the iterate's) rather than the J's: at
+    !> a contact state the LU's, the change of J since is that of the modal factors.
+    subroutine chord_apply(sys, w)
+        type(hbm_condensed), intent(inout) :: sys
+        real(wp), intent(inout) :: w(:, :)
+        complex(wp), allocatable :: d(:)
+        integer(ip) :: k
+        if (.not. (sys%held%wb%ok .and. allocated(sys%g))) then
+            call lu_apply(sys, w)
+            return
+        end if
+        allocate (d(size(sys%held%wb%s, 1)/2))
+        do k = 1, size(d)
+            d(k) = sys%g(sys%wbm(k), sys%wbh(k)) - sys%wbg(k)
+        end do
+        call woodbury_prepare(sys%held, sys%w_cache, d)
+        call held_lu_apply(sys%held, sys%jm, w, sys%w_cache, d)
+    end subroutine chord_apply
 
     !> b := J^-1 b, column by column, by restarted flexible GMRES (fgmres) on jcur (or J
     !> matrix-free), right-preconditioned by the LU held (from an earlier J or in single

@@ -27,13 +27,14 @@
 submodule (frirom_hbm) frirom_hbm_free
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_ALLOC, FRIROM_ERR_SIZE, set_status
     use frirom_aft, only: law_stuck_stiffness, LAW_CUBIC
+    use frirom_csr, only: coo_csr
     implicit none
 
 contains
 
     module procedure hbm_free_bodies
         integer(ip) :: g, e, r, nrows, ndof, i, k, kk, nnz, cnt, stat
-        integer(ip), allocatable :: tp(:), ti(:), tr(:), mark(:), list(:), np(:), ni(:)
+        integer(ip), allocatable :: tp(:), ti(:), grow(:), mark(:), list(:), np(:), ni(:)
         real(wp), allocatable :: ks(:), tx(:), acc(:), nx(:)
         info = FRIROM_OK
         ndof = sys%ndof
@@ -56,29 +57,19 @@ contains
                 end do
             end associate
         end do
-        ! G^T in CSR (tp, ti: its rows are the DoFs, tr the rows of G, tx the values)
+        ! G^T in CSR (tp, ti: its rows are the DoFs, ti the rows of G, tx the values)
         nnz = gp(nrows + 1) - 1
-        allocate (tp(ndof + 1), ti(nnz), tx(nnz), tr(ndof + 1), stat=stat)
+        allocate (grow(nnz), stat=stat)
         if (stat /= 0) then
             call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'hbm_free_bodies: G^T')
             return
         end if
-        tp = 0
-        do k = 1, nnz
-            tp(gi(k) + 1) = tp(gi(k) + 1) + 1
-        end do
-        tp(1) = 1
-        do i = 1, ndof
-            tp(i + 1) = tp(i + 1) + tp(i)
-        end do
-        tr = tp
         do r = 1, nrows
-            do k = gp(r), gp(r + 1) - 1
-                ti(tr(gi(k))) = r
-                tx(tr(gi(k))) = gx(k)
-                tr(gi(k)) = tr(gi(k)) + 1
-            end do
+            grow(gp(r):gp(r + 1) - 1) = r
         end do
+        call coo_csr(ndof, nrows, gi(1:nnz), grow, gx(1:nnz), 'hbm_free_bodies: G^T', tp, ti, &
+                     tx, info, errmsg)
+        if (info /= 0) return
         ! K' row i = K row i + sum over G's rows r reading DoF i of G(r, i) ks_r G(r, :):
         ! a dense accumulator and the list of the columns it touched (Gustavson)
         allocate (mark(ndof), list(ndof), acc(ndof), np(ndof + 1), stat=stat)

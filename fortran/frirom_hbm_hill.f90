@@ -9,10 +9,14 @@ submodule (frirom_hbm) frirom_hbm_hill
                              FRIROM_ERR_SINGULAR, FRIROM_ERR_ARPACK, FRIROM_ERR_MODEL, &
                              FRIROM_ERR_PARAM, set_status
     use frirom_banded, only: band_init, band_add, band_factor, band_solve
+    use frirom_arpack, only: znaupd, zneupd
     implicit none
 
     !> Eigenvalues Arnoldi wants per shift at first, at most.
     integer(ip), parameter :: NEV0 = 16, NEV_MAX = 256
+    !> Exponents of least modulus the s = 0 route asks for (a real exponent, the resonant
+    !> mode's folded pair and the nearest copies)
+    integer(ip), parameter :: NEV_S0 = 8
 
     !> The modal Hill problem of a condensed system with real modes (T = P) at a real
     !> shift sg: unknowns q(r + nm (c-1)), slot c of mode r; Q(s) = Lam(s) + E^T Jc E,
@@ -29,38 +33,6 @@ submodule (frirom_hbm) frirom_hbm_hill
         integer, allocatable :: ipiv(:)
     end type modal_hill
 
-    interface
-        subroutine znaupd(ido, bmat, n, which, nev, tol, resid, ncv, v, ldv, iparam, ipntr, &
-                          workd, workl, lworkl, rwork, info)
-            import :: wp
-            integer, intent(inout) :: ido
-            character(len=1), intent(in) :: bmat
-            integer, intent(in) :: n, nev, ncv, ldv, lworkl
-            character(len=2), intent(in) :: which
-            real(wp), intent(inout) :: tol
-            complex(wp), intent(inout) :: resid(n), v(ldv, ncv), workd(3*n), workl(lworkl)
-            real(wp), intent(inout) :: rwork(ncv)
-            integer, intent(inout) :: iparam(11), ipntr(14), info
-        end subroutine znaupd
-        subroutine zneupd(rvec, howmny, sel, d, z, ldz, sigma, workev, bmat, n, which, nev, &
-                          tol, resid, ncv, v, ldv, iparam, ipntr, workd, workl, lworkl, &
-                          rwork, info)
-            import :: wp
-            integer, intent(in) :: ldz, n, nev, ncv, ldv, lworkl
-            logical, intent(in) :: rvec
-            character(len=1), intent(in) :: howmny, bmat
-            logical, intent(inout) :: sel(ncv)
-            complex(wp), intent(out) :: d(nev + 1), z(ldz, *)
-            complex(wp), intent(in) :: sigma
-            complex(wp), intent(inout) :: workev(2*ncv)
-            character(len=2), intent(in) :: which
-            real(wp), intent(inout) :: tol
-            complex(wp), intent(inout) :: resid(n), v(ldv, ncv), workd(3*n), workl(lworkl)
-            real(wp), intent(inout) :: rwork(ncv)
-            integer, intent(inout) :: iparam(11), ipntr(14), info
-        end subroutine zneupd
-    end interface
-
 contains
 
     module procedure hbm_hill
@@ -73,15 +45,23 @@ contains
             call set_status(info, FRIROM_ERR_SIZE, errmsg, 'hbm_hill: expo needs 2 ndof')
             return
         end if
+        call freq_load(sys, lam, w, s)
         select type (sys)
         type is (hbm_condensed)
+            if (2*n > HILL_DENSE_MAX .and. near0_route(sys)) then
+                ! the exponents nearest 0 through the Newton matrix (frirom_hbm_hill_s0),
+                ! in either condensed coordinates
+                call hill_near0(sys, y, lam, w, min(NEV_S0, 2*n - 2), expo, maxre, info, &
+                                errmsg)
+                return
+            end if
             if (sys%tcontact) then
                 call set_status(info, FRIROM_ERR_PARAM, errmsg, 'Hill stability needs '// &
-                                'the condensed unknowns on the nonlinear DoFs (T = P)')
+                                'the condensed unknowns on the nonlinear DoFs (T = P), or '// &
+                                'receptances from real modes')
                 return
             end if
         end select
-        call freq_load(sys, lam, w, s)
         ! contact Jacobians at the solution
         call hbm_contact_forces(sys, y, .true., info, errmsg)
         if (info /= 0) return
@@ -98,6 +78,14 @@ contains
         end select
         call hill_arnoldi(sys, w, expo, maxre, info, errmsg)
     end procedure hbm_hill
+
+    !> Whether a condensed system's Hill problem above HILL_DENSE_MAX goes by hill_near0:
+    !> real modes, no selection, and the whole strip not asked for (hill_strip).
+    logical function near0_route(sys)
+        type(hbm_condensed), intent(in) :: sys
+        near0_route = sys%modal .and. allocated(sys%phr) .and. .not. allocated(sys%sel) &
+                      .and. .not. sys%hill_strip
+    end function near0_route
 
     !> Whether a condensed system's Hill problem goes by its modes (hill_modal): real
     !> modes (the same for every harmonic) and the unknowns on the contact DoFs.

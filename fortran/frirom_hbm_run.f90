@@ -321,6 +321,7 @@ contains
     module procedure hbm_run
         type(cont_options) :: o1
         real(wp), allocatable :: zero(:), yb(:, :), lb(:), tb(:, :), t0(:), tj(:)
+        real(wp) :: orient
         integer(ip) :: it, n1, maxpts, ib(1)
         logical :: have_fact
         info = FRIROM_OK
@@ -346,8 +347,10 @@ contains
             call sys%accept(y, lam, info, errmsg)
             if (info /= 0) return
             t0 = 0.0_wp
+            ! the curve's orientation (cont_tangent), kept by every point after
+            orient = 0.0_wp
             call cont_tangent(sys, y, lam, opts, t0, sign(1.0_wp, opts%lam_end - lam), t, &
-                              info, errmsg)
+                              info, errmsg, orient)
             if (info /= 0) return
             tj = t
             call store(it)
@@ -361,13 +364,20 @@ contains
             ! J at the resumed point and its tangent tj, as the run that made the point
             ! holds them (cont_tangent left them there): the first corrector's chord steps
             ! and the corner rules, and so the path, do not depend on where calls begin
-            call cont_tangent(sys, y, lam, o1, t, 1.0_wp, tj, info, errmsg)
+            ! (the orientation too: tj along t, as the run that made the point had it)
+            orient = 0.0_wp
+            call cont_tangent(sys, y, lam, o1, t, 1.0_wp, tj, info, errmsg, orient)
             if (info /= 0) return
         end if
         have_fact = .true.
         do while (npts < maxpts)
-            call cont_run(sys, y, lam, t, ds, lam_lo, o1, yb, lb, tb, ib, n1, finished, &
-                          info, errmsg, have_fact, tj)
+            if (orient /= 0.0_wp .and. sys%orient) then
+                call cont_run(sys, y, lam, t, ds, lam_lo, o1, yb, lb, tb, ib, n1, finished, &
+                              info, errmsg, have_fact, tj, orient)
+            else
+                call cont_run(sys, y, lam, t, ds, lam_lo, o1, yb, lb, tb, ib, n1, finished, &
+                              info, errmsg, have_fact, tj)
+            end if
             if (n1 == 1) then
                 it = info
                 call rescale()

@@ -9,6 +9,7 @@
 !> effort, turning points, retries.
 module frirom_newton
     use frirom_kinds, only: wp, ip
+    use frirom_lapack, only: dgetrf
     use frirom_status, only: FRIROM_OK, FRIROM_ERR_SIZE, FRIROM_ERR_PARAM, &
                              FRIROM_ERR_NOCONV, FRIROM_ERR_NONFINITE, FRIROM_ERR_CONT, &
                              set_status
@@ -32,6 +33,9 @@ module frirom_newton
     !> yscale of a solve before any solution size is known: the update test becomes purely
     !> relative, ||dy|| / ||y|| (arc lengths in this scaling mean nothing)
     real(wp), parameter :: YSCALE_RELATIVE = 1.0e-300_wp
+    !> Systems of at most this many unknowns orient their tangents by the sign of det J
+    !> (jac_det_sign: J^-1 formed by n solves, then an LU): a few hundred microseconds
+    integer(ip), parameter :: DET_MAX_N = 64
 
     !> A nonlinear system R(y, lam) = 0 with n unknowns y and one parameter lam.
     type, abstract :: nl_system
@@ -274,9 +278,14 @@ contains
     end subroutine newton_correct
 
     !> Unit tangent (scaled variables) of the solution curve at a converged point, oriented
-    !> along `tprev` (or along increasing lam * sgn when tprev is zero). Leaves the
+    !> along `tprev` (or along increasing lam * sgn when tprev is zero). With `orient`
+    !> (in/out) on a system of at most DET_MAX_N unknowns the orientation is the curve's
+    !> own instead: sign(det J) sign(t_lam), the sign of the determinant of the bordered
+    !> matrix [J, R_lam; t^T], stays the same along a curve through folds and through
+    !> the corners where contact states switch (it changes only where the curve is
+    !> retraced); orient 0 on entry takes it from the tprev orientation here. Leaves the
     !> factorisation of J at this point in the system, for the next corrector.
-    subroutine cont_tangent(sys, y, lam, opts, tprev, sgn, t, info, errmsg)
+    subroutine cont_tangent(sys, y, lam, opts, tprev, sgn, t, info, errmsg, orient, by_det)
         class(nl_system), intent(inout) :: sys
         real(wp), intent(in) :: y(:), lam
         type(cont_options), intent(in) :: opts
@@ -285,8 +294,10 @@ contains
         real(wp), intent(out) :: t(:)         !! (n+1) unit tangent (y/yscale, lam/lscale)
         integer(ip), intent(out) :: info
         character(len=*), intent(inout) :: errmsg
+        real(wp), intent(inout), optional :: orient  !! +-1 the curve's orientation, 0 unset
+        logical, intent(out), optional :: by_det     !! t oriented by orient
         real(wp), allocatable :: r(:), rlam(:), b(:, :)
-        real(wp) :: rref, nrm
+        real(wp) :: rref, nrm, dsg
         integer(ip) :: n
         n = sys%n
         allocate (r(n), rlam(n), b(n, 1))
@@ -304,12 +315,58 @@ contains
             return
         end if
         t = t/nrm
+        dsg = 0.0_wp
+        if (present(by_det)) by_det = .false.
+        if (present(orient)) then
+            if (n <= DET_MAX_N) call jac_det_sign(sys, dsg, info, errmsg)
+            if (info /= 0) return
+        end if
+        if (dsg /= 0.0_wp .and. orient /= 0.0_wp) then
+            ! t(n + 1) > 0 here: the sign that keeps sign(det J) t_lam the curve's
+            t = (orient*dsg)*t
+            if (present(by_det)) by_det = .true.
+            return
+        end if
         if (any(tprev /= 0.0_wp)) then
             if (dot_product(t, tprev) < 0.0_wp) t = -t
         else
             if (t(n + 1)*sgn < 0.0_wp) t = -t
         end if
+        if (dsg /= 0.0_wp) orient = dsg*sign(1.0_wp, t(n + 1))
     end subroutine cont_tangent
+
+    !> Sign of det J (+-1), J as the last eval with jac factorised it: J^-1 by n solves,
+    !> then its LU (for small systems only: n solves and an n^3 LU); 0 where it says
+    !> nothing: J^-1 not finite, or J singular to the working precision (pivots of J^-1
+    !> spread by more than 1e10: a direction the equations leave free, e.g. a slider's
+    !> mean position in gross slip, where the sign is rounding).
+    subroutine jac_det_sign(sys, dsg, info, errmsg)
+        class(nl_system), intent(inout) :: sys
+        real(wp), intent(out) :: dsg
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        real(wp), allocatable :: x(:, :)
+        integer(ip), allocatable :: ipiv(:)
+        integer(ip) :: n, i, linfo
+        n = sys%n
+        dsg = 0.0_wp
+        allocate (x(n, n), ipiv(n))
+        x = 0.0_wp
+        do i = 1, n
+            x(i, i) = 1.0_wp
+        end do
+        call sys%solve(x, info, errmsg)
+        if (info /= 0 .or. .not. all(abs(x) <= huge(1.0_wp))) return
+        call dgetrf(n, n, x, n, ipiv, linfo)
+        if (linfo /= 0) return
+        if (maxval(abs([(x(i, i), i=1, n)])) > 1.0e10_wp*minval(abs([(x(i, i), i=1, n)]))) &
+            return
+        dsg = 1.0_wp
+        do i = 1, n
+            if (ipiv(i) /= i) dsg = -dsg
+            if (x(i, i) < 0.0_wp) dsg = -dsg
+        end do
+    end subroutine jac_det_sign
 
     !> Pseudo-arc-length continuation from a converged point (y, lam) with tangent t,
     !> until lam reaches opts%lam_end (the last point is solved at lam_end exactly), the
@@ -318,9 +375,12 @@ contains
     !> FRIROM_ERR_CONT and every point made so far stays in the outputs. A converged step
     !> longer than ds_max / 4 whose predictor-corrector distance says it was more than
     !> twice too long for the curve's shape is retried once with the step
-    !> cont_step_factor gives.
+    !> cont_step_factor gives. With `orient` (see cont_tangent) a point whose chord runs
+    !> against the curve's orientation there, the curve retraced (at a near-fold the
+    !> corrector or turn_corner can land on the branch just left), is rejected like a
+    !> failed corrector.
     subroutine cont_run(sys, y, lam, t, ds, lam_lo, opts, yout, lout, tout, itout, npts, &
-                        finished, info, errmsg, have_fact, tj)
+                        finished, info, errmsg, have_fact, tj, orient)
         class(nl_system), intent(inout) :: sys
         real(wp), intent(inout) :: y(:)        !! (n) start point in, last point out
         real(wp), intent(inout) :: lam
@@ -340,10 +400,11 @@ contains
         !> (n+1) the unit tangent J gives at (y, lam), in/out: t itself unless a chord
         !> replaced it (the secant rule); absent, t is taken for it at the start
         real(wp), intent(inout), optional :: tj(:)
+        real(wp), intent(inout), optional :: orient  !! +-1 the curve's orientation, 0 unset
         real(wp), allocatable :: y1(:), yp(:), t1(:), cy(:), ch(:), tjl(:)
         real(wp) :: lam1, lp, dirn, frac, cl, angle, dist
         integer(ip) :: n, iters
-        logical :: last, turned, retried
+        logical :: last, turned, retried, by_det
         integer(ip) :: nf, effort
         type(cont_options) :: fresh_opts
         character(len=len(errmsg)) :: why
@@ -413,7 +474,7 @@ contains
             if (info /= 0 .and. .not. last) call turn_corner(sys, y, lam, t, tjl, ds, &
                                                              fresh_opts, y1, lam1, t1, iters, &
                                                              nf, turned, info, errmsg, &
-                                                             have_fact)
+                                                             have_fact, orient)
             if (info == 0 .and. .not. (last .or. retried .or. turned) .and. &
                 ds > 0.25_wp*opts%ds_max) then
                 ! a long step far too long for the curve's shape (the corrector moved off
@@ -447,10 +508,25 @@ contains
             call sys%accept(y1, lam1, info, errmsg)
             ! after a corner the new tangent is oriented along the branch taken (t1)
             if (turned) t = t1
-            if (info == 0) call cont_tangent(sys, y1, lam1, opts, t, dirn, t1, info, errmsg)
+            if (info == 0) call cont_tangent(sys, y1, lam1, opts, t, dirn, t1, info, errmsg, &
+                                             orient, by_det)
             if (info /= 0) then
                 have_fact = .false.
                 return
+            end if
+            if (.not. last .and. by_det .and. retraced(y, lam, y1, lam1, t1, opts, orient)) then
+                if (ds > opts%ds_min*1.000001_wp) then
+                    ! the curve retraced: a shorter step (as after a failed corrector)
+                    have_fact = .false.
+                    ds = 0.5_wp*ds
+                    cycle
+                end if
+                ! still at the minimum step: the determinant's sign is not trusted here (a
+                ! coarse AFT's corner can flip it, e.g. the joint at H = 5, N = 32): the
+                ! point is taken with its tangent along the previous one, as without the
+                ! orientation, which the next point takes up again (orient 0)
+                if (dot_product(t1, t) < 0.0_wp) t1 = -t1
+                orient = 0.0_wp
             end if
             have_fact = .true.
             retried = .false.
@@ -466,7 +542,8 @@ contains
                 ! degrees on the paper_hooks ROM_II). Predict along the chord (secant).
                 ch(1:n) = (y1 - y)/opts%yscale
                 ch(n + 1) = (lam1 - lam)/opts%lscale
-                if (chord_wins(ch, t1, t, ds, opts)) t1 = ch/norm2(ch)
+                if (chord_wins(ch, t1, t, ds, opts) .and. .not. &
+                    (by_det .and. ch(n + 1)*t1(n + 1) < 0.0_wp)) t1 = ch/norm2(ch)
             end if
             angle = acos(max(-1.0_wp, min(1.0_wp, dot_product(t, t1))))
             dist = 0.0_wp
@@ -507,7 +584,7 @@ contains
     !> parameter's direction of travel is the frozen history's branch behind (y, lam), not
     !> the curve ahead: it is never taken.
     subroutine turn_corner(sys, y, lam, t, tj, ds, opts, y1, lam1, tc, iters, nf, turned, &
-                           info, errmsg, have_fact)
+                           info, errmsg, have_fact, orient)
         class(nl_system), intent(inout) :: sys
         real(wp), intent(in) :: y(:), lam     !! (n) last converged point
         real(wp), intent(in) :: t(:)          !! (n+1) its unit tangent (scaled)
@@ -521,16 +598,17 @@ contains
         integer(ip), intent(inout) :: info    !! in: the failed corrector's status
         character(len=*), intent(inout) :: errmsg
         logical, intent(inout) :: have_fact
-        real(wp), allocatable :: yp(:), ch(:)
-        real(wp) :: lp, dch
+        real(wp), intent(in), optional :: orient  !! the curve's orientation (cont_tangent)
+        real(wp), allocatable :: yp(:), ch(:), tk(:)
+        real(wp) :: lp, dch, ork
         integer(ip) :: n, k, info2
-        logical :: ratchet
+        logical :: ratchet, by_det
         character(len=len(errmsg)) :: msg2
         n = size(y)
         turned = .false.
         iters = 0
         nf = 0
-        allocate (yp(n), ch(n + 1))
+        allocate (yp(n), ch(n + 1), tk(n + 1))
         ! is t the tangent J gives here, or a chord (see cont_run)?
         ratchet = abs(dot_product(tj, t)) < secant_cos(ds, opts)
         if (ratchet .and. ds >= 0.05_wp*opts%ds_max) then
@@ -559,6 +637,16 @@ contains
             dch = norm2(ch)
             if (dch <= 3.0_wp*ds .and. dot_product(ch, t) >= -0.5_wp*dch .and. &
                 .not. (ratchet .and. ch(n + 1)*t(n + 1) < 0.0_wp)) then
+                if (present(orient)) then
+                    ! the branch just left, taken backward, is no way past the corner
+                    msg2 = ''
+                    ork = orient
+                    call cont_tangent(sys, y1, lam1, opts, tc, 1.0_wp, tk, info2, msg2, ork, &
+                                      by_det)
+                    have_fact = .false.
+                    if (info2 /= 0) cycle
+                    if (by_det .and. retraced(y, lam, y1, lam1, tk, opts, ork)) cycle
+                end if
                 turned = .true.
                 info = FRIROM_OK
                 return
@@ -566,6 +654,23 @@ contains
         end do
         have_fact = .false.
     end subroutine turn_corner
+
+    !> Whether the step from (y, lam) to (y1, lam1) ran against t1, the tangent at the new
+    !> point in the curve's orientation (orient nonzero, cont_tangent): it went back along
+    !> the curve. False without an orientation.
+    logical function retraced(y, lam, y1, lam1, t1, opts, orient)
+        real(wp), intent(in) :: y(:), lam, y1(:), lam1
+        real(wp), intent(in) :: t1(:)          !! (n+1) unit tangent at (y1, lam1)
+        type(cont_options), intent(in) :: opts
+        real(wp), intent(in), optional :: orient
+        integer(ip) :: n
+        retraced = .false.
+        if (.not. present(orient)) return
+        if (orient == 0.0_wp) return
+        n = size(y)
+        retraced = dot_product(t1(1:n), (y1 - y)/opts%yscale) + &
+                   t1(n + 1)*(lam1 - lam)/opts%lscale < 0.0_wp
+    end function retraced
 
     !> Whether the chord ch that reached a point (scaled, not unit; ch(n+1) the parameter)
     !> replaces the tangent tj that J gives there (unit, oriented along tprev, the tangent

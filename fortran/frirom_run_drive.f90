@@ -487,6 +487,7 @@ contains
         lam = st%lam
         dsout = st%ds
         run%sys%carry = run%s%history /= 0
+        run%sys%orient = run%m%mode /= RUN_MODE
         run%sys%timers = 0.0_wp
         if (st%stability) allocate (hill(mx))
         if (allocated(run%m%keep)) allocate (lk(mx))

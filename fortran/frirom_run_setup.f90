@@ -106,6 +106,8 @@ contains
                            m%outdofs, info, errmsg, contact_coords=m%tcontact, &
                            krylov=m%krylov, sparse_lu=m%sparse, free_bodies=m%free)
             if (info /= 0) return
+            ! stability 2: Hill's whole strip on reduced models (else the exponents near 0)
+            run%sys%hill_strip = run%s%stability == 2
             run%sys%cs%ulaw = m%ulaw
             if (allocated(m%phi)) call hbm_set_modes(run%sys, m%phi, m%wm, m%zm, info, errmsg)
             if (info /= 0) return

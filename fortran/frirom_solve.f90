@@ -21,6 +21,7 @@ module frirom_solve
     use frirom_peak, only: peak_exact => peak_amplitude
     use frirom_damping, only: modal_damping
     use frirom_banded, only: rcm_order
+    use frirom_csr, only: coo_csr
     use frirom_run, only: run_t, run_points, frf_settings => run_settings, run_open, &
                           run_start, run_advance, run_close, run_default_samples, &
                           RUN_CONDENSED, RUN_BANDED, RUN_FREQUENCY, RUN_START_COLD, RUN_GOING, &
@@ -69,89 +70,6 @@ contains
         integer(ip) :: st
         call peak_exact(x, amax, t, st)
     end function peak_amplitude
-
-    !> Coordinate triplets (1-based, duplicates summed) of an nrow x ncol matrix to CSR with
-    !> sorted columns; an empty matrix keeps one explicit zero (hbm_setup needs an entry).
-    subroutine coo_csr(nrow, ncol, r, c, v, name, p, ci, x, info, errmsg)
-        integer(ip), intent(in) :: nrow, ncol, r(:), c(:)
-        real(wp), intent(in) :: v(:)
-        character(len=*), intent(in) :: name
-        integer(ip), allocatable, intent(out) :: p(:), ci(:)
-        real(wp), allocatable, intent(out) :: x(:)
-        integer(ip), intent(out) :: info
-        character(len=*), intent(inout) :: errmsg
-        integer(ip) :: k, i, j, q, nz, at(nrow + 1)
-        integer(ip), allocatable :: cs(:)
-        real(wp), allocatable :: xs(:)
-        real(wp) :: tx
-        info = FRIROM_OK
-        allocate (p(nrow + 1))
-        if (size(c) /= size(r) .or. size(v) /= size(r)) then
-            call set_status(info, FRIROM_ERR_SIZE, errmsg, name//': rows, columns and values '// &
-                            'differ in length')
-            return
-        end if
-        if (any(r < 1) .or. any(r > nrow) .or. any(c < 1) .or. any(c > ncol)) then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, name//': an index is out of range')
-            return
-        end if
-        if (.not. all(abs(v) <= huge(1.0_wp))) then
-            call set_status(info, FRIROM_ERR_PARAM, errmsg, name//': NaN or Inf value')
-            return
-        end if
-        ! counting sort by row, then insertion sort of each row's columns
-        at = 0
-        do k = 1, size(r)
-            at(r(k) + 1) = at(r(k) + 1) + 1
-        end do
-        at(1) = 1
-        do i = 1, nrow
-            at(i + 1) = at(i + 1) + at(i)
-        end do
-        allocate (cs(size(r)), xs(size(r)))
-        p = at
-        do k = 1, size(r)
-            cs(p(r(k))) = c(k)
-            xs(p(r(k))) = v(k)
-            p(r(k)) = p(r(k)) + 1
-        end do
-        nz = 0
-        p(1) = 1
-        do i = 1, nrow
-            do k = at(i) + 1, at(i + 1) - 1
-                q = cs(k)
-                tx = xs(k)
-                j = k - 1
-                do while (j >= at(i))
-                    if (cs(j) <= q) exit
-                    cs(j + 1) = cs(j)
-                    xs(j + 1) = xs(j)
-                    j = j - 1
-                end do
-                cs(j + 1) = q
-                xs(j + 1) = tx
-            end do
-            do k = at(i), at(i + 1) - 1      ! merge duplicates in place (nz <= k)
-                if (nz >= p(i)) then
-                    if (cs(nz) == cs(k)) then
-                        xs(nz) = xs(nz) + xs(k)
-                        cycle
-                    end if
-                end if
-                nz = nz + 1
-                cs(nz) = cs(k)
-                xs(nz) = xs(k)
-            end do
-            p(i + 1) = nz + 1
-        end do
-        if (nz == 0) then
-            ci = [1_ip]
-            x = [0.0_wp]
-        else
-            ci = cs(1:nz)
-            x = xs(1:nz)
-        end if
-    end subroutine coo_csr
 
     !> Dense modal damping C = M Phi diag(2 zeta_r w_r) Phi^T M of the lowest size(zeta)
     !> modes (frirom_damping modal_damping, the kernel frirom.reduction.damping calls too).

@@ -325,3 +325,44 @@ def resume_refuses_changed_mu_and_h(deck, text: str, out, capsys, main) -> str:
     assert "the deck changed" in err and "contacts[0].mu: 0.5 then, 0.4 now" in err
     assert "solver.harmonics: 5 then, 6 now" in err
     return err
+
+
+class Killed(BaseException):
+    """Raised by a sink to stop a run as a kill would (not an Exception: nothing in the
+    library may catch it)."""
+
+
+def run_then_kill(run, writer, folder, kill_after: int):
+    """The same run twice into HDF5 files of ``folder``: uninterrupted into ref.h5, then
+    killed when cut.h5 holds ``kill_after`` points (the file left "running", as after
+    SIGKILL). run(sink, start=None) is frf with a sink; writer(path, append) an FRFWriter.
+    Returns (the uninterrupted result, ref.h5 loaded, cut.h5's path)."""
+    import pytest
+
+    from frirom.results import FRF
+    w = writer(folder / "ref.h5", False)
+    full = run(w.append)
+    w.close(full.complete, full.message)
+    ref = FRF.load(folder / "ref.h5")
+    path = folder / "cut.h5"
+    w = writer(path, False)
+
+    def dying(p):
+        if w._commit[0] == kill_after:
+            raise Killed
+        w.append(p)
+    with pytest.raises(Killed):
+        run(dying)
+    w.f.close()
+    return full, ref, path
+
+
+def resume_into(run, writer, path):
+    """Resume the killed run of ``path`` from its last checkpoint into the same file:
+    (the start it resumed from, the result of the rest)."""
+    from frirom.results import FRFWriter
+    start = FRFWriter.resume_point(path)
+    w = writer(path, True)
+    rest = run(w.append, start)
+    w.close(rest.complete, rest.message)
+    return start, rest

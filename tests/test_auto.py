@@ -34,13 +34,9 @@ def _deck(name, solver, hz=None):
 
 def _peaks(deck, H, N):
     # history=False: the promise checked is the accuracy of the chosen H, N, not whether
-    # the continuation gets through. With the carried contact history, the lift-off
-    # case's H = 8, N = 128 curve wanders through spurious folds at 446-450 Hz (aliasing
-    # at the lift-off onset) and whether it comes out forward depends on rounding: it
-    # did at e38f25a (383 points, peak 1.2946e-3), it turns back after the travelling-wave
-    # merge (4d1adfd) with no change of logic on this path; without history it completes
-    # (peak 1.2934e-3, against 1.2917e-3 at H = 19, N = 2048). An open defect (session
-    # note), not what this test is about.
+    # the continuation gets through. (The lift-off case's H = 8 curve folds several times
+    # at 446-450 Hz; it used to retrace them and turn back at some N, with or without the
+    # history, until tangents kept the curve's orientation: tests/test_orientation.py.)
     opts = dataclasses.replace(deck.options(), harmonics=H, samples=N, stability=False,
                                history=False)
     r = frf(deck.model(), _excitation(deck.F, H), deck.omega_start, deck.omega_end, opts,

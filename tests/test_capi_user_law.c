@@ -1,4 +1,5 @@
-/* A C driver's own contact law through frirom.h: the Jenkins law written here as a
+/* A C driver's own contact law through frirom.h: the Jenkins law of tests/data/userlaw.c
+ * (written from docs/deck.md's rules, not from the Fortran) wrapped as a
  * frirom_user_law_fn, registered with a run whose contact group carries
  * frirom_law_user_code(1, 3, 1), gives the built-in Jenkins run's unknowns to 1e-10 at
  * frequencies below, at and above the stuck resonance; the context pointer comes back
@@ -9,6 +10,9 @@
 #include <string.h>
 #include "frirom.h"
 
+int user_jenkins(int ne, int nd, int n, int np, int ns, const double *u, const double *p,
+                 double *w, double *f);
+
 struct counter { long calls; int fail; };
 
 static int jenkins(void *ctx, int group, int ne, int nd, int n, int np, int ns,
@@ -16,19 +20,8 @@ static int jenkins(void *ctx, int group, int ne, int nd, int n, int np, int ns,
 {
     struct counter *c = ctx;
     c->calls++;
-    if (c->fail || group != 1 || nd != 1 || np != 3 || ns != 1) return 7;
-    for (int k = 0; k < n; ++k)
-        for (int e = 0; e < ne; ++e) {
-            double kt = p[e], lim = p[e + ne] * fmax(p[e + 2 * ne], 0.0);
-            double x = u[e + (long)ne * k], t = kt * (x - w[e]);
-            if (fabs(t) > lim) {
-                double fs = copysign(lim, t);
-                w[e] = x - fs / kt;
-                t = fs;
-            }
-            f[e + (long)ne * k] = t;
-        }
-    return 0;
+    if (c->fail || group != 1) return 7;
+    return user_jenkins(ne, nd, n, np, ns, u, p, w, f) ? 7 : 0;
 }
 
 static int open_run(frirom_run **run, int law, char *msg)

@@ -280,6 +280,12 @@ def test_reduced_fe_deck(block_dir):
     c, b = ends["condensed"], ends["banded"]
     assert c.omega[-1] == pytest.approx(b.omega[-1], rel=1e-7)
     assert c.damping_ratio[-1] == pytest.approx(b.damping_ratio[-1], rel=1e-6)
+    # frirom show at the backbone point of largest damping: the interface maps of the FE
+    # deck, as for a forced-response point
+    out = block_dir / "out_condensed"
+    assert main(["show", str(out), "--dir", str(out / "shown")]) == 0
+    assert (out / "shown" / "maps.png").is_file()
+    assert (out / "shown" / "hysteresis.png").is_file()
 
 
 @pytest.mark.parametrize("analysis, field", [

@@ -11,6 +11,7 @@ failed: a singular D_0 (zgbtrf: zero pivot) or K."""
 import numpy as np
 import pytest
 
+from _models import resume_into, run_then_kill
 from frirom.model import ContactGroup, Damping, Excitation, Model
 from frirom.options import SolverOptions
 from frirom.solver import frf, solve_point
@@ -73,10 +74,6 @@ def test_gross_slip_sweep_has_no_family(form):
     assert 0.1 < peak < 0.5
 
 
-class _Killed(BaseException):
-    """Stands for SIGKILL in-process: nothing after it runs, the writer is not closed."""
-
-
 @pytest.mark.parametrize("form", ["condensed", pytest.param("banded", marks=pytest.mark.slow)])
 def test_free_body_killed_and_resumed_equals_uninterrupted(form, tmp_path):
     """Issue 29: bit-for-bit resume with a free body. The gross-slip sweep (the damper's
@@ -91,26 +88,13 @@ def test_free_body_killed_and_resumed_equals_uninterrupted(form, tmp_path):
 
     def writer(path, append=False):
         return FRFWriter(path, out, ["damper"], 5, append=append)
-    w = writer(tmp_path / "ref.h5")
-    full = frf(model, EXC, 0.5, 1.6, opts, outputs=out, sink=w.append)
-    w.close(full.complete, full.message)
-    ref = FRF.load(tmp_path / "ref.h5")
-    assert full.complete and len(ref) > 40
-    path = tmp_path / "cut.h5"
-    w = writer(path)
 
-    def dying(p):
-        if w._commit[0] == 27:
-            raise _Killed
-        w.append(p)
-    with pytest.raises(_Killed):
-        frf(model, EXC, 0.5, 1.6, opts, outputs=out, sink=dying)
-    w.f.close()
-    start = FRFWriter.resume_point(path)
+    def run(sink, start=None):
+        return frf(model, EXC, 0.5, 1.6, opts, outputs=out, sink=sink, start=start)
+    full, ref, path = run_then_kill(run, writer, tmp_path, 27)
+    assert full.complete and len(ref) > 40
+    start, rest = resume_into(run, writer, path)
     assert 0 < start["n_points"] < 27
-    w = writer(path, append=True)
-    rest = frf(model, EXC, 0.5, 1.6, opts, outputs=out, sink=w.append, start=start)
-    w.close(rest.complete, rest.message)
     got = FRF.load(path)
     assert len(got) == len(ref)
     for name in ("omega", "X", "amp_max", "state_fractions", "slider", "iterations"):

@@ -51,14 +51,8 @@ def _check(outcome, exc, what):
 @settings(max_examples=200, **FUZZ)
 @given(name=st.sampled_from(sorted(DECKS)), rnd=st.randoms(use_true_random=False))
 def test_mutated_decks_load_or_raise_frirom_errors(decks, name, rnd):
-    d = decks[name]
-    data = mutate_deck(DECKS[name].read_text(), rnd)
-    path = d / "fuzzed.toml"
-    path.write_bytes(data)
-    t0 = time.perf_counter()
-    outcome, exc = try_input(lambda: load_and_check(path))
-    _check(outcome, exc, data[:2000])
-    assert time.perf_counter() - t0 < HANG_SECONDS
+    _fuzz(decks[name] / "fuzzed.toml", mutate_deck(DECKS[name].read_text(), rnd),
+          load_and_check)
 
 
 @settings(max_examples=150, **FUZZ)
@@ -94,12 +88,15 @@ def _write(files):
 def test_mutated_study_decks_load_or_raise_frirom_errors(decks, name, rnd):
     """Study decks (a bundled deck with a [study] table) mutated: read, members checked
     and the scheduler chosen (never connected to), or a frirom error."""
-    d = decks[name]
-    data = mutate_deck(DECKS[name].read_text() + STUDY_TABLE, rnd)
-    path = d / "fuzzed_study.toml"
+    _fuzz(decks[name] / "fuzzed_study.toml",
+          mutate_deck(DECKS[name].read_text() + STUDY_TABLE, rnd), study_check)
+
+
+def _fuzz(path, data: bytes, check):
+    """Write the mutated deck, run check(path): a clean outcome or a frirom error, in time."""
     path.write_bytes(data)
     t0 = time.perf_counter()
-    outcome, exc = try_input(lambda: study_check(path))
+    outcome, exc = try_input(lambda: check(path))
     _check(outcome, exc, data[:2000])
     assert time.perf_counter() - t0 < HANG_SECONDS
 

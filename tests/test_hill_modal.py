@@ -50,17 +50,21 @@ def dense_reduced(n=80, seed=3, alpha=0.01, beta=2e-4):
 
 
 @pytest.mark.parametrize("w", [0.9, 1.1, 1.35])
-def test_modal_hill_matches_dense_reference_and_banded_path(w):
+@pytest.mark.parametrize("stability", [True, "strip"])
+def test_modal_hill_matches_dense_reference_and_banded_path(w, stability):
     """Stick-slip (and, at 1.1, near resonance) points of the 80-DoF dense model: the modal
-    route's largest Re s equals numpy's strip and the banded Arnoldi path's, 1e-8 of w."""
+    routes' largest Re s (the exponents nearest 0 through the Newton matrix, and the whole
+    strip by the modes) equal numpy's strip and the banded Arnoldi path's, 1e-8 of w."""
     model, ex = dense_reduced()
     H = 3
     assert 2 * model.n_dof * (2 * H + 1) > HILL_MAX
-    base = dict(harmonics=H, samples=128, stability=True)
+    base = dict(harmonics=H, samples=128)
     pm = solve_point(model, ex, w, SolverOptions(formulation="condensed",
-                                                 receptances="modes", **base),
+                                                 receptances="modes", stability=stability,
+                                                 **base),
                      outputs=np.arange(model.n_dof))
-    pb = solve_point(model, ex, w, SolverOptions(formulation="banded", **base),
+    pb = solve_point(model, ex, w, SolverOptions(formulation="banded", stability=True,
+                                                 **base),
                      outputs=np.arange(model.n_dof))
     np.testing.assert_allclose(pm.X, pb.X, atol=1e-9 * np.abs(pb.X).max())
     assert abs(pm.floquet_max_re - pb.floquet_max_re) < 1e-8 * w, \
@@ -81,7 +85,7 @@ def test_modal_hill_flags_the_saddle_branch_as_the_dense_path():
     small = frf(*duffing_plus_oscillators(0), 1.0, 2.0, SolverOptions(**OPTS), outputs=[0])
     big = frf(*duffing_plus_oscillators(80, zeta_e=0.2), 1.0, 2.0,
               SolverOptions(receptances="modes", **OPTS), outputs=[0])
-    assert "Arnoldi on the modes" in big.solver_info
+    assert "Arnoldi at s = 0" in big.solver_info
     assert big.complete and big.stability_computed
     assert len(small) == len(big)
     np.testing.assert_allclose(big.omega, small.omega, rtol=1e-9)
@@ -114,3 +118,42 @@ def test_truncated_modes_give_the_truncated_models_exponents():
     assert 2 * nm * (2 * H + 1) > HILL_MAX
     assert abs(pm.floquet_max_re - pr.floquet_max_re) < 1e-8 * w, \
         (pm.floquet_max_re, pr.floquet_max_re)
+
+
+def test_near0_in_contact_coordinates_matches_the_banded_path():
+    """Two relative contacts (a Jenkins element between DoFs 0 and 2, a cubic spring
+    between 1 and 3) on the 80-DoF dense model: 2 contact coordinates against 4 contact
+    DoFs, so the s = 0 route (which works in either) leaves the solve on the shorter
+    coordinates; its largest Re s equals the banded Arnoldi path's and the whole strip's
+    (on the contact DoFs), 1e-8 of w."""
+    model, ex = dense_reduced()
+    n = model.n_dof
+    G1 = sp.csr_matrix(([1.0, -1.0], ([0, 0], [0, 2])), shape=(1, n))
+    G2 = sp.csr_matrix(([1.0, -1.0], ([0, 0], [1, 3])), shape=(1, n))
+    model.contacts = [ContactGroup("jenkins", G1, [[2.0, 0.15, 1.0]], name="slider"),
+                      ContactGroup("cubic", G2, [[0.0, 0.3]], name="spring")]
+    from frirom._pack import pack
+    base = dict(harmonics=3, samples=128)
+    o0 = SolverOptions(formulation="condensed", receptances="modes", stability=True, **base)
+    os_ = SolverOptions(formulation="condensed", receptances="modes", stability="strip",
+                        **base)
+    info = pack(model, ex, o0, None).info
+    assert "2 contact coordinates" in info and "s = 0" in info, info
+    assert "4 contact DoFs" in pack(model, ex, os_, None).info
+    for w in (0.9, 1.1):
+        p0 = solve_point(model, ex, w, o0)
+        ps = solve_point(model, ex, w, os_)
+        pb = solve_point(model, ex, w, SolverOptions(formulation="banded", stability=True,
+                                                     **base))
+        assert abs(p0.floquet_max_re - pb.floquet_max_re) < 1e-8 * w, \
+            (p0.floquet_max_re, pb.floquet_max_re)
+        assert abs(ps.floquet_max_re - pb.floquet_max_re) < 1e-8 * w
+
+
+def test_stability_strip_is_an_option_and_bad_values_are_named():
+    """'strip' is a valid stability value (the route it picks is checked above); another
+    string is refused naming the values."""
+    from frirom import ParameterError
+    SolverOptions(stability="strip").check()
+    with pytest.raises(ParameterError, match="'strip'"):
+        SolverOptions(stability="full").check()

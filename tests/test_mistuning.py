@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from _mistuned import disk
-from frirom import ParameterError, SizeError
+from frirom import InputError, ParameterError, SizeError
 from frirom.mistuning import (MistunedDisk, linear_response, monte_carlo, sample_deviations,
                               statistics)
 from frirom.model import ContactGroup, Damping, Excitation, Model
@@ -67,14 +67,35 @@ def test_tuned_annulus_equals_cyclic_sector(built, mu):
             assert np.abs(Xa[s][:, 0] - pc.X[:, 0]).max() / scale < 1e-8
 
 
-def test_mistuned_annulus_equals_full_fe_rotor(built):
+def _blade_elements(K, blade, c):
+    """A blade-elements matrix for the root term: K's blade rows and columns, and on the
+    root (the DoFs they reach) (1 + c) K_rB K_BB^-1 K_Br, so that the blade's condensed
+    root stiffness is S = c K_rB K_BB^-1 K_Br."""
+    K = sp_csr(K)
+    rest = np.setdiff1d(np.arange(K.shape[0]), blade)
+    root = rest[np.unique(K[blade][:, rest].nonzero()[1])]
+    Kbr = K[blade][:, root].toarray()
+    Ke = np.zeros(K.shape)
+    Ke[np.ix_(blade, blade)] = K[blade][:, blade].toarray()
+    Ke[np.ix_(blade, root)] = Kbr
+    Ke[np.ix_(root, blade)] = Kbr.T
+    Ke[np.ix_(root, root)] = (1 + c) * Kbr.T @ np.linalg.solve(Ke[np.ix_(blade, blade)], Kbr)
+    return Ke, root
+
+
+@pytest.mark.parametrize("c", [0.0, 0.5])
+def test_mistuned_annulus_equals_full_fe_rotor(built, c):
     """Complete Craig-Bampton (every fixed-interface mode) and every clamped-blade mode: the
     mistuned annulus equals the full FE rotor whose blade b gets delta_b C^T K_BB C, the
     clamped blade's stiffness acting on its motion relative to its root (C x = x_B - Psi
-    x_root, Psi = -K_BB^-1 K_B,root), assembled in physical DoFs and solved directly (no
-    reduction, no cyclic map), to 1e-9."""
+    x_root, Psi = -K_BB^-1 K_B,root), plus with c > 0 delta_b times the blade's condensed
+    root stiffness S = c K_rB K_BB^-1 K_Br (given to the reduction as the blade elements'
+    matrix), assembled in physical DoFs and solved directly (no reduction, no cyclic map),
+    to 1e-9."""
     d, _ = built
-    ms = mistuning_sector(d["sector"], d["Ks"], d["Ms"], None, d["blade"], keep=d["keep"])
+    Ke = _blade_elements(d["Ks"], d["blade"], c)[0] if c else None
+    ms = mistuning_sector(d["sector"], d["Ks"], d["Ms"], None, d["blade"], keep=d["keep"],
+                          blade_stiffness=Ke)
     delta = deviations(N, 0.05, seed=3)
     damp = Damping.rayleigh(ALPHA, BETA)
     ann = ms.model(delta, damp, interfaces="free")
@@ -93,6 +114,7 @@ def test_mistuned_annulus_equals_full_fe_rotor(built):
         C = np.hstack([np.eye(dofs.size), np.linalg.solve(Kbb, K0[dofs][:, root].toarray())])
         both = np.concatenate([dofs, root])
         K[np.ix_(both, both)] += delta[s] * (C.T @ Kbb @ C)
+        K[np.ix_(root, root)] += delta[s] * c * (C[:, dofs.size:].T @ Kbb @ C[:, dofs.size:])
     full = Model(d["M"], sp_csr(K), damp)
     r = d["r"]
     Q = axis_rotation(2 * np.pi / N)
@@ -111,6 +133,27 @@ def test_mistuned_annulus_equals_full_fe_rotor(built):
         assert np.abs(xa - xf).max() < 1e-9 * np.abs(xf).max()
         # the mistuning shows: blades differ by more than the tolerance
         assert np.ptp(np.linalg.norm(xf, axis=1)) > 1e-3 * np.abs(xf).max()
+
+
+def test_blade_stiffness_checked(built):
+    """The blade elements' matrix: wrong size, a blade block not the sector's, or stiffness
+    on DoFs the blade does not reach: each a clear error."""
+    d, _ = built
+    Ke, root = _blade_elements(d["Ks"], d["blade"], 0.5)
+    args = (d["sector"], d["Ks"], d["Ms"], 4, d["blade"])
+    with pytest.raises(SizeError, match="blade_stiffness: shape"):
+        mistuning_sector(*args, blade_stiffness=Ke[:-1, :-1])
+    bad = Ke.copy()
+    bad[d["blade"][0], d["blade"][0]] *= 1.01
+    with pytest.raises(InputError, match="blade block differs"):
+        mistuning_sector(*args, blade_stiffness=bad)
+    far = np.setdiff1d(np.arange(Ke.shape[0]), np.concatenate([d["blade"], root]))[0]
+    bad = Ke.copy()
+    bad[far, far] = 1.0
+    with pytest.raises(InputError, match="no coupling to it"):
+        mistuning_sector(*args, blade_stiffness=bad)
+    ms = mistuning_sector(*args, blade_stiffness=Ke, keep_root=True)
+    assert ms.root_K is not None and np.isin(ms.reduced(root), np.arange(ms.n_reduced)).all()
 
 
 def test_deviations_inputs(tmp_path):
@@ -215,7 +258,6 @@ def sp_csr(a):
 
 
 def test_mistuning_table(tmp_path):
-    from frirom import InputError
     from frirom.reduction.mistuning import deviations_from_table
     assert np.array_equal(deviations_from_table({"std": 0.02, "seed": 4}, 8),
                           deviations(8, 0.02, seed=4))

@@ -91,10 +91,14 @@ def test_run_deck_equals_api(sector, tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_study_deck_equals_serial_monte_carlo(sector, tmp_path, capsys):
+@pytest.mark.parametrize("scheduler", ["serial", "local"])
+def test_study_deck_equals_serial_monte_carlo(sector, tmp_path, capsys, scheduler):
+    """The deck's study equals monte_carlo run serially; 'local': one LocalCluster of two
+    workers for both interface states."""
     d, folder = sector
     deck = _deck(folder, study='[study]\nkind = "mistuning"\nsamples = 4\n'
-                 'interfaces = ["stuck", "free"]\nscheduler = "serial"\n')
+                 f'interfaces = ["stuck", "free"]\nscheduler = "{scheduler}"\n'
+                 'workers = 2\n')
     assert main(["study", str(deck), "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "stuck 2/4: amplification mean" in out and "free 4/4" in out
@@ -145,3 +149,32 @@ def main_raise(argv):
     from frirom.cli import build_parser
     a = build_parser().parse_args(argv)
     return a.func(a)
+
+
+def test_sector_file_with_blade_stiffness(sector, tmp_path):
+    """A sector file with the blade elements' matrix: the deck's disk carries the root
+    term (keep_root) and equals the API's; a blade matrix that is not the blade's is an
+    error naming the deck and the sector file."""
+    from test_mistuning import _blade_elements
+
+    from frirom.mistuning_deck import build_disk
+    d, _ = sector
+    Ke, root = _blade_elements(d["Ks"], d["blade"], 0.5)
+    kw = dict(blade=d["blade"], keep=d["keep"], output=int(d["tip"][0]), F=d["F"],
+              contacts=d["contacts"])
+    write_sector(tmp_path / "sector.npz", d["Ks"], d["Ms"], d["sector"], blade_stiffness=Ke,
+                 **kw)
+    md = parse_mistuning_deck(_deck(tmp_path))
+    disk_ = build_disk(md)
+    ms = mistuning_sector(d["sector"], d["Ks"], d["Ms"], 12, d["blade"], keep=d["keep"],
+                          blade_stiffness=Ke, keep_root=True)
+    assert disk_.sector.root_K is not None
+    delta = deviations(N, 0.04, seed=3)
+    assert np.allclose(disk_.sector.stiffness(delta).toarray(), ms.stiffness(delta).toarray(),
+                       rtol=1e-12, atol=1e-9 * np.abs(ms.K).max())
+    bad = Ke.copy()
+    bad[d["blade"][0], d["blade"][0]] *= 2
+    write_sector(tmp_path / "sector.npz", d["Ks"], d["Ms"], d["sector"], blade_stiffness=bad,
+                 **kw)
+    with pytest.raises(InputError, match=r"disk.toml: model.sector: .*blade block differs"):
+        build_disk(parse_mistuning_deck(_deck(tmp_path)))

@@ -163,7 +163,7 @@ program test_newton
     type(vee_curve) :: v
     type(ratchet_curve) :: r, rc
     type(cont_options) :: o
-    real(wp) :: y(2), lam, t(3), ds, yout(2, 500), lout(500), tout(3, 500), y1ref
+    real(wp) :: y(2), lam, t(3), ds, yout(2, 500), lout(500), tout(3, 500), y1ref, orient
     integer(ip) :: it(500), npts, info, k, iters, nfold
     logical :: fin, hf
     character(len=256) :: msg
@@ -209,6 +209,38 @@ program test_newton
     call check(abs(yout(1, npts) - y1ref) < 1.0e-10_wp, 'end on the upper branch')
     call check(maxval(lout(1:npts)) < 2.0_wp + 1.0e-9_wp .or. yout(1, npts) > 1.0_wp, &
                'branch order')
+    ! with the curve's orientation (sign(det J) t_lam, cont_tangent): the same two folds;
+    ! then a step against it (the tangent reversed) retraces the curve and is never taken
+    y = [-2.0_wp, 4.0_wp]
+    lam = -4.0_wp
+    hf = .false.
+    call newton_correct(s, y, lam, y, lam, [0.0_wp, 0.0_wp], 1.0_wp, o, iters, info, msg, hf)
+    orient = 0.0_wp
+    call cont_tangent(s, y, lam, o, [0.0_wp, 0.0_wp, 0.0_wp], 1.0_wp, t, info, msg, orient)
+    ! on the lower branch det J = 3 y1^2 - 3 > 0 and lam rises
+    call check(info == 0 .and. orient == 1.0_wp, 'orientation at the first point')
+    ds = o%ds
+    call cont_run(s, y, lam, t, ds, -4.5_wp, o, yout, lout, tout, it, npts, fin, info, msg, &
+                  hf, orient=orient)
+    nfold = count(tout(3, 2:npts)*tout(3, 1:npts - 1) < 0.0_wp)
+    call check(info == 0 .and. fin .and. nfold == 2 .and. &
+               abs(yout(1, npts) - y1ref) < 1.0e-10_wp, 'oriented: two folds, upper branch')
+    call check(all((3*yout(1, 1:npts)**2 - 3)*tout(3, 1:npts) > 0.0_wp), &
+               'oriented: sign(det J) t_lam the same at every point')
+    y = yout(:, 10)
+    lam = lout(10)
+    t = -tout(:, 10)
+    ds = 0.05_wp
+    o%ds_min = 0.01_wp
+    call cont_run(s, y, lam, t, ds, -4.5_wp, o, yout, lout, tout, it, npts, fin, info, msg, &
+                  hf, orient=orient)
+    ! a tangent against the curve's orientation: refused at every step above ds_min; at
+    ! ds_min the caller's direction is taken (the determinant's sign is not trusted there)
+    ! and the orientation taken again from it: the run goes back to its end, orient -1
+    call check(info == 0 .and. fin .and. orient == -1.0_wp .and. lout(npts) <= -4.5_wp, &
+               'a step back along the curve: refused above ds_min, then the caller''s '// &
+               'direction, re-oriented: '//trim(msg))
+    o%ds_min = 1.0e-6_wp
     ! step factors: each shape measure brought to its target (angle ~ ds, distance ~ ds^2),
     ! the Newton effort limiting, growth and shrink bounded
     call check(abs(cont_step_factor(2.0_wp*o%angle_target, 0.0_wp, 1_ip, o) - 0.5_wp) < &

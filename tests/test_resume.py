@@ -22,7 +22,7 @@ import h5py
 import numpy as np
 import pytest
 
-from _models import resume_refuses_changed_mu_and_h
+from _models import resume_into, resume_refuses_changed_mu_and_h, run_then_kill
 from frirom.cli import main
 from frirom.deck import load_deck
 from frirom.results import FRF, FRFWriter
@@ -366,26 +366,14 @@ def test_resume_exact_when_the_solver_carries_its_lu(tmp_path):
 
     def writer(path, append=False):
         return FRFWriter(path, out, ["interface"], 3, append=append)
-    w = writer(tmp_path / "ref.h5")
-    full = frf(model, exc, w0, w1, opts, outputs=out, sink=w.append)
-    w.close(full.complete, full.message)
-    ref = FRF.load(tmp_path / "ref.h5")
-    assert len(ref) == 34 and full.timings["krylov_iterations"] > 0
-    path = tmp_path / "cut.h5"
-    w = writer(path)
 
-    def dying(p):
-        if w._commit[0] == 15:
-            raise Killed
-        w.append(p)
-    with pytest.raises(Killed):
-        frf(model, exc, w0, w1, opts, outputs=out, sink=dying)
-    w.f.close()
+    def run(sink, start=None):
+        return frf(model, exc, w0, w1, opts, outputs=out, sink=sink, start=start)
+    full, ref, path = run_then_kill(run, writer, tmp_path, 15)
+    assert len(ref) == 34 and full.timings["krylov_iterations"] > 0
     start = FRFWriter.resume_point(path)
     assert start["n_points"] == 11 and start["held_lu"][0] == 1.0
-    w = writer(path, append=True)
-    rest = frf(model, exc, w0, w1, opts, outputs=out, sink=w.append, start=start)
-    w.close(rest.complete, rest.message)
+    start, rest = resume_into(run, writer, path)
     _same(FRF.load(path), ref, "resumed with a carried LU")
     # a tampered state is refused by name, not used (a flag of -1 made GMRES run on a
     # Jacobian never formed: tests/fuzz_capi.c found it through the C checkpoint)

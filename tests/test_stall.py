@@ -39,3 +39,21 @@ def test_no_progress_in_frequency_stops_with_a_diagnosis():
     assert "tolerance floor" in r.message and "tol_stall" in r.message, r.message
     assert "max_points" not in r.message
     assert np.ptp(r.omega) < 1e-6 * (200.0 - 20.0)
+
+
+def test_stop_messages_give_hz_with_units():
+    """Issue 29 item 5: FRF.message named frequencies in rad/s only (and a stall none).
+    A curve stopped by max_points and one that stalls: the message ends with the last
+    point's frequency in Hz and rad/s, each with its unit, equal to the stored point's."""
+    from frirom._errors import with_hz
+    model, exc = _chain()
+    r = frf(model, exc, 20.0, 200.0, SolverOptions(harmonics=1, max_points=5,
+                                                   stability=False, refine_peak=False))
+    assert not r.complete and "max_points" in r.message, r.message
+    w = float(r.omega[-1])
+    assert f"last point at {w / 2 / np.pi:.7g} Hz, {w:.7g} rad/s" in r.message, r.message
+    # a Fortran frequency in rad/s gets its Hz beside it, once (idempotent)
+    text = "left the range through 11905.52 rad/s (start 11938.05 rad/s)"
+    assert with_hz(text) == ("left the range through 11905.52 rad/s (1894.82 Hz) "
+                             "(start 11938.05 rad/s (1900 Hz))")
+    assert with_hz(with_hz(text)) == with_hz(text)

@@ -11,11 +11,16 @@ dense numpy solve is timed for scale only with --dense-ref (minutes at these siz
     python cases/bench/hill.py [--quick] [--repeat 3] [--flange WORK [--rom1]]
 
 Above HILL_MAX a condensed system with receptances from real modes (a reduced model)
-takes Hill's modal route (the modes diagonal per harmonic, the contacts by Woodbury on
-the contact DoFs), the others the banded one. Per model the table gives the Hill
-unknowns, the route, its memory (frirom._routes.hill_bytes), seconds per point with and
-without stability, and |max Re s - the banded path's| where that path fits (dense ROM of
-80 DoFs). --flange WORK: the paper flange's ROM_II (WORK/rom2.toml, made by
+takes Hill's route at s = 0 ('near0': the exponents nearest 0 by real shift-invert
+Arnoldi, each solve by Woodbury through the point solve's own Newton matrix and the LU it
+holds), or with --strip (stability = "strip") the modal route over the whole strip (the
+modes diagonal per harmonic, the contacts by Woodbury on the contact DoFs); the others
+the banded one. "F solve" and "F Hill" are the Fortran run's own times (the solve
+without stability, T_HILL with it), free of the Python packing the wall times include.
+Per model the table gives the Hill unknowns, the route, its memory
+(frirom._routes.hill_bytes), seconds per point with and without stability, and
+|max Re s - the banded path's| where that path fits (dense ROM of 80 DoFs).
+--flange WORK: the paper flange's ROM_II (WORK/rom2.toml, made by
 cases/paper_flange/paper_flange.py make --work WORK) and, with --rom1, ROM_I, one point
 each mid-band; the last line is ROM_I's stability cost per point relative to its solve
 and its memory (targets <= 1x, <= 2 GiB). Writes cases/bench/results/hill.json.
@@ -31,6 +36,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import sys
 import tempfile
 import time
@@ -101,26 +107,30 @@ def flange_deck(work: Path, rom: str):
     return d.model(), d.excitation(), 0.5 * (d.omega_start + d.omega_end), d.options()
 
 
-def route_memory(model, H, o):
+def route_memory(model, H, o, strip=False):
     """Hill's route and memory [bytes] for this model and options (as _pack decides)."""
     import frirom._routes as rt
     n = model.n_dof
     nl = model.nonlinear_dofs().size
     modal = o.get("formulation", "condensed") == "condensed" and (
         o.get("receptances") == "modes" or "flange" in o.get("_tag", ""))
-    route = rt._hill_route(n, H, 1 if modal else 0, nl)
-    if route == "modal":
-        return route, rt.hill_bytes(n, H, 0, (n, nl))
+    route = rt._hill_route(n, H, 1 if modal else 0, nl, strip=strip)
+    if route in ("modal", "near0"):
+        return route, rt.hill_bytes(n, H, 0, (n, nl), near0=route == "near0")
     return route, rt.hill_bytes(n, H, n - 1 if route == "banded" else 0)
 
 
 def timed(model, ex, w, o, repeat):
-    best = np.inf
+    """Best wall time of solve_point, its point, and the best Fortran times (the run's
+    total and Hill's, T_HILL) over the repeats."""
+    best, fort, hill = np.inf, np.inf, np.inf
     for _ in range(repeat):
         t = time.perf_counter()
         p = solve_point(model, ex, w, o)
         best = min(best, time.perf_counter() - t)
-    return best, p
+        fort = min(fort, p.timings.get("fortran_total", np.nan))
+        hill = min(hill, p.timings.get("hill", np.nan))
+    return best, p, fort, hill
 
 
 def numpy_dense(m):
@@ -141,6 +151,8 @@ def main(argv=None):
                     help="time numpy's dense eig above HILL_MAX too (slow)")
     ap.add_argument("--flange", help="paper flange work folder (rom2.toml, rom1.toml)")
     ap.add_argument("--rom1", action="store_true", help="with --flange: ROM_I too")
+    ap.add_argument("--strip", action="store_true",
+                    help='stability = "strip" (the whole strip on reduced models)')
     a = ap.parse_args(argv)
     cases = [("duffing+osc", 80, 3), ("duffing+osc", 400, 3), ("chain", 80, 3),
              ("chain", 400, 3)]
@@ -163,7 +175,8 @@ def main(argv=None):
     rows = []
     print(f"HILL_MAX = {HILL_MAX} (dense up to 2 n_dof (2H+1))")
     print(f"{'model':>14} {'n_dof':>6} {'H':>2} {'Hill n':>7} {'route':>7} {'MiB':>8} "
-          f"{'solve s':>8} {'Hill s':>8} {'Hill/solve':>10} {'max Re':>10} {'|dRe|':>9}")
+          f"{'solve s':>8} {'Hill s':>8} {'Hill/solve':>10} {'F solve':>8} {'F Hill':>8} "
+          f"{'max Re':>10} {'|dRe|':>9}")
     for name, n, H in cases:
         ref = None
         rep = a.repeat
@@ -190,9 +203,10 @@ def main(argv=None):
             model, ex, w = cantilever(H, tmp)
             o = dict(harmonics=H, samples=128)
         tag = o.pop("_tag", "")
-        route, mem = route_memory(model, H, dict(o, _tag=tag))
-        t0, _ = timed(model, ex, w, SolverOptions(**o, stability=False), rep)
-        t1, p = timed(model, ex, w, SolverOptions(**o, stability=True), rep)
+        route, mem = route_memory(model, H, dict(o, _tag=tag), a.strip)
+        stab = "strip" if a.strip else True
+        t0, _, f0, _ = timed(model, ex, w, SolverOptions(**o, stability=False), rep)
+        t1, p, _, fh = timed(model, ex, w, SolverOptions(**o, stability=stab), rep)
         d_re = float("nan")
         if ref is not None:
             pr = solve_point(model, ex, w, SolverOptions(**ref, stability=True))
@@ -200,12 +214,15 @@ def main(argv=None):
         nh = model.n_dof * (2 * H + 1)
         row = dict(model=name, n_dof=model.n_dof, H=H, hill_unknowns=2 * nh, route=route,
                    memory_bytes=int(mem), solve_s=t0, hill_s=t1 - t0,
-                   hill_per_solve=(t1 - t0) / t0, max_re=p.floquet_max_re,
+                   hill_per_solve=(t1 - t0) / t0, solve_fortran_s=f0, hill_fortran_s=fh,
+                   hill_per_solve_fortran=fh / f0,
+                   peak_rss_bytes=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
+                   max_re=p.floquet_max_re,
                    stable=bool(p.stable), abs_diff_re_banded=d_re, omega=w)
         rows.append(row)
         print(f"{name:>14} {model.n_dof:6d} {H:2d} {2 * nh:7d} {route:>7} {mem / 2**20:8.1f} "
-              f"{t0:8.3f} {t1 - t0:8.3f} {(t1 - t0) / t0:10.2f} {p.floquet_max_re:+10.3e} "
-              f"{d_re:9.1e}", flush=True)
+              f"{t0:8.3f} {t1 - t0:8.3f} {(t1 - t0) / t0:10.2f} {f0:8.3f} {fh:8.3f} "
+              f"{p.floquet_max_re:+10.3e} {d_re:9.1e}", flush=True)
     try:
         # the common results file (cases/bench/_results.py, record() in __main__) where
         # there is one: the rows as its data
@@ -223,9 +240,11 @@ def main(argv=None):
     if last:
         r = last[0]
         print(f"{'paper' if r['n_dof'] > 1000 else 'coarse (--quick)'} flange ROM_I "
-              f"({r['n_dof']} DoFs): stability costs {r['hill_per_solve']:.2f}x its solve "
-              f"per point (target <= 1x), {r['memory_bytes'] / 2**30:.2f} GiB "
-              f"(target <= 2 GiB)")
+              f"({r['n_dof']} DoFs, route {r['route']}): stability costs "
+              f"{r['hill_per_solve']:.2f}x its solve per point (wall; Fortran "
+              f"{r['hill_per_solve_fortran']:.2f}x) (target <= 1x), Hill "
+              f"{r['memory_bytes'] / 2**30:.3f} GiB, process peak "
+              f"{r['peak_rss_bytes'] / 2**30:.2f} GiB (target <= 2 GiB)")
 
 
 if __name__ == "__main__":

@@ -10,8 +10,10 @@ harmonics 0..3.
 
 Measures: the sizes (FE sector and annulus, reduced sector and annulus, contact unknowns),
 the seconds of one tuned and one mistuned FRF with friction, the throughput of the friction
-study in samples per minute serially and on a LocalCluster of two worker processes (and
-its memory per worker), the amplification factor's statistics with friction, stuck and
+study in samples per minute serially and on frirom's LocalCluster of two worker processes
+(frirom.mistuning.local_cluster), back to back, three times (min and median speed-up, the
+load average before each, CPU seconds per sample serially and in a worker, each worker's
+import seconds and memory), the amplification factor's statistics with friction, stuck and
 free; writes cases/bench/results/mistuning.json and the figures
 cases/bench/results/mistuning_*.png (copied into docs/_static by --docs). Last line: seconds
 per mistuned FRF and the Dask speed-up.
@@ -25,19 +27,24 @@ import argparse
 import json
 import os
 import shutil
+import statistics as stat
 import sys
 import time
 from pathlib import Path
 
-import numpy as np
+# before numpy: one BLAS thread here as in every worker, so that serial and two workers
+# compare one core with two
+for _v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_v, "1")
+import numpy as np  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 from _mistuned import disk  # noqa: E402
 
-from frirom.mistuning import MistunedDisk, monte_carlo, sample_deviations  # noqa: E402
+from frirom.mistuning import (MistunedDisk, local_cluster, monte_carlo,  # noqa: E402
+                              sample_deviations)
 from frirom.mistuning_plots import (plot_amplification, plot_blade_amplitudes,  # noqa: E402
                                     plot_envelopes)
 from frirom.model import Damping  # noqa: E402
@@ -88,28 +95,13 @@ def main(argv=None):
     one = md.response(sample_deviations(N, STD, 0, 0), "friction")
     print(f"one FRF with friction: tuned {tuned.seconds:.2f} s ({tuned.omega.size} points), "
           f"mistuned {one.seconds:.2f} s ({one.omega.size} points)")
+    speed = _speedup(md, tuned, n_per=4 if a.quick else 8, reps=2 if a.quick else 3)
     t0 = time.perf_counter()
     serial = monte_carlo(md, n_fr, STD, seed=1, tuned=tuned)
     t_serial = time.perf_counter() - t0
-
-    def progress(done, total, af):
-        print(f"  dask: {done}/{total} samples, amplification so far mean {af.mean():.3f} "
-              f"max {af.max():.3f}", flush=True)
-
-    from dask.distributed import Client, LocalCluster
-    with LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=None) as c:
-        with Client(c) as cl:        # workers up and frirom imported before the clock
-            cl.run(lambda: __import__("frirom.mistuning"))
-            mem = {k: round(v, 1) for k, v in cl.run(_rss).items()}
-        t0 = time.perf_counter()
-        dist = monte_carlo(md, n_fr, STD, seed=1, scheduler=c.scheduler_address,
-                           progress=progress, tuned=tuned)
-        t_dask = time.perf_counter() - t0
-    assert np.allclose(dist["af"], serial["af"], rtol=1e-10), "Dask and serial differ"
     rate_s = 60 * n_fr / t_serial
-    rate_d = 60 * n_fr / t_dask
-    print(f"friction study, {n_fr} samples: serial {rate_s:.1f} samples/min, two workers "
-          f"{rate_d:.1f} samples/min (speed-up {rate_d / rate_s:.2f}); worker memory {mem} MB")
+    print(f"friction study, {n_fr} samples serially: {rate_s:.1f} samples/min, so 200 "
+          f"samples in {200 / rate_s:.1f} min")
     t0 = time.perf_counter()
     lin = {st: monte_carlo(md, n_lin, STD, seed=1, interfaces=st) for st in ("stuck", "free")}
     t_lin = (time.perf_counter() - t0) / (2 * n_lin)
@@ -136,13 +128,66 @@ def main(argv=None):
            "seconds_tuned_frf": tuned.seconds, "seconds_mistuned_frf": one.seconds,
            "points_mistuned_frf": int(one.omega.size),
            "friction_samples": n_fr, "serial_samples_per_min": rate_s,
-           "dask2_samples_per_min": rate_d, "dask_speedup": rate_d / rate_s,
-           "worker_memory_mb": mem, "linear_samples": n_lin,
+           "dask2_samples_per_min": speed["dask_rate_median"],
+           "dask_speedup": speed["speedup_median"], "dask": speed,
+           "worker_memory_mb": speed["worker_memory_mb"], "linear_samples": n_lin,
            "seconds_per_linear_sample": t_lin, "statistics": stats,
            "cpu_count": os.cpu_count()}
     (out / "mistuning.json").write_text(json.dumps(res, indent=1))
     print(f"seconds per mistuned FRF {one.seconds:.2f}, Dask speed-up "
-          f"{rate_d / rate_s:.2f}")
+          f"{speed['speedup_median']:.2f} (median of {len(speed['speedup'])}, min "
+          f"{speed['speedup_min']:.2f}; load average {speed['load_median']:.1f})")
+
+
+def _speedup(md, tuned, n_per: int, reps: int) -> dict:
+    """Serial and two LocalCluster workers back to back, ``reps`` times, ``n_per`` friction
+    samples each (the same samples): samples per minute, speed-up, CPU seconds per sample
+    (serial and in the workers) and the load average (1 min) before each run. The cluster
+    is started and frirom imported in its workers (one at a time: warm_workers) before
+    any clock (frirom.mistuning.local_cluster); the seconds of that import are
+    reported."""
+    out = {"n_per_run": n_per, "serial_rate": [], "dask_rate": [], "speedup": [],
+           "load": [], "cpu_serial": [], "cpu_worker": [], "wall_worker": [],
+           "process_cpu_serial": [], "process_cpu_worker": []}
+    c, cl, imp = local_cluster(2)      # workers up and frirom imported, one at a time
+    with c, cl:
+        out["worker_import_seconds"] = sorted(round(v, 2) for v in imp.values())
+        out["worker_memory_mb"] = sorted(round(v, 1) for v in cl.run(_rss).values())
+        for r in range(reps):
+            seed = 100 + r                            # fresh samples each repetition
+            out["load"].append(os.getloadavg()[0])
+            t0 = time.perf_counter()
+            s = monte_carlo(md, n_per, STD, seed=seed, tuned=tuned)
+            ts = time.perf_counter() - t0
+            t0 = time.perf_counter()
+            d = monte_carlo(md, n_per, STD, seed=seed, tuned=tuned, scheduler=cl)
+            td = time.perf_counter() - t0
+            assert np.allclose(d["af"], s["af"], rtol=1e-10), "Dask and serial differ"
+            out["serial_rate"].append(60 * n_per / ts)
+            out["dask_rate"].append(60 * n_per / td)
+            out["speedup"].append(ts / td)
+            out["cpu_serial"].append(float(np.mean([x["cpu_seconds"] for x in s["samples"]])))
+            out["cpu_worker"].append(float(np.mean([x["cpu_seconds"] for x in d["samples"]])))
+            out["wall_worker"].append(float(np.mean([x["seconds"] for x in d["samples"]])))
+            out["process_cpu_serial"].append(float(np.mean([x["process_cpu_seconds"]
+                                                            for x in s["samples"]])))
+            out["process_cpu_worker"].append(float(np.mean([x["process_cpu_seconds"]
+                                                            for x in d["samples"]])))
+            print(f"  run {r + 1}/{reps} (load average {out['load'][-1]:.1f}): serial "
+                  f"{out['serial_rate'][-1]:.1f}/min, two workers {out['dask_rate'][-1]:.1f}"
+                  f"/min, speed-up {out['speedup'][-1]:.2f}; CPU s per sample serial "
+                  f"{out['cpu_serial'][-1]:.2f}, in a worker {out['cpu_worker'][-1]:.2f} "
+                  f"(whole process {out['process_cpu_serial'][-1]:.2f}, "
+                  f"{out['process_cpu_worker'][-1]:.2f}; wall in a worker "
+                  f"{out['wall_worker'][-1]:.2f})", flush=True)
+    out.update(speedup_min=min(out["speedup"]), speedup_median=stat.median(out["speedup"]),
+               dask_rate_median=stat.median(out["dask_rate"]),
+               load_median=stat.median(out["load"]))
+    print(f"Dask speed-up, two workers over serial: min {out['speedup_min']:.2f}, median "
+          f"{out['speedup_median']:.2f} (load average {min(out['load']):.1f}.."
+          f"{max(out['load']):.1f}); worker import {out['worker_import_seconds']} s, "
+          f"memory {out['worker_memory_mb']} MB")
+    return out
 
 
 def _rss() -> float:

@@ -18,6 +18,17 @@ The references: ccx's own eigenfrequencies of the blades without the damper (``f
 the damper's modes are its rigid motions and ones far above) and of the assembly with the
 contact patches joined by springs kt (x, z) and kn (y) pair by pair (``stuck``: SPRING2
 elements), written to free.dat and stuck.dat.
+
+The retainer (``retainer`` [N/m], default RETAINER): a soft elastic support of the damper
+to the ground, SPRING1 elements on every damper node in x, y and z, the stiffness per
+direction split evenly over the nodes. Real dampers sit in a pocket and are kept in place
+by it or by a retaining wire; here it gives the damper's rigid motions finite
+frequencies (200.8 Hz its translations, 222-228 Hz its rotations: a tenth of the band),
+so that once the damper slips on both platforms its mean position is decided by a force
+the structure carries in every harmonic, in the HBM and in the time integration alike,
+instead of being left free. It is in the matrices (upd.sti) and in stuck.dat (the stuck
+frequencies move by 2e-5); free.dat (the blades alone) has no damper. ``retainer = 0``:
+the damper held only by its contacts (six rigid motions at 0 Hz).
 """
 
 from __future__ import annotations
@@ -41,6 +52,11 @@ def _blade(i):
 
 
 DAMPER = [(15, 25, 8, 10, 1, 9)]
+#: the damper's retainer, N/m per direction (the whole damper): 1.6e4 N/m puts its
+#: translations on the retainer near 200 Hz (mass 10.0 g), 1/10 of the band; it is
+#: 8.9e-5 of the contacts' stuck tangential stiffness on the full model (90 x 2e6 N/m),
+#: 2.7e-4 on the coarse one (30 pairs)
+RETAINER = 1.6e4
 #: contact patches (x0, x1) at y = 10, z in [1, 9]: left on blade 0, right on blade 1
 PATCHES = {"L": (15, 19, 0), "R": (21, 25, 1)}
 
@@ -99,7 +115,8 @@ def upd_mesh(h=0.002, damper=True, stride=1):
     return (np.array(ids), np.vstack(xyz), np.vstack(elems), sets)
 
 
-def _deck(path, title, ids, xyz, elems, sets, springs=None, n_ref_modes=0, storage=True):
+def _deck(path, title, ids, xyz, elems, sets, springs=None, n_ref_modes=0, storage=True,
+          retainer=0.0):
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "w") as fh:
@@ -115,12 +132,27 @@ def _deck(path, title, ids, xyz, elems, sets, springs=None, n_ref_modes=0, stora
                 e0 += len(pairs)
             for d, k in ((1, kt), (2, kn), (3, kt)):
                 fh.write(f"*SPRING, ELSET=SP{d}\n{d},{d}\n{k:.10e}\n")
+        if retainer > 0:
+            _retainer(fh, elems, sets, springs, retainer)
         fh.write("*BOUNDARY\nFIX, 1, 3\n")
         if storage:
             fh.write(matrix_storage_steps(n_ref_modes))
         else:
             fh.write(f"*STEP\n*FREQUENCY\n{n_ref_modes}\n*END STEP\n")
     return path
+
+
+def _retainer(fh, elems, sets, springs, k):
+    """SPRING1 elements on every DAMPER node, x, y, z: k [N/m] per direction in all.
+    Element numbers follow the C3D8 (and SPRING2) ones."""
+    nodes = np.asarray(sets["DAMPER"])
+    e0 = len(elems) + 1 + (3 * len(springs[0]) if springs is not None else 0)
+    for d in (1, 2, 3):
+        fh.write(f"*ELEMENT, TYPE=SPRING1, ELSET=RT{d}\n")
+        for j, n in enumerate(nodes):
+            fh.write(f"{e0 + j}, {int(n)}\n")
+        e0 += len(nodes)
+        fh.write(f"*SPRING, ELSET=RT{d}\n{d}\n{k / len(nodes):.10e}\n")
 
 
 def contact_pairs(xyz, sets):
@@ -133,15 +165,19 @@ def contact_pairs(xyz, sets):
     return out
 
 
-def write_upd(out, h=0.002, kt=2.0e6, kn=5.0e6, n_ref_modes=12, stride=1):
+def write_upd(out, h=0.002, kt=2.0e6, kn=5.0e6, n_ref_modes=12, stride=1,
+              retainer=RETAINER):
     """The matrices (upd.sti/.mas/.dof + upd.inp) and the two references (free.dat,
-    stuck.dat); returns the job path. stride: see upd_mesh."""
+    stuck.dat); returns the job path. stride: see upd_mesh; retainer [N/m]: the damper's
+    elastic support (module docstring; 0: none)."""
     out = Path(out)
     ids, xyz, elems, sets = upd_mesh(h, stride=stride)
-    job = run_ccx(_deck(out / "upd.inp", f"UPD, C3D8, h = {h} m", ids, xyz, elems, sets))
+    job = run_ccx(_deck(out / "upd.inp", f"UPD, C3D8, h = {h} m", ids, xyz, elems, sets,
+                        retainer=retainer))
     pairs = contact_pairs(xyz, sets)
     run_ccx(_deck(out / "stuck.inp", "UPD stuck: patches joined by springs", ids, xyz,
-                  elems, sets, (pairs, kt, kn), n_ref_modes, storage=False), expect=(".dat",))
+                  elems, sets, (pairs, kt, kn), n_ref_modes, storage=False,
+                  retainer=retainer), expect=(".dat",))
     ids0, xyz0, elems0, sets0 = upd_mesh(h, damper=False)
     run_ccx(_deck(out / "free.inp", "UPD free: the blades alone", ids0, xyz0, elems0, sets0,
                   None, n_ref_modes, storage=False), expect=(".dat",))

@@ -60,26 +60,58 @@ def optimum(loads, peaks) -> tuple[float, float]:
     return float(np.exp(xs)), float(np.polyval([a, b, c], xs))
 
 
+def stored_peaks(design_deck, out):
+    """(loads, peaks, complete) of the study's members stored in ``out`` so far: the
+    largest stored amplitude of TIP_0 x (FRF.peak) of every member with points, complete
+    or not: complete, or unfinished but 10 % down past its peak, True; stopped early
+    (turned back, failed) False; unfinished before its peak (still running, or killed:
+    its largest amplitude so far is a lower bound) None."""
+    from frirom.results import FRF
+    from frirom.study import load_study
+    loads, peaks, ok = [], [], []
+    for m in load_study(design_deck).members:
+        h5 = Path(out) / "members" / m["name"] / "frf.h5"
+        if not h5.is_file():
+            continue
+        r = FRF.load(h5)
+        if len(r):
+            loads.append(float(next(iter(m["values"].values()))))
+            peaks.append(float(r.peak(0).amplitude))
+            unfinished = not r.complete and r.message.strip() in ("", "running")
+            amp = r.amp_max[:, 0]
+            k = int(np.argmax(amp))
+            # an unfinished curve already past its peak (10 % down since) has its peak
+            passed = unfinished and 0 < k < len(amp) - 1 and amp[-1] < 0.9 * amp[k]
+            ok.append(True if passed or r.complete else (None if unfinished else False))
+    return loads, peaks, ok
+
+
 def plot_design(loads, peaks, limits, opt, ok):
     """The design curve: peak against load (log), limits dashed, optimum marked."""
     import matplotlib.figure
     fig = matplotlib.figure.Figure(figsize=(6.4, 4.2), layout="constrained")
     ax = fig.add_subplot()
-    loads, peaks, ok = np.asarray(loads), np.asarray(peaks) * 1e6, np.asarray(ok)
-    ax.semilogx(loads[ok], peaks[ok], "o-", color="C0", label="HBM: peak of TIP_0 x")
-    if np.any(~ok):
-        ax.semilogx(loads[~ok], peaks[~ok], "x", color="C3", ms=9,
-                    label="curve stopped early")
+    loads, peaks = np.asarray(loads), np.asarray(peaks) * 1e6
+    state = np.array([2 if v is None else int(bool(v)) for v in ok])
+    done, stop, going = state == 1, state == 0, state == 2
+    ax.semilogx(loads[done], peaks[done], "o-", color="C0", label="HBM: peak of TIP_0 x")
+    if np.any(stop):
+        ax.semilogx(loads[stop], peaks[stop], "x", color="C3", ms=9,
+                    label="curve turned back at a fold (lift-off): largest before it")
+    if np.any(going):
+        ax.semilogx(loads[going], peaks[going], "^", color="C4", ms=8,
+                    label="curve unfinished: largest so far (a lower bound)")
     for name, style, col in (("free", "--", "C1"), ("stuck", ":", "C2")):
         fz, a = limits[name]
         ax.axhline(a * 1e6, ls=style, color=col,
                    label=f"linear, contacts {name} ({fz:.1f} Hz)")
-    ax.plot([opt[0]], [opt[1] * 1e6], "*", color="C3", ms=14,
-            label=f"optimum: {opt[0]:.3g} N, {opt[1] * 1e6:.3g} um")
+    if opt is not None:
+        ax.plot([opt[0]], [opt[1] * 1e6], "*", color="C3", ms=14,
+                label=f"optimum: {opt[0]:.3g} N, {opt[1] * 1e6:.3g} um")
     ax.set_xlabel("damper normal load [N]")
     ax.set_ylabel("peak amplitude of TIP_0 x [um]")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(loc="upper right", fontsize=8)
+    ax.legend(loc="best", fontsize=8)
     ax.set_title("Under-platform damper: design curve")
     return fig
 
@@ -91,6 +123,11 @@ def main(argv=None):
                     help="contact pairs at every stride-th lattice point (2: coarse)")
     ap.add_argument("--work", type=Path, default=None,
                     help="folder of the matrices and decks (default: cases/upd itself)")
+    ap.add_argument("--workers", type=int, default=1,
+                    help="members run at once (a local Dask cluster; 1: in this process)")
+    ap.add_argument("--plot-only", action="store_true",
+                    help="draw the design curve from the members stored in OUT so far "
+                         "(a study still running or stopped; no solve)")
     a = ap.parse_args(argv)
     from frirom.deck import load_deck
     from frirom.study import run_study
@@ -102,28 +139,43 @@ def main(argv=None):
                 shutil.copy(HERE / name, work / name)
     if not (work / "upd.sti").exists():
         make_upd.make(work, stride=a.stride)
-    res = run_study(work / "upd_design.toml", a.out, scheduler="serial")
-    loads, peaks, ok = [], [], []
-    for s in res["summaries"]:
-        loads.append(float(next(iter(s["values"].values()))))
-        peaks.append(float(s["peaks"][0][1]))
-        ok.append(bool(s.get("complete", False)) and not s.get("failed"))
+    if a.plot_only:
+        loads, peaks, ok = stored_peaks(work / "upd_design.toml", a.out)
+    else:
+        if a.workers > 1:
+            # a member's solve holds the GIL in Fortran for minutes at H = 3: without
+            # this the scheduler takes the silent worker for dead after its 5-minute
+            # heartbeat TTL, restarts it and the member starts over
+            import dask
+            dask.config.set({"distributed.scheduler.worker-ttl": None})
+        res = run_study(work / "upd_design.toml", a.out,
+                        scheduler="serial" if a.workers <= 1 else "local",
+                        workers=a.workers if a.workers > 1 else None)
+        loads, peaks, ok = [], [], []
+        for s in res["summaries"]:
+            loads.append(float(next(iter(s["values"].values()))))
+            peaks.append(float(s["peaks"][0][1]))
+            ok.append(bool(s.get("complete", False)) and not s.get("failed"))
     order = np.argsort(loads)
     loads, peaks, ok = (list(np.asarray(v)[order]) for v in (loads, peaks, ok))
     deck = load_deck(work / "upd.toml")
     f_lo, f_hi = deck.omega_start / 2 / np.pi, deck.omega_end / 2 / np.pi
     limits = linear_peaks(deck, f_lo, f_hi)
-    good = np.asarray(ok)
-    opt = optimum(np.asarray(loads)[good], np.asarray(peaks)[good])
+    good = np.array([v is True or v is np.True_ for v in ok])
+    opt = (optimum(np.asarray(loads)[good], np.asarray(peaks)[good]) if np.any(good)
+           else None)
     a.out.mkdir(parents=True, exist_ok=True)
     with open(a.out / "design.csv", "w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(["load_N", "peak_m", "complete"])
+        w.writerow(["load_N", "peak_m", "curve"])
         for row in zip(loads, peaks, ok):
-            w.writerow([f"{row[0]:.6g}", f"{row[1]:.6e}", int(row[2])])
+            kind = "unfinished" if row[2] is None else ("peak" if row[2] else "stopped")
+            w.writerow([f"{row[0]:.6g}", f"{row[1]:.6e}", kind])
     plot_design(loads, peaks, limits, opt, ok).savefig(a.out / "design.png", dpi=120)
-    print(f"design curve: {len(loads)} loads; optimum {opt[0]:.4g} N, peak "
-          f"{opt[1]:.4e} m; linear free {limits['free'][1]:.4e} m at "
+    best = (f"optimum {opt[0]:.4g} N, peak {opt[1]:.4e} m" if opt is not None
+            else "no complete curve yet")
+    print(f"design curve: {len(loads)} loads ({int(np.sum(good))} complete); {best}; "
+          f"linear free {limits['free'][1]:.4e} m at "
           f"{limits['free'][0]:.1f} Hz, stuck {limits['stuck'][1]:.4e} m at "
           f"{limits['stuck'][0]:.1f} Hz; wrote {a.out / 'design.png'}")
     return 0

@@ -25,6 +25,15 @@ CONNECT_TIMEOUT = 10.0
 PROBE_MAX_BYTES = 1 << 26
 #: Most LocalCluster workers a study may ask for.
 MAX_WORKERS = 1024
+#: Environment of frirom's LocalCluster workers: one BLAS/OpenMP thread each, so that n
+#: workers use n cores and not n times the machine.
+ONE_THREAD = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
+#: Dask settings of frirom's LocalCluster workers (see :func:`local_workers`).
+QUIET_WORKER = {"distributed.worker.profile.enabled": False,
+                "distributed.admin.tick.interval": "1s",
+                "distributed.admin.system-monitor.interval": "5s",
+                "distributed.worker.memory.monitor-interval": "1s",
+                "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
 def probe_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
     """Check that a Dask scheduler answers at a tcp:// ``address`` before a Client is
     made: it must accept the connection and send the length of a handshake-sized first
@@ -89,6 +98,29 @@ def _security(proto: str, tls: dict | None):
     return sec if proto == "tls" or sec.require_encryption else None
 
 
+def local_workers(n: int):
+    """A LocalCluster of ``n`` one-thread worker processes (no dashboard) set up so that
+    n workers come near n times one on a machine of n cores:
+
+    - one BLAS/OpenMP thread per worker (:data:`ONE_THREAD`);
+    - glibc's allocator left to its own: Dask's nanny starts workers with
+      ``MALLOC_TRIM_THRESHOLD_=65536``, which also freezes glibc's mmap threshold, so that
+      every large array is mapped from the kernel and handed back afresh. Measured on a
+      mistuned FRF (cases/bench/mistuning.py): 10x the page faults, 16-24 % more CPU per
+      sample, the whole gap between two workers and twice one. The variable is dropped;
+      a variable of the caller's own environment still wins;
+    - Dask's statistical profiler off: it samples the task thread's stack every 10 ms,
+      15-30 % more CPU per friction sample; the workers' event-loop tick, system and
+      memory monitors at 1-5 s instead of 20-500 ms (an idle worker: 2.2 % of a core,
+      then 0.26 %).
+    """
+    import dask
+    from dask.distributed import LocalCluster
+    with dask.config.set(QUIET_WORKER):
+        return LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                            dashboard_address=None, env=ONE_THREAD)
+
+
 class Failed:
     """A task that raised: ``message`` is its exception's class and text."""
 
@@ -110,13 +142,9 @@ class _Runner:
         distributed = require("distributed", "study",
                               "study.scheduler: running members as Dask tasks (or "
                               "scheduler = \"serial\")")
-        Client, LocalCluster = distributed.Client, distributed.LocalCluster
+        Client = distributed.Client
         if scheduler == "local":
-            n = workers or os.cpu_count() or 1
-            env = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
-                   "MKL_NUM_THREADS": "1"}
-            self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                        dashboard_address=None, env=env)
+            self.cluster = local_workers(workers or os.cpu_count() or 1)
             self.client = Client(self.cluster)
         else:
             sec = _security(proto, tls)

@@ -5,6 +5,9 @@ The codes are read from the Fortran library by name at import, never typed here.
 
 from __future__ import annotations
 
+import math
+import re
+
 from . import _kernels
 
 
@@ -90,12 +93,24 @@ for _cls, _names in _RAISED_FOR.items():
 del _cls, _names
 
 
+#: a frequency in rad/s not yet followed by its value in Hz
+_RAD_S = re.compile(r"([-+]?\d[\d.]*(?:[eE][-+]?\d+)?) ?rad/s(?! \([-+\d.eE]+ Hz\))")
+
+
+def with_hz(text: str) -> str:
+    """A message's frequencies in rad/s followed by the same in Hz:
+    ``through omega = 2950.3 rad/s`` -> ``... 2950.3 rad/s (469.56 Hz)``; idempotent."""
+    return _RAD_S.sub(lambda m: f"{m.group(0)} ({float(m.group(1)) / 2 / math.pi:.6g}"
+                      " Hz)", text)
+
+
 def raise_for_status(info: int, message: str) -> None:
-    """Raise the exception class of a nonzero Fortran status, with Fortran's message."""
+    """Raise the exception class of a nonzero Fortran status, with Fortran's message
+    (frequencies in rad/s also in Hz)."""
     if info == 0:
         return
     cls = _BY_CODE.get(int(info), NumericalError)
-    raise cls(message.strip() or f"frirom status {info}", code=int(info))
+    raise cls(with_hz(message.strip()) or f"frirom status {info}", code=int(info))
 
 
 # ---- checks of Python API arguments: each names the argument and what was expected ----

@@ -20,11 +20,10 @@ so the two are not told apart yet).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from . import _run
+from ._bifurcation import Bifurcation
 from ._peak import _offset
 from .results import FRFPoint
 
@@ -34,29 +33,6 @@ FOLD_TLAM = 1e-10
 FOLD_STOL = 1e-9
 #: at most this many correctors per fold
 FOLD_MAX_SOLVES = 40
-
-
-@dataclass
-class Bifurcation:
-    """A bifurcation of the curve (FRF.bifurcations).
-
-    kind: 'fold' (a turning point in the parameter), 'ns_or_pd' (a Floquet exponent
-    crossed the imaginary axis away from 0: Neimark-Sacker or period doubling);
-    omega (rad/s), parameter: where it is (a fold: located on the curve; 'ns_or_pd': the
-    midpoint of the bracketing points); amp_max (n_out,): the outputs' max over the period
-    there; index: the point after it (it lies between points index - 1 and index);
-    located: True where solved on the curve (t_lam: the parameter part of the tangent
-    there, 0 at the fold), False where only bracketed.
-    """
-
-    kind: str
-    omega: float
-    parameter: float
-    amp_max: np.ndarray
-    index: int
-    located: bool = False
-    t_lam: float = float("nan")
-    solves: int = 0
 
 
 def locate_fold(solve, base: FRFPoint, after: FRFPoint, lscale: float):

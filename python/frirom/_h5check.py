@@ -124,15 +124,20 @@ def attr_text(f, path, name: str, default=None) -> str | None:
     v = f.attrs[name]
     if isinstance(v, np.ndarray) and v.shape == () and v.dtype.kind in "SUO":
         v = v[()]
-    if isinstance(v, bytes):
+    t = _text(v)
+    if t is None:
+        raise InputError(f"{path}: attribute {name!r}: expected text, got {_shown(v)}")
+    return t
+
+
+def _text(x) -> str | None:
+    """x as str (bytes decoded as UTF-8), or None if it is neither."""
+    if isinstance(x, bytes):
         try:
-            v = v.decode()
+            return x.decode()
         except UnicodeDecodeError:
-            v = None
-    if not isinstance(v, str):
-        raise InputError(f"{path}: attribute {name!r}: expected text, got "
-                         f"{_shown(v)}")
-    return v
+            return None
+    return x if isinstance(x, str) else None
 
 
 def attr_texts(f, path, name: str) -> list:
@@ -144,17 +149,10 @@ def attr_texts(f, path, name: str) -> list:
     if a.ndim != 1 or a.dtype.kind not in "SUO":
         raise InputError(f"{path}: attribute {name!r}: expected a list of names, got "
                          f"{_shown(v)}")
-    out = []
-    for x in a:
-        if isinstance(x, bytes):
-            try:
-                x = x.decode()
-            except UnicodeDecodeError:
-                x = None
-        if not isinstance(x, str):
-            raise InputError(f"{path}: attribute {name!r}: expected a list of names, got "
-                             f"{_shown(v)}")
-        out.append(x)
+    out = [_text(x) for x in a]
+    if any(x is None for x in out):
+        raise InputError(f"{path}: attribute {name!r}: expected a list of names, got "
+                         f"{_shown(v)}")
     return out
 
 
@@ -214,7 +212,7 @@ _NDIM = {"tangent": 2, "yscale": 1, "ck_scalars": 2, "ck_unknowns": 2, "ck_tange
          "ck_lu": 2}
 #: text attributes of a results file (META_KEYS among them)
 _TEXT = ("parameter_name", "message", "solver_info", "deck_path", "deck_text",
-         "solver_settings", "model_fingerprint", "frirom_version", "auto")
+         "solver_settings", "model_fingerprint", "frirom_version", "auto", "method")
 
 
 def check_results(f, path) -> None:

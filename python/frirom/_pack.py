@@ -315,7 +315,7 @@ def resolve_stability(model, opts: SolverOptions) -> tuple[SolverOptions, str]:
     """opts with stability "auto" made true or false, and why it is off ('' when on, or
     not "auto"): off for a cyclic sector, a selection, contact coordinates or more than
     HILL_AUTO_MAX Hill unknowns."""
-    if not isinstance(opts.stability, str):
+    if opts.stability != "auto":
         return opts, ""
     n, H = model.n_dof, opts.harmonics
     nh = 2 * n * (2 * H + 1)
@@ -494,6 +494,7 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
     band = _Band(model, c.G)
     out = _check_outputs((np.arange(n) if n <= 100 else nl) if outputs is None else outputs, n)
     tcontact, sparse, info = False, False, f"banded: {n * (2 * H + 1)} unknowns"
+    hill = None
     modes = _Modes.none(n, H)
     free = model.free_bodies()
     if free:
@@ -501,25 +502,33 @@ def _pack_model(model: Model, opts: SolverOptions, fe0, fe1, outputs) -> _Packed
                  "linear part")
     if opts.formulation == "condensed":
         nrows = c.G.shape[0]
-        tcontact = _contact_coords(opts, nrows, nl.size)
         rmodel = model
         if free:        # the receptances' modes are the stuck structure's
             rmodel = copy.copy(model)
             rmodel.K = sp.csr_matrix(model.K + model.stuck_stiffness())
         modes, route, sparse = _receptance_route(rmodel, opts, H, band)
+        # Hill's route at s = 0 (the Newton matrix) works in either coordinates: then
+        # stability does not hold the unknowns on the contact DoFs
+        near0 = opts.stability and _hill_route(
+            n, H, modes.nmodes, nl.size,
+            strip=opts.stability == "strip") == "near0"
+        tcontact = _contact_coords(dataclasses.replace(opts, stability=False) if near0
+                                   else opts, nrows, nl.size)
         nu = nrows if tcontact else nl.size
         info = (f"condensed: {nu * (2 * H + 1)} unknowns, "
                 + (f"{nu} contact coordinates G x" if tcontact else f"{nu} contact DoFs")
                 + f"; {route}")
     if opts.stability:
-        hill = _hill_route(n, H, modes.nmodes if not tcontact else 0, nl.size)
+        hill = _hill_route(n, H, modes.nmodes, nl.size,
+                           strip=opts.stability == "strip")
         if hill == "banded":
             _check_hill_memory(n, H, band.bw)
-        else:
+        elif hill != "near0":
             _check_hill_memory(n, H, 0, modal=(modes.nmodes, nl.size))
         info += "; " + HILL_ROUTES[hill]
-    if modes.nmodes and not opts.stability:
-        # modal receptances without Hill's method: Fortran reads neither K, M, C nor the
+    if modes.nmodes and (not opts.stability or hill == "near0"):
+        # modal receptances without Hill's method or with its s = 0 route (modes only):
+        # Fortran reads neither K, M, C nor the
         # order (frirom_hbm_receptances, _condensed; hbm_setup checks that perm is a
         # permutation), so empty matrices, as for a cyclic sector, and the natural order:
         # no copy and check of the model's matrices at every call into Fortran

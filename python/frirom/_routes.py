@@ -238,38 +238,50 @@ def _contact_coords(opts: SolverOptions, nrows: int, nnl: int) -> bool:
     run_contact_coords: 'auto' takes the shorter unless stability or a selection needs
     the DoFs)."""
     code = int_constant("COORD_" + opts.coordinates.upper())
-    return bool(_kernels.contact_coords(code, nrows, nnl, int(opts.stability),
+    return bool(_kernels.contact_coords(code, nrows, nnl, int(bool(opts.stability)),
                                         int(opts.selection is not None)))
 
 
 #: How Hill's method goes (fortran/frirom_hbm_hill.f90 hbm_hill's rule), as logged
 HILL_ROUTES = {
     "dense": "stability: Hill, dense (all exponents)",
+    "near0": "stability: Hill by shift-invert Arnoldi at s = 0 through the point solve's "
+             "Newton matrix (the exponents nearest 0: folds, the resonant pair)",
     "modal": "stability: Hill by shift-invert Arnoldi on the modes, the contacts by "
              "Woodbury on the contact DoFs",
     "banded": "stability: Hill by shift-invert Arnoldi on the banded matrices",
 }
 
 
-def _hill_route(n_dof: int, H: int, nmodes: int, nnl: int) -> str:
-    """'dense', 'modal' or 'banded': Fortran's rule (hbm_hill): dense up to HILL_MAX
-    unknowns, then by the modes when a condensed system takes its receptances from real
-    modes on the contact DoFs (nmodes > 0: pass 0 otherwise), else banded."""
+def _hill_route(n_dof: int, H: int, nmodes: int, nnl: int, strip: bool = False) -> str:
+    """'dense', 'near0', 'modal' or 'banded': Fortran's rule (hbm_hill): dense up to
+    HILL_MAX unknowns, then, when a condensed system takes its receptances from real modes
+    on the contact DoFs (nmodes > 0: pass 0 otherwise), the exponents nearest 0 through
+    the Newton matrix ('near0') or, with stability = 'strip', the whole strip by the
+    modes ('modal'); else banded."""
     if 2 * n_dof * (2 * H + 1) <= HILL_MAX:
         return "dense"
-    return "modal" if nmodes > 0 and nnl > 0 else "banded"
+    if nmodes > 0 and nnl > 0:
+        return "modal" if strip else "near0"
+    return "banded"
 
 
-def hill_bytes(n_dof: int, H: int, bw: int, modal: tuple[int, int] | None = None) -> int:
+def hill_bytes(n_dof: int, H: int, bw: int, modal: tuple[int, int] | None = None,
+               near0: bool = False) -> int:
     """Memory [bytes] Hill's method needs at one point for n_dof DoFs (band half-width bw
     after RCM) and H harmonics: the dense 2n(2H+1) eigenproblem up to HILL_MAX; by the
     modes (modal = (modes, contact DoFs)): the contact Jacobian and the LU of I + Jc R
     (m = contact DoFs x (2H+1) squared, twice) and the Arnoldi basis; else the banded J,
     D1, M and the factored complex Q(s) (LAPACK band storage, 2 kl + ku + 1 rows) and the
-    Arnoldi basis (fortran/frirom_hbm_hill.f90, NEV_MAX = 256)."""
+    Arnoldi basis (fortran/frirom_hbm_hill.f90, NEV_MAX = 256); near0 (the exponents
+    nearest 0 through the solver's own Newton matrix, frirom_hbm_hill_s0.f90): the real
+    Arnoldi basis of 28 vectors over 2 modes (2H+1) and ARPACK's work, nothing of the
+    contact DoFs' size beyond the solver's own."""
     nh = n_dof * (2 * H + 1)
     if 2 * nh <= HILL_MAX:
         return 16 * (2 * nh) ** 2 * 3
+    if modal is not None and near0:
+        return 8 * 2 * modal[0] * (2 * H + 1) * (28 + 6) + 8 * 3 * 28 * 28
     if modal is not None:
         nm, nnl = modal
         m = nnl * (2 * H + 1)

@@ -235,5 +235,7 @@ def _setting(opts, name: str):
                             else "RUN_BANDED")
     if name == "reuse_jacobian":
         return int(opts.reuse_jacobian)
+    if name == "stability":     # 2: Hill's whole strip on reduced models (hill_strip)
+        return 2 if opts.stability == "strip" else int(bool(opts.stability))
     v = getattr(opts, name)
     return int(v) if isinstance(v, (bool, np.bool_)) else v

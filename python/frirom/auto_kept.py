@@ -2,7 +2,7 @@
 nonlinear DoF's harmonic), chosen before the run and checked after it.
 
 1. **Probes**: a coarse run at the smallest H finds, per output, its largest-amplitude
-   point and that point's neighbours (:func:`frirom.auto._probes`, the points the H and N
+   point and that point's neighbours (:func:`frirom._probes._probes`, the points the H and N
    estimates use); at each probe frequency the solution with the run's H and N is solved
    from it (every harmonic, the contact DoFs as unknowns).
 2. **Candidates**: harmonic h of nonlinear DoF j is dropped when its amplitude stays
@@ -135,7 +135,7 @@ def choose_kept(model, F, omega_start, omega_end, options, outputs=None, *,
     probes : list of FRFPoint, optional
         Probe points (a coarse run's) instead of running one.
     """
-    from .auto import _excitation, _first_harmonic, _probes, _rel
+    from ._probes import _excitation, _first_harmonic, _probes, _rel
     from .solver import solve_point
     t0 = time.perf_counter()
     H = options.harmonics

@@ -37,6 +37,7 @@ def save_h5(bb: Backbone, path, attrs: dict | None = None) -> None:
         f.create_dataset("damping_ratio", data=bb.damping_ratio)
         for name in _SCALARS:
             f.attrs[name] = getattr(bb, name)
+        f.attrs["lscale"] = bb.lscale
         for k, v in (attrs or {}).items():
             f.attrs[k] = v
     os.replace(tmp, path)
@@ -52,6 +53,7 @@ def load_h5(path) -> tuple[Backbone, dict]:
     except OSError as exc:
         raise InputError(f"{path}: cannot be read as a backbone file ({exc})") from None
     kw = {k: attrs.pop(k) for k in _SCALARS}
+    kw["lscale"] = float(attrs.pop("lscale", 0.0))
     for k in ("start", "status", "message"):
         kw[k] = kw[k].decode() if isinstance(kw[k], bytes) else str(kw[k])
     kw["mode"], kw["H"], kw["omega0"] = int(kw["mode"]), int(kw["H"]), float(kw["omega0"])

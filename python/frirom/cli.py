@@ -35,7 +35,7 @@ import warnings
 from pathlib import Path
 
 from . import __version__
-from ._errors import FriromError, InputError
+from ._errors import FriromError, InputError, with_hz
 from ._resume import EXIT_INPUT, EXIT_INTERRUPTED, EXIT_OK, EXIT_STOPPED
 
 
@@ -113,14 +113,19 @@ def _add_show(sub) -> None:
         "energy.png (per contact element: dissipated energy, stick/slip/lift-off fractions, "
         "peak normal force, slip amplitude); with an FE deck also maps.png (the fields on "
         "the contact face) and with --vtk point.vtu for ParaView.")
-    p.add_argument("out", type=Path, help="the run's output folder (or its frf.h5)")
+    p.add_argument("out", type=Path, help="the run's output folder (or its frf.h5, or "
+                   "a nonlinear mode's backbone.h5)")
     which = p.add_mutually_exclusive_group()
     which.add_argument("--at", metavar="FREQ",
                        help="frequency, e.g. 470Hz, 2950rad/s, or a number in the deck's unit")
     which.add_argument("--point", type=int, metavar="K", help="stored point K (from 0; "
                        "negative from the end)")
     which.add_argument("--peak", action="store_true",
-                       help="the peak of the first output (the default)")
+                       help="the peak of the first output (the default); of a backbone: "
+                       "its point of largest damping ratio")
+    which.add_argument("--amplitude", type=float, metavar="A", default=None,
+                       help="a backbone (OUT/backbone.h5): the point nearest modal "
+                       "amplitude A")
     p.add_argument("--contact", action="append", metavar="GROUP:E", default=None,
                    help="a contact element to draw (repeatable); default the most "
                    "dissipative ones")
@@ -142,6 +147,21 @@ def _add_show(sub) -> None:
 
 
 def cmd_show(args) -> int:
+    out = Path(args.out)
+    bb = (out if out.name == "backbone.h5" else
+          out / "backbone.h5" if out.is_dir() and not (out / "frf.h5").exists() else None)
+    if bb is not None and bb.is_file():
+        from .show_backbone import cmd_show_backbone
+        return cmd_show_backbone(args, bb)
+    if out.is_dir() and (out / "frf.h5").is_file() and (out / "backbone.h5").is_file():
+        from .results import FRF
+        if FRF.load(out / "frf.h5").meta.get("method") == "snmt":
+            raise InputError(f"{out / 'frf.h5'}: synthesised from the nonlinear mode (kind "
+                             f"from_backbone), no solved point to show; show a point of "
+                             f"its backbone: frirom show {out / 'backbone.h5'} "
+                             "[--amplitude A | --point K]")
+    if args.amplitude is not None:
+        raise InputError(f"--amplitude: {out} holds no backbone.h5 (a nonlinear-mode run)")
     from .show import cmd_show as run
     return run(args)
 
@@ -327,6 +347,9 @@ def cmd_run(args) -> int:
         if mode_deck:
             from .cli_modes import run_mode_deck
             return run_mode_deck(args, deck, out)
+        if analysis is not None and getattr(analysis, "from_backbone", False):
+            from .cli_modes import run_synthesis_deck
+            return run_synthesis_deck(args, deck, out)
         return _run_locked(args, deck, out, linear)
     finally:
         lock.release()
@@ -682,14 +705,6 @@ def _print_peaks(result, deck) -> None:
               f"({p.method})")
 
 
-_RAD_S = re.compile(r"([-+]?\d[\d.]*(?:[eE][-+]?\d+)?) ?rad/s(?! \()")
-
-
-def with_hz(text: str) -> str:
-    """A message's frequencies in rad/s followed by the same in Hz:
-    ``through omega = 2950.3 rad/s`` -> ``... 2950.3 rad/s (469.56 Hz)``."""
-    return _RAD_S.sub(lambda m: f"{m.group(0)} ({float(m.group(1)) / 2 / 3.141592653589793:.6g}"
-                      " Hz)", text)
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:

@@ -38,7 +38,7 @@ import numpy as np
 from . import _kernels
 from ._errors import (ParameterError, SamplesError, SizeError, as_floats, check_integer,
                       check_number, raise_for_status, samples_problem)
-from .harmonics import default_samples, n_harmonics
+from .harmonics import default_samples, element_harmonics, n_harmonics
 
 
 @dataclass(frozen=True)
@@ -187,12 +187,7 @@ def _prepare(law, x, params, n_samples, w0, tol, max_periods):
     law = get_law(law)
     check_number("tol", tol, positive=True)
     check_integer("max_periods", max_periods, minimum=1, maximum=2**31 - 1)
-    x = as_floats("x", x)
-    if x.ndim == 2 and law.n_dir == 1:
-        x = x[:, None, :]
-    if x.ndim != 3 or x.shape[1] != law.n_dir:
-        raise SizeError(f"{law.name}: x has shape {x.shape}; expected (n_elem, {law.n_dir}, 2H+1) "
-                        f"with directions {list(law.directions)}")
+    x = element_harmonics(x, law.n_dir, f"{law.name} (directions {list(law.directions)})")
     h = n_harmonics(x.shape[2])
     n_elem = x.shape[0]
     if n_samples is None:

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._errors import SamplesError, SizeError
+from ._errors import SamplesError, SizeError, as_floats
 
 
 def n_harmonics(n_coef: int) -> int:
@@ -21,6 +21,18 @@ def n_harmonics(n_coef: int) -> int:
     if n_coef < 1 or n_coef % 2 == 0:
         raise SizeError(f"harmonic axis has length {n_coef}; expected 2H+1 (odd, >= 1)")
     return (n_coef - 1) // 2
+
+
+def element_harmonics(x, n_dir: int, what: str) -> np.ndarray:
+    """x as floats of shape (n_elem, n_dir, 2H+1) (a 2-D x taken as one direction); a
+    SizeError naming ``what`` (the law) otherwise."""
+    x = as_floats("x", x)
+    if x.ndim == 2 and n_dir == 1:
+        x = x[:, None, :]
+    if x.ndim != 3 or x.shape[1] != n_dir:
+        raise SizeError(f"{what}: x has shape {x.shape}; expected (n_elem, {n_dir}, 2H+1)")
+    n_harmonics(x.shape[2])
+    return x
 
 
 def default_samples(n_harm: int) -> int:

@@ -50,7 +50,7 @@ from typing import Callable
 import numpy as np
 
 from ._errors import ParameterError, SizeError, ConvergenceError, as_floats, check_number
-from .harmonics import default_samples, n_harmonics, basis
+from .harmonics import default_samples, element_harmonics, n_harmonics, basis
 
 ENTRY_POINT_GROUP = "frirom.laws"
 
@@ -133,12 +133,7 @@ def aft(law: UserLaw, x, params, n_samples: int | None = None, w0=None,
     (n_elem, n_par) or a dict, w0 (n_elem, n_slider) or None (zeros).
     """
     check_number("tol", tol, positive=True)
-    x = as_floats("x", x)
-    if x.ndim == 2 and law.n_dir == 1:
-        x = x[:, None, :]
-    if x.ndim != 3 or x.shape[1] != law.n_dir:
-        raise SizeError(f"user law {law.name!r}: x has shape {x.shape}; expected "
-                        f"(n_elem, {law.n_dir}, 2H+1)")
+    x = element_harmonics(x, law.n_dir, f"user law {law.name!r}")
     ne, nd, nc = x.shape
     h = n_harmonics(nc)
     n = default_samples(h) if n_samples is None else int(n_samples)

@@ -30,13 +30,14 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.stats import binom
 
+from ._cluster import local_workers
 from ._errors import InputError, ParameterError
 from .model import Damping
 from .reduction.mistuning import (MistuningSector, deviations, stick_stiffnesses,
                                   whitehead_bound)
 
 __all__ = ["MistunedDisk", "Response", "monte_carlo", "statistics", "sample_deviations",
-           "whitehead_bound"]
+           "local_cluster", "warm_workers", "whitehead_bound"]
 
 
 @dataclass
@@ -211,11 +212,13 @@ def sample_deviations(n_blades: int, std: float, seed: int, index: int) -> np.nd
 
 def _one(disk: MistunedDisk, std: float, seed: int, index: int, interfaces: str,
          tuned_peak: float) -> dict:
+    c0, p0 = time.thread_time(), time.process_time()
     d = sample_deviations(disk.n_blades, std, seed, index)
     r = disk.response(d, interfaces)
     return {"index": index, "deviations": d, "peak": r.peak, "af": r.peak / tuned_peak,
             "blade_peaks": r.blade_peaks, "omega": r.omega, "envelope": r.envelope,
-            "seconds": r.seconds}
+            "seconds": r.seconds, "cpu_seconds": time.thread_time() - c0,
+            "process_cpu_seconds": time.process_time() - p0}
 
 
 def _save(out: Path, tag: str, res: dict) -> None:
@@ -231,8 +234,9 @@ def monte_carlo(disk: MistunedDisk, n_samples: int, std: float, seed: int = 0,
     """Amplification factors of ``n_samples`` mistuning samples.
 
     out: folder of per-sample files (resumable; default none); scheduler: address of a
-    running ``distributed`` scheduler, or 'local' for a LocalCluster of ``workers``
-    processes, or None (serial); progress: callable(done, total, partial_af) after every
+    running ``distributed`` scheduler, a ``distributed.Client`` (kept open: one cluster for
+    several studies), or 'local' for a LocalCluster of ``workers`` processes (made and
+    closed here), or None (serial); progress: callable(done, total, partial_af) after every
     sample; tuned: the tuned disk's Response in the same interface state if already known.
     Returns {'tuned': Response, 'af': (n,), 'samples': [dict], 'stats': ...}.
     """
@@ -280,27 +284,94 @@ def monte_carlo(disk: MistunedDisk, n_samples: int, std: float, seed: int = 0,
     return {"tuned": tuned, "af": af, "samples": samples, "stats": statistics(af)}
 
 
+def _warm() -> float:
+    """Run on a worker: import what a sample needs (the import itself happens when this
+    function is unpickled there); returns the worker's pid for the caller's bookkeeping."""
+    from . import solver  # noqa: F401
+    import os
+    return os.getpid()
+
+
+def warm_workers(client) -> dict:
+    """Import frirom on every worker of ``client`` that has not yet done so, ONE WORKER AT
+    A TIME, before any task runs; returns {worker address: seconds}. An editable install
+    (meson-python) checks and rebuilds its extension on the first import in every
+    process: workers that import at once race on the same build folder (and a stale build
+    fails in all of them); one after the other, the first rebuilds, the rest find it up to
+    date. The seconds are each worker's import cost, kept out of the samples' clock."""
+    out = {}
+    for w in sorted(client.scheduler_info()["workers"]):
+        t0 = time.perf_counter()
+        client.run(_warm, workers=[w], wait=True)
+        out[w] = time.perf_counter() - t0
+    return out
+
+
+def _own_session() -> str:
+    """Run on a LocalCluster worker: make it a session of its own (os.setsid)."""
+    import os
+    try:
+        os.setsid()
+    except OSError as exc:          # already a session or group leader
+        return f"not moved ({exc})"
+    return "own session"
+
+
+def local_cluster(n_workers: int = 2):
+    """A LocalCluster of ``n_workers`` one-thread worker processes set up for Monte Carlo
+    samples: (cluster, client, {worker: seconds of its frirom import}); close the client
+    and the cluster (pass the client to :func:`monte_carlo` for several studies). What
+    keeps two workers near twice one on a shared machine:
+
+    - the workers of :func:`frirom._cluster.local_workers` (one BLAS thread, glibc's
+      allocator as in a serial run, Dask's profiler and monitors quiet);
+    - every worker a session of its own: Linux (``sched_autogroup``) shares the CPU
+      between sessions, not processes, and the workers would otherwise share the session
+      of the process that started them, so that on a loaded machine two workers got the
+      CPU time of one (0.8-1.0x serial at load average 8-14; 1.5-1.8x in their own
+      sessions; on an idle machine both ways get a core each);
+    - frirom imported in each worker before any task, one worker at a time
+      (:func:`warm_workers`).
+    """
+    from dask.distributed import Client
+    cluster = local_workers(n_workers)
+    client = Client(cluster)
+    try:
+        seconds = warm_workers(client)        # first: unpickling imports frirom
+        client.run(_own_session)
+    except Exception:
+        client.close()
+        cluster.close()
+        raise
+    return cluster, client, seconds
+
+
 def _distributed(disk, std, seed, todo, interfaces, tp, scheduler, workers, finish):
-    from dask.distributed import Client, LocalCluster, as_completed
+    from dask.distributed import Client, as_completed
     cluster = None
-    if scheduler == "local":
-        cluster = LocalCluster(n_workers=workers or 2, threads_per_worker=1, processes=True,
-                               dashboard_address=None)
-        client = Client(cluster)
+    own = not hasattr(scheduler, "submit")          # a Client of the caller's: keep it
+    if not own:
+        client = scheduler
+    elif scheduler == "local":
+        cluster, client, _ = local_cluster(workers or 2)
     else:
         client = Client(scheduler)
     try:
-        fut_disk = client.scatter(disk, broadcast=True)
+        warm_workers(client)
+        # the disk goes to every worker once; each task names it by its key
+        fut_disk = client.scatter(disk, broadcast=True, hash=False)
         futs = [client.submit(_one, fut_disk, std, seed, i, interfaces, tp, pure=False,
                               retries=3, key=f"mistuning-{interfaces}-{seed}-{i}")
                 for i in todo]
         for f in as_completed(futs):
             finish(f.result())
             f.release()
+        fut_disk.release()
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        if own:
+            client.close()
+            if cluster is not None:
+                cluster.close()
 
 
 def statistics(af, percentiles=(50, 90, 95, 99), confidence: float = 0.95) -> dict:

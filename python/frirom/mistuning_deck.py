@@ -121,16 +121,8 @@ def parse_mistuning_deck(path) -> MistuningDeck:
             or any(i not in INTERFACES for i in itf)):
         raise ctx.error("study.interfaces", "a non-empty list of distinct names among "
                         "\"friction\", \"stuck\", \"free\"", itf)
-    sched = string(ctx, st, "scheduler", "study.scheduler", default="local")
-    if sched not in ("local", "serial"):
-        from .deck.schema_study import check_address
-        try:
-            check_address(sched)
-        except InputError as e:
-            raise ctx.error("study.scheduler", str(e).split(": expected ", 1)[1],
-                            sched) from None
-    workers = number(ctx, st, "workers", "study.workers", integer=True, minimum=1,
-                     maximum=1024)
+    from .deck.schema_study import scheduler_and_workers
+    sched, workers = scheduler_and_workers(ctx, st)
     if study and "std" not in mis:
         raise ctx.error("mistuning.std", "a standard deviation (and seed) for a [study] of "
                         "kind \"mistuning\": each sample draws its own deviations (the "
@@ -183,11 +175,15 @@ def _get(z, name: str) -> sp.csr_matrix:
                          shape=tuple(z[f"{name}_shape"]))
 
 
-def write_sector(path, K, M, sector, *, blade, keep, output: int, F, contacts) -> None:
+def write_sector(path, K, M, sector, *, blade, keep, output: int, F, contacts,
+                 blade_stiffness=None) -> None:
     """Write a tuned sector for a mistuning deck: K, M (n, n); sector: its CyclicSector;
     blade: blade DoFs; keep: more reduction masters (contact, load, output DoFs); output:
     the blade's output DoF; F: (n, H+1) sector 0's load; contacts: ContactGroups on the
-    sector's DoFs (n or 2 n columns)."""
+    sector's DoFs (n or 2 n columns); blade_stiffness: the blade elements' own stiffness
+    (n, n), optional: the mistuning then includes the blade's condensed root stiffness
+    and the root DoFs become masters (see :func:`frirom.reduction.mistuning.
+    mistuning_sector`)."""
     d = {"left": sector.left, "right": sector.right, "axis": np.asarray(sector.axis, float),
          "n_sectors": sector.n_sectors, "blade": np.asarray(blade), "keep": np.asarray(keep),
          "output": int(output), "F": np.asarray(F, complex),
@@ -198,6 +194,8 @@ def write_sector(path, K, M, sector, *, blade, keep, output: int, F, contacts) -
     for i, g in enumerate(contacts):
         _put(d, f"G{i}", g.G)
         d[f"P{i}"] = np.asarray(g.params, float)
+    if blade_stiffness is not None:
+        _put(d, "Kblade", blade_stiffness)
     np.savez(path, **d)
 
 
@@ -218,9 +216,10 @@ def read_sector(path: Path, deck: Path | None = None) -> dict:
             groups = [ContactGroup(str(law), _get(z, f"G{i}"), z[f"P{i}"], name=str(name))
                       for i, (name, law) in enumerate(zip(z["contact_names"],
                                                           z["contact_laws"]))]
+            kb = _get(z, "Kblade") if "Kblade_data" in z.files else None
             return {"K": K, "M": M, "sector": sector, "blade": z["blade"],
                     "keep": z["keep"], "output": int(z["output"]), "F": z["F"],
-                    "contacts": groups}
+                    "contacts": groups, "blade_stiffness": kb}
     except (KeyError, ValueError, OSError) as exc:
         raise InputError(f"{deck or path}: model.sector: {path} is not a sector file "
                          f"({exc})") from None
@@ -242,8 +241,13 @@ def build_disk(md: MistuningDeck):
                          f"sector's {n} DoFs, got {md.fixed_interface_modes}")
     if s["F"].shape[1] < 2:
         raise InputError(f"{md.path}: model.sector: the load has no harmonic 1")
-    ms = mistuning_sector(s["sector"], s["K"], s["M"], md.fixed_interface_modes, s["blade"],
-                          keep=s["keep"], n_blade_modes=md.blade_modes)
+    kb = s["blade_stiffness"]
+    try:
+        ms = mistuning_sector(s["sector"], s["K"], s["M"], md.fixed_interface_modes,
+                              s["blade"], keep=s["keep"], n_blade_modes=md.blade_modes,
+                              blade_stiffness=kb, keep_root=kb is not None)
+    except InputError as exc:
+        raise InputError(f"{md.path}: model.sector: {md.sector_file}: {exc}") from None
     contacts = ms.reduce_contacts(s["contacts"])
     opts = {"harmonics": md.harmonics}
     if md.samples is not None:
@@ -351,21 +355,31 @@ def run_mistuning_study(path, out=None, scheduler=None, workers=None, log=print,
     log(f"mistuning study: {md.n_samples} samples x {list(md.interfaces)}, {N} blades, "
         f"std {std:g}, seed {seed}, scheduler {sched}")
     res = {}
-    for state in md.interfaces:
-        shown = []
+    cluster = client = None
+    if sched == "local":            # one cluster for every interface state
+        from .mistuning import local_cluster
+        cluster, client, _ = local_cluster(workers or md.workers or 2)
+    try:
+        for state in md.interfaces:
+            shown = []
 
-        def progress(done, total, af, state=state, shown=shown):
-            if not quiet:
-                log(_partial(state, done, total, af))
-                shown.append(done)
-        r = monte_carlo(disk, md.n_samples, std, seed=seed, interfaces=state,
-                        out=out / "samples", scheduler=None if sched == "serial" else sched,
-                        workers=workers or md.workers, progress=progress)
-        res[state] = r
-        if not shown or shown[-1] != md.n_samples:     # quiet, or resumed with all done
-            log(_partial(state, md.n_samples, md.n_samples, r["af"]))
-        plot_envelopes(r["samples"], r["tuned"]).savefig(out / f"envelope_{state}.png",
-                                                         dpi=110)
+            def progress(done, total, af, state=state, shown=shown):
+                if not quiet:
+                    log(_partial(state, done, total, af))
+                    shown.append(done)
+            r = monte_carlo(disk, md.n_samples, std, seed=seed, interfaces=state,
+                            out=out / "samples",
+                            scheduler=None if sched == "serial" else (client or sched),
+                            workers=workers or md.workers, progress=progress)
+            res[state] = r
+            if not shown or shown[-1] != md.n_samples:   # quiet, or resumed with all done
+                log(_partial(state, md.n_samples, md.n_samples, r["af"]))
+            plot_envelopes(r["samples"], r["tuned"]).savefig(out / f"envelope_{state}.png",
+                                                             dpi=110)
+    finally:
+        if client is not None:
+            client.close()
+            cluster.close()
     with open(out / "amplification.csv", "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["sample"] + [f"af_{s}" for s in md.interfaces])

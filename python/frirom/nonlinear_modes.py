@@ -87,6 +87,12 @@ class Backbone:
     yscales: np.ndarray = field(default=None, repr=False)
     ds_next: np.ndarray = field(default=None, repr=False)
     sliders: np.ndarray = field(default=None, repr=False)
+    #: |log10 a_end - log10 a_start| of the run: the tangents' scale of log10 a (0: unknown)
+    lscale: float = 0.0
+    #: (n,) the viscous part of xi along harmonic 1, psi_1^H C psi_1 (psi_1 the harmonic 1
+    #: per unit modal amplitude), 1/s: xi - xi_viscous is the contacts' share (None: not
+    #: kept, files written before it)
+    xi_viscous: np.ndarray = field(default=None, repr=False)
 
     def __len__(self) -> int:
         return int(self.amplitude.size)
@@ -128,6 +134,13 @@ class Backbone:
         """Amplitude of harmonic 1 at output j (m): hypot(a1, b1)."""
         return np.hypot(self.outputs[:, j, 1], self.outputs[:, j, 2])
 
+    def forced_response(self, load, omega=None, points: int = 400):
+        """The forced response near this mode's resonance under a harmonic-1 load, by
+        single nonlinear mode theory (:func:`frirom.nlm_synthesis.forced_response`): an
+        FRF at the backbone's outputs, in milliseconds."""
+        from .nlm_synthesis import forced_response
+        return forced_response(self, load, omega, points)
+
     def table(self) -> np.ndarray:
         """(n, 5 + n_out) columns: amplitude, frequency (Hz), damping ratio, energy per
         cycle (J), slip fraction (mean over the elements), harmonic-1 amplitude at each
@@ -140,7 +153,7 @@ class Backbone:
 
 
 _POINT_FIELDS = ("amplitude", "omega", "xi", "energy", "harmonics", "outputs", "states",
-                 "iterations", "y", "tans", "yscales", "ds_next", "sliders")
+                 "iterations", "y", "tans", "yscales", "ds_next", "sliders", "xi_viscous")
 
 
 def _map_points(bb: Backbone, f, other: Backbone | None = None) -> Backbone:
@@ -148,9 +161,11 @@ def _map_points(bb: Backbone, f, other: Backbone | None = None) -> Backbone:
     new = {}
     for name in _POINT_FIELDS:
         v = getattr(bb, name)
-        if v is None:
+        w = None if other is None else getattr(other, name)
+        if v is None or (other is not None and w is None):
+            new[name] = None        # not kept by one of them (an older file)
             continue
-        new[name] = f(v) if other is None else f(v, getattr(other, name))
+        new[name] = f(v) if other is None else f(v, w)
     out = dataclasses.replace(bb, **new)
     if other is not None:
         out.status, out.message = other.status, other.message
@@ -292,6 +307,7 @@ def nonlinear_mode(model: Model, mode: int = 0, amplitudes=(1e-6, 1e-2), start: 
         run.close()
     bb = _backbone(model, packed, phi, w0, mode, start, ys, lams, xos, sts, its, cks, status,
                    message)
+    bb.lscale = abs(np.log10(a1) - np.log10(a0))
     if bb.amplitude.size == 0 and resume is None:
         raise ConvergenceError(f"nonlinear mode: no point converged ({message})")
     return bb
@@ -381,6 +397,10 @@ def _backbone(model, packed, phi, w0, mode, start, ys, lams, xos, sts, its, cks,
     mnorm = np.einsum("pic,pic->pc", Xp, np.stack([M @ Xp[p] for p in range(len(a))])
                       if len(a) else Xp)
     energy = np.pi * xi * omega * (mnorm * h2).sum(axis=1)
+    C = model.C
+    xi_visc = (np.einsum("pi,pi->p", Xp[:, :, 1], (C @ Xp[:, :, 1].T).T)
+               + np.einsum("pi,pi->p", Xp[:, :, 2], (C @ Xp[:, :, 2].T).T)) / np.maximum(
+                   a, 1e-300) ** 2 if len(a) else np.zeros(0)
     xo = np.einsum("oj,pjc->poc", packed.select, Xp)
     st = (np.concatenate(sts, axis=2).transpose(2, 0, 1) if sts else np.zeros((0, 3, 0)))
     st = st[:, :, :packed.ne_tot]
@@ -394,4 +414,4 @@ def _backbone(model, packed, phi, w0, mode, start, ys, lams, xos, sts, its, cks,
                     mode=int(mode), start=start, omega0=w0, H=H,
                     status=_status_name(status), message=message,
                     iterations=np.concatenate(its) if its else np.zeros(0, int), y=y,
-                    tans=tans, yscales=ysc, ds_next=dsn, sliders=sl)
+                    tans=tans, yscales=ysc, ds_next=dsn, sliders=sl, xi_viscous=xi_visc)

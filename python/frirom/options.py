@@ -54,14 +54,18 @@ class SolverOptions:
         Keep a factorisation while Newton contracts by a factor 10 per iteration (a
         corrector that fails with reuse is retried with a fresh Jacobian every iteration).
         Without it Newton takes the Jacobian at every iterate from its line-search
-        evaluation (no extra one): on small models (the friction beam of
-        cases/bench/run.py, 15 unknowns) about 20 % faster, but another path where the
-        curve has spurious folds.
-    stability : bool or "auto"
+        evaluation (no extra one): on small models about 15 % faster (the friction beam of
+        cases/bench/run.py, 15 unknowns: 810 evaluations against 1 327).
+    stability : bool, "auto" or "strip"
         Hill's method at every point: the Floquet exponents in the strip |Im s| <= omega/2
         (and the centred copies of modes above (H + 1/2) omega); a dense eigen-solve of
         size 2 n_dof (2H+1) up to :data:`HILL_MAX`, shift-invert Arnoldi about s = 0 above
-        (strip only). "auto": on where affordable (frirom._pack.resolve_stability: at most
+        (strip only). Above HILL_MAX a reduced model (receptances from real modes) gets
+        the exponents nearest s = 0 only, through the point solve's own Newton matrix
+        (folds and the resonant mode's pair; docs/theory.md, "Stability: Hill's
+        method"); "strip" asks for the whole strip there too (Neimark-Sacker
+        and period doubling of modes far from resonance), at many times the cost.
+        "auto": on where affordable (frirom._pack.resolve_stability: at most
         HILL_AUTO_MAX Hill unknowns, not with a selection, contact coordinates or a cyclic
         sector), off otherwise, the reason in FRF.solver_info.
     history : bool
@@ -202,15 +206,15 @@ class SolverOptions:
         if self.modes is not None and (self.modes < 1 or self.formulation != "condensed"):
             raise ParameterError("options.modes: a positive number of modes, with "
                                  "formulation 'condensed'")
-        if isinstance(self.stability, str) and self.stability != "auto":
-            raise ParameterError(f"options.stability: expected true, false or 'auto', got "
-                                 f"{self.stability!r}")
+        if isinstance(self.stability, str) and self.stability not in ("auto", "strip"):
+            raise ParameterError(f"options.stability: expected true, false, 'auto' or "
+                                 f"'strip', got {self.stability!r}")
         for nm in ("refine_peak", "krylov", "history", "reuse_jacobian", "orbits") + \
                 (("stability",) if not isinstance(self.stability, str) else ()):
             if not isinstance(getattr(self, nm), (bool, np.bool_)):
                 raise ParameterError(f"options.{nm}: expected true or false, got "
                                      f"{getattr(self, nm)!r}")
-        if self.coordinates == "contact" and self.stability is True:
+        if self.coordinates == "contact" and self.stability in (True, "strip"):
             raise ParameterError("options.coordinates: 'contact' cannot be used with "
                                  "stability (Hill's method needs the contact DoFs)")
         kh = self.harmonics_kept
@@ -221,7 +225,8 @@ class SolverOptions:
             what = ("options.selection: a travelling-wave selection" if self.selection
                     is not None else "options.harmonics_kept: a harmonic selection")
             for bad, why in ((self.formulation != "condensed", "the 'condensed' formulation"),
-                             (self.stability is True, "stability = false (Hill's method would see "
+                             (self.stability in (True, "strip"),
+                              "stability = false (Hill's method would see "
                                               "only perturbations inside the selection)"),
                              (self.krylov, "krylov = false (direct solves)"),
                              (self.coordinates == "contact", "coordinates 'dofs' or 'auto'")):

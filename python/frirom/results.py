@@ -117,9 +117,10 @@ def output_values(X: np.ndarray, amp_max: np.ndarray) -> list:
     return row
 
 
-#: attributes of a result file saying how it was made (FRF.meta)
+#: attributes of a result file saying how it was made (FRF.meta); method: "snmt" for a
+#: forced response synthesised from a nonlinear mode (frirom.nlm_synthesis)
 META_KEYS = ("deck_path", "deck_text", "solver_settings", "model_fingerprint",
-             "frirom_version")
+             "frirom_version", "method")
 
 
 @dataclass
@@ -217,7 +218,7 @@ class FRF:
     #: (n_pts,) FRFPoint.leak of each point (None without a travelling-wave selection; NaN
     #: for points a resumed run's file held from before the leak was kept)
     leak: np.ndarray | None = None
-    #: bifurcations of the curve (frirom._fold.Bifurcation: folds located on it, stability
+    #: bifurcations of the curve (frirom._bifurcation.Bifurcation: folds located on it, stability
     #: changes away from folds); None when not searched
     bifurcations: list | None = None
 
@@ -455,7 +456,7 @@ def store_bifurcations(path, bifs: list) -> None:
 
 
 def _load_bifurcations(f, path) -> list:
-    from ._fold import Bifurcation
+    from ._bifurcation import Bifurcation
     kinds = [k.decode() if isinstance(k, bytes) else str(k)
              for k in np.atleast_1d(f.attrs["bif_kind"])]
     if not kinds:

@@ -128,18 +128,29 @@ def parse_frequency(text: str, unit: str = "hz") -> float:
     return v * 2.0 * np.pi if u == "hz" else v
 
 
+def stored_count(stored, what: str) -> int:
+    """len(stored), an InputError naming ``what`` when it holds no point."""
+    n = len(stored)
+    if n == 0:
+        raise InputError(f"{what} holds no point")
+    return n
+
+
+def stored_index(point: int, n: int) -> int:
+    """--point (negative from the end) as an index into n stored points."""
+    if not -n <= point < n:
+        raise InputError(f"--point: expected an index in {-n}..{n - 1}, got {point}")
+    return point % n
+
+
 def pick_point(frf: FRF, *, at: float | None = None, point: int | None = None,
                peak: bool = False) -> tuple[int, float]:
     """(stored point index, omega rad/s) of one choice: a frequency (the stored point
     nearest in frequency starts the solve; on a folded curve, the first of the nearest
     ones), a point index (negative from the end), or the peak of the first output."""
-    n = len(frf)
-    if n == 0:
-        raise InputError("the result holds no point")
+    n = stored_count(frf, "the result")
     if point is not None:
-        if not -n <= point < n:
-            raise InputError(f"--point: expected an index in {-n}..{n - 1}, got {point}")
-        k = point % n
+        k = stored_index(point, n)
         return k, float(frf.omega[k])
     if peak:
         p = frf.peak(0)
@@ -271,6 +282,15 @@ def point_state(frf: FRF, deck, index: int, omega: float) -> PointState:
     return PointState(omega=float(omega), index=int(index), x=x, outputs=P @ x,
                       labels=list(deck.output_names), contacts=contacts, balance=bal,
                       held=held, patch=patch_warnings(model, contacts))
+
+
+def print_contacts(state, top: int, per: str) -> None:
+    """The (at most three) elements that dissipate most, with their states."""
+    for g, e in _chosen(state, None, min(top, 3)):
+        c = state.contacts[g]
+        print(f"frirom: contact {c.name}:{e} dissipates {c.energy[e]:.4g} J per {per} "
+              f"(stick {c.states[e, 0]:.0%}, slip {c.states[e, 1]:.0%}, lift-off "
+              f"{c.states[e, 2]:.0%})")
 
 
 def _chosen(state: PointState, chosen, n_top: int) -> list:
@@ -461,11 +481,7 @@ def cmd_show(args) -> int:
     print(f"frirom: work per period: excitation {b['excitation']:.6g} J = contacts "
           f"{b['contacts']:.6g} J + viscous {b['viscous']:.6g} J (residual "
           f"{b['residual']:.3g} J)")
-    for g, e in _chosen(state, None, min(args.top, 3)):
-        c = state.contacts[g]
-        print(f"frirom: contact {c.name}:{e} dissipates {c.energy[e]:.4g} J per period "
-              f"(stick {c.states[e, 0]:.0%}, slip {c.states[e, 1]:.0%}, lift-off "
-              f"{c.states[e, 2]:.0%})")
+    print_contacts(state, args.top, "period")
     from .held import held_lines
     for line in held_lines(state.held):
         print(f"frirom: {line}")

@@ -27,7 +27,7 @@ import numpy as np
 
 from . import _run
 from ._errors import (CODES, MAX_OMEGA, ParameterError, SizeError, check_number,
-                      raise_for_status)
+                      raise_for_status, with_hz)
 from ._pack import ORBIT_TOL, TIMER_NAMES, kept_unknowns  # noqa: F401 - public here
 from ._pack import _Packed, add_timings, pack
 from ._routes import HILL_MAX, MODES_MAX  # noqa: F401 - public here
@@ -175,10 +175,20 @@ class _Continuation:
                 return True, ""
             if res.status == _run.FAILED:
                 return False, self._stopped(res)
+            message = self._located(res.message)
             if res.status == _run.STALLED:
                 warnings.warn(f"frirom: continuation stalled, {len(self.points)} points kept: "
-                              f"{res.message}", RuntimeWarning, stacklevel=4)
-            return False, res.message
+                              f"{message}", RuntimeWarning, stacklevel=4)
+            return False, message
+
+    def _located(self, message: str) -> str:
+        """A stop message with its frequencies in Hz too (rad/s kept: the API's unit) and,
+        for a frequency curve, the last point's frequency."""
+        message = with_hz(message.strip())
+        if self.points and self.packed.opts.parameter == "frequency":
+            w = float(self.points[-1].omega)
+            message += f" (last point at {w / 2 / np.pi:.7g} Hz, {w:.7g} rad/s)"
+        return message
 
     def _advice(self, res) -> str:
         if res.fail_info == CODES["FRIROM_ERR_CONT"] and self.packed.nw:
@@ -187,7 +197,7 @@ class _Continuation:
 
     def _stopped(self, res) -> str:
         """Explain a run Fortran stopped, with the advice that would change its outcome."""
-        message = res.message.strip() + self._advice(res)
+        message = self._located(res.message) + self._advice(res)
         warnings.warn(f"frirom: continuation stopped early, {len(self.points)} points kept: "
                       f"{message}", RuntimeWarning, stacklevel=5)
         return message

@@ -182,6 +182,9 @@ def _run_member_locked(deck_path, overrides, folder: Path, done: Path, progress)
     from .auto import resolve_deck
     deck = resolve_deck(load_member(deck_path, overrides), lambda s: None)
     h5 = folder / "frf.h5"
+    an = getattr(deck.settings, "analysis", None)
+    if an is not None and getattr(an, "from_backbone", False):
+        return _run_synthesis_member(deck, overrides, folder, done)
     start = None
     if h5.is_file():
         try:
@@ -231,6 +234,40 @@ def _run_member_locked(deck_path, overrides, folder: Path, done: Path, progress)
         "memory_mb": (model_bytes + 8.0 * (n_nl * (2 * H + 1)) ** 2) / 2 ** 20,
         "rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
         "values": dict(overrides),
+    }
+    tmp = done.with_suffix(".tmp")
+    tmp.write_text(json.dumps(summary, indent=1, default=float))
+    os.replace(tmp, done)
+    return summary
+
+
+def _run_synthesis_member(deck, overrides, folder: Path, done: Path) -> dict:
+    """A member whose deck synthesises its forced response from a nonlinear mode
+    (``[analysis] kind = "from_backbone"``, frirom.nlm_synthesis): the backbone and the
+    synthesis run whole (seconds), frf.h5 is written at the end; ``seconds`` is the
+    backbone's and the synthesis' together, ``snmt_seconds`` the synthesis alone."""
+    from .cli_modes import synthesise_deck
+    t0, c0, epoch = time.perf_counter(), time.process_time(), time.time()
+    bb, frf, tb, ts = synthesise_deck(deck)
+    seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
+    frf.save_h5(folder / "frf.h5")
+    (folder / "points").write_text(str(len(frf)))
+    model = deck.model()
+    n_nl, H = len(model.nonlinear_dofs()), deck.harmonics
+    summary = {
+        "points": len(frf), "seconds": seconds, "cpu_seconds": cpu, "pid": os.getpid(),
+        "started": epoch, "ended": epoch + seconds,
+        "complete": bool(frf.complete and bb.status == "done"),
+        "message": frf.message or bb.message, "resumed": False,
+        "peaks": [[frf.peak(j).omega, frf.peak(j).amplitude] for j in
+                  range(len(deck.outputs))],
+        "fold": bool(np.any(frf.fold)), "n_dof": int(deck.n_dof), "n_nl": int(n_nl),
+        "harmonics": int(H), "unknowns": int(n_nl * (2 * H + 1)),
+        "rom_seconds": float(getattr(deck.reduced, "build_seconds", 0.0) or 0.0),
+        "memory_mb": 0.0,
+        "rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+        "values": dict(overrides), "method": "snmt", "backbone_seconds": tb,
+        "backbone_points": len(bb), "snmt_seconds": ts,
     }
     tmp = done.with_suffix(".tmp")
     tmp.write_text(json.dumps(summary, indent=1, default=float))
@@ -612,7 +649,9 @@ def convergence_table(study: Study, frfs: list, summaries: list) -> list:
     Cost: ``rom_s`` reduction, ``frf_s`` FRF wall time, ``cost_s`` their sum,
     ``memory_mb`` the estimate of :func:`run_member`. ``notes`` lists what failed: the
     curve stopped, a fold only in this model, the error not falling from the previous
-    rung.
+    rung (of the same ``method``: 'hbm', or 'snmt' for a forced response synthesised from
+    a backbone, ``[analysis] kind = "from_backbone"``, whose cost is the backbone's and
+    the synthesis').
     """
     j = study.settings.output
     ref, fref = summaries[-1], frfs[-1]
@@ -628,7 +667,8 @@ def convergence_table(study: Study, frfs: list, summaries: list) -> list:
                             if len(fr) and len(cref) else float("inf")),
                "rom_s": s["rom_seconds"], "frf_s": s["seconds"],
                "memory_mb": s["memory_mb"], "reference": i == len(summaries) - 1,
-               "complete": s["complete"], "notes": []}
+               "complete": s["complete"], "notes": [],
+               "method": s.get("method", "hbm")}
         row["cost_s"] = row["rom_s"] + row["frf_s"]
         row["error"] = max(row["err_amp"], row["err_freq"], row["distance"])
         if s.get("failed"):
@@ -640,7 +680,7 @@ def convergence_table(study: Study, frfs: list, summaries: list) -> list:
         if not np.isfinite(row["error"]):
             row["notes"].append("no peak")
         if rows and not row["reference"] and row["error"] > 1.5 * rows[-1]["error"] \
-                and rows[-1]["error"] > 0:
+                and rows[-1]["error"] > 0 and rows[-1]["method"] == row["method"]:
             row["notes"].append("error rose from the previous rung")
         rows.append(row)
     return rows

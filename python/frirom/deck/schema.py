@@ -63,7 +63,8 @@ class SolverSettings:
         the solver's name ``max_iter``.
     stability : bool or "auto"
         Hill stability of every point (false with [reduction.cyclic]); "auto": on where
-        affordable, the reason in the run's summary where not; default
+        affordable, the reason in the run's summary where not; "strip": the whole strip
+        |Im s| <= w/2 on reduced models too (else the exponents nearest 0 there); default
         ``SolverOptions.stability``.
     tol_stall : float or None
         A corrector stalling below this residual is accepted (None: the solver's default).
@@ -300,7 +301,7 @@ def parse_deck(path, raw: dict | None = None, allow_code=()) -> DeckSettings:
 
     analysis = parse_analysis(ctx, raw, fe, labels)
     nlm = analysis.nonlinear_mode
-    if nlm and cyc is not None:
+    if (nlm or analysis.from_backbone) and cyc is not None:
         raise ctx.error("analysis.kind", "'forced_response' with [reduction.cyclic] (a "
                         "nonlinear mode of a cyclic sector: not yet)", analysis.kind)
     solver = _solver(ctx, table(ctx, raw, "solver"), cyc)
@@ -378,8 +379,8 @@ def _solver(ctx, sol, cyc) -> SolverSettings:
                     minimum=1)
     # "auto": on where affordable (frirom._pack.resolve_stability)
     stability = sol.get("stability", SOLVER_DEFAULTS.stability)
-    if not (isinstance(stability, bool) or stability == "auto"):
-        raise ctx.error("solver.stability", 'true or false (or "auto")', stability)
+    if not (isinstance(stability, bool) or stability in ("auto", "strip")):
+        raise ctx.error("solver.stability", 'true or false (or "auto", "strip")', stability)
     stall = number(ctx, sol, "tol_stall", "solver.tol_stall", nonneg=True)
     history = boolean(ctx, sol, "history", "solver.history", SOLVER_DEFAULTS.history)
     kept = _harmonics_kept(ctx, sol.get("harmonics_kept"), H)

@@ -1,6 +1,9 @@
 """``[analysis]``: what a deck computes. ``kind = "forced_response"`` (the default: the
 FRF over ``[frequency]`` under ``[excitation]``) or ``kind = "nonlinear_mode"`` (the
-backbone of one mode by the extended periodic motion concept, frirom.nonlinear_mode).
+backbone of one mode by the extended periodic motion concept, frirom.nonlinear_mode) or
+``kind = "from_backbone"`` (the forced response over ``[frequency]`` under the harmonic-1
+loads of ``[excitation]`` synthesised from that backbone by single nonlinear mode theory,
+frirom.nlm_synthesis).
 
 A nonlinear-mode deck needs no ``[frequency]``; its ``[excitation]`` may hold static
 loads (harmonic 0, a preload) only.
@@ -12,14 +15,14 @@ from dataclasses import dataclass
 
 from .fields import Context, dof_ref, number, string, unknown
 
-KINDS = ("forced_response", "nonlinear_mode")
+KINDS = ("forced_response", "nonlinear_mode", "from_backbone")
 
 
 @dataclass(frozen=True)
 class AnalysisSettings:
     """``[analysis]``.
 
-    kind : 'forced_response' or 'nonlinear_mode'
+    kind : 'forced_response', 'nonlinear_mode' or 'from_backbone'
     mode : int
         The linear mode the nonlinear mode starts from, 1 = the lowest with a nonzero
         frequency (of the stuck or free structure).
@@ -42,6 +45,10 @@ class AnalysisSettings:
     def nonlinear_mode(self) -> bool:
         return self.kind == "nonlinear_mode"
 
+    @property
+    def from_backbone(self) -> bool:
+        return self.kind == "from_backbone"
+
 
 def parse_analysis(ctx: Context, raw: dict, fe: bool, labels: bool) -> AnalysisSettings:
     """The deck's [analysis] table (the default forced response when absent)."""
@@ -49,9 +56,10 @@ def parse_analysis(ctx: Context, raw: dict, fe: bool, labels: bool) -> AnalysisS
     if not isinstance(an, dict):
         raise ctx.error("analysis", "a table [analysis]", an)
     kind = string(ctx, an, "kind", "analysis.kind", default="forced_response", choices=KINDS)
-    if kind == "forced_response":
-        unknown(ctx, an, {"kind"}, "analysis")
+    if kind == "forced_response" and set(an) <= {"kind"}:
         return AnalysisSettings()
+    # a forced response accepts (and does not use) the nonlinear mode's keys, so that a
+    # study can switch analysis.kind between from_backbone and forced_response
     unknown(ctx, an, {"kind", "mode", "start", "amplitudes", "output"}, "analysis")
     mode = number(ctx, an, "mode", "analysis.mode", default=1, integer=True, minimum=1)
     start = string(ctx, an, "start", "analysis.start", default="stuck",

@@ -37,6 +37,20 @@ def check_address(address) -> tuple:
     return m.group(1), m.group(2).strip("[]"), int(m.group(3))
 
 
+def scheduler_and_workers(ctx: Context, st: dict) -> tuple:
+    """study.scheduler (``"local"``, ``"serial"`` or a checked address; default local) and
+    study.workers (None or 1..1024) of a ``[study]`` table, for every study kind."""
+    sched = string(ctx, st, "scheduler", "study.scheduler", default="local")
+    if sched not in ("local", "serial"):
+        try:
+            check_address(sched)
+        except InputError as exc:
+            raise ctx.error("study.scheduler", str(exc).split(": expected ", 1)[1],
+                            sched) from None
+    workers = number(ctx, st, "workers", "study.workers", integer=True, minimum=1,
+                     maximum=1024)
+    return sched, workers
+
 @dataclass(frozen=True)
 class StudySettings:
     """``[study]``, checked.
@@ -260,15 +274,7 @@ def parse_study(path, raw: dict, read=None) -> StudySettings | None:
     if combine == "zip" and len({len(v) for _, v in params}) > 1:
         raise ctx.error("study.parameters", "lists of one length with combine = \"zip\"",
                         {k: len(v) for k, v in params})
-    sched = string(ctx, st, "scheduler", "study.scheduler", default="local")
-    if sched not in ("local", "serial"):
-        try:
-            check_address(sched)
-        except InputError as exc:
-            raise ctx.error("study.scheduler", str(exc).split(": expected ", 1)[1],
-                            sched) from None
-    workers = number(ctx, st, "workers", "study.workers", integer=True, minimum=1,
-                     maximum=1024)
+    sched, workers = scheduler_and_workers(ctx, st)
     outputs = raw.get("outputs", {}).get("dofs", []) if isinstance(raw.get("outputs"),
                                                                    dict) else []
     output = number(ctx, st, "output", "study.output", default=0, integer=True, minimum=0)
