@@ -34,7 +34,7 @@ module frirom_contact
 
     public :: STATE_LIFTOFF, STATE_STICK, STATE_SLIP
     public :: jenkins_march, friction1d_march, friction2d_march, cubic_spring
-    public :: recontact_follow
+    public :: recontact_follow, slip2d_step
 
     integer(ip), parameter :: STATE_LIFTOFF = 0  !! open contact, no force
     integer(ip), parameter :: STATE_STICK = 1    !! tangential spring, slider fixed
@@ -127,6 +127,8 @@ contains
     !> tangent(j, 1:4, k) = G_k, (j, 5:6, k) = b_k, (j, 7:10, k) = A_k (2x2 column-major),
     !> (j, 11:12, k) = c_k (zero at other samples). After an open sample A_k = G_k =
     !> (mu f_n / |t|) kt (I - n n^T), b_k = mu kn n, c_k = 0 (t: the trial force, n = t/|t|).
+    !> A start slider beyond the limit (the first period from a given w) first slides
+    !> radially onto it at the previous sample; that sample is then a slip sample.
     pure subroutine friction2d_march(u1, u2, v, kt, kn, mu, n0, w, f1, f2, fn, state, tangent)
         real(wp), intent(in) :: u1(:, :), u2(:, :)  !! (m, N) in-plane tangential displ.
                                                     !! (recontact_follow's uf), m
@@ -138,8 +140,10 @@ contains
         real(wp), intent(out) :: tangent(:, :, :)  !! (m, 12, N) slip tangents, see above
         integer(ip) :: j, k, kp, n
         real(wp) :: t1, t2, tn, lim, limp, n1, n2, r, nf, nfp, g1, g2
-        real(wp) :: z0(2), du(2), nv(2), dn(2, 6), r0, r1
+        real(wp) :: z0(2), du(2), nv(2), dn(2, 6), r0, r1, rz, g(2), tgl(12)
         logical :: slip, open
+        !> |z0|^2 beyond r0^2 by this fraction: a start slider outside the limit
+        real(wp), parameter :: OUTSIDE = 1.0e-10_wp
         n = size(u1, 2)
         do k = 1, n
             kp = k - 1
@@ -191,6 +195,19 @@ contains
                 du = [u1(j, k) - u1(j, kp), u2(j, k) - u2(j, kp)]
                 r0 = limp/kt(j)
                 r1 = lim/kt(j)
+                rz = norm2(z0)
+                if (rz**2 > r0**2*(1.0_wp + OUTSIDE)) then
+                    ! a start slider beyond the limit (the first period from a given w):
+                    ! it slides radially onto the limit at sample kp, z0 -> r0 z0/|z0|
+                    call outside_step(z0/rz, rz, du, r0, r1, kt(j), mu(j)*kn(j), g, tgl)
+                    tangent(j, :, k) = tgl
+                    w(j, 1) = u1(j, k) - g(1)/kt(j)
+                    w(j, 2) = u2(j, k) - g(2)/kt(j)
+                    f1(j, k) = g(1)
+                    f2(j, k) = g(2)
+                    state(j, k) = STATE_SLIP
+                    cycle
+                end if
                 call slip2d_step(z0, du, r0, r1, slip, nv, dn)
                 if (.not. slip) then
                     f1(j, k) = t1
@@ -211,6 +228,36 @@ contains
             end do
         end do
     end subroutine friction2d_march
+
+    !> A 2-D sample after a start slider outside the limit (|z0| = rz > r0, z0 = rz e):
+    !> it slides radially onto the limit at the previous sample, z0 -> r0 e
+    !> (d z0 -> P d z0 + e d r0, P = (r0/rz) (I - e e^T)), then steps exactly (slip2d_step).
+    !> f: the force at the sample (the slider is u - f/kt); tg: its tangent as in
+    !> friction2d_march (G = G' P, c = c' + mu kn r1 dn/dz0 e from the step's own G', c').
+    pure subroutine outside_step(e, rz, du, r0, r1, kt, mukn, f, tg)
+        real(wp), intent(in) :: e(2), rz, du(2), r0, r1  !! direction, |z0|, motion, radii, m
+        real(wp), intent(in) :: kt, mukn                 !! kt, mu kn, N/m
+        real(wp), intent(out) :: f(2)                    !! tangential force, N
+        real(wp), intent(out) :: tg(12)                  !! tangent, see friction2d_march
+        real(wp) :: pm(2, 2), zp(2), nv(2), dn(2, 6)
+        logical :: slip
+        pm = r0/rz*reshape([1.0_wp - e(1)**2, -e(1)*e(2), -e(1)*e(2), 1.0_wp - e(2)**2], [2, 2])
+        zp = r0*e
+        tg = 0.0_wp
+        call slip2d_step(zp, du, r0, r1, slip, nv, dn)
+        if (.not. slip) then                ! sticks from the slid slider
+            f = kt*(zp + du)
+            tg(1:4) = kt*reshape(pm, [4])
+            tg(7:10) = kt*[1.0_wp, 0.0_wp, 0.0_wp, 1.0_wp]
+            tg(11:12) = mukn*e
+            return
+        end if
+        f = kt*r1*nv
+        tg(1:4) = kt*r1*reshape(matmul(dn(:, 1:2), pm), [4])
+        tg(7:10) = kt*r1*reshape(dn(:, 3:4), [4])
+        tg(5:6) = mukn*(nv + r1*dn(:, 6))
+        tg(11:12) = mukn*r1*(dn(:, 5) + matmul(dn(:, 1:2), e))
+    end subroutine outside_step
 
     !> Exact slider update of the 2-D law along one sample interval on which the relative
     !> displacement moves linearly by du and the slip radius (friction limit / kt) changes
