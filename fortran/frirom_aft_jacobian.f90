@@ -332,10 +332,11 @@ contains
         logical, intent(in) :: accumulate
         real(wp), intent(inout) :: jac(:, :)
         integer(ip) :: n, nc, k, i, c, kp
-        real(wp) :: gsum(plan%fp%ncoef), pk(plan%fp%ncoef)
+        real(wp) :: gsum(plan%fp%ncoef), pk(plan%fp%ncoef), rkt
         logical :: open_seg
         n = plan%fp%nsamp
         nc = plan%fp%ncoef
+        rkt = -1.0_wp/kt                    ! (a divide per entry was a seventh of this)
         associate (st => plan%state(j, :), tg => plan%tangent(j, :, :), bas => plan%fp%basis, &
                    wgt => plan%fp%weight, dw => plan%dw, dft => plan%dft)
             gsum = 0.0_wp
@@ -374,7 +375,7 @@ contains
                             end do
                         end do
                     end if
-                    dw = -dft/kt
+                    dw = dft*rkt
                 else
                     dw = 0.0_wp
                 end if

@@ -299,7 +299,10 @@ contains
         do k = 1, plan%fp%nsamp
             select case (plan%state(j, k))
             case (STATE_SLIP)
-                b = reshape(plan%tangent(j, 1:4, k), [2, 2])/kt
+                b(1, 1) = plan%tangent(j, 1, k)/kt
+                b(2, 1) = plan%tangent(j, 2, k)/kt
+                b(1, 2) = plan%tangent(j, 3, k)/kt
+                b(2, 2) = plan%tangent(j, 4, k)/kt
                 m = matmul(b, m)
             case (STATE_LIFTOFF)
                 m = 0.0_wp

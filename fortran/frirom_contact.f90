@@ -221,8 +221,14 @@ contains
                 f2(j, k) = lim*nv(2)
                 state(j, k) = STATE_SLIP
                 ! f = kt r1 n1(z0, du, r0, r1), r = mu (n0 + kn v)/kt
-                tangent(j, 1:4, k) = lim*reshape(dn(:, 1:2), [4])
-                tangent(j, 7:10, k) = lim*reshape(dn(:, 3:4), [4])
+                tangent(j, 1, k) = lim*dn(1, 1)      ! (a reshape here was a library call)
+                tangent(j, 2, k) = lim*dn(2, 1)
+                tangent(j, 3, k) = lim*dn(1, 2)
+                tangent(j, 4, k) = lim*dn(2, 2)
+                tangent(j, 7, k) = lim*dn(1, 3)
+                tangent(j, 8, k) = lim*dn(2, 3)
+                tangent(j, 9, k) = lim*dn(1, 4)
+                tangent(j, 10, k) = lim*dn(2, 4)
                 tangent(j, 5:6, k) = mu(j)*kn(j)*(nv + r1*dn(:, 6))
                 tangent(j, 11:12, k) = mu(j)*kn(j)*r1*dn(:, 5)
             end do
