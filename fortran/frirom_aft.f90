@@ -128,7 +128,6 @@ module frirom_aft
         real(wp), allocatable :: res_base(:)         !! (nbatch) mismatch of the base period
         real(wp), allocatable :: res_last(:)         !! (nbatch) mismatch of the last period
         logical, allocatable :: stepped(:)           !! (nbatch) period started from a step
-        logical, allocatable :: weak(:)              !! (nbatch) projected fixed point
         logical, allocatable :: accelerated(:)       !! (nbatch) a step was accepted
         integer(ip), allocatable :: hold(:)          !! (nbatch) plain periods before a step
         real(wp), allocatable :: damp(:)             !! (nbatch) fraction of the step taken
@@ -266,18 +265,6 @@ module frirom_aft
             real(wp), intent(out) :: a(2, 2), det
             logical, intent(out) :: isolated, opened
         end subroutine slider_fixed_point
-
-        !> The weak and strong parts of a 2-D slider's period map, from a = I - M
-        !> (slider_fixed_point) with det(a) = det small: a's eigenvalues alpha_w (the weak one,
-        !> |alpha_w| <= |alpha_s|) and alpha_s, v the right eigenvector of alpha_w, l the left
-        !> one with l.v = 1 (so I - v l^T projects onto the strong eigenvector along v).
-        !> ok: both real, the strong one at least WEAK_SEP times the weak one and >= 1e-3
-        !> (otherwise no split: the slider is history along both, or isolated).
-        pure module subroutine weak_split(a, det, v, l, alpha_s, ok)
-            real(wp), intent(in) :: a(2, 2), det
-            real(wp), intent(out) :: v(2), l(2), alpha_s
-            logical, intent(out) :: ok
-        end subroutine weak_split
 
         !> (x1, x2) = a^-1 (g1, g2) for slider_fixed_point's a (2 x 2, determinant det) by
         !> Cramer's rule, elementwise in g and x.
@@ -470,8 +457,7 @@ contains
                   plan%jt(0:2*nharm, 6))
         allocate (plan%wplain(nb, 2), plan%res_base(nb), &
                   plan%res_last(nb), plan%stepped(nb), plan%accelerated(nb), plan%hold(nb), &
-                  plan%damp(nb), plan%damp_cap(nb), plan%weak(nb))
-        plan%weak = .false.
+                  plan%damp(nb), plan%damp_cap(nb))
     end subroutine aft_plan_create
 
     !> Release the plans and work arrays (a destroyed or never created plan is fine).
@@ -486,6 +472,6 @@ contains
         if (allocated(plan%dw)) deallocate (plan%dw, plan%dw0, plan%dft, plan%jw, plan%jt)
         if (allocated(plan%wplain)) deallocate (plan%wplain, plan%res_base, plan%res_last, &
                                                 plan%stepped, plan%accelerated, plan%hold, &
-                                                plan%damp, plan%damp_cap, plan%weak)
+                                                plan%damp, plan%damp_cap)
     end subroutine aft_plan_destroy
 end module frirom_aft

@@ -262,30 +262,17 @@ contains
         integer(ip), intent(in) :: j
         real(wp), intent(in) :: kt
         real(wp), intent(inout) :: jac(:, :)
-        real(wp) :: a(2, 2), det, v(2), l(2), als
-        real(wp) :: r1(size(plan%dw, 2)), r2(size(plan%dw, 2)), rl(size(plan%dw, 2))
-        logical :: opened, ok
+        real(wp) :: a(2, 2), det
+        real(wp) :: r1(size(plan%dw, 2)), r2(size(plan%dw, 2))
+        logical :: opened
         call slider_fixed_point(plan, j, a, det, done, opened)
-        if (.not. done .and. .not. plan%weak(j)) return
-        if (plan%weak(j)) then
-            call weak_split(a, det, v, l, als, ok)
-            done = ok
-            if (.not. done) return
-        end if
+        if (.not. done) return
         plan%dw = 0.0_wp
         call propagate2d(plan, j, kt, .false., jac)
         r1 = plan%dw(1, :)
         r2 = plan%dw(2, :)
-        if (plan%weak(j)) then
-            ! the projected fixed point (frirom_aft_march project2d): l.dw = 0 and
-            ! (I - v l^T)(I - M) dw = (I - v l^T) r, so dw = (I - v l^T) r / alpha_s
-            rl = l(1)*r1 + l(2)*r2
-            plan%dw(1, :) = (r1 - v(1)*rl)/als
-            plan%dw(2, :) = (r2 - v(2)*rl)/als
-        else
-            call cramer2(a(1, 1), a(1, 2), a(2, 1), a(2, 2), det, r1, r2, plan%dw(1, :), &
-                         plan%dw(2, :))
-        end if
+        call cramer2(a(1, 1), a(1, 2), a(2, 1), a(2, 2), det, r1, r2, plan%dw(1, :), &
+                     plan%dw(2, :))
         call propagate2d(plan, j, kt, .true., jac)
     end function fixed_point2d
 

@@ -95,7 +95,6 @@ contains
             plan%hold(1:m) = 0
             plan%damp(1:m) = 1.0_wp
             plan%damp_cap(1:m) = 1.0_wp
-            plan%weak(1:m) = .false.
             do nper = 1, max_periods
                 plan%wstart(1:m, :) = w
                 select case (law)
@@ -129,13 +128,7 @@ contains
             end do
             if (law == LAW_NORMAL2D) then
                 do j = 1, m
-                    if (.not. plan%weak(j)) cycle
-                    call project2d(plan, j, w0(:, j), tol)
-                    if (.not. plan%weak(j)) call march_plain2d(plan, j, w0(:, j), tol, &
-                                                               max_periods)
-                end do
-                do j = 1, m
-                    if (.not. plan%accelerated(j) .or. plan%weak(j)) cycle
+                    if (.not. plan%accelerated(j)) cycle
                     call slider_fixed_point(plan, j, a, det, isolated, opened)
                     if (.not. isolated) call march_plain2d(plan, j, w0(:, j), tol, max_periods)
                 end do
@@ -177,7 +170,7 @@ contains
         real(wp), parameter :: DET_MIN = 1.0e-8_wp
         integer(ip), parameter :: HOLD = 2
         real(wp), parameter :: DAMP_MIN = 2.0_wp**(-12)
-        real(wp) :: res, a(2, 2), det, g(2), x(2), als
+        real(wp) :: res, a(2, 2), det, g(2), x(2)
         logical :: opened, isolated, try
         associate (w => plan%w(j, 1:2), ws => plan%wstart(j, 1:2))
             res = maxval(abs(w - ws))
@@ -200,14 +193,6 @@ contains
                 return
             end if
             call slider_fixed_point(plan, j, a, det, isolated, opened)
-            if (.not. isolated .and. any(plan%state(j, :) == STATE_SLIP)) then
-                ! one weak direction: the projected fixed point (project2d), after the march
-                call weak_split(a, det, g, x, als, plan%weak(j))
-                if (plan%weak(j)) then
-                    plan%closed_at(j) = nper
-                    return
-                end if
-            end if
             if (.not. isolated) then
                 ! the slider is history along its weak direction: closed once it drifts by
                 ! less than DRIFT a period; a step towards a fixed point ~1/det away only
@@ -248,35 +233,6 @@ contains
         isolated = det >= DET_ISOLATED
     end procedure slider_fixed_point
 
-    module procedure weak_split
-        real(wp), parameter :: WEAK_SEP = 16.0_wp
-        real(wp) :: tr, disc, alw, v2(2), l2(2), lv
-        v = 0.0_wp
-        l = 0.0_wp
-        alpha_s = 0.0_wp
-        ok = .false.
-        tr = a(1, 1) + a(2, 2)
-        disc = 0.25_wp*tr*tr - det
-        if (disc < 0.0_wp) return
-        alpha_s = 0.5_wp*tr + sign(sqrt(disc), tr)
-        if (abs(alpha_s) < 1.0e-3_wp) return
-        alw = det/alpha_s
-        if (abs(alpha_s) < WEAK_SEP*abs(alw)) return
-        ! (a - alw I) v = 0 and l^T (a - alw I) = 0, each from the larger of its two forms
-        v = [a(1, 2), alw - a(1, 1)]
-        v2 = [alw - a(2, 2), a(2, 1)]
-        if (norm2(v2) > norm2(v)) v = v2
-        l = [a(2, 1), alw - a(1, 1)]
-        l2 = [alw - a(2, 2), a(1, 2)]
-        if (norm2(l2) > norm2(l)) l = l2
-        if (norm2(v) <= 0.0_wp .or. norm2(l) <= 0.0_wp) return
-        v = v/norm2(v)
-        lv = dot_product(l, v)
-        if (abs(lv) < 1.0e-6_wp*norm2(l)) return
-        l = l/lv
-        ok = .true.
-    end procedure weak_split
-
     module procedure cramer2
         x1 = (a22*g1 - a12*g2)/det
         x2 = (a11*g2 - a21*g1)/det
@@ -310,55 +266,6 @@ contains
             end select
         end do
     end subroutine slider_map
-
-    !> The projected fixed point of 2-D element j, whose slider one period determines
-    !> along one direction only weakly (weak_split: M's eigenvalue 1 - alpha_w near 1,
-    !> right eigenvector v, left l): the weak component l.w is history, held at w0's, and
-    !> the strong one is closed exactly: w* with (I - v l^T)(P(w*) - w*) = 0 and
-    !> l.(w* - w0) = 0, by Newton steps w += (I - v l^T) g / alpha_s + v l.(w0 - w) (g the
-    !> period's mismatch), v and l from each period. The forces are those of the period
-    !> from w*, which is also the slider carried on (its end differs from it by the
-    !> weak drift only). Where a period is isolated, opens, has no split, or PROJ_MAX
-    !> periods do not close it, weak(j) is reset (the caller then marches it as history).
-    subroutine project2d(plan, j, w0j, tol)
-        type(aft_plan), intent(inout) :: plan
-        integer(ip), intent(in) :: j
-        real(wp), intent(in) :: w0j(:)    !! (2) initial slider, m
-        real(wp), intent(in) :: tol
-        integer(ip), parameter :: PROJ_MAX = 30
-        integer(ip) :: nper
-        real(wp) :: a(2, 2), det, v(2), l(2), als, g(2), q(2), off, lim
-        logical :: isolated, opened, ok
-        lim = tol*plan%scale(j)
-        plan%weak(j) = .false.
-        associate (rin => plan%fp%rin, rout => plan%fp%rout, par => plan%par, &
-                   uf => plan%follow)
-            plan%w(j, 1:2) = w0j(1:2)
-            do nper = 1, PROJ_MAX
-                plan%wstart(j, 1:2) = plan%w(j, 1:2)
-                call friction2d_march(uf(j:j, :, 1), uf(j:j, :, 2), rin(j:j, :, 3), &
-                                      par(j:j, 1), par(j:j, 2), par(j:j, 3), par(j:j, 4), &
-                                      plan%w(j:j, 1:2), rout(j:j, :, 1), rout(j:j, :, 2), &
-                                      rout(j:j, :, 3), plan%state(j:j, :), &
-                                      plan%tangent(j:j, :, :))
-                call slider_fixed_point(plan, j, a, det, isolated, opened)
-                if (isolated .or. opened) return
-                call weak_split(a, det, v, l, als, ok)
-                if (.not. ok) return
-                g = plan%w(j, 1:2) - plan%wstart(j, 1:2)
-                q = g - v*dot_product(l, g)
-                off = dot_product(l, w0j(1:2) - plan%wstart(j, 1:2))
-                if (maxval(abs(q)) <= lim .and. abs(off)*maxval(abs(v)) <= lim) then
-                    plan%closed_at(j) = nper
-                    plan%w(j, 1:2) = plan%wstart(j, 1:2)
-                    plan%weak(j) = .true.
-                    plan%accelerated(j) = .false.
-                    return
-                end if
-                plan%w(j, 1:2) = plan%wstart(j, 1:2) + q/als + v*off
-            end do
-        end associate
-    end subroutine project2d
 
     !> March 2-D element j again from w0j without steps, for a march with a kept step whose
     !> closed cycle is not isolated (slider_fixed_point): if plain marching closes within

@@ -150,16 +150,17 @@ contains
     end function ieee_nan
 
     !> Two 2-D cycles from the paper_hooks case (coarse, ROM_I, normal2d, lug tied, f0 =
-    !> 1 000 N, near 180.2 Hz: H = 1, N = 128), each from the slider the previous
-    !> continuation point left: 1-2 samples of 128 slip, and one period determines the
-    !> slider along one direction by det(I - M) ~ 4e-3 only (plain marching takes 4 345 and
-    !> 6 822 periods to close). The AFT holds that weak component at w0's and closes the
-    !> strong one (a projected fixed point). Checks, against the test's own plain march
-    !> and a period map M by central differences of it (h = 1e-12 of the 1e-7 m motion):
-    !> the AFT's forces are those of one period from the slider it returns (1e-12); that
-    !> slider moved from w0 along M's strong eigenvector, and the period's mismatch lies
-    !> along its weak one (the sines of the angles to them <= 1e-5, seen <= 4e-7); at most
-    !> 5 periods.
+    !> 1 000 N, near 180.2 Hz: H = 1, N = 128), each marched from the slider the previous
+    !> continuation point left: 1-2 samples of 128 slip, plain marching contracts the
+    !> mismatch 1 - 3e-5 a period (4 345 and 6 822 periods to close) and the full Newton
+    !> step on the slider is rejected every time (the friction disc's curvature: the
+    !> stepped period's mismatch is larger), so the AFT did not close in 200 periods and the
+    !> FRF stopped there. With the step damped after each rejection they close in 35 and 11
+    !> periods; their forces equal those of a plain march of 200 000 periods from the same
+    !> slider to 2e-6 of their scale. Their sliders are weakly determined (det(I - M) <
+    !> 1e-2): the AFT closes them on their drift (DRIFT = 1e-9 a period) instead of on the
+    !> far fixed point, whose error det amplifies (measured 6.5e-8 and 1.3e-6; closed exactly
+    !> they were 1e-13). Projecting the weak component out would tighten this (issue 31).
     subroutine check_normal2d_carried_slider()
         integer(ip), parameter :: h1 = 1, c1 = 3, s1 = 128, nplain = 200000
         real(wp), parameter :: cases(15, 2) = reshape([ &
@@ -177,63 +178,29 @@ contains
             3.57078416284049260e-08_wp], [15, 2])
         type(aft_plan) :: pl
         real(wp) :: xc(c1, 3, 1), pc(4, 1), wc(2, 1), fc(c1, 3, 1), xt(s1, 3, 1), ft(s1, 3, 1)
-        real(wp) :: w(1, 2), fr(1, s1, 3), last, ferr, fscale, ws(2, 1), g(2), d(2), mfd(2, 2)
-        real(wp) :: wpl(1, 2), wmi(1, 2), par_, per_, sv(2), sl(2)
-        real(wp), parameter :: hh = 1.0e-9_wp*1.0e-7_wp
-        integer(ip) :: i, k, m, per(1), st(1, s1)
+        real(wp) :: w(1, 2), fr(1, s1, 3), last, ferr, fscale
+        integer(ip) :: i, k, per(1), st(1, s1)
         call aft_plan_create(pl, h1, s1, info, msg)
         if (info /= FRIROM_OK) error stop 'normal2d carried: plan'
         do i = 1, 2
             xc(:, :, 1) = reshape(cases(1:9, i), [c1, 3])
             pc(:, 1) = cases(10:13, i)
             wc(:, 1) = cases(14:15, i)
-            call aft_eval(pl, LAW_NORMAL2D, xc, pc, wc, fc, info, msg, periods=per, slider=ws)
+            call aft_eval(pl, LAW_NORMAL2D, xc, pc, wc, fc, info, msg, periods=per)
             if (info /= FRIROM_OK) error stop 'normal2d carried: the AFT did not close'
             call aft_time(pl, LAW_NORMAL2D, xc, pc, wc, xt, ft, info, msg)
             if (info /= FRIROM_OK) error stop 'normal2d carried: aft_time'
-            w(1, :) = ws(:, 1)
-            call march_plainly(xt, pc, w, 1_ip, fr, st, k, last)
+            w(1, :) = wc(:, 1)
+            call march_plainly(xt, pc, w, nplain, fr, st, k, last)
             fscale = maxval(abs(fr))
             ferr = force_error(ft, fr)
-            g = w(1, :) - ws(:, 1)
-            do m = 1, 2
-                wpl(1, :) = ws(:, 1)
-                wpl(1, m) = wpl(1, m) + hh
-                wmi(1, :) = ws(:, 1)
-                wmi(1, m) = wmi(1, m) - hh
-                call march_plainly(xt, pc, wpl, 1_ip, fr, st, k, last)
-                call march_plainly(xt, pc, wmi, 1_ip, fr, st, k, last)
-                mfd(:, m) = (wpl(1, :) - wmi(1, :))/(2*hh)
-            end do
-            ! A = I - M, eigenvalues ~4e-3 (weak) and ~1 (strong): its strong right (sv) and
-            ! left (sl) eigenvectors by three power steps (error (4e-3)^3); d along sv, g
-            ! along the weak right eigenvector, that is orthogonal to sl
-            d = ws(:, 1) - wc(:, 1)
-            mfd = reshape([1.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [2, 2]) - mfd
-            sv = [1.0_wp, 1.0_wp]
-            sl = [1.0_wp, 1.0_wp]
-            do m = 1, 3
-                sv = matmul(mfd, sv)/norm2(matmul(mfd, sv))
-                sl = matmul(sl, mfd)/norm2(matmul(sl, mfd))
-            end do
-            par_ = cross(sv, d)/norm2(d)
-            per_ = dot_product(sl, g)/norm2(g)
-            print '(a,i0,a,i0,a,es9.2,a,2es9.2)', 'normal2d carried slider case ', i, ': AFT ', &
-                per(1), ' periods; force error ', ferr/fscale, '; eigenvector errors ', &
-                par_, per_
-            if (per(1) > 5) error stop 'normal2d carried: slow closure'
-            if (ferr > 1.0e-12_wp*fscale) error stop 'normal2d carried: off one period'
-            if (abs(par_) > 1.0e-5_wp .or. abs(per_) > 1.0e-5_wp) &
-                error stop 'normal2d carried: not the projected fixed point'
+            print '(a,i0,a,i0,a,es9.2)', 'normal2d carried slider case ', i, ': AFT ', per(1), &
+                ' periods; force error ', ferr/fscale
+            if (per(1) > 50) error stop 'normal2d carried: slow closure'
+            if (ferr > 2.0e-6_wp*fscale) error stop 'normal2d carried: off the plain march'
         end do
         call aft_plan_destroy(pl)
     end subroutine check_normal2d_carried_slider
-
-    !> The 2-D cross product a1 b2 - a2 b1.
-    pure real(wp) function cross(a_, b_)
-        real(wp), intent(in) :: a_(2), b_(2)
-        cross = a_(1)*b_(2) - a_(2)*b_(1)
-    end function cross
     !> The 2-D law marched plainly, nper periods from slider w (in/out), over the time
     !> histories xt (ns, 3, 1) of aft_time: the last period's forces fr and states st, the
     !> first period whose slider mismatch is below 1e-12 of the displacement scale (0:

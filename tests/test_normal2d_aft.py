@@ -126,46 +126,29 @@ HOOK_P = [55555600.0, 111111000.0, 0.3, 27.77777777777778]
 HOOK_W0 = [-1.0088930426122499e-08, 1.216946519734509e-07]
 
 
-def _fd_jacobian(x, w0, h):
-    """Central differences of the AFT forces in the harmonics of x, w0 held; and the
-    largest number of periods any of them took."""
-    cols, most = [], 0
-    for c in range(x.size):
-        f = []
-        for s in (h, -h):
-            xp = x.copy()
-            xp.reshape(-1)[c] += s
-            r = contact.aft("normal2d", xp, HOOK_P, 128, w0=w0, jacobian=False)
-            most = max(most, int(r.periods[0]))
-            f.append(r.forces[0].reshape(-1))
-        cols.append((f[0] - f[1]) / (2 * h))
-    return np.array(cols).T, most
-
-
-def test_nearly_undetermined_slider_is_a_projected_fixed_point():
-    """The hook element above from the slider its previous point left: its slider along the
-    weak direction is history (like a stuck one), held at w0's, and the strong component
-    closes exactly (the projected fixed point; a step ~1/det towards the far fixed point
-    took 175 periods, and a change of 1e-12 m in one harmonic then did not close in 200).
-    Checks: it closes within 3 periods, so does every +-1e-14 and +-1e-12 m change of a
-    harmonic (seen 2-3); from the slider it returns (the next point's w0) it closes in one
-    period at that same slider, and its Jacobian there equals central differences of the
-    forces at h = 1e-14 m to 1e-7 of its largest entry (seen 1.6e-9). From the other w0
-    the Jacobian leaves out the turn of the weak direction with the motion times the
-    slider's move (w* - w0): within 1e-4 (seen 2.5e-5)."""
+def test_nearly_undetermined_slider_is_history_and_its_jacobian_is_the_march_s():
+    """The hook element above from the slider its previous point left: its slider across
+    the line of slip is history (like a stuck one), so the march closes once it drifts by
+    less than 1e-9 of the motion a period instead of stepping ~1/det towards a far fixed
+    point (which took 175 periods, and a change of 1e-12 m in one harmonic then did not
+    close in 200). Checks: it closes within 3 periods, so does every +-1e-14 m change of
+    a harmonic; every +-1e-12 m change closes within 80 (seen 2, and 37-52 for three
+    whose drift exceeds 1e-9 and which step); the Jacobian equals central differences of the
+    forces with the same w0 at h = 1e-14 m (a step within which no sample changes state)
+    to 1e-7 of its largest entry (seen 1.6e-9)."""
     x = HOOK_U[None]
     w0 = np.array([HOOK_W0])
     res = contact.aft("normal2d", x, HOOK_P, 128, w0=w0)
     assert res.periods[0] <= 3 and 0 < res.states[0, 1] < 0.05
-    fd, most = _fd_jacobian(x, w0, 1e-14)
-    assert most <= 3
     J = res.jacobian[0]
-    assert np.abs(J - fd).max() <= 1e-4 * np.abs(J).max(), np.abs(J - fd).max() / np.abs(J).max()
-    assert _fd_jacobian(x, w0, 1e-12)[1] <= 3
-    ws = res.slider.copy()
-    again = contact.aft("normal2d", x, HOOK_P, 128, w0=ws)
-    assert again.periods[0] == 1 and np.array_equal(again.slider, ws)
-    np.testing.assert_array_equal(again.forces, res.forces)
-    fd, most = _fd_jacobian(x, ws, 1e-14)
-    J = again.jacobian[0]
-    assert np.abs(J - fd).max() <= 1e-7 * np.abs(J).max(), np.abs(J - fd).max() / np.abs(J).max()
+    h, fd = 1e-14, np.zeros_like(J)
+    for c in range(x.size):
+        f = []
+        for s in (h, -h, 1e-12, -1e-12):
+            xp = x.copy()
+            xp.reshape(-1)[c] += s
+            r = contact.aft("normal2d", xp, HOOK_P, 128, w0=w0, jacobian=False)
+            assert r.periods[0] <= (3 if abs(s) < 1e-13 else 80), (c, s, r.periods)
+            f.append(r.forces[0].reshape(-1))
+        fd[:, c] = (f[0] - f[1]) / (2 * h)
+    assert np.abs(J - fd).max() <= 1e-7 * np.abs(J).max(), np.abs(J - fd).max()
