@@ -128,6 +128,15 @@ contains
             end do
             if (law == LAW_NORMAL2D) then
                 do j = 1, m
+                    ! a history slider still drifting by more than DRIFT after max_periods
+                    ! plain periods is the state they leave (a fixed count: smooth in the
+                    ! motion), as a stuck one is; a paper-hooks ROM_II sweep (300 N down)
+                    ! stopped on one at 137.29 Hz
+                    if (plan%closed_at(j) <= max_periods .or. plan%accelerated(j)) cycle
+                    call slider_fixed_point(plan, j, a, det, isolated, opened)
+                    if (.not. isolated .and. .not. opened) plan%closed_at(j) = max_periods
+                end do
+                do j = 1, m
                     if (.not. plan%accelerated(j)) cycle
                     call slider_fixed_point(plan, j, a, det, isolated, opened)
                     if (.not. isolated) call march_plain2d(plan, j, w0(:, j), tol, max_periods)
@@ -308,6 +317,13 @@ contains
                 end if
             end do
         end associate
+        if (plan%closed_at(j) > max_periods .and. .not. isolated .and. .not. opened) then
+            ! the stepped cycle did not close either: the state max_periods plain periods
+            ! leave, as march_closed keeps for an unstepped history slider
+            plan%closed_at(j) = max_periods
+            plan%accelerated(j) = .false.
+            return
+        end if
         plan%state(j, :) = st_keep
         plan%fp%rout(j, :, 1:3) = f_keep
         plan%tangent(j, :, :) = tg_keep

@@ -152,3 +152,32 @@ def test_nearly_undetermined_slider_is_history_and_its_jacobian_is_the_march_s()
             f.append(r.forces[0].reshape(-1))
         fd[:, c] = (f[0] - f[1]) / (2 * h)
     assert np.abs(J - fd).max() <= 1e-7 * np.abs(J).max(), np.abs(J - fd).max()
+
+
+def test_history_slider_still_drifting_is_the_state_max_periods_leave():
+    """The hook element above with max_periods = 1 (it closes on its drift in 2): a slider
+    that is history and still drifts after max_periods plain periods is the state they
+    leave, not a failure (a paper-hooks ROM_II sweep stopped on one); its forces and
+    Jacobian are those of the period marched: the Jacobian equals central differences
+    of the forces (same w0, same max_periods) at h = 1e-14 m to 1e-7 of its largest entry,
+    and the forces differ from the closed ones (2 periods) by < 1e-5 of their scale (seen
+    1.1e-6)."""
+    x = HOOK_U[None]
+    w0 = np.array([HOOK_W0])
+    closed = contact.aft("normal2d", x, HOOK_P, 128, w0=w0, jacobian=False)
+    assert closed.periods[0] == 2
+    res = contact.aft("normal2d", x, HOOK_P, 128, w0=w0, max_periods=1)
+    assert res.periods[0] == 1
+    scale = np.abs(closed.forces).max()
+    assert 0 < np.abs(res.forces - closed.forces).max() < 1e-5 * scale
+    J, h = res.jacobian[0], 1e-14
+    fd = np.zeros_like(J)
+    for c in range(x.size):
+        f = []
+        for s in (h, -h):
+            xp = x.copy()
+            xp.reshape(-1)[c] += s
+            r = contact.aft("normal2d", xp, HOOK_P, 128, w0=w0, jacobian=False, max_periods=1)
+            f.append(r.forces[0].reshape(-1))
+        fd[:, c] = (f[0] - f[1]) / (2 * h)
+    assert np.abs(J - fd).max() <= 1e-7 * np.abs(J).max(), np.abs(J - fd).max()
