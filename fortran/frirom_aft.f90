@@ -102,6 +102,13 @@ module frirom_aft
     !> iterations the forces jump by up to that: 1e-7 and 1e-8 stalled paper-hooks sweeps
     !> at |R|/rref ~1e-8 (ROM_II 1 000 N down, 300 N up), 1e-9 runs them through.
     real(wp), parameter :: DRIFT = 1.0e-9_wp
+    ! HELD (aft_forces' held): how many periods a history cycle takes to close changes with
+    ! the motion, and the forces jump by up to DRIFT where it does: a Newton corrector whose
+    ! iterations straddle such a change stalls at |R|/rref ~1e-8 (the coarse paper hooks'
+    ! ROM_I at 180.2 Hz). A caller that holds the counts the first evaluation of a corrector
+    ! finds (frirom_hbm: hbm_begin_correct clears them) marches those cycles exactly that
+    ! many periods from w0 in every later evaluation: R is then one smooth function of the
+    ! motion during the corrector, and the Jacobian (settle2d) is exactly its derivative.
 
     !> Everything one caller needs to evaluate contact forces at H harmonics and N samples:
     !> FFTW plans, buffers and per-batch work arrays. Owned by the caller (one per thread).
@@ -133,6 +140,12 @@ module frirom_aft
         real(wp), allocatable :: damp(:)             !! (nbatch) fraction of the step taken
         real(wp), allocatable :: damp_cap(:)         !! (nbatch) largest fraction since a
                                                      !! rejected step
+        integer(ip), allocatable :: held(:)          !! (nbatch) aft_forces' held, 0: none
+        ! a 2-D cycle closed while others of its batch march on: its period, kept
+        real(wp), allocatable :: kf(:, :, :)         !! (nbatch, N, 3) forces
+        integer(ip), allocatable :: kst(:, :)        !! (nbatch, N) states
+        real(wp), allocatable :: ktg(:, :, :)        !! (nbatch, 12, N) tangents
+        real(wp), allocatable :: kw(:, :)            !! (nbatch, 4) slider at end and start
     end type aft_plan
 
     ! The two entry points are generic names over separate module procedures: gfortran 12
@@ -158,7 +171,8 @@ module frirom_aft
         !> normal preload on harmonic 0), its samples computed as kn v (-n0 open), not as
         !> (n0 + kn v) - n0: no rounding of the size eps n0 (a large preload).
         recursive module subroutine aft_forces(plan, law, x, params, w0, f, info, errmsg, jac, periods, &
-                                     states, tol, max_periods, index_base, slider, relative)
+                                     states, tol, max_periods, index_base, slider, relative, &
+                                     held)
             type(aft_plan), intent(inout) :: plan
             integer(ip), intent(in) :: law                !! LAW_*
             real(wp), intent(in) :: x(:, :, :)            !! (2H+1, ndir, ne), m
@@ -175,6 +189,10 @@ module frirom_aft
             integer(ip), intent(in), optional :: index_base   !! element numbering in messages
             real(wp), intent(out), optional :: slider(:, :)   !! (nslider, ne), m
             logical, intent(in), optional :: relative         !! (.false.)
+            !> (ne) 2-D law: periods a history cycle is marched, held through a Newton
+            !> corrector (see HELD below); 0 on entry: march and closure test as usual, and
+            !> a history cycle's period count is returned to be held
+            integer(ip), intent(inout), optional :: held(:)
         end subroutine aft_forces
     end interface aft_eval
 
@@ -457,7 +475,10 @@ contains
                   plan%jt(0:2*nharm, 6))
         allocate (plan%wplain(nb, 2), plan%res_base(nb), &
                   plan%res_last(nb), plan%stepped(nb), plan%accelerated(nb), plan%hold(nb), &
-                  plan%damp(nb), plan%damp_cap(nb))
+                  plan%damp(nb), plan%damp_cap(nb), plan%held(nb))
+        allocate (plan%kf(nb, nsamp, 3), plan%kst(nb, nsamp), plan%ktg(nb, 12, nsamp), &
+                  plan%kw(nb, 4))
+        plan%held = 0
     end subroutine aft_plan_create
 
     !> Release the plans and work arrays (a destroyed or never created plan is fine).
@@ -472,6 +493,7 @@ contains
         if (allocated(plan%dw)) deallocate (plan%dw, plan%dw0, plan%dft, plan%jw, plan%jt)
         if (allocated(plan%wplain)) deallocate (plan%wplain, plan%res_base, plan%res_last, &
                                                 plan%stepped, plan%accelerated, plan%hold, &
-                                                plan%damp, plan%damp_cap)
+                                                plan%damp, plan%damp_cap, plan%held)
+        if (allocated(plan%kf)) deallocate (plan%kf, plan%kst, plan%ktg, plan%kw)
     end subroutine aft_plan_destroy
 end module frirom_aft

@@ -20,6 +20,12 @@ contains
                         index_base, slider)
         if (info /= FRIROM_OK) return
         call defaults(tol, max_periods, index_base, tl, mp, base)
+        if (present(held)) then
+            if (size(held) /= size(x, 3)) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'held must be (ne)')
+                return
+            end if
+        end if
         if (law == LAW_IWAN4 .or. law == LAW_IWAN) then
             call iwan_forces(plan, law, x, params, w0, f, info, errmsg, jac, periods, states, &
                              tl, mp, base, slider)
@@ -39,7 +45,10 @@ contains
 
         do e0 = 1, ne, nb
             m = min(nb, ne - e0 + 1)
+            plan%held(1:m) = 0
+            if (present(held) .and. law == LAW_NORMAL2D) plan%held(1:m) = held(e0:e0 + m - 1)
             call time_batch(plan, law, x, params, w0, e0, m, tl, mp)
+            if (present(held) .and. law == LAW_NORMAL2D) held(e0:e0 + m - 1) = plan%held(1:m)
             do j = 1, m
                 e = e0 + j - 1
                 nper = plan%closed_at(j)
@@ -120,6 +129,7 @@ contains
         nb = plan%fp%nbatch
         do e0 = 1, ne, nb
             m = min(nb, ne - e0 + 1)
+            plan%held(1:m) = 0
             call time_batch(plan, law, x, params, w0, e0, m, tl, mp)
             do j = 1, m
                 e = e0 + j - 1

@@ -240,7 +240,11 @@ contains
         call jac_diagonal(plan, j, 4_ip, jac, 0_ip, 0_ip)       ! d f1/du1, stick
         call jac_diagonal(plan, j, 4_ip, jac, nc, nc)           ! d f2/du2, stick
         call jac_diagonal(plan, j, 5_ip, jac, 2*nc, 2*nc)       ! d fn/dv, contact
-        if (fixed_point2d(plan, j, kt, jac)) return
+        ! a held history cycle (aft_forces' held) is differentiated as marched even where
+        ! its last period would count as isolated
+        if (plan%held(j) == 0) then
+            if (fixed_point2d(plan, j, kt, jac)) return
+        end if
         ! not isolated: the forces are those of the closed_at-th period marched plainly
         ! from w0 (frirom_aft_march), differentiated as such (the settling periods give
         ! the slider tangent at the start of the last one); a stepped cycle kept where the

@@ -45,6 +45,7 @@ module frirom_newton
         procedure(solve_iface), deferred :: solve
         procedure :: accept => nl_accept
         procedure :: roundoff => nl_roundoff
+        procedure :: begin_correct => nl_begin_correct
     end type nl_system
 
     abstract interface
@@ -136,6 +137,14 @@ contains
         if (.false.) this%n = size(y) + int(lam)
     end subroutine nl_accept
 
+    !> Called as a corrector starts: a system whose residual holds choices of its first
+    !> evaluation through the corrector (frirom_hbm: the 2-D sliders' period counts)
+    !> makes them afresh here. Default: nothing.
+    subroutine nl_begin_correct(this)
+        class(nl_system), intent(inout) :: this
+        if (.false.) this%n = this%n + 0
+    end subroutine nl_begin_correct
+
     !> Whether the residual r (rref from the same eval) is at the round-off level of its
     !> terms, where Newton accepts a point whatever its last update (a near-singular J,
     !> e.g. gross slip, can keep the update above tol_x there): ||r|| <= 100 eps rref. A
@@ -180,6 +189,7 @@ contains
             return
         end if
         allocate (r(n), rlam(n), ab(n, 2), y1(n), r1(n), dy(n), rlam1(n))
+        call sys%begin_correct()
         rate = 1.0_wp
         fresh = .not. (have_fact .and. opts%reuse_jac)
         if (present(nfact)) nfact = merge(1, 0, fresh)

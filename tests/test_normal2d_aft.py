@@ -132,8 +132,10 @@ def test_nearly_undetermined_slider_is_history_and_its_jacobian_is_the_march_s()
     less than 1e-9 of the motion a period instead of stepping ~1/det towards a far fixed
     point (which took 175 periods, and a change of 1e-12 m in one harmonic then did not
     close in 200). Checks: it closes within 3 periods, so does every +-1e-14 m change of
-    a harmonic; every +-1e-12 m change closes within 80 (seen 2, and 37-52 for three
-    whose drift exceeds 1e-9 and which step); the Jacobian equals central differences of the
+    a harmonic; every +-1e-12 m change gives its cycle without an error (seen 2 periods,
+    and for three whose drift exceeds 1e-9 the state 200 plain periods leave: history
+    too, where the stepped fixed point kept before moved ~1/det times the change); the
+    Jacobian equals central differences of the
     forces with the same w0 at h = 1e-14 m (a step within which no sample changes state)
     to 1e-7 of its largest entry (seen 1.6e-9)."""
     x = HOOK_U[None]
@@ -148,7 +150,8 @@ def test_nearly_undetermined_slider_is_history_and_its_jacobian_is_the_march_s()
             xp = x.copy()
             xp.reshape(-1)[c] += s
             r = contact.aft("normal2d", xp, HOOK_P, 128, w0=w0, jacobian=False)
-            assert r.periods[0] <= (3 if abs(s) < 1e-13 else 80), (c, s, r.periods)
+            if abs(s) < 1e-13:
+                assert r.periods[0] <= 3, (c, s, r.periods)
             f.append(r.forces[0].reshape(-1))
         fd[:, c] = (f[0] - f[1]) / (2 * h)
     assert np.abs(J - fd).max() <= 1e-7 * np.abs(J).max(), np.abs(J - fd).max()
