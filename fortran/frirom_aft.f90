@@ -141,6 +141,9 @@ module frirom_aft
         real(wp), allocatable :: damp_cap(:)         !! (nbatch) largest fraction since a
                                                      !! rejected step
         integer(ip), allocatable :: held(:)          !! (nbatch) aft_forces' held, 0: none
+        !> (nbatch) a history cycle still drifting after max_periods periods (its slider is
+        !> not handed on: aft_forces' slider is w0 for it)
+        logical, allocatable :: drifting(:)
         ! a 2-D cycle closed while others of its batch march on: its period, kept
         real(wp), allocatable :: kf(:, :, :)         !! (nbatch, N, 3) forces
         integer(ip), allocatable :: kst(:, :)        !! (nbatch, N) states
@@ -164,10 +167,12 @@ module frirom_aft
         !> (FRIROM_ERR_NOCLOSE, with the forces of the last period). periods(e): periods
         !> marched; states(:, e): fraction of samples in stick, slip and lift-off;
         !> slider(:, e): slider position with which the closed cycle starts (= where it
-        !> ends, after the last sample). A continuation passes slider back as the next
-        !> point's w0, so that a contact entering stick-all-cycle keeps the slider where it
-        !> last slipped (the stuck state is not unique; history decides it) instead of
-        !> jumping back to w0. relative: f less the force at rest (law_rest_force: the
+        !> ends, after the last sample); w0 for a history cycle still drifting after
+        !> max_periods periods (handed on, it would advance by max_periods periods at
+        !> every continuation point: a paper-hooks ROM_II sweep ratcheted in place at
+        !> 134.76 Hz). A continuation passes slider back as the next point's w0, so that a
+        !> contact entering stick-all-cycle keeps the slider where it last slipped (the
+        !> stuck state is not unique; history decides it) instead of jumping back to w0. relative: f less the force at rest (law_rest_force: the
         !> normal preload on harmonic 0), its samples computed as kn v (-n0 open), not as
         !> (n0 + kn v) - n0: no rounding of the size eps n0 (a large preload).
         recursive module subroutine aft_forces(plan, law, x, params, w0, f, info, errmsg, jac, periods, &
@@ -475,7 +480,7 @@ contains
                   plan%jt(0:2*nharm, 6))
         allocate (plan%wplain(nb, 2), plan%res_base(nb), &
                   plan%res_last(nb), plan%stepped(nb), plan%accelerated(nb), plan%hold(nb), &
-                  plan%damp(nb), plan%damp_cap(nb), plan%held(nb))
+                  plan%damp(nb), plan%damp_cap(nb), plan%held(nb), plan%drifting(nb))
         allocate (plan%kf(nb, nsamp, 3), plan%kst(nb, nsamp), plan%ktg(nb, 12, nsamp), &
                   plan%kw(nb, 4))
         plan%held = 0
@@ -493,7 +498,8 @@ contains
         if (allocated(plan%dw)) deallocate (plan%dw, plan%dw0, plan%dft, plan%jw, plan%jt)
         if (allocated(plan%wplain)) deallocate (plan%wplain, plan%res_base, plan%res_last, &
                                                 plan%stepped, plan%accelerated, plan%hold, &
-                                                plan%damp, plan%damp_cap, plan%held)
+                                                plan%damp, plan%damp_cap, plan%held, &
+                                                plan%drifting)
         if (allocated(plan%kf)) deallocate (plan%kf, plan%kst, plan%ktg, plan%kw)
     end subroutine aft_plan_destroy
 end module frirom_aft

@@ -60,6 +60,9 @@ contains
                 if (present(periods)) periods(e) = min(nper, mp)
                 if (present(slider) .and. NSLIDER_OF(law) > 0) &
                     slider(1:NSLIDER_OF(law), e) = plan%w(j, 1:NSLIDER_OF(law))
+                if (present(slider) .and. law == LAW_NORMAL2D) then
+                    if (plan%drifting(j)) slider(1:2, e) = w0(1:2, e)
+                end if
             end do
             if (present(states)) call state_fractions(plan%state, m, states(:, e0:e0 + m - 1))
             ! the series slots are read by the 2-D law's Jacobian only (the 1-D one scans the

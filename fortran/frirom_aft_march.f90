@@ -91,6 +91,7 @@ contains
             end if
             plan%closed_at(1:m) = max_periods + 1
             plan%stepped(1:m) = .false.
+            plan%drifting(1:m) = .false.
             plan%accelerated(1:m) = .false.
             plan%hold(1:m) = 0
             plan%damp(1:m) = 1.0_wp
@@ -146,7 +147,9 @@ contains
                     ! stopped on one at 137.29 Hz
                     if (plan%closed_at(j) <= max_periods .or. plan%accelerated(j)) cycle
                     call slider_fixed_point(plan, j, a, det, isolated, opened)
-                    if (.not. isolated .and. .not. opened) plan%closed_at(j) = max_periods
+                    if (isolated .or. opened) cycle
+                    plan%closed_at(j) = max_periods
+                    plan%drifting(j) = .true.
                 end do
                 do j = 1, m
                     if (.not. plan%accelerated(j)) cycle
@@ -354,6 +357,7 @@ contains
         ! crawled there in 1 300 points and stopped on a cycle that would not close.)
         plan%closed_at(j) = max_periods
         plan%accelerated(j) = .false.
+        plan%drifting(j) = .true.
     end subroutine march_plain2d
 
     !> Remember the last slip or lift-off sample of the period just marched: a contact that
