@@ -21,7 +21,11 @@
 !> marching can contract its mismatch as little as 0.99 a period (the onset of partial
 !> slip); its march takes Newton steps on the slider fixed point between periods, with
 !> the 2x2 derivative of the period map from the slip tangents (frirom_aft_march), and
-!> the Jacobian then solves the closed cycle's slider tangent directly.
+!> the Jacobian then solves the closed cycle's slider tangent directly. Where one period
+!> determines the slider along a direction only weakly (det(I - M) < DET_ISOLATED: stuck,
+!> or barely slipping to and fro along one line) the slider is history, as a stuck 1-D
+!> slider is: marched plainly from w0 until it drifts by less than DRIFT a period, and
+!> differentiated as marched.
 !>
 !> Cost per element: O(N) marching per period (usually 2 periods from a cold slider, about
 !> 5 for the 2-D law near the onset of partial slip),
@@ -34,8 +38,9 @@
 !> the march locates lift-off and re-contact between samples (frirom_contact), so the
 !> force harmonics of the 1-D laws converge like O(N^-2) in every regime; the default N
 !> is chosen from measurements in the Python package (frirom.harmonics.default_samples).
-!> Use N >= 4H+1 for the cubic law to be exact. The 2-D law's radial return is first
-!> order on curved slip paths (energy error ~ 1/N relative under circular motion).
+!> Use N >= 4H+1 for the cubic law to be exact. The 2-D law moves its slider exactly along
+!> the interpolated path between samples (frirom_contact slip2d_step), so it converges
+!> like O(N^-2) too, curved slip paths and lift-off included.
 !>
 !> Layout: this parent module holds the law table, the plan and the interfaces; the work
 !> is in submodules by job: frirom_aft_eval (the two entry points and the checks of their
@@ -84,15 +89,37 @@ module frirom_aft
     !> A closed 2-D cycle is an isolated fixed point of the period map when
     !> det(I - dw_end/dw_start) >= this (stuck all cycle: 0; touching the friction limit
     !> with a slip of the order of the closure tolerance: ~1e-12; onset of partial slip at
-    !> 0.991 a period: ~1e-2).
-    real(wp), parameter :: DET_ISOLATED = 1.0e-6_wp
+    !> 0.991 a period: ~1e-2). Below it the slider is determined along one direction by
+    !> less than this a period (a hook element of the paper mesh that barely slips to and
+    !> fro along one line: 2.3e-6): like a stuck slider, it is history, carried from w0.
+    !> (The fixed point's tangent is amplified by up to 1/det: with 1e-4 here the paper
+    !> hooks' ROM_II at f0 = 300 N turned back at 131.2 Hz, with 1e-2 it runs through.)
+    real(wp), parameter :: DET_ISOLATED = 1.0e-2_wp
+    !> A cycle that is not isolated closes once its slider moves less than DRIFT times the
+    !> displacement scale a period (its weak direction drifts by that, the force by kt
+    !> times it: a relative error of DRIFT), where an exact closure to tol would take
+    !> ~1/det periods. Where the number of periods marched changes between two Newton
+    !> iterations the forces jump by up to that: 1e-7 and 1e-8 stalled paper-hooks sweeps
+    !> at |R|/rref ~1e-8 (ROM_II 1 000 N down, 300 N up), 1e-9 runs them through.
+    real(wp), parameter :: DRIFT = 1.0e-9_wp
+    ! HELD (aft_forces' held): how many periods a history cycle takes to close changes with
+    ! the motion, and the forces jump by up to DRIFT where it does: a Newton corrector whose
+    ! iterations straddle such a change stalls at |R|/rref ~1e-8 (the coarse paper hooks'
+    ! ROM_I at 180.2 Hz). A caller that holds the counts the first evaluation of a corrector
+    ! finds (frirom_hbm: hbm_begin_correct clears them) marches those cycles exactly that
+    ! many periods from w0 in every later evaluation: R is then one smooth function of the
+    ! motion during the corrector, and the Jacobian (settle2d) is exactly its derivative.
+    ! Where the corrector converges far from where the counts were found, a held cycle may
+    ! not close there (a count of 1 found stuck, then slipping: its forces the first
+    ! period's from w0, a transient): settled says so, and the corrector finds the counts
+    ! afresh at its point and goes on (frirom_newton newton_correct).
 
     !> Everything one caller needs to evaluate contact forces at H harmonics and N samples:
     !> FFTW plans, buffers and per-batch work arrays. Owned by the caller (one per thread).
     type :: aft_plan
         type(fourier_plan) :: fp
         integer(ip), allocatable :: state(:, :)      !! (nbatch, N) contact state per sample
-        real(wp), allocatable :: tangent(:, :, :)    !! (nbatch, 6, N) 2-D slip tangents
+        real(wp), allocatable :: tangent(:, :, :)    !! (nbatch, 12, N) 2-D slip tangents
         real(wp), allocatable :: follow(:, :, :)     !! (nbatch, N, 2) u the sliders follow
                                                      !! (frirom_contact recontact_follow)
         real(wp), allocatable :: par(:, :)           !! (nbatch, 4) parameters of the batch
@@ -115,6 +142,18 @@ module frirom_aft
         logical, allocatable :: accelerated(:)       !! (nbatch) a step was accepted
         integer(ip), allocatable :: hold(:)          !! (nbatch) plain periods before a step
         real(wp), allocatable :: damp(:)             !! (nbatch) fraction of the step taken
+        real(wp), allocatable :: damp_cap(:)         !! (nbatch) largest fraction since a
+                                                     !! rejected step
+        integer(ip), allocatable :: held(:)          !! (nbatch) aft_forces' held, 0: none
+        !> (nbatch) a history cycle still drifting after max_periods periods (its slider is
+        !> not handed on: aft_forces' slider is w0 for it)
+        logical, allocatable :: drifting(:)
+        logical, allocatable :: unsettled(:)         !! (nbatch) a held cycle not closed
+        ! a 2-D cycle closed while others of its batch march on: its period, kept
+        real(wp), allocatable :: kf(:, :, :)         !! (nbatch, N, 3) forces
+        integer(ip), allocatable :: kst(:, :)        !! (nbatch, N) states
+        real(wp), allocatable :: ktg(:, :, :)        !! (nbatch, 12, N) tangents
+        real(wp), allocatable :: kw(:, :)            !! (nbatch, 4) slider at end and start
     end type aft_plan
 
     ! The two entry points are generic names over separate module procedures: gfortran 12
@@ -133,14 +172,17 @@ module frirom_aft
         !> (FRIROM_ERR_NOCLOSE, with the forces of the last period). periods(e): periods
         !> marched; states(:, e): fraction of samples in stick, slip and lift-off;
         !> slider(:, e): slider position with which the closed cycle starts (= where it
-        !> ends, after the last sample). A continuation passes slider back as the next
-        !> point's w0, so that a contact entering stick-all-cycle keeps the slider where it
-        !> last slipped (the stuck state is not unique; history decides it) instead of
-        !> jumping back to w0. relative: f less the force at rest (law_rest_force: the
+        !> ends, after the last sample); w0 for a history cycle still drifting after
+        !> max_periods periods (handed on, it would advance by max_periods periods at
+        !> every continuation point: a paper-hooks ROM_II sweep ratcheted in place at
+        !> 134.76 Hz). A continuation passes slider back as the next point's w0, so that a
+        !> contact entering stick-all-cycle keeps the slider where it last slipped (the
+        !> stuck state is not unique; history decides it) instead of jumping back to w0. relative: f less the force at rest (law_rest_force: the
         !> normal preload on harmonic 0), its samples computed as kn v (-n0 open), not as
         !> (n0 + kn v) - n0: no rounding of the size eps n0 (a large preload).
         recursive module subroutine aft_forces(plan, law, x, params, w0, f, info, errmsg, jac, periods, &
-                                     states, tol, max_periods, index_base, slider, relative)
+                                     states, tol, max_periods, index_base, slider, relative, &
+                                     held, settled)
             type(aft_plan), intent(inout) :: plan
             integer(ip), intent(in) :: law                !! LAW_*
             real(wp), intent(in) :: x(:, :, :)            !! (2H+1, ndir, ne), m
@@ -157,6 +199,13 @@ module frirom_aft
             integer(ip), intent(in), optional :: index_base   !! element numbering in messages
             real(wp), intent(out), optional :: slider(:, :)   !! (nslider, ne), m
             logical, intent(in), optional :: relative         !! (.false.)
+            !> (ne) 2-D law: periods a history cycle is marched, held through a Newton
+            !> corrector (see HELD below); 0 on entry: march and closure test as usual, and
+            !> a history cycle's period count is returned to be held
+            integer(ip), intent(inout), optional :: held(:)
+            !> every cycle held in held (below max_periods) closes at this x: its last
+            !> period drifts by at most max(tol, DRIFT) of the element's scale
+            logical, intent(out), optional :: settled
         end subroutine aft_forces
     end interface aft_eval
 
@@ -265,12 +314,11 @@ module frirom_aft
 
         !> Jacobian block of element j of the batch, after fill_series and the forward
         !> transforms (frirom_aft_jacobian).
-        module subroutine element_jacobian(plan, law, j, p, w0j, tol, max_periods, jac)
+        module subroutine element_jacobian(plan, law, j, p, w0j, jac)
             type(aft_plan), intent(inout) :: plan
-            integer(ip), intent(in) :: law, j, max_periods
+            integer(ip), intent(in) :: law, j
             real(wp), intent(in) :: p(:)        !! (npar) the element's parameters
             real(wp), intent(in) :: w0j(:)      !! (nslider) its initial slider, m
-            real(wp), intent(in) :: tol
             real(wp), intent(inout) :: jac(:, :)  !! (ndir(2H+1), ndir(2H+1))
         end subroutine element_jacobian
     end interface
@@ -430,7 +478,7 @@ contains
         if (info /= FRIROM_OK) return
         nb = plan%fp%nbatch
         nc = plan%fp%ncoef
-        allocate (plan%state(nb, nsamp), plan%tangent(nb, 6, nsamp), plan%par(nb, 4), &
+        allocate (plan%state(nb, nsamp), plan%tangent(nb, 12, nsamp), plan%par(nb, 4), &
                   plan%follow(nb, nsamp, 2))
         allocate (plan%w(nb, 2), plan%wstart(nb, 2), plan%scale(nb), plan%closed_at(nb))
         allocate (plan%anchor(nb), plan%anchor_state(nb), plan%anchor_dtv(nb), &
@@ -439,7 +487,11 @@ contains
                   plan%jt(0:2*nharm, 6))
         allocate (plan%wplain(nb, 2), plan%res_base(nb), &
                   plan%res_last(nb), plan%stepped(nb), plan%accelerated(nb), plan%hold(nb), &
-                  plan%damp(nb))
+                  plan%damp(nb), plan%damp_cap(nb), plan%held(nb), plan%drifting(nb), &
+                  plan%unsettled(nb))
+        allocate (plan%kf(nb, nsamp, 3), plan%kst(nb, nsamp), plan%ktg(nb, 12, nsamp), &
+                  plan%kw(nb, 4))
+        plan%held = 0
     end subroutine aft_plan_create
 
     !> Release the plans and work arrays (a destroyed or never created plan is fine).
@@ -454,6 +506,8 @@ contains
         if (allocated(plan%dw)) deallocate (plan%dw, plan%dw0, plan%dft, plan%jw, plan%jt)
         if (allocated(plan%wplain)) deallocate (plan%wplain, plan%res_base, plan%res_last, &
                                                 plan%stepped, plan%accelerated, plan%hold, &
-                                                plan%damp)
+                                                plan%damp, plan%damp_cap, plan%held, &
+                                                plan%drifting, plan%unsettled)
+        if (allocated(plan%kf)) deallocate (plan%kf, plan%kst, plan%ktg, plan%kw)
     end subroutine aft_plan_destroy
 end module frirom_aft

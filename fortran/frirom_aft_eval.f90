@@ -20,6 +20,13 @@ contains
                         index_base, slider)
         if (info /= FRIROM_OK) return
         call defaults(tol, max_periods, index_base, tl, mp, base)
+        if (present(settled)) settled = .true.
+        if (present(held)) then
+            if (size(held) /= size(x, 3)) then
+                call set_status(info, FRIROM_ERR_SIZE, errmsg, 'held must be (ne)')
+                return
+            end if
+        end if
         if (law == LAW_IWAN4 .or. law == LAW_IWAN) then
             call iwan_forces(plan, law, x, params, w0, f, info, errmsg, jac, periods, states, &
                              tl, mp, base, slider)
@@ -39,7 +46,12 @@ contains
 
         do e0 = 1, ne, nb
             m = min(nb, ne - e0 + 1)
+            plan%held(1:m) = 0
+            if (present(held) .and. law == LAW_NORMAL2D) plan%held(1:m) = held(e0:e0 + m - 1)
             call time_batch(plan, law, x, params, w0, e0, m, tl, mp)
+            if (present(held) .and. law == LAW_NORMAL2D) held(e0:e0 + m - 1) = plan%held(1:m)
+            if (present(settled) .and. law == LAW_NORMAL2D) &
+                settled = settled .and. .not. any(plan%unsettled(1:m))
             do j = 1, m
                 e = e0 + j - 1
                 nper = plan%closed_at(j)
@@ -51,6 +63,9 @@ contains
                 if (present(periods)) periods(e) = min(nper, mp)
                 if (present(slider) .and. NSLIDER_OF(law) > 0) &
                     slider(1:NSLIDER_OF(law), e) = plan%w(j, 1:NSLIDER_OF(law))
+                if (present(slider) .and. law == LAW_NORMAL2D) then
+                    if (plan%drifting(j)) slider(1:2, e) = w0(1:2, e)
+                end if
             end do
             if (present(states)) call state_fractions(plan%state, m, states(:, e0:e0 + m - 1))
             ! the series slots are read by the 2-D law's Jacobian only (the 1-D one scans the
@@ -72,8 +87,8 @@ contains
             end do
             do j = 1, m
                 e = e0 + j - 1
-                if (want_jac) call element_jacobian(plan, law, j, params(:, e), w0(:, e), tl, &
-                                                    mp, jac(:, :, e))
+                if (want_jac) call element_jacobian(plan, law, j, params(:, e), w0(:, e), &
+                                                    jac(:, :, e))
             end do
         end do
         if (nfail /= 0) call set_status(info, FRIROM_ERR_NOCLOSE, errmsg, trim(buf))
@@ -120,6 +135,7 @@ contains
         nb = plan%fp%nbatch
         do e0 = 1, ne, nb
             m = min(nb, ne - e0 + 1)
+            plan%held(1:m) = 0
             call time_batch(plan, law, x, params, w0, e0, m, tl, mp)
             do j = 1, m
                 e = e0 + j - 1

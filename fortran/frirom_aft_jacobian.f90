@@ -26,7 +26,7 @@ contains
         case (LAW_NORMAL1D)
             call jac_friction1d(plan, j, p(1), .true., jac)
         case (LAW_NORMAL2D)
-            call jac_friction2d(plan, j, p(1), w0j, tol, max_periods, jac)
+            call jac_friction2d(plan, j, p(1), w0j, jac)
         case (LAW_CUBIC)
             call jac_diagonal(plan, j, 2_ip, jac, 0_ip, 0_ip)
         end select
@@ -224,34 +224,34 @@ contains
     !> Jacobian of the 2-D element. The slip direction depends on the whole history, so
     !> the slider tangent dw (2 x 3(2H+1)) is propagated through the period from the
     !> closed cycle's own tangent, solved directly when that cycle is an isolated fixed
-    !> point (fixed_point2d). Otherwise (stuck all cycle, or only touching the friction
-    !> limit, where the recursion does not contract) the slider depends on the path: the
-    !> propagation starts from the tangent the settling periods leave (marched again from
-    !> w0) and is repeated until it closes (or max_periods), then once more accumulating.
-    subroutine jac_friction2d(plan, j, kt, w0j, tol, max_periods, jac)
+    !> point (fixed_point2d). Otherwise (stuck all cycle, or determined along a direction
+    !> by less than DET_ISOLATED a period) the slider is history: the propagation starts
+    !> from the tangent the settling periods leave (marched again from w0), so that the
+    !> Jacobian is that of the forces as marched.
+    subroutine jac_friction2d(plan, j, kt, w0j, jac)
         type(aft_plan), intent(inout) :: plan
-        integer(ip), intent(in) :: j, max_periods
-        real(wp), intent(in) :: kt, tol
+        integer(ip), intent(in) :: j
+        real(wp), intent(in) :: kt
         real(wp), intent(in) :: w0j(:)        !! (2) the element's initial slider
         real(wp), intent(inout) :: jac(:, :)  !! (3 nc, 3 nc)
-        integer(ip) :: nc, pass
+        integer(ip) :: nc
         nc = plan%fp%ncoef
         call jac_diagonal(plan, j, 4_ip, jac, 0_ip, 0_ip)       ! d f1/du1, stick
         call jac_diagonal(plan, j, 4_ip, jac, nc, nc)           ! d f2/du2, stick
         call jac_diagonal(plan, j, 5_ip, jac, 2*nc, 2*nc)       ! d fn/dv, contact
-        if (fixed_point2d(plan, j, kt, jac)) return
-        plan%dw = 0.0_wp
-        if (plan%closed_at(j) > 1 .and. any(plan%w(j, 1:2) /= w0j(1:2))) &
-            call settle2d(plan, j, kt, w0j, jac)
-        if (all(plan%state(j, :) == STATE_STICK)) then
-            if (any(plan%dw /= 0.0_wp)) call propagate2d(plan, j, kt, .true., jac)
-            return
+        ! a held history cycle (aft_forces' held) is differentiated as marched even where
+        ! its last period would count as isolated
+        if (plan%held(j) == 0) then
+            if (fixed_point2d(plan, j, kt, jac)) return
         end if
-        do pass = 1, max_periods
-            plan%dw0 = plan%dw
-            call propagate2d(plan, j, kt, .false., jac)
-            if (maxval(abs(plan%dw - plan%dw0)) <= tol*max(1.0_wp, maxval(abs(plan%dw)))) exit
-        end do
+        ! not isolated: the forces are those of the closed_at-th period marched plainly
+        ! from w0 (frirom_aft_march), differentiated as such (the settling periods give
+        ! the slider tangent at the start of the last one); a stepped cycle kept where the
+        ! plain march does not close starts from its own slider, held
+        plan%dw = 0.0_wp
+        if (plan%closed_at(j) > 1 .and. .not. plan%accelerated(j)) &
+            call settle2d(plan, j, kt, w0j, jac)
+        if (all(plan%state(j, :) == STATE_STICK) .and. all(plan%dw == 0.0_wp)) return
         call propagate2d(plan, j, kt, .true., jac)
     end subroutine jac_friction2d
 
@@ -290,7 +290,7 @@ contains
         integer(ip), allocatable :: st(:, :), st_keep(:)
         real(wp), allocatable :: w(:, :), f(:, :, :), tg(:, :, :), tg_keep(:, :)
         n = plan%fp%nsamp
-        allocate (st(1, n), w(1, 2), f(1, n, 3), tg(1, 6, n))
+        allocate (st(1, n), w(1, 2), f(1, n, 3), tg(1, 12, n))
         st_keep = plan%state(j, :)
         tg_keep = plan%tangent(j, :, :)
         w(1, :) = w0j(1:2)
@@ -310,8 +310,8 @@ contains
     end subroutine settle2d
 
     !> One period of the 2-D slider tangent recursion (see friction2d_march):
-    !> stick: d f = kt (dU_k - dw), dw kept; slip: d f = A_k (dU_k - dw) + b_k dV_k,
-    !> dw = dU_k - d f / kt; lift-off: d f = 0, dw = dU_k; a closed sample after an open
+    !> stick: d f = kt (dU_k - dw), dw kept; slip: d f = G_k (dU_{k-1} - dw) +
+    !> A_k (dU_k - dU_{k-1}) + b_k dV_k + c_k dV_{k-1}, dw = dU_k - d f / kt; lift-off: d f = 0, dw = dU_k; a closed sample after an open
     !> one first puts the slider at the re-contact point (recontact). The same-sample
     !> stick part is in the Toeplitz blocks already; here only the terms in dw and the
     !> slip samples.
@@ -322,10 +322,11 @@ contains
         logical, intent(in) :: accumulate
         real(wp), intent(inout) :: jac(:, :)
         integer(ip) :: n, nc, k, i, c, kp
-        real(wp) :: gsum(plan%fp%ncoef), pk(plan%fp%ncoef)
+        real(wp) :: gsum(plan%fp%ncoef), pk(plan%fp%ncoef), rkt
         logical :: open_seg
         n = plan%fp%nsamp
         nc = plan%fp%ncoef
+        rkt = -1.0_wp/kt                    ! (a divide per entry was a seventh of this)
         associate (st => plan%state(j, :), tg => plan%tangent(j, :, :), bas => plan%fp%basis, &
                    wgt => plan%fp%weight, dw => plan%dw, dft => plan%dft)
             gsum = 0.0_wp
@@ -342,14 +343,19 @@ contains
                 if (open_seg .and. accumulate) call flush_stick(gsum)
                 open_seg = .false.
                 if (st(k) == STATE_SLIP) then
+                    ! G (du_{k-1} - dw) + A (du_k - du_{k-1}) + b dv_k + c dv_{k-1}
+                    ! (friction2d_march); after an open sample A = G and c = 0
                     dft(1, :) = -(tg(1, k)*dw(1, :) + tg(3, k)*dw(2, :))
                     dft(2, :) = -(tg(2, k)*dw(1, :) + tg(4, k)*dw(2, :))
-                    dft(1, 1:nc) = dft(1, 1:nc) + tg(1, k)*bas(k, :)
-                    dft(2, 1:nc) = dft(2, 1:nc) + tg(2, k)*bas(k, :)
-                    dft(1, nc + 1:2*nc) = dft(1, nc + 1:2*nc) + tg(3, k)*bas(k, :)
-                    dft(2, nc + 1:2*nc) = dft(2, nc + 1:2*nc) + tg(4, k)*bas(k, :)
-                    dft(1, 2*nc + 1:3*nc) = dft(1, 2*nc + 1:3*nc) + tg(5, k)*bas(k, :)
-                    dft(2, 2*nc + 1:3*nc) = dft(2, 2*nc + 1:3*nc) + tg(6, k)*bas(k, :)
+                    do i = 1, 2
+                        do c = 1, 2
+                            dft(i, (c - 1)*nc + 1:c*nc) = dft(i, (c - 1)*nc + 1:c*nc) &
+                                + tg(6 + i + 2*(c - 1), k)*bas(k, :) &
+                                + (tg(i + 2*(c - 1), k) - tg(6 + i + 2*(c - 1), k))*bas(kp, :)
+                        end do
+                        dft(i, 2*nc + 1:3*nc) = dft(i, 2*nc + 1:3*nc) + tg(4 + i, k)*bas(k, :) &
+                                                + tg(10 + i, k)*bas(kp, :)
+                    end do
                     if (accumulate) then
                         pk = wgt*bas(k, :)
                         do i = 1, 2
@@ -359,7 +365,7 @@ contains
                             end do
                         end do
                     end if
-                    dw = -dft/kt
+                    dw = dft*rkt
                 else
                     dw = 0.0_wp
                 end if

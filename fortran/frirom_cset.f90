@@ -19,6 +19,8 @@ module frirom_cset
         real(wp), allocatable :: f(:, :, :)     !! (nc, ndir, ne) local forces
         real(wp), allocatable :: jac(:, :, :)   !! (nc ndir, nc ndir, ne)
         real(wp), allocatable :: states(:, :)   !! (3, ne) stick, slip, lift-off fractions
+        !> (ne) 2-D law: the period counts held through a corrector (frirom_aft HELD)
+        integer(ip), allocatable :: held(:)
         !> (ndir, ne) stuck stiffness moved into K (hbm_free_bodies; unallocated: none)
         !> and the pin on each mean, FREE_PIN ks (0 for a cubic spring)
         real(wp), allocatable :: ks(:, :), kp(:, :)
@@ -81,5 +83,7 @@ module frirom_cset
         !> the callback of the groups whose law is a user law (negative code; frirom_run
         !> run_set_user_law)
         type(user_law) :: ulaw
+        !> the last evaluation's held 2-D history cycles all closed (frirom_aft HELD)
+        logical :: settled = .true.
     end type contact_set
 end module frirom_cset

@@ -14,12 +14,14 @@ contains
         integer(ip) :: g, e, d, row, k, c, nc, nrg, ns
         real(wp) :: acc
         real(wp), allocatable :: wnew(:, :), fkeep(:, :, :)
-        logical :: upd
+        logical :: upd, ok
         info = FRIROM_OK
+        ok = .true.
         upd = .false.
         if (present(carry)) upd = carry
         nc = cs%nc
         fd = 0.0_wp
+        cs%settled = .true.
         if (present(keep)) then
             if (size(keep, 1) /= size(xd, 1) .or. 2*size(keep, 2) - 1 /= nc) then
                 call set_status(info, FRIROM_ERR_SIZE, errmsg, 'contact_eval: keep must be '// &
@@ -59,6 +61,7 @@ contains
                         end do
                     end do
                 end if
+                if (.not. allocated(gr%held)) allocate (gr%held(gr%ne), source=0_ip)
                 if (gr%law < 0) then            ! a user law: through the run's callback
                     gr%states = 0.0_wp
                     if (upd) then
@@ -78,16 +81,19 @@ contains
                     allocate (wnew, mold=gr%w0)
                     wnew = gr%w0
                     call aft_eval(plan, gr%law, gr%x, gr%params, gr%w0, gr%f, info, errmsg, &
-                                  states=gr%states, slider=wnew, relative=.true.)
+                                  states=gr%states, slider=wnew, relative=.true., &
+                                  held=gr%held, settled=ok)
                     if (info == 0) gr%w0 = wnew
                     deallocate (wnew)
                 else if (jac) then
                     call aft_eval(plan, gr%law, gr%x, gr%params, gr%w0, gr%f, info, errmsg, &
-                                  jac=gr%jac, states=gr%states, relative=.true.)
+                                  jac=gr%jac, states=gr%states, relative=.true., held=gr%held, &
+                                  settled=ok)
                 else
                     call aft_eval(plan, gr%law, gr%x, gr%params, gr%w0, gr%f, info, errmsg, &
-                                  states=gr%states, relative=.true.)
+                                  states=gr%states, relative=.true., held=gr%held, settled=ok)
                 end if
+                if (gr%law > 0) cs%settled = cs%settled .and. ok
                 if (info /= 0) return
                 if (allocated(gr%ks)) then        ! free bodies: f - Ks x, restored below
                     fkeep = gr%f
@@ -583,6 +589,18 @@ contains
         if (size(this%cs%grp) == 0 .or. .not. this%carry) return
         call hbm_contact_forces(this, y, .false., info, errmsg, carry=.true.)
     end procedure hbm_accept
+
+    module procedure hbm_settled
+        yes = this%cs%settled
+    end procedure hbm_settled
+
+    module procedure hbm_begin_correct
+        integer(ip) :: g
+        if (.not. allocated(this%cs%grp)) return
+        do g = 1, size(this%cs%grp)
+            if (allocated(this%cs%grp(g)%held)) this%cs%grp(g)%held = 0
+        end do
+    end procedure hbm_begin_correct
 
     module procedure hbm_slider_offsets
         integer(ip) :: g

@@ -57,6 +57,13 @@ contains
         single = holds(sys)
         if (present(double)) single = single .and. .not. double
         call held_lu_factor(sys%held, sys%jm, single, linfo, stat)
+        if (stat == 0 .and. single .and. linfo > 0) then
+            ! a zero pivot in single precision (normal2d hooks of the paper mesh, ROM_I):
+            ! the double LU of the same J, as cond_solve falls back to when GMRES stalls
+            single = .false.
+            sys%timers(N_DOUBLE) = sys%timers(N_DOUBLE) + 1.0_wp
+            call held_lu_factor(sys%held, sys%jm, single, linfo, stat)
+        end if
         if (stat /= 0) then
             call set_status(info, FRIROM_ERR_ALLOC, errmsg, 'condensed: single LU')
             return

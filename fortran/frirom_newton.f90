@@ -45,6 +45,8 @@ module frirom_newton
         procedure(solve_iface), deferred :: solve
         procedure :: accept => nl_accept
         procedure :: roundoff => nl_roundoff
+        procedure :: begin_correct => nl_begin_correct
+        procedure :: settled => nl_settled
     end type nl_system
 
     abstract interface
@@ -136,6 +138,22 @@ contains
         if (.false.) this%n = size(y) + int(lam)
     end subroutine nl_accept
 
+    !> Called as a corrector starts: a system whose residual holds choices of its first
+    !> evaluation through the corrector (frirom_hbm: the 2-D sliders' period counts)
+    !> makes them afresh here. Default: nothing.
+    subroutine nl_begin_correct(this)
+        class(nl_system), intent(inout) :: this
+        if (.false.) this%n = this%n + 0
+    end subroutine nl_begin_correct
+
+    !> Whether the choices begin_correct clears, held since, still hold at the point of the
+    !> last evaluation (frirom_hbm: every held 2-D history cycle closes there). A corrector
+    !> that converges where they do not makes them afresh there and goes on. Default: yes.
+    logical function nl_settled(this) result(yes)
+        class(nl_system), intent(in) :: this
+        yes = this%n >= 0
+    end function nl_settled
+
     !> Whether the residual r (rref from the same eval) is at the round-off level of its
     !> terms, where Newton accepts a point whatever its last update (a near-singular J,
     !> e.g. gross slip, can keep the update above tol_x there): ||r|| <= 100 eps rref. A
@@ -170,6 +188,10 @@ contains
         real(wp) :: rref, rn, g, denom, dlam, alpha, phi0, phi1, rn1, rref1, g1, lam1, dxn
         real(wp) :: rate
         logical :: fresh, jac_trial, jac_at_y
+        !> converged where the choices held since the corrector began no longer hold
+        !> (settled): made afresh at most this many times
+        integer(ip), parameter :: MAX_REARMS = 3
+        integer(ip) :: rearms
         character(len=120) :: buf
         integer(ip) :: n, k
         n = sys%n
@@ -180,6 +202,8 @@ contains
             return
         end if
         allocate (r(n), rlam(n), ab(n, 2), y1(n), r1(n), dy(n), rlam1(n))
+        call sys%begin_correct()
+        rearms = 0
         rate = 1.0_wp
         fresh = .not. (have_fact .and. opts%reuse_jac)
         if (present(nfact)) nfact = merge(1, 0, fresh)
@@ -230,7 +254,10 @@ contains
                     opts%tol_x) then
                     y = y1
                     lam = lam + dlam
-                    return
+                    if (sys%settled() .or. rearms >= MAX_REARMS) return
+                    call rearm()
+                    if (info /= 0) return
+                    cycle
                 end if
             end if
             ! backtracking on the merit ||R||^2/rref^2 + g^2
@@ -268,13 +295,30 @@ contains
             ! converged: residual and update small; or the residual at round-off level
             ! (near-singular J, e.g. gross slip, can keep the update above tol_x there)
             if (rn <= opts%tol_r .and. abs(g) <= max(opts%tol_x, 1.0e-12_wp) .and. &
-                (dxn <= opts%tol_x .or. sys%roundoff(r, rref))) return
+                (dxn <= opts%tol_x .or. sys%roundoff(r, rref))) then
+                if (sys%settled() .or. rearms >= MAX_REARMS) return
+                call rearm()
+                if (info /= 0) return
+            end if
         end do
         if (rn <= opts%tol_stall .and. abs(g) <= max(opts%tol_x, 1.0e-12_wp)) return
         call set_status(info, FRIROM_ERR_NOCONV, errmsg, 'newton_correct: no convergence')
         write (buf, '(a,i0,a,es9.2,a,es9.2)') ' in ', opts%max_iter, &
             ' iterations, |R|/rref = ', rn, ', update = ', dxn
         errmsg = trim(errmsg)//trim(buf)
+    contains
+        !> The choices afresh at y (its Jacobian with them), and Newton goes on from there.
+        subroutine rearm()
+            rearms = rearms + 1
+            call sys%begin_correct()
+            call sys%eval(y, lam, r, rref, .true., rlam, info, errmsg)
+            if (info /= 0) return
+            if (present(nfact)) nfact = nfact + 1
+            rn = norm2(r)/max(rref, tiny(1.0_wp))
+            g = dot_product(cy, y - yp)/opts%yscale + cl*(lam - lp)/opts%lscale
+            jac_at_y = .true.
+            rate = 1.0_wp
+        end subroutine rearm
     end subroutine newton_correct
 
     !> Unit tangent (scaled variables) of the solution curve at a converged point, oriented

@@ -213,7 +213,7 @@ contains
     !> interpolated re-contact point.
     subroutine friction2d_hand_sequence()
         real(wp) :: u1(1, 4), u2(1, 4), v(1, 4), w(1, 2), f1(1, 4), f2(1, 4), fn(1, 4)
-        real(wp) :: tg(1, 6, 4), uf1(1, 4), uf2(1, 4)
+        real(wp) :: tg(1, 12, 4), uf1(1, 4), uf2(1, 4)
         integer(ip) :: state(1, 4)
         u1(1, :) = [0.03_wp, 0.06_wp, 0.03_wp, 0.0_wp]
         u2(1, :) = [0.04_wp, 0.08_wp, 0.04_wp, 0.04_wp]
@@ -238,46 +238,75 @@ contains
         call check(all(tg(1, :, [1, 3, 4]) == 0.0_wp), '2-D: no slip tangent off slip samples')
     end subroutine friction2d_hand_sequence
 
-    !> 2-D element along an elliptic orbit with normal load variation: at every slip
-    !> sample |f_t| = mu f_n along the trial direction, at every open sample f = 0; motion in
-    !> one plane (u2 = 0) gives the 1-D element's forces, states and sliders.
+    !> 2-D element along an elliptic orbit with normal load variation, one period marched:
+    !> the slider before each sample follows from the forces (w = u - f/kt at closed
+    !> samples, u at open ones). At every stick sample f = kt (u - w) within mu f_n; at
+    !> every slip sample |f_t| = mu f_n; at every open sample f = 0. The slip samples
+    !> against an independent radial return over 4 096 substeps of each interval (u and
+    !> the limit interpolated linearly; first order in the substep: 1e-3 of mu f_n). Motion
+    !> in one plane (u2 = 0) gives the 1-D element's forces, states and sliders.
     subroutine friction2d_limit_and_in_plane()
-        integer(ip), parameter :: n = 64
+        integer(ip), parameter :: n = 64, nsub = 4096
         real(wp), parameter :: kt = 1.0e5_wp, kn = 0.8e5_wp, mu = 0.4_wp, n0 = 60.0_wp
-        real(wp) :: u1(1, n), u2(1, n), v(1, n), w(1, 2), wp_(1, 2), f1(1, n), f2(1, n)
-        real(wp) :: fn(1, n), tg(1, 6, n), w1(1), g(1, n), gn(1, n), dv(1, n), tau, t1, t2
-        integer(ip) :: state(1, n), s1(1, n), k
+        real(wp) :: u1(1, n), u2(1, n), v(1, n), w(1, 2), f1(1, n), f2(1, n)
+        real(wp) :: fn(1, n), tg(1, 12, n), w1(1), g(1, n), gn(1, n), dv(1, n), tau, t1, t2
+        real(wp) :: wb(2), wr(2), wa(2), s, ui(2), li, ti(2), tni, fr(2, n)
+        integer(ip) :: state(1, n), s1(1, n), k, kp, i
         do k = 1, n
             tau = 2.0_wp*pi*real(k - 1, wp)/real(n, wp)
             u1(1, k) = 1.0e-3_wp*cos(tau)
-            u2(1, k) = 0.7e-3_wp*sin(tau)
+            u2(1, k) = 0.2e-3_wp*sin(tau)
             v(1, k) = 1.2e-3_wp*sin(tau) + 0.3e-3_wp*cos(2*tau)
         end do
+        ! two periods: the second starts from the first's end slider
         w = 0.0_wp
+        call friction2d_march(u1, u2, v, [kt], [kn], [mu], [n0], w, f1, f2, fn, state, tg)
+        wa = w(1, :)
+        call friction2d_march(u1, u2, v, [kt], [kn], [mu], [n0], w, f1, f2, fn, state, tg)
+        wb = wa
+        wr = wa
         do k = 1, n
-            ! one sample at a time, to know the slider before each sample
-            wp_ = w
-            call friction2d_march(u1(:, k:k), u2(:, k:k), v(:, k:k), [kt], [kn], [mu], [n0], &
-                                  w, f1(:, k:k), f2(:, k:k), fn(:, k:k), state(:, k:k), &
-                                  tg(:, :, k:k))
-            t1 = kt*(u1(1, k) - wp_(1, 1))
-            t2 = kt*(u2(1, k) - wp_(1, 2))
+            kp = merge(n, k - 1, k == 1)
+            ! the reference: radial return along the interpolated interval kp -> k
+            do i = 1, nsub
+                s = real(i, wp)/real(nsub, wp)
+                ui = [u1(1, kp) + s*(u1(1, k) - u1(1, kp)), u2(1, kp) + s*(u2(1, k) - u2(1, kp))]
+                li = mu*max(n0 + kn*(v(1, kp) + s*(v(1, k) - v(1, kp))), 0.0_wp)
+                if (li <= 0.0_wp) then
+                    wr = ui
+                    cycle
+                end if
+                ti = kt*(ui - wr)
+                tni = hypot(ti(1), ti(2))
+                if (tni > li) wr = ui - li*ti/(tni*kt)
+            end do
+            fr(:, k) = kt*([u1(1, k), u2(1, k)] - wr)
+            t1 = kt*(u1(1, k) - wb(1))
+            t2 = kt*(u2(1, k) - wb(2))
             select case (state(1, k))
             case (STATE_SLIP)
                 call check(abs(hypot(f1(1, k), f2(1, k)) - mu*fn(1, k)) < 1.0e-12_wp*n0, &
                            '2-D slip: |f_t| = mu f_n')
-                call check(abs(f1(1, k)*t2 - f2(1, k)*t1) < 1.0e-12_wp*n0*hypot(t1, t2) &
-                           .and. f1(1, k)*t1 + f2(1, k)*t2 > 0.0_wp, &
-                           '2-D slip: force along the trial force')
+                call check(maxval(abs([f1(1, k), f2(1, k)] - fr(:, k))) < 1.0e-3_wp*mu*n0, &
+                           '2-D slip: force = finely substepped radial return')
             case (STATE_STICK)
                 call check(abs(f1(1, k) - t1) + abs(f2(1, k) - t2) < 1.0e-12_wp*n0 .and. &
-                           hypot(t1, t2) <= mu*fn(1, k), '2-D stick: f = kt (u - w) inside')
+                           hypot(t1, t2) <= mu*fn(1, k)*(1.0_wp + 1.0e-12_wp), &
+                           '2-D stick: f = kt (u - w) inside')
+                call check(all(tg(1, :, k) == 0.0_wp), '2-D stick: zero slip tangent')
+                call check(maxval(abs([f1(1, k), f2(1, k)] - fr(:, k))) < 1.0e-3_wp*mu*n0, &
+                           '2-D stick: force = finely substepped radial return')
             case default
                 call check(f1(1, k) == 0.0_wp .and. f2(1, k) == 0.0_wp .and. &
-                           fn(1, k) == 0.0_wp .and. w(1, 1) == u1(1, k) .and. &
-                           w(1, 2) == u2(1, k), '2-D lift-off: no force, slider on contact')
+                           fn(1, k) == 0.0_wp, '2-D lift-off: no force')
             end select
+            if (state(1, k) == STATE_LIFTOFF) then
+                wb = [u1(1, k), u2(1, k)]
+            else
+                wb = [u1(1, k), u2(1, k)] - [f1(1, k), f2(1, k)]/kt
+            end if
         end do
+        call check(maxval(abs(wb - w(1, :))) < 1.0e-15_wp, '2-D: sliders follow the forces')
         call check(count(state == STATE_SLIP) > 2 .and. count(state == STATE_STICK) > 2 .and. &
                    count(state == STATE_LIFTOFF) > 2, '2-D orbit: all three states')
         ! in one plane: the 1-D element
@@ -286,78 +315,85 @@ contains
         w1 = 0.0_wp
         call friction2d_march(u1, u2, v, [kt], [kn], [mu], [n0], w, f1, f2, fn, state, tg)
         call friction1d_march(u1, v, [kt], [kn], [mu], [n0], w1, g, gn, s1, dv)
+        ! (the second period: a start slider outside the limit slides at different samples)
+        call friction2d_march(u1, u2, v, [kt], [kn], [mu], [n0], w, f1, f2, fn, state, tg)
+        call friction1d_march(u1, v, [kt], [kn], [mu], [n0], w1, g, gn, s1, dv)
         call check(near(f1(1, :), g(1, :), 1.0e-12_wp*n0) .and. all(f2 == 0.0_wp) .and. &
                    near(fn(1, :), gn(1, :), 1.0e-12_wp*n0) .and. all(state == s1) .and. &
                    abs(w(1, 1) - w1(1)) < 1.0e-15_wp, '2-D in one plane = 1-D element')
     end subroutine friction2d_limit_and_in_plane
 
-    !> The 2-D slip tangent A (d f_t/d u), b (d f_t/d v) and -A (d f_t / d w, the slider
-    !> before the sample) against central differences of a one-sample march, at every
-    !> sample of the orbit above; kt I and 0 in stick, 0 in lift-off.
+    !> The exact slip step of the 2-D element (slip2d_step): its slip direction at the end
+    !> of the interval against the radial return over 2^14 substeps (first order: 1e-3),
+    !> and its derivatives d n1 / d (z0, du, r0, r1) against central differences (h = 1e-9
+    !> of the 1e-3 scale: O(h^2) truncation, 1e-5 of the largest derivative). Cases: onset between
+    !> the samples (|z0| < r0), on the limit (|z0| = r0, the previous interval slipped),
+    !> a shrinking and a growing limit; inputs whose difference changes the branch are
+    !> skipped.
     subroutine friction2d_derivatives()
-        integer(ip), parameter :: n = 64
-        real(wp), parameter :: kt = 1.0e5_wp, kn = 0.8e5_wp, mu = 0.4_wp, n0 = 60.0_wp
-        real(wp), parameter :: h = 1.0e-9_wp, p(4) = [kt, kn, mu, n0]
-        real(wp) :: y(5), yh(5), w(2), f(2), tg0(6), tg(6), fd(2, 5), ref(2, 5)
-        real(wp) :: fp(2), fm(2), tau
-        integer(ip) :: k, i, s, sp, sm, tested(0:2)
-        w = 0.0_wp
+        integer(ip), parameter :: ncase = 200, nsub = 16384
+        real(wp), parameter :: h = 1.0e-9_wp
+        real(wp) :: y(6), yh(6), n1(2), dn(2, 6), np(2), nm(2), dd(2, 6), fd(2, 6), ang
+        real(wp) :: z(2), zr(2), s, ri, rho, rnd(6), dir(6, 6)
+        logical :: slip, sp, sm, on
+        integer(ip) :: c, i, tested(2), onlimit
         tested = 0
-        do k = 1, n
-            tau = 2.0_wp*pi*real(k - 1, wp)/real(n, wp)
-            ! y = (u1, u2, v, w1, w2): the sample's motion and the slider before it
-            y = [1.0e-3_wp*cos(tau), 0.7e-3_wp*sin(tau), &
-                 1.2e-3_wp*sin(tau) + 0.3e-3_wp*cos(2*tau), w]
-            call f2d_sample(y, p, f, s, tg0, w)
-            do i = 1, 5
-                yh = y
-                yh(i) = y(i) + h
-                call f2d_sample(yh, p, fp, sp, tg)
-                yh(i) = y(i) - h
-                call f2d_sample(yh, p, fm, sm, tg)
-                if (sp /= s .or. sm /= s) exit
-                fd(:, i) = (fp - fm)/(2*h)
+        onlimit = 0
+        do c = 1, ncase
+            call random_number(rnd)
+            ang = 2.0_wp*pi*rnd(1)
+            ! radii about 1e-3, |z0| inside (or on) r0, a motion of up to 2e-3
+            y(5) = 1.0e-3_wp*(0.5_wp + rnd(2))
+            y(6) = y(5)*(0.7_wp + 0.6_wp*rnd(3))
+            rho = y(5)*merge(1.0_wp, rnd(4), mod(c, 2) == 0)
+            y(1:2) = rho*[cos(ang), sin(ang)]
+            y(3:4) = 2.0e-3_wp*[cos(2*pi*rnd(5)), sin(2*pi*rnd(5))]*(0.2_wp + rnd(6))
+            call slip2d_step(y(1:2), y(3:4), y(5), y(6), slip, n1, dn)
+            ! the reference path: radial return over substeps
+            zr = y(1:2)
+            do i = 1, nsub
+                s = real(i, wp)/real(nsub, wp)
+                ri = y(5) + s*(y(6) - y(5))
+                z = zr + y(3:4)/real(nsub, wp)
+                if (norm2(z) > ri) z = z*ri/norm2(z)
+                zr = z
             end do
-            if (i <= 5) cycle
-            ref = 0.0_wp
-            select case (s)
-            case (STATE_SLIP)
-                ref(:, 1:2) = reshape(tg0(1:4), [2, 2])
-                ref(:, 3) = tg0(5:6)
-                ref(:, 4:5) = -ref(:, 1:2)
-            case (STATE_STICK)
-                ref(1, 1) = kt
-                ref(2, 2) = kt
-                ref(1, 4) = -kt
-                ref(2, 5) = -kt
-                call check(all(tg0 == 0.0_wp), '2-D stick: zero slip tangent')
-            end select
-            call check(maxval(abs(fd - ref)) < 1.0e-6_wp*kt, &
-                       '2-D derivatives = central differences')
-            tested(s) = tested(s) + 1
+            if (.not. slip) then
+                call check(norm2(zr - (y(1:2) + y(3:4))) < 1.0e-12_wp, &
+                           '2-D step: a stuck interval is stuck along the path')
+                cycle
+            end if
+            call check(norm2(zr/y(6) - n1) < 1.0e-3_wp, &
+                       '2-D step: slip direction = finely substepped radial return')
+            ! directions: the inputs; on the limit (a kink across it) z0 along it and z0
+            ! with r0 together (the previous interval slipped: z0 = r0 n0)
+            dir = 0.0_wp
+            do i = 1, 6
+                dir(i, i) = 1.0_wp
+            end do
+            on = abs(norm2(y(1:2)) - y(5)) < 1.0e-12_wp*y(5)
+            if (on) then
+                dir(:, 1) = [-y(2), y(1), 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]/norm2(y(1:2))
+                dir(:, 2) = 0.0_wp
+                dir(1:2, 5) = y(1:2)/norm2(y(1:2))
+            end if
+            do i = 1, 6
+                yh = y + h*dir(:, i)
+                call slip2d_step(yh(1:2), yh(3:4), yh(5), yh(6), sp, np, dd)
+                yh = y - h*dir(:, i)
+                call slip2d_step(yh(1:2), yh(3:4), yh(5), yh(6), sm, nm, dd)
+                if (.not. (sp .and. sm)) exit
+                fd(:, i) = (np - nm)/(2*h)
+            end do
+            if (i <= 6) cycle
+            call check(maxval(abs(fd - matmul(dn, dir))) < 1.0e-5_wp*maxval(abs(dn)), &
+                       '2-D step derivatives = central differences')
+            if (on) onlimit = onlimit + 1
+            tested(merge(1, 2, y(6) < y(5))) = tested(merge(1, 2, y(6) < y(5))) + 1
         end do
-        call check(all(tested > 2), '2-D derivatives: samples in stick, slip and lift-off')
+        call check(all(tested > 5) .and. onlimit > 5, &
+                   '2-D step derivatives: on the limit, shrinking and growing limits')
     end subroutine friction2d_derivatives
-
-    !> One sample of the 2-D element: y = (u1, u2, v, w1, w2) in m.
-    subroutine f2d_sample(y, p, f, state, tangent, w_end)
-        real(wp), intent(in) :: y(5)      !! motion of the sample and slider before it, m
-        real(wp), intent(in) :: p(4)      !! kt, kn (N/m), mu, n0 (N)
-        real(wp), intent(out) :: f(2)     !! tangential force, N
-        integer(ip), intent(out) :: state  !! STATE_*
-        real(wp), intent(out) :: tangent(6)  !! slip tangent, see friction2d_march
-        real(wp), intent(out), optional :: w_end(2)  !! slider after the sample, m
-        real(wp) :: ws(1, 2), f1(1, 1), f2(1, 1), fn(1, 1), tg(1, 6, 1)
-        integer(ip) :: st(1, 1)
-        ws(1, :) = y(4:5)
-        call friction2d_march(reshape(y(1:1), [1, 1]), reshape(y(2:2), [1, 1]), &
-                              reshape(y(3:3), [1, 1]), p(1:1), p(2:2), p(3:3), p(4:4), ws, &
-                              f1, f2, fn, st, tg)
-        f = [f1(1, 1), f2(1, 1)]
-        state = st(1, 1)
-        tangent = tg(1, :, 1)
-        if (present(w_end)) w_end = ws(1, :)
-    end subroutine f2d_sample
 
     !> f = k1 u + k3 u^3 and f' = k1 + 3 k3 u^2 by hand; f' against central differences,
     !> whose error for a cubic is exactly k3 h^2.

@@ -191,25 +191,7 @@ def test_normal2d_reduces_to_normal1d_along_one_axis():
     assert np.abs(r2.forces[0, 1]).max() < 1e-12
 
 
-def test_normal2d_circular_slip_energy_first_order():
-    """Circular motion of radius A at constant normal load: in steady state the slider
-    trails on a circle of radius sqrt(A^2 - (mu N/kt)^2) and dissipates mu N times its
-    path length per cycle. The radial return (one implicit step per sample) is first order
-    on curved slip paths: measured relative error 0.99/N; bound 1.5/N, and must halve
-    when N doubles (where the 2-D law needs more samples than the 1-D ones)."""
-    amp, normal = 1e-3, 100.0
-    fs = MU * normal
-    ref = 2 * np.pi * fs * np.sqrt(amp ** 2 - (fs / KT) ** 2)
-    x = np.zeros((1, 3, 7))
-    x[0, 0, 1], x[0, 1, 2] = amp, amp                 # u1 = A cos, u2 = A sin
-    errs = []
-    for n in (1024, 2048, 8192):
-        r = contact.aft("normal2d", x, {"kt": KT, "kn": 0.0, "mu": MU, "n0": normal}, n)
-        f = r.forces[0]
-        errs.append(abs(np.pi * amp * (-f[0, 2] + f[1, 1]) / ref - 1))
-        assert errs[-1] < 1.5 / n
-        assert r.states[0, 1] == 1.0                  # slips all cycle
-    assert 1.8 < errs[0] / errs[1] < 2.2
+# the circular orbit against its closed form (second order): test_normal2d_aft.py
 
 
 # ---- cubic spring: exact polynomial algebra ------------------------------------------------
@@ -304,6 +286,11 @@ JAC_CASES = {
     # it (the analytical Jacobian without that dependence is off by 6e-2 here)
     "normal1d-recontact": ("normal1d", lambda: _recontact_case(2), [2.0, 1.5, 0.3, 1.0], None),
     "normal2d-recontact": ("normal2d", lambda: _recontact_case(3), [2.0, 1.5, 0.3, 1.0], None),
+    # stick-slip with the onsets between samples under a varying normal load (the slip step
+    # depends on both samples' u and v) and curved slip around lift-off
+    "normal2d-varying": ("normal2d", None, {"kt": KT, "kn": KT, "mu": MU, "n0": 100.0}, None),
+    "normal2d-liftoff-slip": ("normal2d", None, {"kt": KT, "kn": 0.8 * KT, "mu": 0.4, "n0": 60.0},
+                              None),
     "cubic": ("cubic", lambda: single_harmonic(0.3) + single_harmonic(0.1, 3), [1.0, 4.0], None),
 }
 
@@ -325,6 +312,14 @@ def _jac_input(name):
     elif name == "normal2d-onset":   # stick limit mu n0 / kt = 0.3 mm
         x = np.zeros((1, 3, 7))
         x[0, 0, 1], x[0, 1, 1], x[0, 1, 2] = 0.301e-3, 0.02e-3 * np.cos(0.3), 0.02e-3 * np.sin(0.3)
+    elif name == "normal2d-varying":
+        x = np.zeros((1, 3, 7))
+        x[0, 0, 1], x[0, 1, 1], x[0, 2, 3] = 0.45e-3, 0.1e-3, 0.5e-3
+        x[0, 1, 4] = 0.4e-3
+    elif name == "normal2d-liftoff-slip":
+        x = np.zeros((1, 3, 7))
+        x[0, 0, 1], x[0, 0, 4], x[0, 1, 2], x[0, 1, 3] = 1e-3, 0.2e-3, 0.6e-3, 0.2e-3
+        x[0, 2, 2], x[0, 2, 3] = 1.2e-3, 0.3e-3
     else:
         x = build()
     return law, x, params

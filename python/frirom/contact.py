@@ -21,11 +21,12 @@ Arrays of harmonic coefficients have shape (n_elem, n_dir, 2H+1) in the ordering
 flat index d*(2H+1) + c, entry [e, i, j] = d force_i / d displacement_j.
 
 Choice of N (time samples per period): N >= 2H+1 is required. Friction forces have kinks,
-so the 1-D laws' harmonics converge like N^-2 in every regime (error <= 20 N^-2 relative,
-measured in tests/test_aft_convergence.py); the default N is the solver's,
-:func:`frirom.harmonics.default_samples`. The 2-D law's radial return is first order on
-curved slip paths (relative energy error ~ 1/N under circular motion): use N >= 1024 where
-in-plane slip paths curve and 0.1 % matters.
+so the harmonics converge like N^-2 in every regime (error <= 20 N^-2 relative, measured
+in tests/test_aft_convergence.py); the default N is the solver's,
+:func:`frirom.harmonics.default_samples`. The 2-D law moves its slider exactly along the
+interpolated path between samples (slip onset located between them, closed-form turn of
+the slip direction), so it is second order on curved slip paths too (circular orbit:
+force harmonics within 11 N^-2 of the closed form, tests/test_normal2d_aft.py).
 """
 
 from __future__ import annotations
