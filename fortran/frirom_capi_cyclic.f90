@@ -39,6 +39,9 @@ contains
             n = r%m%ndof
             h1 = r%m%nh + 1
             nm = nmodes
+            call check_values(who, psi(:n*nm*h1), omega(:nm*h1), zeta(:nm*h1), st, text)
+        end if
+        if (st == FRIROM_OK) then
             call run_set_modes_harmonic(r, reshape(psi(:n*nm*h1), [n, nm, h1]), &
                                         reshape(omega(:nm*h1), [nm, h1]), &
                                         reshape(zeta(:nm*h1), [nm, h1]), st, text)
@@ -73,11 +76,18 @@ contains
                             '> 0 (rad/s) expected')
         if (st == FRIROM_OK .and. r%m%nh < 1) call set_status(st, FRIROM_ERR_PARAM, text, &
             who//': the run has H = 0 harmonics; a nonlinear mode needs H >= 1')
-        if (st == FRIROM_OK) call run_to_mode(r, .true., st, text)
         if (st == FRIROM_OK) then
             n = r%m%ndof
             h1 = r%m%nh + 1
             nm = nmodes
+            call check_values(who, psi(:n*nm*h1), omega(:nm*h1), zeta(:nm*h1), st, text)
+        end if
+        if (st == FRIROM_OK .and. .not. (all(abs(q0(:nm)) <= huge(1.0_wp)) .and. &
+                                         any(abs(q0(:nm)) > 0.0_wp))) &
+            call set_status(st, FRIROM_ERR_PARAM, text, who//': q0: finite modal '// &
+                            'coordinates, not all zero, expected')
+        if (st == FRIROM_OK) call run_to_mode(r, .true., st, text)
+        if (st == FRIROM_OK) then
             call run_set_nonlinear_mode_cyclic(r, q0(:nm), omega0, &
                                                reshape(psi(:n*nm*h1), [n, nm, h1]), &
                                                reshape(omega(:nm*h1), [nm, h1]), &
@@ -103,4 +113,23 @@ contains
             call set_status(st, FRIROM_ERR_PARAM, text, who//': zeta: NULL')
         end if
     end subroutine check_arrays
+
+    !> FRIROM_ERR_PARAM naming the first of psi (finite), omega (finite, > 0), zeta (finite,
+    !> >= 0) whose values are out of range.
+    subroutine check_values(who, psi, omega, zeta, st, text)
+        character(len=*), intent(in) :: who
+        complex(c_double_complex), intent(in) :: psi(:)
+        real(c_double), intent(in) :: omega(:), zeta(:)
+        integer(ip), intent(inout) :: st
+        character(len=*), intent(inout) :: text
+        if (.not. all(abs(psi) <= huge(1.0_wp))) then
+            call set_status(st, FRIROM_ERR_PARAM, text, who//': psi: finite shapes expected')
+        else if (.not. all(omega > 0.0_wp .and. omega <= huge(1.0_wp))) then
+            call set_status(st, FRIROM_ERR_PARAM, text, who//': omega: finite natural '// &
+                            'frequencies > 0 (rad/s; no rigid-body mode) expected')
+        else if (.not. all(zeta >= 0.0_wp .and. zeta <= huge(1.0_wp))) then
+            call set_status(st, FRIROM_ERR_PARAM, text, who//': zeta: finite damping '// &
+                            'ratios >= 0 expected')
+        end if
+    end subroutine check_values
 end module frirom_capi_cyclic
