@@ -119,3 +119,29 @@ def test_cyclic_load_rows(rotor_case):
     cm, bb, F, td, opts = rotor_case
     with pytest.raises(ParameterError, match="load"):
         bb.forced_response(np.ones(5, complex))
+
+
+def test_large_sector_backbone_synthesises(rotor_case, monkeypatch, tmp_path):
+    """A sector above _ALL_OUTPUTS coordinates (forced here on the rotor's 114) keeps only
+    its contact DoFs and outputs (Backbone.harmonic_dofs): the load on the whole sector is
+    taken on them, and the synthesis equals the one from every DoF's harmonics (1e-10);
+    backbone.h5 keeps those rows; a loaded DoF it does not keep is refused, naming the
+    load and the way out."""
+    import frirom.nonlinear_modes_cyclic as nmc
+    cm, bb, F, td, opts = rotor_case
+    monkeypatch.setattr(nmc, "_ALL_OUTPUTS", 50)
+    small = nonlinear_mode(cm, 0, (1e-6, 3e-1), "stuck", opts, outputs=list(td))
+    assert small.harmonic_dofs is not None and bb.harmonic_dofs is None
+    assert small.harmonics.shape[1] < F.shape[0]
+    lo, hi = 0.9 * bb.omega0, 1.05 * bb.omega0
+    ex = Excitation(F * 1.0)
+    s, ref = small.forced_response(ex, (lo, hi)), bb.forced_response(ex, (lo, hi))
+    assert s.omega.size == ref.omega.size
+    assert np.abs(s.omega - ref.omega).max() < 1e-10 * ref.omega.max()
+    assert np.abs(s.amp_max - ref.amp_max).max() < 1e-10 * ref.amp_max.max()
+    from frirom.backbone import load_h5, save_h5
+    save_h5(small, tmp_path / "bb.h5")
+    assert np.array_equal(load_h5(tmp_path / "bb.h5")[0].harmonic_dofs, small.harmonic_dofs)
+    tip_only = nonlinear_mode(cm, 0, (1e-6, 1e-3), "stuck", opts, outputs=[int(td[0])])
+    with pytest.raises(ParameterError, match="load: DoFs .* outputs"):
+        tip_only.forced_response(ex, (lo, hi))

@@ -63,10 +63,11 @@ _DENSE_MIN = 2000
 _INTERP = CubicSpline
 
 
-def _load_vector(load, n_dof: int, cyclic: bool = False) -> np.ndarray:
+def _load_vector(load, n_dof: int, rows=None) -> np.ndarray:
     """The complex harmonic-1 load F_1 (n_dof,) of an Excitation or an array: (n_dof,)
-    complex (harmonic 1) or (n_dof, H+1) as Excitation.F (cyclic: of a cyclic sector's
-    backbone, sector 0's load)."""
+    complex (harmonic 1) or (n_dof, H+1) as Excitation.F. rows: the model DoFs of the
+    backbone's n_dof rows when it keeps only some (Backbone.harmonic_dofs): a load on the
+    whole model is then taken on them, every loaded DoF among them."""
     if not isinstance(load, Excitation):
         arr = np.asarray(load)
         if arr.ndim == 1:
@@ -76,12 +77,21 @@ def _load_vector(load, n_dof: int, cyclic: bool = False) -> np.ndarray:
         except Exception as exc:       # SizeError, NonFiniteError, ParameterError
             raise ParameterError(f"load: {exc}") from None
     F = load.F
+    if rows is not None and F.shape[0] != n_dof:
+        rows = np.asarray(rows, int)
+        if F.shape[0] <= rows.max():
+            raise ParameterError(f"load: {F.shape[0]} rows; the backbone keeps DoFs up to "
+                                 f"{rows.max()} of its model")
+        loaded = np.flatnonzero(np.any(F[:, 1:] != 0, axis=1))
+        missing = np.setdiff1d(loaded, rows)
+        if missing.size:
+            raise ParameterError(f"load: DoFs {missing[:8].tolist()} are loaded but the "
+                                 "backbone does not keep them (a cyclic sector above 400 "
+                                 "coordinates keeps its contact DoFs and outputs): give "
+                                 "them in nonlinear_mode's outputs")
+        F = F[rows]
     if F.shape[0] != n_dof:
-        raise ParameterError(f"load: {F.shape[0]} rows for a backbone of {n_dof} DoFs"
-                             + (" (a cyclic sector's backbone keeps every sector DoF up to "
-                                "400 coordinates, above them its contact DoFs and outputs "
-                                "only: synthesise from a sector of at most 400)"
-                                if cyclic else ""))
+        raise ParameterError(f"load: {F.shape[0]} rows for a backbone of {n_dof} DoFs")
     if F.shape[1] > 2 and np.any(F[:, 2:] != 0):
         raise ParameterError("load: harmonics above 1 are nonzero; the single nonlinear mode "
                              "synthesis takes a harmonic-1 load (use frirom.frf)")
@@ -305,8 +315,7 @@ def forced_response(bb, load, omega=None, points: int = 400):
     """
     from .results import FRF
     t0 = time.perf_counter()
-    F1 = _load_vector(load, bb.harmonics.shape[1],
-                      getattr(bb, "nodal_diameter", None) is not None)
+    F1 = _load_vector(load, bb.harmonics.shape[1], getattr(bb, "harmonic_dofs", None))
     mode = _Mode(bb, F1)
     if omega is None:
         lo, hi = 0.95 * float(bb.omega.min()), 1.05 * float(bb.omega.max())

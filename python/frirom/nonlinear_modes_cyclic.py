@@ -141,7 +141,8 @@ def open_cyclic(model: CyclicModel, mode, start, opts, outputs=None, static=None
         return np.pi * xi * omega * e, xv
 
     return packed, run, w0, {"n_out": run_out.size, "energy_viscous": energy_viscous,
-                             "nodal_diameter": k1}
+                             "nodal_diameter": k1,
+                             "harmonic_dofs": None if full else run_out}
 
 
 def _modal_from_forces(model: CyclicModel, pers, rows, n_samples, omega, xi, Xp):
