@@ -88,7 +88,8 @@ def _load_vector(load, n_dof: int, rows=None) -> np.ndarray:
             raise ParameterError(f"load: DoFs {missing[:8].tolist()} are loaded but the "
                                  "backbone does not keep them (a cyclic sector above 400 "
                                  "coordinates keeps its contact DoFs and outputs): give "
-                                 "them in nonlinear_mode's outputs")
+                                 "them among the outputs (nonlinear_mode's outputs, a "
+                                 "deck's [outputs])")
         F = F[rows]
     if F.shape[0] != n_dof:
         raise ParameterError(f"load: {F.shape[0]} rows for a backbone of {n_dof} DoFs")
