@@ -68,24 +68,31 @@ contains
         integer(ip) :: st, n, h1, nm
         character(len=512) :: text
         call get_run(run, who, r, st, text, nmodes, 'nmodes')
-        if (st == FRIROM_OK .and. .not. present(q0)) call set_status(st, FRIROM_ERR_PARAM, &
-            text, who//': q0: NULL')
+        if (st == FRIROM_OK) then
+            if (.not. present(q0)) call set_status(st, FRIROM_ERR_PARAM, text, who//': q0: NULL')
+        end if
         call check_arrays(who, st, text, present(psi), present(omega), present(zeta))
-        if (st == FRIROM_OK .and. .not. (omega0 > 0.0_wp .and. omega0 <= huge(1.0_wp))) &
-            call set_status(st, FRIROM_ERR_PARAM, text, who//': omega0: a finite frequency '// &
-                            '> 0 (rad/s) expected')
-        if (st == FRIROM_OK .and. r%m%nh < 1) call set_status(st, FRIROM_ERR_PARAM, text, &
-            who//': the run has H = 0 harmonics; a nonlinear mode needs H >= 1')
+        ! Fortran's .and. need not short-circuit: each check runs only after the last passed
+        if (st == FRIROM_OK) then
+            if (.not. (omega0 > 0.0_wp .and. omega0 <= huge(1.0_wp))) then
+                call set_status(st, FRIROM_ERR_PARAM, text, who//': omega0: a finite '// &
+                                'frequency > 0 (rad/s) expected')
+            else if (r%m%nh < 1) then
+                call set_status(st, FRIROM_ERR_PARAM, text, who//': the run has H = 0 '// &
+                                'harmonics; a nonlinear mode needs H >= 1')
+            end if
+        end if
         if (st == FRIROM_OK) then
             n = r%m%ndof
             h1 = r%m%nh + 1
             nm = nmodes
             call check_values(who, psi(:n*nm*h1), omega(:nm*h1), zeta(:nm*h1), st, text)
         end if
-        if (st == FRIROM_OK .and. .not. (all(abs(q0(:nm)) <= huge(1.0_wp)) .and. &
-                                         any(abs(q0(:nm)) > 0.0_wp))) &
-            call set_status(st, FRIROM_ERR_PARAM, text, who//': q0: finite modal '// &
-                            'coordinates, not all zero, expected')
+        if (st == FRIROM_OK) then
+            if (.not. (all(abs(q0(:nm)) <= huge(1.0_wp)) .and. any(abs(q0(:nm)) > 0.0_wp))) &
+                call set_status(st, FRIROM_ERR_PARAM, text, who//': q0: finite modal '// &
+                                'coordinates, not all zero, expected')
+        end if
         if (st == FRIROM_OK) call run_to_mode(r, .true., st, text)
         if (st == FRIROM_OK) then
             call run_set_nonlinear_mode_cyclic(r, q0(:nm), omega0, &
