@@ -170,7 +170,9 @@ def test_energy_balance_and_resume(models, backbone):
     AFT of frirom show on its harmonics, the tip damper seeing the next sector's motion)
     plus the viscous work, to 1e-9 at the damping peak and in gross slip (measured 2e-14
     and 3e-15; the contacts' share 80 % and 55 %); a run resumed from a checkpoint
-    repeats the uninterrupted one bit for bit."""
+    repeats the uninterrupted one bit for bit, and a run with a callback after every
+    segment (the points' energies computed once, as they come) has the same energies to
+    1e-12 (least squares on fewer right-hand sides at a time)."""
     from frirom.show import contact_fields
     from frirom.show_backbone import _sector_viscous
     cm = models[1]
@@ -192,6 +194,15 @@ def test_energy_balance_and_resume(models, backbone):
     both = part.head(ck["index"] + 1).extended(rest)
     whole = nonlinear_mode(cm, 0, (1e-6, 1e-1), "stuck", opts, batch=4)
     assert np.array_equal(both.omega, whole.omega) and np.array_equal(both.xi, whole.xi)
+    # a callback after every segment (the energies of the points before are kept, only
+    # the new ones computed): the same energies as one Backbone made at the end
+    seen = []
+    cb = nonlinear_mode(cm, 0, (1e-6, 1e-1), "stuck", opts, batch=4,
+                        callback=lambda b: seen.append(b.energy))
+    assert len(seen) > 3 and np.array_equal(cb.omega, whole.omega)
+    for e in (seen[-1], cb.energy):       # least squares on fewer right-hand sides
+        assert np.abs(e / whole.energy - 1).max() < 1e-12
+    assert np.abs(cb.xi_viscous - whole.xi_viscous).max() < 1e-12 * whole.xi.max()
 
 
 def test_bad_input(models):

@@ -123,22 +123,35 @@ def open_cyclic(model: CyclicModel, mode, start, opts, outputs=None, static=None
     pers = [model.modes_of(model.harmonic_index(h)) for h in range(H + 1)]
     full = run_out.size == n
 
+    done = {"y": np.zeros((0, 3)), "e": np.zeros(0), "xv": np.zeros(0)}
+
     def energy_viscous(omega, xi, a, Xp):
         """Energy per cycle (per sector) and the viscous part of xi from the modal
         coordinates of every harmonic: from every DoF's harmonics when the run reports
-        them all, else from the contact forces (_modal_from_forces)."""
-        npt = a.size
-        if npt == 0:
-            return np.zeros(0), np.zeros(0)
-        if full:
-            qs = [np.linalg.lstsq(pers[h].psi, (Xp[:, :, 2 * h - 1] - 1j * Xp[:, :, 2 * h]).T,
-                                  rcond=None)[0] for h in range(1, H + 1)]
-        else:
-            qs = _modal_from_forces(model, pers, run_out, o.n_samples, omega, xi, Xp)
-        e = sum(h ** 2 * (np.abs(q) ** 2).sum(axis=0) for h, q in enumerate(qs, 1))
-        c = 2 * pers[1].zeta * pers[1].omega
-        xv = (c[:, None] * np.abs(qs[0]) ** 2).sum(axis=0) / np.maximum(a, 1e-300) ** 2
-        return np.pi * xi * omega * e, xv
+        them all, else from the contact forces (_modal_from_forces). The Backbone is made
+        again after every segment from all its points: the points computed before are
+        kept (the same amplitude, omega and xi) and only the new ones computed."""
+        y = np.column_stack([a, omega, xi])
+        k = done["y"].shape[0]
+        if not (k <= y.shape[0] and np.array_equal(y[:k], done["y"])):
+            k = 0
+            done.update(y=y[:0], e=np.zeros(0), xv=np.zeros(0))
+        new = slice(k, None)
+        if y.shape[0] > k:
+            if full:
+                qs = [np.linalg.lstsq(pers[h].psi, (Xp[new, :, 2 * h - 1]
+                                                    - 1j * Xp[new, :, 2 * h]).T,
+                                      rcond=None)[0] for h in range(1, H + 1)]
+            else:
+                qs = _modal_from_forces(model, pers, run_out, o.n_samples, omega[new],
+                                        xi[new], Xp[new])
+            e = sum(h ** 2 * (np.abs(q) ** 2).sum(axis=0) for h, q in enumerate(qs, 1))
+            c = 2 * pers[1].zeta * pers[1].omega
+            xv = ((c[:, None] * np.abs(qs[0]) ** 2).sum(axis=0)
+                  / np.maximum(a[new], 1e-300) ** 2)
+            done.update(y=y, e=np.r_[done["e"][:k], np.pi * xi[new] * omega[new] * e],
+                        xv=np.r_[done["xv"][:k], xv])
+        return done["e"].copy(), done["xv"].copy()
 
     return packed, run, w0, {"n_out": run_out.size, "energy_viscous": energy_viscous,
                              "nodal_diameter": k1,
