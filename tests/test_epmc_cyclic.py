@@ -252,7 +252,9 @@ def test_energy_of_a_sector_above_400_coordinates(monkeypatch):
     cycle and xi's viscous part were NaN (the run reports the contact DoFs only, and the
     modal coordinates were taken from every DoF's harmonics); now from the contact forces,
     they equal a run made to report every DoF (_ALL_OUTPUTS raised: least squares on each
-    harmonic's modes) to 1e-9, with the same frequencies and damping."""
+    harmonic's modes) to 1e-9, with the same frequencies and damping; frirom show's
+    energy balance at the damping peak (it refused such backbones) balances to 1e-9 and
+    equals the all-DoF one."""
     import frirom.nonlinear_modes_cyclic as nmc
     r, K, Ks, glob = rotor(per_sector=14)
     n_s = Ks.shape[0]
@@ -270,3 +272,17 @@ def test_energy_of_a_sector_above_400_coordinates(monkeypatch):
     assert np.all(np.isfinite(bb.energy)) and np.all(bb.energy > 0)
     assert np.abs(bb.energy / ref.energy - 1).max() < 1e-9
     assert np.abs(bb.xi_viscous - ref.xi_viscous).max() < 1e-9 * np.abs(ref.xi).max()
+    # frirom show at the damping peak (backbone_point_state, no files): the energy balance
+    # from the kept DoFs equals the one from every DoF's harmonics
+    from types import SimpleNamespace
+    from frirom.show_backbone import backbone_point_state
+    deck = SimpleNamespace(model=lambda: cm, options=lambda: opts, output_map=None,
+                           outputs=[int(d) for d in cm.nonlinear_dofs()[:2]],
+                           output_names=["a", "b"])
+    i = int(np.argmax(ref.damping_ratio))
+    part, whole = (backbone_point_state(b, deck, i).balance for b in (bb, ref))
+    for k in ("contacts", "viscous"):
+        assert abs(part[k] - whole[k]) < 1e-9 * whole["excitation"], k
+    print(f"show balance: residual {part['residual'] / part['excitation']:.1e}, "
+          f"contacts {part['contacts'] / whole['contacts'] - 1:.1e}")
+    assert abs(part["residual"]) < 1e-9 * part["excitation"]
