@@ -171,6 +171,33 @@ int frirom_run_advance_mode(frirom_run *run, int k, int *npts, double *amplitude
                             double *omega, double *xi, double *xo, int *status, char *msg,
                             int msglen);
 
+/* Cyclic sectors (a tuned rotor's sector 0 under a travelling wave; frirom.reduction.cyclic
+ * makes the data from a sector's matrices, docs/nonlinear_modes.md). The run is opened on
+ * the DoFs the solver reads: sector 0's contact DoFs, the next sector's contact DoFs as
+ * DoFs of their own (G's columns for them), the outputs and loaded DoFs; K, M, C are not
+ * used (nk = nm = ncd = 0). Complex arrays are interleaved (re, im) doubles, the layout of
+ * double _Complex and std::complex<double>; H is the run's harmonics.
+ *
+ *   frirom_run_set_modes_harmonic  receptances from modes of their own per harmonic h:
+ *                        psi (n, nmodes, H+1) complex mass-normalised shapes of h's nodal
+ *                        diameter over the sector (the next sector's rows times
+ *                        exp(i k_h 2 pi / N)), omega, zeta (nmodes, H+1) rad/s and ratios
+ *                        (unused modes of a harmonic with fewer: omega 1, zeta 0, psi 0);
+ *                        a forced response under an engine order then uses them
+ *   frirom_run_set_nonlinear_mode_cyclic  makes an open run a condensed mode run of one
+ *                        nodal diameter as a travelling wave, with the modes as above and
+ *                        the linear mode it starts from: its modal coordinates q0 (nmodes,
+ *                        complex) in harmonic 1's modes and frequency omega0 (rad/s); then
+ *                        frirom_run_start_mode / frirom_run_advance_mode (amplitude: the
+ *                        sector's modal amplitude, the rotor's is sqrt(N) times it). */
+int frirom_run_set_modes_harmonic(frirom_run *run, int nmodes, const double *psi,
+                                  const double *omega, const double *zeta, char *msg,
+                                  int msglen);
+int frirom_run_set_nonlinear_mode_cyclic(frirom_run *run, int nmodes, const double *q0,
+                                         double omega0, const double *psi,
+                                         const double *omega, const double *zeta,
+                                         char *msg, int msglen);
+
 /* Contact laws written by the user (docs/tutorials/user_laws.md). A contact group whose
  * ginfo law code is frirom_law_user_code(ndir, npar, nslider) (negative; 0 when a size is
  * out of range: 1 <= ndir <= 7, 0 <= npar <= 255, 0 <= nslider <= 1e6) is evaluated by the

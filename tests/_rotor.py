@@ -22,8 +22,11 @@ P_TIP = (2e5, 0.3, 3.0)
 OPTS = dict(harmonics=H, samples=16 * N, tol_residual=1e-11, tol_update=1e-11, max_iter=40)
 
 
-def rotor():
-    r = tuned_rotor(n_sectors=N, per_sector=3, blade=2)
+def rotor(per_sector: int = 3):
+    """The rotor (per_sector angular stations per sector; its contacts, rotor_contacts,
+    sit on stations 0..2 of each group of three: the cyclic sector's are sector 0's for any
+    per_sector >= 3, the full model's need per_sector = 3)."""
+    r = tuned_rotor(n_sectors=N, per_sector=per_sector, blade=2)
     s = r["sector"]
     n_full = r["K"].shape[0]
     owner = r["node_owner"]

@@ -396,6 +396,9 @@ static void named_cases(void) {
                                              &status, msg, MSG));
         ON("run_solve_at", frirom_run_solve_at(r, 80, NULL, NULL, out_xo, out_amp, msg, MSG));
         ON("run_set_modes", frirom_run_set_modes(r, 1, x, x, x, msg, MSG));
+        ON("run_set_modes_harmonic", frirom_run_set_modes_harmonic(r, 1, x, x, x, msg, MSG));
+        ON("run_set_nonlinear_mode_cyclic", frirom_run_set_nonlinear_mode_cyclic(
+               r, 1, x, 100, x, x, x, msg, MSG));
         ON("run_set_selection", frirom_run_set_selection(r, 1, (int *)x, NULL, 0, msg, MSG));
         ON("run_checkpoint", frirom_run_checkpoint(r, 4, ck, msg, MSG));
         ON("run_restore", frirom_run_restore(r, 4, ck, msg, MSG));
@@ -432,6 +435,35 @@ static void named_cases(void) {
     OPENED("set_modes omega NaN", "omega",
            (x[10] = NAN, frirom_run_set_modes(run, 1, x, x + 10, x, msg, MSG)));
     OPENED("set_modes nmodes > n", "phi", frirom_run_set_modes(run, 5, x, x, x, msg, MSG));
+    {   /* cyclic: n = 2 DoFs, H = 1, one mode (complex arrays interleaved re, im) */
+        double cq[2] = {1, 0}, cp[8] = {1, 0, 0.5, 0, 1, 0, 0.5, 0}, cw[2] = {100, 100},
+               cz[2] = {0, 0};
+        OPENED("set_modes_harmonic nmodes 0", "nmodes",
+               frirom_run_set_modes_harmonic(run, 0, cp, cw, cz, msg, MSG));
+        OPENED("set_modes_harmonic psi NULL", "psi",
+               frirom_run_set_modes_harmonic(run, 1, NULL, cw, cz, msg, MSG));
+        OPENED("set_modes_harmonic omega 0", "omega",
+               frirom_run_set_modes_harmonic(run, 1, cp, x, cz, msg, MSG));
+        OPENED("set_modes_harmonic zeta NaN", "zeta",
+               (cz[1] = NAN, frirom_run_set_modes_harmonic(run, 1, cp, cw, cz, msg, MSG)));
+        cz[1] = 0;
+        OPENED("set_nonlinear_mode_cyclic nmodes -1", "nmodes",
+               frirom_run_set_nonlinear_mode_cyclic(run, -1, cq, 100, cp, cw, cz, msg, MSG));
+        OPENED("set_nonlinear_mode_cyclic q0 NULL", "q0",
+               frirom_run_set_nonlinear_mode_cyclic(run, 1, NULL, 100, cp, cw, cz, msg, MSG));
+        OPENED("set_nonlinear_mode_cyclic q0 zero", "q0",
+               frirom_run_set_nonlinear_mode_cyclic(run, 1, x, 100, cp, cw, cz, msg, MSG));
+        OPENED("set_nonlinear_mode_cyclic omega0 NaN", "omega0",
+               frirom_run_set_nonlinear_mode_cyclic(run, 1, cq, NAN, cp, cw, cz, msg, MSG));
+        OPENED("set_nonlinear_mode_cyclic psi Inf", "psi",
+               (cp[3] = INFINITY, frirom_run_set_nonlinear_mode_cyclic(run, 1, cq, 100, cp, cw,
+                                                                       cz, msg, MSG)));
+        cp[3] = 0;
+        OPENED("set_nonlinear_mode_cyclic zeta NULL", "zeta",
+               frirom_run_set_nonlinear_mode_cyclic(run, 1, cq, 100, cp, cw, NULL, msg, MSG));
+        OPENED("start_mode before set_nonlinear_mode_cyclic", "mode run",
+               frirom_run_start_mode(run, 1e-6, 1e-3, msg, MSG));
+    }
     OPENED("set_selection nnl -1", "nnl", frirom_run_set_selection(run, -1, (int *)x, NULL,
            0, msg, MSG));
     OPENED("set_selection nnl mismatch", "keep", frirom_run_set_selection(run, 3, (int *)x,

@@ -170,7 +170,9 @@ def test_energy_balance_and_resume(models, backbone):
     AFT of frirom show on its harmonics, the tip damper seeing the next sector's motion)
     plus the viscous work, to 1e-9 at the damping peak and in gross slip (measured 2e-14
     and 3e-15; the contacts' share 80 % and 55 %); a run resumed from a checkpoint
-    repeats the uninterrupted one bit for bit."""
+    repeats the uninterrupted one bit for bit, and a run with a callback after every
+    segment (the points' energies computed once, as they come) has the same energies to
+    1e-12 (least squares on fewer right-hand sides at a time)."""
     from frirom.show import contact_fields
     from frirom.show_backbone import _sector_viscous
     cm = models[1]
@@ -192,6 +194,15 @@ def test_energy_balance_and_resume(models, backbone):
     both = part.head(ck["index"] + 1).extended(rest)
     whole = nonlinear_mode(cm, 0, (1e-6, 1e-1), "stuck", opts, batch=4)
     assert np.array_equal(both.omega, whole.omega) and np.array_equal(both.xi, whole.xi)
+    # a callback after every segment (the energies of the points before are kept, only
+    # the new ones computed): the same energies as one Backbone made at the end
+    seen = []
+    cb = nonlinear_mode(cm, 0, (1e-6, 1e-1), "stuck", opts, batch=4,
+                        callback=lambda b: seen.append(b.energy))
+    assert len(seen) > 3 and np.array_equal(cb.omega, whole.omega)
+    for e in (seen[-1], cb.energy):       # least squares on fewer right-hand sides
+        assert np.abs(e / whole.energy - 1).max() < 1e-12
+    assert np.abs(cb.xi_viscous - whole.xi_viscous).max() < 1e-12 * whole.xi.max()
 
 
 def test_bad_input(models):
@@ -213,7 +224,10 @@ def test_bad_input(models):
 
 def test_large_sector_reports_contact_dofs_and_outputs(models, backbone, monkeypatch):
     """Above _ALL_OUTPUTS sector coordinates the run reports the contact DoFs and the
-    outputs only: the same backbone, the outputs' harmonics equal, energy NaN."""
+    outputs only: the same backbone, the outputs' harmonics equal, and the energy per
+    cycle and xi's viscous part, then from the contact forces' modal coordinates
+    (nonlinear_modes_cyclic._modal_from_forces), equal to those from every DoF's
+    harmonics (least squares on each harmonic's modes) to 1e-9 (they were NaN)."""
     import frirom.nonlinear_modes_cyclic as nmc
     cm = models[1]
     monkeypatch.setattr(nmc, "_ALL_OUTPUTS", 50)
@@ -225,4 +239,50 @@ def test_large_sector_reports_contact_dofs_and_outputs(models, backbone, monkeyp
     assert np.array_equal(bb.omega, ref.omega) and np.array_equal(bb.xi, ref.xi)
     assert np.abs(bb.outputs - ref.harmonics[:, out]).max() < 1e-12 * np.abs(
         ref.harmonics[:, out]).max()
-    assert np.all(np.isnan(bb.energy))
+    assert np.all(np.isfinite(bb.energy)) and np.all(np.isfinite(bb.xi_viscous))
+    e_en = np.abs(bb.energy / ref.energy - 1).max()
+    e_xv = np.abs(bb.xi_viscous - ref.xi_viscous).max() / np.abs(ref.xi).max()
+    print(f"energy from forces: relative error {e_en:.1e}, xi_viscous {e_xv:.1e}")
+    assert e_en < 1e-9 and e_xv < 1e-9
+
+
+def test_energy_of_a_sector_above_400_coordinates(monkeypatch):
+    """The smallest rotor of tests/_rotor.py whose sector passes _ALL_OUTPUTS (14 stations
+    per sector: 411 coordinates, 384 modes per nodal diameter): its backbone's energy per
+    cycle and xi's viscous part were NaN (the run reports the contact DoFs only, and the
+    modal coordinates were taken from every DoF's harmonics); now from the contact forces,
+    they equal a run made to report every DoF (_ALL_OUTPUTS raised: least squares on each
+    harmonic's modes) to 1e-9, with the same frequencies and damping; frirom show's
+    energy balance at the damping peak (it refused such backbones) balances to 1e-9 and
+    equals the all-DoF one."""
+    import frirom.nonlinear_modes_cyclic as nmc
+    r, K, Ks, glob = rotor(per_sector=14)
+    n_s = Ks.shape[0]
+    assert nmc._ALL_OUTPUTS < n_s < nmc._ALL_OUTPUTS + 20
+    cm = cyclic_model(rotor_sector(r, N), Ks, r["sector"]["M"],
+                      sector_contacts(r, glob, n_s), KND, H,
+                      damping=Damping.rayleigh(ALPHA, BETA))
+    opts = frirom.SolverOptions(**OPTS)
+    bb = nonlinear_mode(cm, 0, (1e-6, 1e-1), "stuck", opts)
+    assert bb.harmonics.shape[1] < n_s
+    monkeypatch.setattr(nmc, "_ALL_OUTPUTS", 1000)
+    ref = nonlinear_mode(cm, 0, (1e-6, 1e-1), "stuck", opts)
+    assert ref.harmonics.shape[1] == n_s and bb.status == ref.status == "done"
+    assert np.array_equal(bb.omega, ref.omega) and np.array_equal(bb.xi, ref.xi)
+    assert np.all(np.isfinite(bb.energy)) and np.all(bb.energy > 0)
+    assert np.abs(bb.energy / ref.energy - 1).max() < 1e-9
+    assert np.abs(bb.xi_viscous - ref.xi_viscous).max() < 1e-9 * np.abs(ref.xi).max()
+    # frirom show at the damping peak (backbone_point_state, no files): the energy balance
+    # from the kept DoFs equals the one from every DoF's harmonics
+    from types import SimpleNamespace
+    from frirom.show_backbone import backbone_point_state
+    deck = SimpleNamespace(model=lambda: cm, options=lambda: opts, output_map=None,
+                           outputs=[int(d) for d in cm.nonlinear_dofs()[:2]],
+                           output_names=["a", "b"])
+    i = int(np.argmax(ref.damping_ratio))
+    part, whole = (backbone_point_state(b, deck, i).balance for b in (bb, ref))
+    for k in ("contacts", "viscous"):
+        assert abs(part[k] - whole[k]) < 1e-9 * whole["excitation"], k
+    print(f"show balance: residual {part['residual'] / part['excitation']:.1e}, "
+          f"contacts {part['contacts'] / whole['contacts'] - 1:.1e}")
+    assert abs(part["residual"]) < 1e-9 * part["excitation"]

@@ -29,7 +29,7 @@ def save_h5(bb: Backbone, path, attrs: dict | None = None) -> None:
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
     with h5py.File(tmp, "w") as f:
-        for name in _POINT_FIELDS + ("output_dofs",):
+        for name in _POINT_FIELDS + ("output_dofs", "harmonic_dofs"):
             v = getattr(bb, name)
             if v is not None:
                 f.create_dataset(name, data=np.asarray(v))
@@ -50,7 +50,8 @@ def load_h5(path) -> tuple[Backbone, dict]:
     import h5py
     try:
         with h5py.File(path, "r") as f:
-            arrays = {k: f[k][()] for k in _POINT_FIELDS + ("output_dofs",) if k in f}
+            arrays = {k: f[k][()] for k in _POINT_FIELDS + ("output_dofs", "harmonic_dofs")
+                      if k in f}
             attrs = {k: f.attrs[k] for k in f.attrs}
     except OSError as exc:
         raise InputError(f"{path}: cannot be read as a backbone file ({exc})") from None

@@ -32,6 +32,12 @@ amplitudes to the peak and the upper branch back down (folds included); the phas
 from the modal equation and gives every harmonic at the outputs. Cost: interpolating the
 backbone and evaluating P, milliseconds per curve.
 
+A cyclic sector's backbone (frirom.nonlinear_modes_cyclic: one nodal diameter, a
+travelling wave) synthesises the same way: psi_1 is sector 0's harmonic 1, mass-normalised
+over the sector in the modes of its nodal diameter, and the load F_1 sector 0's under the
+engine order whose harmonic 1 lives on that diameter (each sector carries it delayed, as in
+frirom.frf on the CyclicModel); tests/test_nlm_synthesis_cyclic.py.
+
 Where it does not hold: a load that also excites another mode near the frequency range
 (several resonances close together, or modal interaction), and motions whose higher
 harmonics are not those of the free mode (internal resonances, strong harmonic content
@@ -57,9 +63,11 @@ _DENSE_MIN = 2000
 _INTERP = CubicSpline
 
 
-def _load_vector(load, n_dof: int) -> np.ndarray:
+def _load_vector(load, n_dof: int, rows=None) -> np.ndarray:
     """The complex harmonic-1 load F_1 (n_dof,) of an Excitation or an array: (n_dof,)
-    complex (harmonic 1) or (n_dof, H+1) as Excitation.F."""
+    complex (harmonic 1) or (n_dof, H+1) as Excitation.F. rows: the model DoFs of the
+    backbone's n_dof rows when it keeps only some (Backbone.harmonic_dofs): a load on the
+    whole model is then taken on them, every loaded DoF among them."""
     if not isinstance(load, Excitation):
         arr = np.asarray(load)
         if arr.ndim == 1:
@@ -69,6 +77,20 @@ def _load_vector(load, n_dof: int) -> np.ndarray:
         except Exception as exc:       # SizeError, NonFiniteError, ParameterError
             raise ParameterError(f"load: {exc}") from None
     F = load.F
+    if rows is not None and F.shape[0] != n_dof:
+        rows = np.asarray(rows, int)
+        if F.shape[0] <= rows.max():
+            raise ParameterError(f"load: {F.shape[0]} rows; the backbone keeps DoFs up to "
+                                 f"{rows.max()} of its model")
+        loaded = np.flatnonzero(np.any(F[:, 1:] != 0, axis=1))
+        missing = np.setdiff1d(loaded, rows)
+        if missing.size:
+            raise ParameterError(f"load: DoFs {missing[:8].tolist()} are loaded but the "
+                                 "backbone does not keep them (a cyclic sector above 400 "
+                                 "coordinates keeps its contact DoFs and outputs): give "
+                                 "them among the outputs (nonlinear_mode's outputs, a "
+                                 "deck's [outputs])")
+        F = F[rows]
     if F.shape[0] != n_dof:
         raise ParameterError(f"load: {F.shape[0]} rows for a backbone of {n_dof} DoFs")
     if F.shape[1] > 2 and np.any(F[:, 2:] != 0):
@@ -275,6 +297,8 @@ def forced_response(bb, load, omega=None, points: int = 400):
     load : Excitation or array_like
         Harmonic-1 load: an Excitation (harmonics above 1 must be zero; a static column is
         ignored, the backbone has its own) or F_1 (n_dof,) complex, f = Re F_1 e^{i Omega t}.
+        A cyclic sector's backbone: sector 0's load under the engine order of its nodal
+        diameter (the CyclicModel's Excitation for frirom.frf).
     omega : (float, float), optional
         Frequency range, rad/s; default 0.95 and 1.05 times the backbone's lowest and
         highest frequency.
@@ -292,7 +316,7 @@ def forced_response(bb, load, omega=None, points: int = 400):
     """
     from .results import FRF
     t0 = time.perf_counter()
-    F1 = _load_vector(load, bb.harmonics.shape[1])
+    F1 = _load_vector(load, bb.harmonics.shape[1], getattr(bb, "harmonic_dofs", None))
     mode = _Mode(bb, F1)
     if omega is None:
         lo, hi = 0.95 * float(bb.omega.min()), 1.05 * float(bb.omega.max())

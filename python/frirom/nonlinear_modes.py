@@ -97,6 +97,9 @@ class Backbone:
     #: amplitude, energy and harmonics are then the sector's (the rotor's amplitude is
     #: sqrt(N) times it, its energy N times)
     nodal_diameter: int | None = None
+    #: the model DoFs of the rows of ``harmonics`` (None: every DoF, in order; a cyclic
+    #: sector above 400 coordinates keeps its contact DoFs and outputs only)
+    harmonic_dofs: np.ndarray | None = field(default=None, repr=False)
 
     def __len__(self) -> int:
         return int(self.amplitude.size)
@@ -433,7 +436,8 @@ def _backbone(model, packed, phi, w0, mode, start, ys, lams, xos, sts, its, cks,
 
 
 def _backbone_from(packed, w0, mode, start, ys, lams, xos, sts, its, cks, status, message,
-                   n_out, energy_viscous, nodal_diameter=None) -> Backbone:
+                   n_out, energy_viscous, nodal_diameter=None,
+                   harmonic_dofs=None) -> Backbone:
     """A Backbone from a mode run's points so far: n_out, the run's outputs per point;
     energy_viscous(omega, xi, a, Xp) -> (energy per cycle, xi's viscous part)."""
     n, H = n_out, packed.H
@@ -459,4 +463,4 @@ def _backbone_from(packed, w0, mode, start, ys, lams, xos, sts, its, cks, status
                     status=_status_name(status), message=message,
                     iterations=np.concatenate(its) if its else np.zeros(0, int), y=y,
                     tans=tans, yscales=ysc, ds_next=dsn, sliders=sl, xi_viscous=xi_visc,
-                    nodal_diameter=nodal_diameter)
+                    nodal_diameter=nodal_diameter, harmonic_dofs=harmonic_dofs)

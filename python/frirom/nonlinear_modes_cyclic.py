@@ -26,7 +26,9 @@ from .reduction.cyclic import contact_rows
 
 __all__ = ["cyclic_linear_mode", "open_cyclic"]
 
-#: largest sector whose every DoF is an output of the run (energy per cycle, harmonics)
+#: largest sector whose every DoF is an output of the run (Backbone.harmonics); above, the
+#: run reports the contact DoFs and the outputs, and the energy per cycle comes from the
+#: contact forces (_modal_from_forces)
 _ALL_OUTPUTS = 400
 
 
@@ -92,8 +94,8 @@ def open_cyclic(model: CyclicModel, mode, start, opts, outputs=None, static=None
             raise ParameterError(f"static: {n} finite values expected")
         F[:, 0] = st
     out, P = _output_map(outputs, n)
-    # the run reports every sector DoF (up to _ALL_OUTPUTS: the energy per cycle by the
-    # modal coordinates), else the contact DoFs and the outputs asked for
+    # the run reports every sector DoF (up to _ALL_OUTPUTS), else the contact DoFs and the
+    # outputs asked for
     run_out = (np.arange(n) if n <= _ALL_OUTPUTS else
                np.unique(np.r_[model.nonlinear_dofs(),
                                np.asarray(out if out is not None else [], int)]))
@@ -121,23 +123,81 @@ def open_cyclic(model: CyclicModel, mode, start, opts, outputs=None, static=None
     pers = [model.modes_of(model.harmonic_index(h)) for h in range(H + 1)]
     full = run_out.size == n
 
+    done = {"y": np.zeros((0, 3)), "e": np.zeros(0), "xv": np.zeros(0)}
+
     def energy_viscous(omega, xi, a, Xp):
         """Energy per cycle (per sector) and the viscous part of xi from the modal
-        coordinates of every harmonic (NaN when the run does not report every DoF)."""
-        npt = a.size
-        if not full:
-            return np.full(npt, np.nan), np.full(npt, np.nan)
-        e = np.zeros(npt)
-        for h in range(1, H + 1):
-            psi = pers[h].psi
-            z = Xp[:, :, 2 * h - 1] - 1j * Xp[:, :, 2 * h]        # (npt, n)
-            q = np.linalg.lstsq(psi, z.T, rcond=None)[0]         # (nm, npt)
-            s = (np.abs(q) ** 2).sum(axis=0)
-            e += h ** 2 * s
-            if h == 1:
-                c = 2 * pers[1].zeta * pers[1].omega
-                xv = (c[:, None] * np.abs(q) ** 2).sum(axis=0) / np.maximum(a, 1e-300) ** 2
-        return np.pi * xi * omega * e, xv
+        coordinates of every harmonic: from every DoF's harmonics when the run reports
+        them all, else from the contact forces (_modal_from_forces). The Backbone is made
+        again after every segment from all its points: the points computed before are
+        kept (the same amplitude, omega and xi) and only the new ones computed."""
+        y = np.column_stack([a, omega, xi])
+        k = done["y"].shape[0]
+        if not (k <= y.shape[0] and np.array_equal(y[:k], done["y"])):
+            k = 0
+            done.update(y=y[:0], e=np.zeros(0), xv=np.zeros(0))
+        new = slice(k, None)
+        if y.shape[0] > k:
+            if full:
+                qs = [np.linalg.lstsq(pers[h].psi, (Xp[new, :, 2 * h - 1]
+                                                    - 1j * Xp[new, :, 2 * h]).T,
+                                      rcond=None)[0] for h in range(1, H + 1)]
+            else:
+                qs = _modal_from_forces(model, pers, run_out, o.n_samples, omega[new],
+                                        xi[new], Xp[new])
+            e = sum(h ** 2 * (np.abs(q) ** 2).sum(axis=0) for h, q in enumerate(qs, 1))
+            c = 2 * pers[1].zeta * pers[1].omega
+            xv = ((c[:, None] * np.abs(qs[0]) ** 2).sum(axis=0)
+                  / np.maximum(a[new], 1e-300) ** 2)
+            done.update(y=y, e=np.r_[done["e"][:k], np.pi * xi[new] * omega[new] * e],
+                        xv=np.r_[done["xv"][:k], xv])
+        return done["e"].copy(), done["xv"].copy()
 
     return packed, run, w0, {"n_out": run_out.size, "energy_viscous": energy_viscous,
-                             "nodal_diameter": k1}
+                             "nodal_diameter": k1,
+                             "harmonic_dofs": None if full else run_out}
+
+
+def _modal_from_forces(model: CyclicModel, pers, rows, n_samples, omega, xi, Xp):
+    """Modal coordinates q_h (nm_h, npt) of harmonics h = 1..H of a cyclic mode's points
+    from the harmonics Xp (npt, rows.size, 2H+1) of the DoFs `rows` (every contact DoF
+    among them), as the condensed run defines them (frirom_hbm_epmc_modal epmd_outputs):
+    q_h = -psi_ext^H f_h / (w_r^2 - W^2 + i W (2 zeta_r w_r - xi)), W = h omega, f_h the
+    contact forces' harmonic h on sector 0 and the next sector (G^T f), psi_ext harmonic
+    h's modes on both (the next sector's times exp(i k_h 2 pi / N)). The forces come from
+    the AFT of the contact displacements of every point at once with n_samples samples
+    (the run's); harmonics >= 1 of a closed cycle do not depend on where its sliders
+    start, so the law's initial sliders serve."""
+    from .contact import LAWS, aft
+    from .show import _next_sector
+    n, npt = model.n_dof, omega.size
+    nc = Xp.shape[2]
+    H = (nc - 1) // 2
+    x = np.zeros((npt, n, nc))
+    x[:, rows] = Xp
+    xx = np.concatenate([x, np.stack([_next_sector(model, x[p]) for p in range(npt)])],
+                        axis=1)                                       # (npt, 2n, nc)
+    gf = np.zeros((npt, 2 * n, nc))
+    for g in model.contacts:
+        law = LAWS[g.law]
+        ne, nd = g.n_elem, law.n_dir
+        m = g.G.shape[1]
+        u = np.stack([np.asarray(g.G @ xx[p, :m]) for p in range(npt)])   # (npt, ne nd, nc)
+        par = np.broadcast_to(np.asarray(g.params, float), (ne, len(law.parameters)))
+        w0 = (None if not law.n_slider or g.w0 is None else
+              np.tile(np.broadcast_to(np.asarray(g.w0, float), (ne, law.n_slider)), (npt, 1)))
+        f = aft(law, u.reshape(npt * ne, nd, nc), np.tile(par, (npt, 1)), n_samples,
+                w0=w0, jacobian=False).forces.reshape(npt, ne * nd, nc)
+        for p in range(npt):
+            gf[p, :m] += np.asarray(g.G.T @ f[p])
+    alpha = 2 * np.pi / model.n_sectors
+    qs = []
+    for h in range(1, H + 1):
+        m = pers[h]
+        psi = np.vstack([m.psi, m.psi * np.exp(1j * m.k * alpha)])        # (2n, nm)
+        fh = gf[:, :, 2 * h - 1] - 1j * gf[:, :, 2 * h]                  # (npt, 2n)
+        W = h * omega[None, :]
+        den = (m.omega[:, None] ** 2 - W ** 2
+               + 1j * W * (2 * m.zeta[:, None] * m.omega[:, None] - xi[None, :]))
+        qs.append(-(psi.conj().T @ fh.T) / den)
+    return qs

@@ -44,19 +44,26 @@ def backbone_point_state(bb, deck, index: int) -> PointState:
     """The PointState of backbone point `index` of the deck's model (no new solve)."""
     model, opts = deck.model(), deck.options()
     n = model.n_dof
-    if bb.harmonics.shape[1] != n and hasattr(model, "n_sectors"):
-        raise InputError(f"the backbone keeps {bb.harmonics.shape[1]} of the sector's {n} "
-                         "coordinates (a cyclic sector above 400 coordinates keeps the "
-                         "contact DoFs and outputs only): frirom show needs every one")
-    if bb.harmonics.shape[1] != n:
+    rows = getattr(bb, "harmonic_dofs", None)
+    cyclic = hasattr(model, "n_sectors")
+    if bb.harmonics.shape[1] != n and not (cyclic and rows is not None
+                                           and len(rows) == bb.harmonics.shape[1]
+                                           and int(np.max(rows)) < n):
         raise InputError(f"the backbone has {bb.harmonics.shape[1]} coordinates, the deck's "
                          f"model {n}: not the deck it was made with")
-    x = np.asarray(bb.harmonics[index], float)
+    # a cyclic sector above 400 coordinates keeps its contact DoFs and outputs only
+    # (Backbone.harmonic_dofs): the others are left zero, which the contacts, outputs and
+    # energies do not read
+    x = np.zeros((n, bb.harmonics.shape[2]))
+    x[np.arange(n) if bb.harmonics.shape[1] == n else rows] = bb.harmonics[index]
     slider = (np.asarray(bb.sliders[index], float) if bb.sliders is not None
               else np.zeros(0))
     contacts = contact_fields(model, x, slider, opts.n_samples)
     omega = float(bb.omega[index])
-    if hasattr(model, "n_sectors"):
+    if cyclic and bb.harmonics.shape[1] != n:
+        visc = _sector_viscous_from_forces(model, np.asarray(rows), opts.n_samples, omega,
+                                           float(bb.xi[index]), bb.harmonics[index])
+    elif cyclic:
         visc = _sector_viscous(model, x[:, 1::2] - 1j * x[:, 2::2], omega)
     else:
         visc = viscous_work(model.C, x, omega, bb.H)
@@ -84,6 +91,21 @@ def _sector_viscous(model, z: np.ndarray, omega: float) -> float:
     return work
 
 
+def _sector_viscous_from_forces(model, rows, n_samples: int, omega: float, xi: float,
+                                X: np.ndarray) -> float:
+    """_sector_viscous from the modal coordinates the contact forces give
+    (frirom.nonlinear_modes_cyclic._modal_from_forces) when only the DoFs `rows` are
+    known (their harmonics X (rows.size, 2H+1))."""
+    from .nonlinear_modes_cyclic import _modal_from_forces
+    H = (X.shape[1] - 1) // 2
+    pers = [model.modes_of(model.harmonic_index(h)) for h in range(H + 1)]
+    qs = _modal_from_forces(model, pers, rows, n_samples, np.array([omega]), np.array([xi]),
+                            X[None])
+    return float(sum(np.pi * omega * h ** 2 * np.sum(2 * pers[h].zeta * pers[h].omega
+                                                     * np.abs(q[:, 0]) ** 2)
+                     for h, q in enumerate(qs, 1)))
+
+
 def cmd_show_backbone(args, h5: Path) -> int:
     """`frirom show OUT` where OUT holds backbone.h5: write the point's files."""
     from . import maps
@@ -100,6 +122,10 @@ def cmd_show_backbone(args, h5: Path) -> int:
     if args.at is not None:
         raise InputError("--at: a backbone point is chosen by --amplitude A (modal "
                          "amplitude), --point K or --peak (largest damping ratio)")
+    if args.vtk and getattr(bb, "harmonic_dofs", None) is not None:
+        raise InputError("--vtk: the backbone keeps the contact DoFs and outputs only (a "
+                         "cyclic sector above 400 coordinates): the deformed sector needs "
+                         "every coordinate")
     deck = load_deck(path)
     k = pick_backbone_point(bb, amplitude=getattr(args, "amplitude", None),
                             point=args.point)

@@ -301,10 +301,6 @@ def parse_deck(path, raw: dict | None = None, allow_code=()) -> DeckSettings:
 
     analysis = parse_analysis(ctx, raw, fe, labels)
     nlm = analysis.nonlinear_mode
-    if analysis.from_backbone and cyc is not None:
-        raise ctx.error("analysis.kind", "'forced_response' or 'nonlinear_mode' with "
-                        "[reduction.cyclic] (a synthesis from a cyclic sector's backbone: "
-                        "not yet)", analysis.kind)
     if analysis.nodal_diameter is not None:
         if not (nlm and cyc is not None):
             raise ctx.error("analysis.nodal_diameter", "only in a nonlinear-mode deck with "
