@@ -191,3 +191,38 @@ def test_backbone_with_every_slip_prone_element_matches_rom_i(lap):
           f"{out['cd'][0]:.2e}, {out['cd'][1]:.2e}")
     assert out["cd"][0] < 1e-4 and out["cd"][1] < 0.02
     assert out["gsi"][0] > 10 * out["cd"][0] and out["gsi"][1] > 10 * out["cd"][1]
+
+
+def test_deck_key_builds_the_enriched_basis_and_keys_the_cache(block_dir):
+    """[reduction.interface_modes.contact_driven] through a deck: the basis holds the
+    vectors (labels, log), the enrichment is part of the cache key, and bad keys are named."""
+    from _models import GSI_DECK
+    from frirom.deck import load_deck
+    # 2 + 2 GSI modes: the block's end face has 4 nodes (12 DoFs), 6 + 6 would span it
+    text = (GSI_DECK.format(kt="2.0e8", h=1, mu=0.5)
+            .replace("free = 6\nstick = 6\n", "free = 2\nstick = 2\n"))
+    deck = block_dir / "cd.toml"
+    deck.write_text(text)
+    plain = load_deck(deck).reduced
+    cd = text.replace("stick = 2\n", "stick = 2\n\n[reduction.interface_modes."
+                      "contact_driven]\nfrequency = 150.0\nelements = 3\n")
+    deck.write_text(cd)
+    d = load_deck(deck)
+    rom = d.reduced
+    labels = [lb for lb in rom.labels if lb.startswith("contact-driven")]
+    assert len(labels) == 6 and rom.K.shape[0] == plain.K.shape[0] + 6
+    assert not rom.from_cache and any("contact-driven basis" in s for s in d.log)
+    assert load_deck(deck).reduced.from_cache
+    deck.write_text(cd.replace("elements = 3", "elements = 4"))
+    more = load_deck(deck).reduced        # 4 GSI + 8 vectors on 12 DoFs: 1-2 are dependent
+    assert not more.from_cache and plain.K.shape[0] + 6 < more.K.shape[0] <= 12 + \
+        plain.K.shape[0] - 4
+    deck.write_text(cd.replace("frequency = 150.0\n", ""))
+    with pytest.raises(InputError, match="contact_driven.frequency"):
+        load_deck(deck)
+    deck.write_text(cd.replace("elements = 3", "elements = 3\nsize = 2"))
+    with pytest.raises(InputError, match="contact_driven.size"):
+        load_deck(deck)
+    deck.write_text(cd.replace("n0 = 100.0", "n0 = 0.0"))
+    with pytest.raises(InputError, match="n0"):
+        load_deck(deck)

@@ -205,6 +205,7 @@ def main(argv=None) -> int:
             print(f"{p['acc']:>8.1f}  {p['f']:>9.3f}  {p['f_pub']:>9.2f}  "
                   f"{100 * p['df_rel']:>+7.2f}%  {100 * p['zeta']:>7.3f}  "
                   f"{100 * p['zeta_pub']:>9.3f}  {100 * p['dzeta']:>+8.3f}")
+    if brb is not None:
         last.append(f"BRB: backbone {brb['backbone_s']:.1f} s ({brb['backbone_cpu_s']:.1f} s "
                     f"CPU, {brb['backbone_points']} points), f/zeta at 0.1/7/65 m/s^2 "
                     + ", ".join(f"{p['f']:.2f} Hz/{100 * p['zeta']:.3f} %"
@@ -212,11 +213,12 @@ def main(argv=None) -> int:
                     + " (published " + ", ".join(f"{p['f_pub']:.2f}/{100 * p['zeta_pub']:.3f}"
                                                  for p in brb["published"]) + ")")
     if brb_cd is not None:
-        last.append(f"BRB CD: backbone {brb_cd['backbone_s']:.1f} s ({brb_cd['backbone_cpu_s']:.1f}"
-                    f" s CPU, {brb_cd['backbone_points']} points, {brb_cd['n_dof']} "
-                    "coordinates), f/zeta at 0.1/7/65 m/s^2 "
+        b = brb_cd
+        last.append(f"BRB CD: backbone {b['backbone_s']:.1f} s ({b['backbone_cpu_s']:.1f} s "
+                    f"CPU, {b['backbone_points']} points, {b['n_dof']} coordinates), "
+                    "f/zeta at 0.1/7/65 m/s^2 "
                     + ", ".join(f"{p['f']:.2f} Hz/{100 * p['zeta']:.3f} %"
-                                for p in brb_cd["published"]))
+                                for p in b["published"]))
     print("; ".join(last))
     return 0
 

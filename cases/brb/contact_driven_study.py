@@ -105,7 +105,8 @@ def main(argv=None) -> int:
     a.out.mkdir(parents=True, exist_ok=True)
     rows = []
     print(f"{'variant':>12s} {'H':>2s} {'coord':>5s} {'cd':>4s} {'red s':>6s} {'pts':>4s} "
-          f"{'bb s':>6s} {'cpu s':>6s} {'f0 Hz':>8s} | " + " | ".join(f"f, zeta at {x:g}" for x in ACC))
+          f"{'bb s':>6s} {'cpu s':>6s} {'f0 Hz':>8s} | "
+          + " | ".join(f"f, zeta at {x:g}" for x in ACC))
     for H in a.harmonics:
         for name in a.variants:
             r = run(name, H, a.amplitudes, a.rebuild)
