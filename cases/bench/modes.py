@@ -20,7 +20,9 @@ gmsh and ccx are there, else skipped; --quick or --no-brb skip it): its backbone
 stuck joint to the end of microslip (seconds wall and CPU, points), frequency and damping
 ratio at the published tip accelerations 0.1, 7 and 65 m/s^2 (points landed on them by
 run_brb.exact_at_accelerations, timed apart) against the published backbone (Porter &
-Brake 2023, cases/brb/run_brb.py PUBLISHED), with the deck's own step control. The joint
+Brake 2023, cases/brb/run_brb.py PUBLISHED), with the deck's own step control; then the
+same for the reduced interface with the contact-driven basis (cases/brb/brb_cd_mode.toml,
+row "BRB CD", appended to the last line). The joint
 and lap joint backbones from the stuck mode with continuation steps of at most 0.01 in
 log10 a (the microslip range resolved: the synthesis interpolates the backbone).
 One core (OPENBLAS_NUM_THREADS=1 is set before numpy loads). Writes
@@ -68,8 +70,9 @@ def lap_joint_deck(work: Path, size: float) -> Path | None:
     return work / "lap_joint.toml"
 
 
-def bench_brb() -> dict | None:
-    """The BRB backbone as cases/brb/run_brb.py runs it (None: no gmsh/ccx to build it)."""
+def bench_brb(deck_name: str = "brb_mode.toml") -> dict | None:
+    """The BRB backbone of a deck of cases/brb as cases/brb/run_brb.py runs it (None: no
+    gmsh/ccx to build it)."""
     brb = CASES / "brb"
     if not (brb / "brb.sti").exists():
         if shutil.which("ccx") is None:
@@ -81,20 +84,21 @@ def bench_brb() -> dict | None:
     sys.path.insert(0, str(brb))
     import run_brb
     run_brb.ensure_built(log=lambda *a: None)
-    d = load_deck(brb / "brb_mode.toml")
+    d = load_deck(brb / deck_name)
     t0 = time.perf_counter()
     model = d.model()                       # the reduction (cached after the first run)
     t_model = time.perf_counter() - t0
     c0 = time.process_time()
-    bb, deck, sec = run_brb.backbone(brb / "brb_mode.toml")
+    bb, deck, sec = run_brb.backbone(brb / deck_name)
     cpu = time.process_time() - c0
     t0 = time.perf_counter()
-    at = run_brb.exact_at_accelerations(bb, brb / "brb_mode.toml")
+    at = run_brb.exact_at_accelerations(bb, brb / deck_name)
     t_land = time.perf_counter() - t0
     pts = [{"acc": acc, "f": float(f), "zeta": float(z), "f_pub": fp, "zeta_pub": zp,
             "df_rel": float(f / fp - 1), "dzeta": float(z - zp)}
            for (acc, fp, zp), (f, z) in zip(run_brb.PUBLISHED, at)]
-    return {"model": "BRB", "n_dof": model.n_dof,
+    return {"model": "BRB", "deck": deck_name, "n_dof": model.n_dof,
+            "reduction_s": float(d.reduced.build_seconds),
             "n_contact": int(sum(g.n_elem for g in model.contacts)), "H": d.harmonics,
             "samples": deck.options().samples, "backbone_points": len(bb),
             "backbone_s": sec, "backbone_cpu_s": cpu, "model_s": t_model, "landing_s": t_land,
@@ -165,13 +169,15 @@ def main(argv=None) -> int:
                 print("lap joint: skipped (needs gmsh and ccx)")
             else:
                 rows.append(bench("lap joint", deck, (1e-8, 3e-4), args.repeat))
-    brb = None
+    brb = brb_cd = None
     if not (args.quick or args.no_brb):
         brb = bench_brb()
         if brb is None:
             print("BRB: skipped (needs gmsh and ccx to build cases/brb)")
+        else:
+            brb_cd = bench_brb("brb_cd_mode.toml")
     from _results import add
-    add(models=rows, brb=brb)
+    add(models=rows, brb=brb, brb_cd=brb_cd)
     print(f"{'model':>10s}  {'n_dof':>5s}  {'contacts':>8s}  {'H':>2s}  {'bb points':>9s}  "
           f"{'bb s':>6s}  {'SNMT ms':>8s}  {'HBM points':>10s}  {'HBM s':>6s}  "
           f"{'err amp':>9s}  {'err freq':>9s}  {'speed-up':>9s}")
@@ -184,25 +190,35 @@ def main(argv=None) -> int:
             f"points), SNMT peak error {100 * r['err_amp']:+.2f} % amplitude, "
             f"{100 * r['err_freq']:+.3f} % frequency, {r['speedup']:.0f}x faster than "
             f"one HBM FRF" for r in rows]
-    if brb is not None:
-        print(f"BRB (CB + GSI, {brb['n_dof']} coordinates, {brb['n_contact']} contact "
-              f"elements, H = {brb['H']}, N = {brb['samples']}): backbone "
-              f"{brb['backbone_s']:.1f} s wall, {brb['backbone_cpu_s']:.1f} s CPU, "
-              f"{brb['backbone_points']} points ({brb['backbone_status']}); reduced model "
-              f"{brb['model_s']:.1f} s; landing on the three accelerations "
-              f"{brb['landing_s']:.1f} s")
+    for b, what in ((brb, "CB + GSI"), (brb_cd, "CB + GSI + contact-driven")):
+        if b is None:
+            continue
+        print(f"BRB ({b['deck']}: {what}, {b['n_dof']} coordinates, {b['n_contact']} "
+              f"contact elements, H = {b['H']}, N = {b['samples']}): backbone "
+              f"{b['backbone_s']:.1f} s wall, {b['backbone_cpu_s']:.1f} s CPU, "
+              f"{b['backbone_points']} points ({b['backbone_status']}); reduced model "
+              f"{b['model_s']:.1f} s (built in {b['reduction_s']:.1f} s); landing on the "
+              f"three accelerations {b['landing_s']:.1f} s")
         print(f"{'tip acc.':>8s}  {'f Hz':>9s}  {'published':>9s}  {'df':>8s}  "
               f"{'zeta %':>7s}  {'published':>9s}  {'dzeta %':>8s}")
-        for p in brb["published"]:
+        for p in b["published"]:
             print(f"{p['acc']:>8.1f}  {p['f']:>9.3f}  {p['f_pub']:>9.2f}  "
                   f"{100 * p['df_rel']:>+7.2f}%  {100 * p['zeta']:>7.3f}  "
                   f"{100 * p['zeta_pub']:>9.3f}  {100 * p['dzeta']:>+8.3f}")
+    if brb is not None:
         last.append(f"BRB: backbone {brb['backbone_s']:.1f} s ({brb['backbone_cpu_s']:.1f} s "
                     f"CPU, {brb['backbone_points']} points), f/zeta at 0.1/7/65 m/s^2 "
                     + ", ".join(f"{p['f']:.2f} Hz/{100 * p['zeta']:.3f} %"
                                 for p in brb["published"])
                     + " (published " + ", ".join(f"{p['f_pub']:.2f}/{100 * p['zeta_pub']:.3f}"
                                                  for p in brb["published"]) + ")")
+    if brb_cd is not None:
+        b = brb_cd
+        last.append(f"BRB CD: backbone {b['backbone_s']:.1f} s ({b['backbone_cpu_s']:.1f} s "
+                    f"CPU, {b['backbone_points']} points, {b['n_dof']} coordinates), "
+                    "f/zeta at 0.1/7/65 m/s^2 "
+                    + ", ".join(f"{p['f']:.2f} Hz/{100 * p['zeta']:.3f} %"
+                                for p in b["published"]))
     print("; ".join(last))
     return 0
 

@@ -30,7 +30,7 @@ import brb  # noqa: E402
 import brb_preload as bp  # noqa: E402
 from ccx import run_ccx  # noqa: E402
 
-DECKS = ("brb.toml", "brb_cb.toml", "brb_mode.toml", "brb_cb_mode.toml")
+DECKS = ("brb.toml", "brb_cb.toml", "brb_mode.toml", "brb_cb_mode.toml", "brb_cd_mode.toml")
 BEGIN = "# >>> contact groups: written by cases/brb/build_brb.py, do not edit"
 END = "# <<< contact groups"
 

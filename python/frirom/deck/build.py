@@ -23,6 +23,7 @@ from ..contact import LAWS
 from ..io import DIRECTION_NAMES, read_mtx
 from ..io._common import read_text
 from ..model import ContactGroup, CyclicModel, Damping, Excitation, Model, check_definite
+from ..reduction.contact_basis import preload_n0
 from ..reduction.multistage import (cylindrical_frame, travelling_wave_pairs,
                                      travelling_wave_selection)
 from ..reduction.rom import (PairSpec, build_reduced_model, cache_file, rom_key,
@@ -503,12 +504,7 @@ class _Builder:
         A = np.array(S).T                                   # (3, n_contacts)
         sign = 1.0 if pl.body == "a" else -1.0
         target = sign * pl.load * np.asarray(pl.direction)
-        # unknowns sqrt(pairs) n0: lstsq's least-norm answer is then the least sum over
-        # pairs of n0^2 (one pressure on parallel faces); the same answer when determined
-        root = np.sqrt(np.asarray(npairs, float))
-        y, _, rank, _ = np.linalg.lstsq(A / root, target, rcond=None)
-        n0 = y / root
-        miss = np.linalg.norm(A @ n0 - target)
+        n0, miss, rank = preload_n0(A, npairs, target)
         if miss > 1e-6 * pl.load:
             raise ctx.error(f"{pl.key}.direction", "a load the contacts' normals can carry "
                             f"({miss:.4g} N of it is along no face normal: friction would "
@@ -622,7 +618,19 @@ def pair_specs(settings: DeckSettings) -> list:
     """The contact pairs of an ``[fe_model]`` deck as the reduction takes them."""
     return [PairSpec(name=c.name, a=c.a, b=c.b, normal=c.normal, tangent=c.tangent,
                      n_dir=LAWS[c.law].n_dir, kt=c.stick[0], kn=c.stick[1], tol=c.tol,
-                     key=c.key, b_sector=c.b_sector) for c in settings.contacts]
+                     key=c.key, b_sector=c.b_sector, **_slip_data(c))
+            for c in settings.contacts]
+
+
+def _slip_data(c) -> dict:
+    """mu and the normal load (n0, or fn0 of 'jenkins'; None when a [[preload]] derives
+    it) of a node-set contact, for the contact-driven interface basis; {} for other laws."""
+    pn = LAWS[c.law].parameters
+    load = "n0" if "n0" in pn else ("fn0" if "fn0" in pn else None)
+    if "mu" not in pn or load is None:
+        return {}
+    n0 = float(c.params[pn.index(load)])
+    return {"mu": float(c.params[pn.index("mu")]), "n0": n0 if n0 > 0 else None}
 
 
 def rom_file(settings: DeckSettings) -> Path | None:

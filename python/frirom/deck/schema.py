@@ -323,6 +323,12 @@ def parse_deck(path, raw: dict | None = None, allow_code=()) -> DeckSettings:
                                 "\"nonlinear_mode\")", ld.harmonic)
     preloads = parse_preloads(ctx, raw, fe)
     contacts = parse_contacts(ctx, raw, fe, labels, cyc, preloads)
+    if spec is not None and spec.contact_driven is not None:
+        # the [[preload]] tables give the contact-driven basis its n0 (rom key included)
+        spec = dataclasses.replace(spec, contact_driven=dataclasses.replace(
+            spec.contact_driven, preloads=tuple(
+                (float(p.load), tuple(float(x) for x in p.direction), p.body,
+                 tuple(p.contacts)) for p in preloads)))
     frequency = (None if nlm and "frequency" not in raw else
                  _frequency(ctx, table(ctx, raw, "frequency")))
     continuation = _continuation(ctx, table(ctx, raw, "continuation", required=False))

@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..reduction.rom import FORMATS, FESource, ReductionSpec
+from ..reduction.rom import FORMATS, ContactDrivenSpec, FESource, ReductionSpec
 from .schema_study import parse_modes_auto
 from .fields import Context, boolean, file, integers, names, number, string, table, unknown, \
     vector
@@ -126,7 +126,8 @@ def parse_reduction(ctx: Context, red: dict) -> tuple:
     method = string(ctx, im, "method", f"{pre}.method", default="none",
                     choices=("none", "gsi", "ms"))
     allowed = {"none": {"method"}, "gsi": {"method", "free", "stick", "per_side",
-                                                 "separate", "separate_stick"},
+                                                 "separate", "separate_stick",
+                                                 "contact_driven"},
                "ms": {"method", "sectors", "engine_orders", "time_harmonics",
                       "harmonic_indices", "axis", "origin", "travelling_wave"}}[method]
     im, modes_auto = parse_modes_auto(ctx, im, method)
@@ -153,6 +154,12 @@ def parse_reduction(ctx: Context, red: dict) -> tuple:
         if kw["separate_stick"] and not sep:
             raise ctx.error(f"{pre}.separate_stick", "with separate = [node sets]",
                             kw["separate_stick"])
+        if "contact_driven" in im:
+            if sep:
+                raise ctx.error(f"{pre}.contact_driven", "no separate joints with the "
+                                "contact-driven basis", sep)
+            kw["contact_driven"] = parse_contact_driven(
+                ctx, table(ctx, im, f"{pre}.contact_driven"), f"{pre}.contact_driven")
     axis = vector(ctx, red, "axis", "reduction.axis", (0.0, 0.0, 1.0))
     origin = vector(ctx, red, "origin", "reduction.origin", (0.0, 0.0, 0.0), nonzero=False)
     kw["axis"], kw["origin"] = axis, origin
@@ -190,6 +197,25 @@ def parse_reduction(ctx: Context, red: dict) -> tuple:
     spec = ReductionSpec(interface=tuple(iface), active=tuple(active),
                          fixed_interface_modes=n_cb, method=method, cache=cache, **kw)
     return spec, cyc, modes_auto
+
+
+def parse_contact_driven(ctx: Context, cd: dict, pre: str) -> ContactDrivenSpec:
+    """``[reduction.interface_modes.contact_driven]``: the stuck mode (``frequency``, Hz)
+    whose slip onset ranks the contact elements, and which of them get static responses:
+    the first ``elements`` by onset and/or those slipping below ``amplitude`` (modal
+    amplitude, sqrt(kg) m); ``normal``: unit normal forces too; ``tol``: drop tolerance."""
+    unknown(ctx, cd, {"frequency", "elements", "amplitude", "normal", "tol"}, pre)
+    freq = number(ctx, cd, "frequency", f"{pre}.frequency", required=True, positive=True)
+    n = number(ctx, cd, "elements", f"{pre}.elements", integer=True, minimum=1)
+    amp = number(ctx, cd, "amplitude", f"{pre}.amplitude", positive=True)
+    if n is None and amp is None:
+        raise ctx.error(f"{pre}.elements", "elements (the first n by slip onset) or "
+                        "amplitude (every element slipping below it), or both", None)
+    tol = number(ctx, cd, "tol", f"{pre}.tol", default=1e-6, positive=True, maximum=0.5)
+    return ContactDrivenSpec(frequency=float(freq), elements=n,
+                             amplitude=None if amp is None else float(amp),
+                             normal=boolean(ctx, cd, "normal", f"{pre}.normal", False),
+                             tol=float(tol))
 
 
 def parse_cyclic(ctx: Context, cy: dict) -> CyclicSettings:
