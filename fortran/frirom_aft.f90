@@ -113,6 +113,12 @@ module frirom_aft
     ! not close there (a count of 1 found stuck, then slipping: its forces the first
     ! period's from w0, a transient): settled says so, and the corrector finds the counts
     ! afresh at its point and goes on (frirom_newton newton_correct).
+    !> A held history cycle whose last period drifts by more than this times its scale
+    !> does not close (settled): a transient, not the drift closure's rounding (held at
+    !> DRIFT, a few 1e-9 after the corrector moved re-armed most BRB backbone points:
+    !> 64 points and 50 s of CPU where 34 and 35 s do without; the free-body transient
+    !> it is there for drifts by ~1e-2)
+    real(wp), parameter :: UNSETTLED = 1.0e-6_wp
 
     !> Everything one caller needs to evaluate contact forces at H harmonics and N samples:
     !> FFTW plans, buffers and per-batch work arrays. Owned by the caller (one per thread).
@@ -204,7 +210,7 @@ module frirom_aft
             !> a history cycle's period count is returned to be held
             integer(ip), intent(inout), optional :: held(:)
             !> every cycle held in held (below max_periods) closes at this x: its last
-            !> period drifts by at most max(tol, DRIFT) of the element's scale
+            !> period drifts by at most UNSETTLED of the element's scale
             logical, intent(out), optional :: settled
         end subroutine aft_forces
     end interface aft_eval

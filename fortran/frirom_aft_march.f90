@@ -124,7 +124,7 @@ contains
                                     plan%closed_at(j) = nper
                                     plan%unsettled(j) = plan%held(j) < max_periods .and. &
                                         maxval(abs(w(j, 1:2) - plan%wstart(j, 1:2))) > &
-                                        max(tol, DRIFT)*plan%scale(j)
+                                        max(tol, UNSETTLED)*plan%scale(j)
                                 end if
                             else
                                 call settle_step2d(plan, j, nper, tol*plan%scale(j))
