@@ -104,8 +104,8 @@ def _security(proto: str, tls: dict | None):
 
 
 def local_workers(n: int):
-    """A LocalCluster of ``n`` one-thread worker processes (no dashboard) set up so that
-    n workers come near n times one on a machine of n cores:
+    """A LocalCluster of ``n`` one-thread worker processes (its HTTP server on a free
+    port) set up so that n workers come near n times one on a machine of n cores:
 
     - one BLAS/OpenMP thread per worker (:data:`ONE_THREAD`);
     - glibc's allocator left to its own: Dask's nanny starts workers with
@@ -131,8 +131,10 @@ def local_workers(n: int):
     import dask
     from dask.distributed import LocalCluster
     with dask.config.set({**QUIET_WORKER, **PATIENT_SCHEDULER}):
+        # the scheduler's HTTP server on a free port: dashboard_address=None still takes
+        # :8787, and warns where another cluster holds it (seen in a CI run)
         return LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                            dashboard_address=None, env=ONE_THREAD)
+                            dashboard_address=":0", env=ONE_THREAD)
 
 
 class Failed:
