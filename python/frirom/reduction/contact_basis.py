@@ -257,3 +257,48 @@ def preload_n0(normal_sums: np.ndarray, n_pairs, target: np.ndarray):
     y, _, rank, _ = np.linalg.lstsq(A / root, np.asarray(target, float), rcond=None)
     n0 = y / root
     return n0, float(np.linalg.norm(A @ n0 - target)), int(rank)
+
+
+def enrich_from_specs(K0, M0, iface, act, specs, pairs0, prs, basis, groups, cd, pre, log):
+    """The GSI ``basis`` of frirom.reduction.rom enriched by :func:`contact_driven_basis`
+    (settings ``cd``, a ContactDrivenSpec); the slip limits mu n0 from the pair specs
+    ``specs`` (n0 from the contacts or their [[preload]], over the pairs ``prs``), the
+    elements from ``pairs0``. ``pre`` names the deck table in messages. Returns (basis,
+    number of vectors added)."""
+    n0 = {p.name: p.n0 for p in specs}
+    for load, direction, body, names in cd.preloads:
+        fr = [prs[c].frames for c in names]
+        normals = np.array([f[:, -1, :].sum(axis=0) for f in fr]).T
+        target = (1.0 if body == "a" else -1.0) * load * np.asarray(direction, float)
+        share, _, _ = preload_n0(normals, [f.shape[0] for f in fr], target)
+        n0.update({c: v for c, v in zip(names, share) if n0.get(c) is None})
+    slip, nload = [], []
+    for p in specs:
+        if p.mu is None:
+            raise InputError(f"{pre}.contact_driven: {p.key} has no friction coefficient "
+                             "mu (laws jenkins, normal1d, normal2d)")
+        if n0.get(p.name) is None or not n0[p.name] > 0:
+            raise InputError(f"{pre}.contact_driven: {p.key} needs its normal load n0 "
+                             "(given, or from a [[preload]])")
+        slip.append(np.full(pairs0[p.name].n_elem, p.mu * n0[p.name]))
+        nload.append(np.full(pairs0[p.name].n_elem, n0[p.name]))
+    if len({p.n_dir for p in pairs0.values()}) > 1:
+        raise InputError(f"{pre}.contact_driven: all contacts must have the same number of "
+                         "local directions")
+    allp = ContactPairs(*(np.vstack([getattr(pairs0[p.name], k) for p in specs])
+                          for k in ("dofs_a", "dofs_b", "frames", "stiffness")))
+    has_n = any(p.kn > 0 for p in specs)
+    try:
+        out, info = contact_driven_basis(
+            K0, M0, iface, act, allp, basis, np.concatenate(slip), cd.frequency,
+            np.concatenate(nload) if has_n else None, cd.elements, cd.amplitude, cd.normal,
+            groups, cd.tol)
+    except InputError as exc:
+        raise InputError(f"{pre}.contact_driven: {exc}") from None
+    if log:
+        on = info.onset[info.elements]
+        log(f"contact-driven basis: stuck mode {info.frequency:.4g} Hz, {info.elements.size}"
+            f" elements (slip onset {on.min() if on.size else 0:.3g} .. "
+            f"{on.max() if on.size else 0:.3g}), {info.formed} static responses, "
+            f"{info.kept} kept")
+    return out, info.kept

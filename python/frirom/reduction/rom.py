@@ -43,7 +43,7 @@ from .._h5check import seal, verify
 from ..io import DIRECTION_NAMES
 from .cb import craig_bampton
 from .cyclic import axis_rotation
-from .contact_basis import contact_driven_basis, preload_n0
+from .contact_basis import enrich_from_specs
 from .interface import ContactPairs, contact_matrix, gsi_basis, local_frames, reduce_interface
 from .multistage import harmonic_indices, ms_basis, radial_line_segments
 
@@ -688,7 +688,7 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
             if spec.separate or rot:
                 raise InputError(f"{pre}.contact_driven: not with separate joints nor with "
                                  "contacts to the next sector (b_sector = 1)")
-            basis, n_cd = _contact_driven(K0, M0, iface_r, act_r, pairs, pairs0, prs,
+            basis, n_cd = enrich_from_specs(K0, M0, iface_r, act_r, pairs, pairs0, prs,
                                           basis, groups, spec.contact_driven, f"{pre}", log)
             mode_labels += [f"contact-driven {j + 1}" for j in range(n_cd)]
     else:
@@ -759,49 +759,6 @@ def build_reduced_model(source: FESource, spec: ReductionSpec, pairs=(), deck_pa
         log(f"reduced model built in {out.build_seconds:.1f} s: {n_fe} FE DoFs -> "
             f"{K.shape[0]} coordinates; saved to {cache}")
     return out
-
-
-def _contact_driven(K0, M0, iface, act, specs, pairs0, prs, basis, groups, cd, pre, log):
-    """The GSI ``basis`` enriched by :func:`contact_driven_basis` (settings ``cd``); the
-    slip limits mu n0 from the pair specs (n0 from the contacts or their [[preload]]).
-    Returns (basis, number of vectors added)."""
-    n0 = {p.name: p.n0 for p in specs}
-    for load, direction, body, names in cd.preloads:
-        fr = [prs[c].frames for c in names]
-        normals = np.array([f[:, -1, :].sum(axis=0) for f in fr]).T
-        target = (1.0 if body == "a" else -1.0) * load * np.asarray(direction, float)
-        share, _, _ = preload_n0(normals, [f.shape[0] for f in fr], target)
-        n0.update({c: v for c, v in zip(names, share) if n0.get(c) is None})
-    slip, nload = [], []
-    for p in specs:
-        if p.mu is None:
-            raise InputError(f"{pre}.contact_driven: {p.key} has no friction coefficient "
-                             "mu (laws jenkins, normal1d, normal2d)")
-        if n0.get(p.name) is None or not n0[p.name] > 0:
-            raise InputError(f"{pre}.contact_driven: {p.key} needs its normal load n0 "
-                             "(given, or from a [[preload]])")
-        slip.append(np.full(pairs0[p.name].n_elem, p.mu * n0[p.name]))
-        nload.append(np.full(pairs0[p.name].n_elem, n0[p.name]))
-    if len({p.n_dir for p in pairs0.values()}) > 1:
-        raise InputError(f"{pre}.contact_driven: all contacts must have the same number of "
-                         "local directions")
-    allp = ContactPairs(*(np.vstack([getattr(pairs0[p.name], k) for p in specs])
-                          for k in ("dofs_a", "dofs_b", "frames", "stiffness")))
-    has_n = any(p.kn > 0 for p in specs)
-    try:
-        out, info = contact_driven_basis(
-            K0, M0, iface, act, allp, basis, np.concatenate(slip), cd.frequency,
-            np.concatenate(nload) if has_n else None, cd.elements, cd.amplitude, cd.normal,
-            groups, cd.tol)
-    except InputError as exc:
-        raise InputError(f"{pre}.contact_driven: {exc}") from None
-    if log:
-        on = info.onset[info.elements]
-        log(f"contact-driven basis: stuck mode {info.frequency:.4g} Hz, {info.elements.size}"
-            f" elements (slip onset {on.min() if on.size else 0:.3g} .. "
-            f"{on.max() if on.size else 0:.3g}), {info.formed} static responses, "
-            f"{info.kept} kept")
-    return out, info.kept
 
 
 def _read_matrix(node):
