@@ -43,7 +43,7 @@ contains
         real(wp), intent(in) :: tol
         integer(ip), intent(in) :: max_periods
         integer(ip) :: ns, d, j, i, nper, last
-        real(wp) :: a(2, 2), det
+        real(wp) :: a(2, 2), det, res
         logical :: isolated, opened
         associate (rin => plan%fp%rin, rout => plan%fp%rout, st => plan%state(1:m, :), &
                    w => plan%w(1:m, :), par => plan%par(1:m, :), uf => plan%follow(1:m, :, :))
@@ -122,9 +122,12 @@ contains
                             if (plan%held(j) > 0) then      ! a held history cycle
                                 if (nper >= plan%held(j)) then
                                     plan%closed_at(j) = nper
+                                    res = maxval(abs(w(j, 1:2) - plan%wstart(j, 1:2)))
                                     plan%unsettled(j) = plan%held(j) < max_periods .and. &
-                                        maxval(abs(w(j, 1:2) - plan%wstart(j, 1:2))) > &
-                                        max(tol, UNSETTLED)*plan%scale(j)
+                                        res > max(tol, UNSETTLED)*plan%scale(j)
+                                    ! still drifting at max_periods: as unheld (below)
+                                    plan%drifting(j) = plan%held(j) >= max_periods .and. &
+                                        res > max(tol, DRIFT)*plan%scale(j)
                                 end if
                             else
                                 call settle_step2d(plan, j, nper, tol*plan%scale(j))
