@@ -172,7 +172,7 @@ contains
     !> cy.(y - yp)/yscale + cl (lam - lp)/lscale = 0 (cy = 0, cl = 1 fixes lam = lp;
     !> cy, cl = tangent gives pseudo-arc-length). y, lam enter as the start, leave solved.
     subroutine newton_correct(sys, y, lam, yp, lp, cy, cl, opts, iters, info, errmsg, &
-                              have_fact, nfact)
+                              have_fact, nfact, stalled, stall_window)
         class(nl_system), intent(inout) :: sys
         real(wp), intent(inout) :: y(:)       !! (n) start in, solution out
         real(wp), intent(inout) :: lam        !! start in, solution out
@@ -184,6 +184,10 @@ contains
         character(len=*), intent(inout) :: errmsg
         logical, intent(inout) :: have_fact   !! a usable factorisation exists (in/out)
         integer(ip), intent(out), optional :: nfact  !! Jacobian factorisations made
+        !> give up after this many iterations without halving the merit (absent: only
+        !> after max_iter); stalled: it gave up so
+        integer(ip), intent(in), optional :: stall_window
+        logical, intent(out), optional :: stalled
         real(wp), allocatable :: r(:), rlam(:), ab(:, :), y1(:), r1(:), dy(:), rlam1(:)
         real(wp) :: rref, rn, g, denom, dlam, alpha, phi0, phi1, rn1, rref1, g1, lam1, dxn
         real(wp) :: rate
@@ -191,7 +195,8 @@ contains
         !> converged where the choices held since the corrector began no longer hold
         !> (settled): made afresh at most this many times
         integer(ip), parameter :: MAX_REARMS = 3
-        integer(ip) :: rearms
+        integer(ip) :: rearms, kref, window
+        real(wp) :: mref
         character(len=120) :: buf
         integer(ip) :: n, k
         n = sys%n
@@ -203,6 +208,9 @@ contains
         end if
         allocate (r(n), rlam(n), ab(n, 2), y1(n), r1(n), dy(n), rlam1(n))
         call sys%begin_correct()
+        if (present(stalled)) stalled = .false.
+        window = opts%max_iter
+        if (present(stall_window)) window = stall_window
         rearms = 0
         rate = 1.0_wp
         fresh = .not. (have_fact .and. opts%reuse_jac)
@@ -212,6 +220,8 @@ contains
         have_fact = .true.
         rn = norm2(r)/max(rref, tiny(1.0_wp))
         g = dot_product(cy, y - yp)/opts%yscale + cl*(lam - lp)/opts%lscale
+        mref = hypot(rn, g)
+        kref = 0
         ! without chord steps every iteration takes J at its point: the line search's
         ! trial evaluations take it too, and the next iteration needs no evaluation
         jac_trial = .not. opts%reuse_jac
@@ -299,12 +309,20 @@ contains
                 if (sys%settled() .or. rearms >= MAX_REARMS) return
                 call rearm()
                 if (info /= 0) return
+            else if (hypot(rn, g) < 0.5_wp*mref) then
+                mref = hypot(rn, g)
+                kref = k
+            else if (k - kref >= window) then
+                exit
             end if
         end do
         if (rn <= opts%tol_stall .and. abs(g) <= max(opts%tol_x, 1.0e-12_wp)) return
+        if (present(stalled)) stalled = iters < opts%max_iter
         call set_status(info, FRIROM_ERR_NOCONV, errmsg, 'newton_correct: no convergence')
         write (buf, '(a,i0,a,es9.2,a,es9.2)') ' in ', opts%max_iter, &
             ' iterations, |R|/rref = ', rn, ', update = ', dxn
+        if (iters < opts%max_iter) write (buf, '(a,i0,a,es9.2,a,es9.2)') ' (stalled) in ', &
+            iters, ' iterations, |R|/rref = ', rn, ', update = ', dxn
         errmsg = trim(errmsg)//trim(buf)
     contains
         !> The choices afresh at y (its Jacobian with them), and Newton goes on from there.
@@ -318,6 +336,8 @@ contains
             g = dot_product(cy, y - yp)/opts%yscale + cl*(lam - lp)/opts%lscale
             jac_at_y = .true.
             rate = 1.0_wp
+            mref = hypot(rn, g)
+            kref = k
         end subroutine rearm
     end subroutine newton_correct
 
@@ -448,7 +468,14 @@ contains
         real(wp), allocatable :: y1(:), yp(:), t1(:), cy(:), ch(:), tjl(:)
         real(wp) :: lam1, lp, dirn, frac, cl, angle, dist
         integer(ip) :: n, iters
-        logical :: last, turned, retried, by_det
+        logical :: last, turned, retried, by_det, stalled
+        !> a corrector gives up after this many iterations without halving its merit: its
+        !> residual stalled where R is not smooth (a contact switching inside a time
+        !> sample), and a shorter step is cheaper than max_iter iterations and a retry (a
+        !> BRB backbone corrector sat at |R|/rref ~8e-7 for 13 iterations with fresh
+        !> Jacobians and line searches, then as long in the retry). Only in continuation:
+        !> a solve from a far start (a probe) may take longer to find its way
+        integer(ip), parameter :: STALL_WINDOW = 5
         integer(ip) :: nf, effort
         type(cont_options) :: fresh_opts
         character(len=len(errmsg)) :: why
@@ -495,10 +522,11 @@ contains
             y1 = yp
             lam1 = lp
             call newton_correct(sys, y1, lam1, yp, lp, cy, cl, opts, iters, info, errmsg, &
-                                have_fact, nf)
-            if (info /= 0 .and. opts%reuse_jac) then
+                                have_fact, nf, stalled, STALL_WINDOW)
+            if (info /= 0 .and. opts%reuse_jac .and. .not. stalled) then
                 ! chord steps can stall where a contact changes state: retry the same step
-                ! with a fresh Jacobian at every iteration before shrinking it
+                ! with a fresh Jacobian at every iteration before shrinking it (not after a
+                ! stall, which took fresh Jacobians already: the retry stalls alike)
                 y1 = yp
                 lam1 = lp
                 have_fact = .false.

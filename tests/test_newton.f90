@@ -44,7 +44,39 @@ module newton_test_system
         procedure :: eval => ratchet_eval
         procedure :: accept => ratchet_accept
     end type ratchet_curve
+    !> R = y - lam + 1e-7 sign(y): no root at lam = 0, R jumps from -1e-7 to 1e-7 at
+    !> y = 0 (as forces jump where a contact cycle changes kind): Newton with the slope 1
+    !> and its line search stall at |R| ~1e-7 around the jump.
+    type, extends(nl_system) :: noisy_line
+        integer :: neval = 0
+    contains
+        procedure :: eval => noisy_eval
+        procedure :: solve => noisy_solve
+    end type noisy_line
 contains
+    subroutine noisy_eval(this, y, lam, r, rref, jac, rlam, info, errmsg)
+        class(noisy_line), intent(inout) :: this
+        real(wp), intent(in) :: y(:), lam
+        real(wp), intent(out) :: r(:), rref, rlam(:)
+        logical, intent(in) :: jac
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        info = 0
+        this%neval = this%neval + 1
+        r(1) = y(1) - lam + merge(1.0e-7_wp, -1.0e-7_wp, y(1) >= 0.0_wp)
+        rref = 1.0_wp
+        rlam = [-1.0_wp]
+        if (jac .and. .false.) errmsg = ''
+    end subroutine noisy_eval
+    subroutine noisy_solve(this, b, info, errmsg)
+        class(noisy_line), intent(inout) :: this
+        real(wp), intent(inout) :: b(:, :)
+        integer(ip), intent(out) :: info
+        character(len=*), intent(inout) :: errmsg
+        info = 0
+        if (.false.) errmsg = ''
+        if (.false.) this%n = 1
+    end subroutine noisy_solve
     !> The hook must see every converged point once, at the converged (y, lam).
     subroutine cc_accept(this, y, lam, info, errmsg)
         class(cubic_curve), intent(inout) :: this
@@ -162,6 +194,8 @@ program test_newton
     type(cubic_curve) :: s, sq
     type(vee_curve) :: v
     type(ratchet_curve) :: r, rc
+    type(noisy_line) :: nz
+    logical :: stalled
     type(cont_options) :: o
     real(wp) :: y(2), lam, t(3), ds, yout(2, 500), lout(500), tout(3, 500), y1ref, orient
     integer(ip) :: it(500), npts, info, k, iters, nfold
@@ -338,6 +372,29 @@ program test_newton
                'converged update')
     call check(abs(y(1)**3 - 3*y(1) + 4.0_wp) < 1.0e-12_wp .and. &
                abs(y(2) - y(1)**2) < 1.0e-11_wp, 'fixed-lam Newton: on the curve')
+    ! a corrector whose residual stalls at its noise (|R| ~1e-7, tol_r 1e-12): with a
+    ! stall window of 5 it gives up after 5 iterations without halving its merit, says
+    ! so (stalled, the message), and has not used max_iter; without one it takes all 25
+    nz%n = 1
+    o = cont_options(tol_r=1.0e-12_wp, tol_x=1.0e-12_wp)
+    y(1) = 0.3_wp
+    lam = 0.0_wp
+    hf = .false.
+    msg = ''
+    call newton_correct(nz, y(1:1), lam, y(1:1), lam, [0.0_wp], 1.0_wp, o, iters, info, msg, &
+                        hf, stalled=stalled, stall_window=5_ip)
+    print '(a,i0,a,i0,a)', 'noisy line, stall window 5: ', iters, ' iterations, ', &
+        nz%neval, ' evaluations'
+    call check(info /= 0 .and. stalled .and. iters <= 7 .and. index(msg, '(stalled)') > 0, &
+               'a stalled corrector gives up early: '//trim(msg))
+    call check(abs(y(1)) < 1.0e-6_wp, 'it stalled at its noise, near the solution')
+    y(1) = 0.3_wp
+    lam = 0.0_wp
+    msg = ''
+    call newton_correct(nz, y(1:1), lam, y(1:1), lam, [0.0_wp], 1.0_wp, o, iters, info, msg, &
+                        hf, stalled=stalled)
+    call check(info /= 0 .and. .not. stalled .and. iters == o%max_iter, &
+               'without a window: max_iter iterations ('//trim(msg)//')')
     call check_done('test_newton')
 contains
     !> cont_run of a ratchet (slope a = 3) from y = 0 at lam = 0 towards lam = 1, steps of
