@@ -155,11 +155,6 @@ module frirom_aft
         !> not handed on: aft_forces' slider is w0 for it)
         logical, allocatable :: drifting(:)
         logical, allocatable :: unsettled(:)         !! (nbatch) a held cycle not closed
-        ! a 2-D cycle closed while others of its batch march on: its period, kept
-        real(wp), allocatable :: kf(:, :, :)         !! (nbatch, N, 3) forces
-        integer(ip), allocatable :: kst(:, :)        !! (nbatch, N) states
-        real(wp), allocatable :: ktg(:, :, :)        !! (nbatch, 12, N) tangents
-        real(wp), allocatable :: kw(:, :)            !! (nbatch, 4) slider at end and start
     end type aft_plan
 
     ! The two entry points are generic names over separate module procedures: gfortran 12
@@ -495,8 +490,6 @@ contains
                   plan%res_last(nb), plan%stepped(nb), plan%accelerated(nb), plan%hold(nb), &
                   plan%damp(nb), plan%damp_cap(nb), plan%held(nb), plan%drifting(nb), &
                   plan%unsettled(nb))
-        allocate (plan%kf(nb, nsamp, 3), plan%kst(nb, nsamp), plan%ktg(nb, 12, nsamp), &
-                  plan%kw(nb, 4))
         plan%held = 0
     end subroutine aft_plan_create
 
@@ -514,6 +507,5 @@ contains
                                                 plan%stepped, plan%accelerated, plan%hold, &
                                                 plan%damp, plan%damp_cap, plan%held, &
                                                 plan%drifting, plan%unsettled)
-        if (allocated(plan%kf)) deallocate (plan%kf, plan%kst, plan%ktg, plan%kw)
     end subroutine aft_plan_destroy
 end module frirom_aft

@@ -34,7 +34,8 @@ contains
     !> March the first m elements of the batch period after period until every slider
     !> closes its cycle; the last period's forces (output slots 1..ndir), states and
     !> tangents stay in the plan. closed_at(j) = period element j closed in, or
-    !> max_periods + 1. Elements that closed earlier repeat their closed cycle exactly.
+    !> max_periods + 1. 2-D elements that closed earlier keep their closed period (the
+    !> others march on alone: march_open2d); 1-D ones repeat their closed cycle exactly.
     subroutine march_closed(plan, law, m, p, w0, tol, max_periods)
         type(aft_plan), intent(inout) :: plan
         integer(ip), intent(in) :: law, m
@@ -42,7 +43,7 @@ contains
         real(wp), intent(in) :: w0(:, :)   !! (nslider, m)
         real(wp), intent(in) :: tol
         integer(ip), intent(in) :: max_periods
-        integer(ip) :: ns, d, j, i, nper, last
+        integer(ip) :: ns, d, j, i, nper
         real(wp) :: a(2, 2), det, res
         logical :: isolated, opened
         associate (rin => plan%fp%rin, rout => plan%fp%rout, st => plan%state(1:m, :), &
@@ -98,7 +99,14 @@ contains
             plan%damp(1:m) = 1.0_wp
             plan%damp_cap(1:m) = 1.0_wp
             do nper = 1, max_periods
-                plan%wstart(1:m, :) = w
+                if (law == LAW_NORMAL2D) then
+                    ! only the cycles still open march on: one closed keeps its period as
+                    ! it closed (marched on, a history slider would drift on)
+                    call march_open2d(plan, m, max_periods)
+                    call record_anchors(plan, law, m)
+                else
+                    plan%wstart(1:m, :) = w
+                end if
                 select case (law)
                 case (LAW_JENKINS)
                     call jenkins_march(rin(1:m, :, 1), par(:, 1), par(:, 2), par(:, 3), w(:, 1), &
@@ -109,13 +117,8 @@ contains
                                           plan%par(:, 2), plan%par(:, 3), plan%par(:, 4), &
                                           plan%w(:, 1), rout(:, :, 1), rout(:, :, 2), &
                                           plan%state, rout(:, :, 4))
-                case (LAW_NORMAL2D)
-                    call friction2d_march(uf(:, :, 1), uf(:, :, 2), rin(1:m, :, 3), &
-                                          par(:, 1), par(:, 2), par(:, 3), par(:, 4), w, &
-                                          rout(1:m, :, 1), rout(1:m, :, 2), rout(1:m, :, 3), &
-                                          st, plan%tangent(1:m, :, :))
                 end select
-                call record_anchors(plan, law, m)
+                if (law /= LAW_NORMAL2D) call record_anchors(plan, law, m)
                 do j = 1, m
                     if (plan%closed_at(j) > max_periods) then
                         if (law == LAW_NORMAL2D) then
@@ -132,7 +135,6 @@ contains
                             else
                                 call settle_step2d(plan, j, nper, tol*plan%scale(j))
                             end if
-                            if (plan%closed_at(j) == nper) call keep2d(j)
                         else if (maxval(abs(w(j, 1:ns) - plan%wstart(j, 1:ns))) <= &
                                  tol*plan%scale(j)) then
                             plan%closed_at(j) = nper
@@ -142,13 +144,9 @@ contains
                 if (all(plan%closed_at(1:m) <= max_periods)) exit
             end do
             if (law == LAW_NORMAL2D) then
-                ! a cycle closed before the batch's last period is the period it closed in
-                ! (marched on, a history slider would drift on: its forces would depend on
-                ! how long the other elements of its batch take)
-                last = min(nper, max_periods)
-                do j = 1, m
-                    if (plan%closed_at(j) < last) call restore2d(j)
-                end do
+                ! (a cycle closed before the batch's last period kept the period it closed
+                ! in: march_open2d; marched on, a history slider would drift on and its
+                ! forces depend on how long the other elements of its batch take)
                 do j = 1, m
                     ! a history slider still drifting by more than DRIFT after max_periods
                     ! plain periods is the state they leave (a fixed count: smooth in the
@@ -173,26 +171,40 @@ contains
                 end do
             end if
         end associate
-    contains
-        !> Keep the period 2-D element j just closed in (restore2d puts it back).
-        subroutine keep2d(j)
-            integer(ip), intent(in) :: j
-            plan%kf(j, :, :) = plan%fp%rout(j, :, 1:3)
-            plan%kst(j, :) = plan%state(j, :)
-            plan%ktg(j, :, :) = plan%tangent(j, :, :)
-            plan%kw(j, 1:2) = plan%w(j, 1:2)
-            plan%kw(j, 3:4) = plan%wstart(j, 1:2)
-        end subroutine keep2d
-
-        subroutine restore2d(j)
-            integer(ip), intent(in) :: j
-            plan%fp%rout(j, :, 1:3) = plan%kf(j, :, :)
-            plan%state(j, :) = plan%kst(j, :)
-            plan%tangent(j, :, :) = plan%ktg(j, :, :)
-            plan%w(j, 1:2) = plan%kw(j, 1:2)
-            plan%wstart(j, 1:2) = plan%kw(j, 3:4)
-        end subroutine restore2d
     end subroutine march_closed
+
+    !> One period of the 2-D law for the elements of the batch's first m whose cycle is
+    !> still open (closed_at > max_periods), run by run of consecutive open elements: a
+    !> closed element keeps the period it closed in (forces, states, tangents, its slider
+    !> at the start and end), and a batch whose last open element drifts to max_periods
+    !> (a history cycle, held or not) marches that one alone.
+    subroutine march_open2d(plan, m, max_periods)
+        type(aft_plan), intent(inout) :: plan
+        integer(ip), intent(in) :: m, max_periods
+        integer(ip) :: j1, j2
+        associate (rin => plan%fp%rin, rout => plan%fp%rout, par => plan%par, &
+                   uf => plan%follow)
+            j1 = 1
+            do while (j1 <= m)
+                if (plan%closed_at(j1) <= max_periods) then
+                    j1 = j1 + 1
+                    cycle
+                end if
+                j2 = j1
+                do while (j2 < m)
+                    if (plan%closed_at(j2 + 1) <= max_periods) exit
+                    j2 = j2 + 1
+                end do
+                plan%wstart(j1:j2, :) = plan%w(j1:j2, :)
+                call friction2d_march(uf(j1:j2, :, 1), uf(j1:j2, :, 2), rin(j1:j2, :, 3), &
+                                      par(j1:j2, 1), par(j1:j2, 2), par(j1:j2, 3), &
+                                      par(j1:j2, 4), plan%w(j1:j2, :), rout(j1:j2, :, 1), &
+                                      rout(j1:j2, :, 2), rout(j1:j2, :, 3), &
+                                      plan%state(j1:j2, :), plan%tangent(j1:j2, :, :))
+                j1 = j2 + 1
+            end do
+        end associate
+    end subroutine march_open2d
 
     !> Closure test and slider update of 2-D element j after period nper: plain marching
     !> accelerated by Newton steps on the slider fixed point w = P(w) (P: one period).
