@@ -76,6 +76,7 @@ contains
         info = 0
         if (.false.) errmsg = ''
         if (.false.) this%n = 1
+        b = b/1.0_wp                    ! J = 1: the solution is the right-hand side
     end subroutine noisy_solve
     !> The hook must see every converged point once, at the converged (y, lam).
     subroutine cc_accept(this, y, lam, info, errmsg)
