@@ -99,14 +99,7 @@ contains
             plan%damp(1:m) = 1.0_wp
             plan%damp_cap(1:m) = 1.0_wp
             do nper = 1, max_periods
-                if (law == LAW_NORMAL2D) then
-                    ! only the cycles still open march on: one closed keeps its period as
-                    ! it closed (marched on, a history slider would drift on)
-                    call march_open2d(plan, m, max_periods)
-                    call record_anchors(plan, law, m)
-                else
-                    plan%wstart(1:m, :) = w
-                end if
+                if (law /= LAW_NORMAL2D) plan%wstart(1:m, :) = w
                 select case (law)
                 case (LAW_JENKINS)
                     call jenkins_march(rin(1:m, :, 1), par(:, 1), par(:, 2), par(:, 3), w(:, 1), &
@@ -117,8 +110,12 @@ contains
                                           plan%par(:, 2), plan%par(:, 3), plan%par(:, 4), &
                                           plan%w(:, 1), rout(:, :, 1), rout(:, :, 2), &
                                           plan%state, rout(:, :, 4))
+                case (LAW_NORMAL2D)
+                    ! only the cycles still open march on: one closed keeps its period as
+                    ! it closed (marched on, a history slider would drift on)
+                    call march_open2d(plan, m, max_periods)
                 end select
-                if (law /= LAW_NORMAL2D) call record_anchors(plan, law, m)
+                call record_anchors(plan, law, m)
                 do j = 1, m
                     if (plan%closed_at(j) > max_periods) then
                         if (law == LAW_NORMAL2D) then

@@ -319,10 +319,9 @@ contains
         if (rn <= opts%tol_stall .and. abs(g) <= max(opts%tol_x, 1.0e-12_wp)) return
         if (present(stalled)) stalled = iters < opts%max_iter
         call set_status(info, FRIROM_ERR_NOCONV, errmsg, 'newton_correct: no convergence')
-        write (buf, '(a,i0,a,es9.2,a,es9.2)') ' in ', opts%max_iter, &
-            ' iterations, |R|/rref = ', rn, ', update = ', dxn
-        if (iters < opts%max_iter) write (buf, '(a,i0,a,es9.2,a,es9.2)') ' (stalled) in ', &
-            iters, ' iterations, |R|/rref = ', rn, ', update = ', dxn
+        write (buf, '(a,i0,a,es9.2,a,es9.2)') ' in ', iters, ' iterations, |R|/rref = ', &
+            rn, ', update = ', dxn
+        if (iters < opts%max_iter) buf = ' (stalled)'//buf
         errmsg = trim(errmsg)//trim(buf)
     contains
         !> The choices afresh at y (its Jacobian with them), and Newton goes on from there.

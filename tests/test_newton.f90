@@ -46,12 +46,11 @@ module newton_test_system
     end type ratchet_curve
     !> R = y - lam + 1e-7 sign(y): no root at lam = 0, R jumps from -1e-7 to 1e-7 at
     !> y = 0 (as forces jump where a contact cycle changes kind): Newton with the slope 1
-    !> and its line search stall at |R| ~1e-7 around the jump.
-    type, extends(nl_system) :: noisy_line
+    !> (vee_curve's solve) and its line search stall at |R| ~1e-7 around the jump.
+    type, extends(vee_curve) :: noisy_line
         integer :: neval = 0
     contains
         procedure :: eval => noisy_eval
-        procedure :: solve => noisy_solve
     end type noisy_line
 contains
     subroutine noisy_eval(this, y, lam, r, rref, jac, rlam, info, errmsg)
@@ -68,16 +67,6 @@ contains
         rlam = [-1.0_wp]
         if (jac .and. .false.) errmsg = ''
     end subroutine noisy_eval
-    subroutine noisy_solve(this, b, info, errmsg)
-        class(noisy_line), intent(inout) :: this
-        real(wp), intent(inout) :: b(:, :)
-        integer(ip), intent(out) :: info
-        character(len=*), intent(inout) :: errmsg
-        info = 0
-        if (.false.) errmsg = ''
-        if (.false.) this%n = 1
-        b = b/1.0_wp                    ! J = 1: the solution is the right-hand side
-    end subroutine noisy_solve
     !> The hook must see every converged point once, at the converged (y, lam).
     subroutine cc_accept(this, y, lam, info, errmsg)
         class(cubic_curve), intent(inout) :: this
